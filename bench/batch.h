@@ -1,0 +1,69 @@
+// Batch: a contiguous range of samples made ready for the backends and the
+// judge. The builder draws the samples, encodes every depth the run's cells
+// read, packs the shader inputs (exactly the bytes a GPU uploads) and
+// computes the reference for every (encoding, sample).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bench/cells.h"
+#include "bench/formulas.h"
+#include "bench/reference.h"
+#include "bench/sampler.h"
+#include "bench/thread_pool.h"
+
+namespace depthbench {
+
+struct Batch {
+  std::uint64_t first_index = 0;
+  std::uint32_t count = 0;
+  std::uint32_t first_offset = 0;  // first_index % kSamplesPerFrame
+
+  // Backend inputs.
+  std::vector<f32::FrameParams> frame_params;  // [frame]
+  std::vector<f32::DepthParams> depth_params;  // [frame * kHardwareConventionCount + convention]
+  std::vector<std::uint32_t> pixels;           // [sample]: x | y << 16
+  std::vector<float> depths;                   // [depth slot * count + sample]: fetched values
+
+  // Judge inputs.
+  std::vector<Frame> frames;                   // [frame]: exact parameters
+  std::vector<ReferenceSample> reference;      // [depth slot * count + sample]
+  std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: stored texel bits
+
+  std::uint32_t FrameOf(std::uint32_t sample) const {
+    return (sample + first_offset) / kSamplesPerFrame;
+  }
+  std::size_t frame_count() const { return frames.size(); }
+};
+
+// Where one cell's inputs live in a Batch.
+struct CellPlan {
+  Cell cell;
+  std::uint32_t depth_slot = 0;       // index of the cell's encoding among the run's encodings
+  std::uint32_t convention_slot = 0;  // index into a frame's DepthParams (hardware conventions)
+};
+
+// Lays out the cells of a run: one depth slot per distinct encoding.
+struct RunLayout {
+  std::vector<CellPlan> cells;
+  std::vector<Encoding> encodings;  // [depth slot]
+};
+RunLayout MakeRunLayout(std::span<const Cell> cells);
+
+class BatchBuilder {
+ public:
+  BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings);
+
+  // Fills `batch` with samples [first, first + count).
+  void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const;
+
+ private:
+  const Sampler& sampler_;
+  std::vector<Encoding> encodings_;
+};
+
+}  // namespace depthbench

@@ -1,0 +1,83 @@
+// The sampler: random projections, camera poses, pixels and depths, each a
+// pure function of (seed, index). Samples come in frames of
+// kSamplesPerFrame consecutive indices that share one projection and pose,
+// as the pixels of a real frame do; frame f holds samples
+// [f * kSamplesPerFrame, (f + 1) * kSamplesPerFrame). Any split of the index
+// range (shards, batches, threads) therefore draws exactly the same samples.
+//
+// The random bits come from shared/random.h, so a GPU can draw them too.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "bench/domain.h"
+
+namespace depthbench {
+
+inline constexpr std::uint32_t kSamplesPerFrame = 64;
+
+// One frame's exact parameters. They are the definition of the scene: the
+// reference evaluates them in double-double, the backends receive float32
+// constants rounded from them.
+struct Frame {
+  std::uint64_t index = 0;
+  double fov_y_degrees = 0.0;
+  double tan_half_fov_y = 0.0;  // the exact lens parameter (tan computed once, then taken as exact)
+  double aspect = 0.0;
+  double near = 0.0;
+  // Far plane of the finite-far conventions (+infinity when the domain has
+  // infinite far planes only; finite-far cells then do not apply).
+  double far = 0.0;
+  // Largest eye depth sampled: far, or near * Domain::kInfiniteDepthSpan.
+  double depth_limit = 0.0;
+  double eye_depth_min = 0.0;  // eye-depth range samples are drawn from
+  double eye_depth_max = 0.0;
+  glm::dvec3 camera_position{0.0};  // float32-representable components
+  glm::dmat3 rotation{1.0};         // columns: the camera's x, y, z axes in world space
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  double volume_depth = 0.0;  // eye depth of the light-volume surface (volume_ray)
+
+  bool finite() const { return far < INFINITY; }
+  double ratio() const { return far / near; }
+  double camera_distance() const { return glm::length(camera_position); }
+};
+
+// How a sample chose its depth.
+enum class DepthPick : std::uint8_t {
+  kEyeDepth,         // an eye depth (log-uniform, or in the near or far band)
+  kStoredZero,       // the stored value 0, whatever it denotes
+  kStoredOne,        // the stored value 1 (the far plane for linear formats)
+  kStoredAfterZero,  // the smallest stored value above 0
+  kStoredBeforeOne,  // the largest stored value below 1
+};
+
+struct PixelSample {
+  std::uint64_t index = 0;
+  std::uint32_t x = 0;
+  std::uint32_t y = 0;
+  DepthPick pick = DepthPick::kEyeDepth;
+  double eye_depth = 0.0;  // for kEyeDepth
+};
+
+class Sampler {
+ public:
+  Sampler(std::uint64_t seed, Domain domain);
+
+  Frame FrameAt(std::uint64_t frame_index) const;
+  PixelSample SampleAt(std::uint64_t index, const Frame& frame) const;
+
+  std::uint64_t seed() const { return seed_; }
+  const Domain& domain() const { return domain_; }
+
+ private:
+  std::uint32_t Bits(std::uint64_t index, std::uint32_t stream) const;
+  double Unit(std::uint64_t index, std::uint32_t stream) const;  // [0, 1), 53 bits
+
+  std::uint64_t seed_;
+  Domain domain_;
+};
+
+}  // namespace depthbench

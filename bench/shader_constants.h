@@ -1,0 +1,28 @@
+// Shader constants of a frame: the FrameParams and DepthParams of
+// shared/params.h, computed exactly (double-double) from the frame's
+// parameters and then rounded once to float32. That is the best an engine
+// can hand its shaders, so what remains is the error of the reconstruction
+// itself, not of a sloppy host-side matrix inverse.
+#pragma once
+
+#include "bench/cells.h"
+#include "bench/formulas.h"
+#include "bench/sampler.h"
+
+namespace depthbench {
+
+hp::FrameParams BuildFrameParams(const Frame& frame);
+// Only for the projective conventions (Info(c).hardware); `frame_params` is
+// BuildFrameParams(frame).
+hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& frame_params,
+                                 Convention convention);
+
+f32::FrameParams RoundToFloat(const hp::FrameParams& params);
+f32::DepthParams RoundToFloat(const hp::DepthParams& params);
+
+// The exact world-space direction of the pixel's ray scaled to unit eye
+// depth: R * (ndc.x * tan_x, ndc.y * tan_y, -1). A point at eye depth z on
+// it is camera + z * ray.
+hp::vec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
+
+}  // namespace depthbench

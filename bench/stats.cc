@@ -1,0 +1,209 @@
+#include "bench/stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace depthbench {
+
+const char* MetricName(Metric m) {
+  switch (m) {
+    case Metric::kTotal: return "total";
+    case Metric::kArith: return "arith";
+    case Metric::kStorage: return "storage";
+    case Metric::kAbsolute: return "absolute";
+  }
+  return "?";
+}
+
+std::string RatioBandName(int band) {
+  if (band == kInfiniteRatioBand) return "inf";
+  if (band == kInfiniteRatioBand - 1) return "1e9+";
+  return fmt::format("1e{}", band);
+}
+std::string DepthBandName(int band) {
+  return band == kDepthBands - 1 ? fmt::format("1e{}+", band) : fmt::format("1e{}", band);
+}
+std::string DistanceBandName(int band) {
+  if (band == 0) return "<1";
+  return band == kDistanceBands - 1 ? fmt::format("1e{}+", 2 * band - 2)
+                                    : fmt::format("1e{}", 2 * band - 2);
+}
+double RatioBandLow(int band) { return band == kInfiniteRatioBand ? INFINITY : std::pow(10.0, band); }
+double DepthBandLow(int band) { return std::pow(10.0, band); }
+double DistanceBandLow(int band) { return band == 0 ? 0.0 : std::pow(10.0, 2 * band - 2); }
+
+std::uint64_t MetricStats::Count() const {
+  std::uint64_t n = 0;
+  for (const auto& [slot, count] : bins) n += count;
+  return n;
+}
+
+void MetricStats::Merge(const MetricStats& other) {
+  for (const auto& [slot, count] : other.bins) bins[slot] += count;
+  if (other.max > max || (other.max == max && other.worst_index < worst_index)) {
+    max = other.max;
+    worst_index = other.worst_index;
+  }
+}
+
+double MetricStats::Quantile(double q, int lowest_octave) const {
+  const std::uint64_t n = Count();
+  if (n == 0) return 0.0;
+  // Rank of the q-quantile among n sorted values (1-based, nearest rank
+  // with interpolation inside the bin that holds it).
+  const double rank = std::clamp(q, 0.0, 1.0) * static_cast<double>(n);
+  std::uint64_t below = 0;
+  for (const auto& [slot, count] : bins) {
+    if (static_cast<double>(below + count) >= rank && count > 0) {
+      if (slot == 0) return std::ldexp(1.0, lowest_octave);
+      if (slot == kBinsKept + 1) return max;
+      double fraction = std::clamp((rank - static_cast<double>(below)) / static_cast<double>(count), 0.0, 1.0);
+      double log2_value = lowest_octave + (slot - 1 + fraction) / kBinsPerOctave;
+      return std::min(std::exp2(log2_value), max);
+    }
+    below += count;
+  }
+  return max;
+}
+
+void BandStats::Merge(const BandStats& other) {
+  finite += other.finite;
+  nan += other.nan;
+  inf += other.inf;
+  degenerate += other.degenerate;
+  first_nonfinite_index = std::min(first_nonfinite_index, other.first_nonfinite_index);
+  for (int m = 0; m < kMetricCount; ++m) metrics[m].Merge(other.metrics[m]);
+}
+
+double BitsLost(double relative_error) {
+  if (!(relative_error > 0.0)) return 0.0;
+  return std::max(0.0, std::log2(relative_error) + 24.0);
+}
+
+Summary Summarize(const BandStats& band, Metric metric) {
+  const MetricStats& m = band[metric];
+  const int low = kLowestOctave[static_cast<int>(metric)];
+  Summary s;
+  s.p50 = m.Quantile(0.5, low);
+  s.p99 = m.Quantile(0.99, low);
+  s.p999 = m.Quantile(0.999, low);
+  s.max = m.max;
+  s.worst_index = m.worst_index;
+  return s;
+}
+
+void CellStats::Merge(const CellStats& other) {
+  for (const auto& [band, stats] : other.joint) joint[band].Merge(stats);
+  for (const auto& [band, stats] : other.distance) distance[band].Merge(stats);
+}
+
+BandStats CellStats::All() const {
+  BandStats all;
+  for (const auto& [band, stats] : joint) all.Merge(stats);
+  return all;
+}
+
+BandStats CellStats::ForRatio(int ratio_band) const {
+  BandStats out;
+  for (const auto& [band, stats] : joint)
+    if (RatioOfJoint(band) == ratio_band) out.Merge(stats);
+  return out;
+}
+
+BandStats CellStats::ForDepth(int depth_band) const {
+  BandStats out;
+  for (const auto& [band, stats] : joint)
+    if (DepthOfJoint(band) == depth_band) out.Merge(stats);
+  return out;
+}
+
+BandStats CellStats::ForDistance(int distance_band) const {
+  auto it = distance.find(distance_band);
+  return it == distance.end() ? BandStats{} : it->second;
+}
+
+CellAccumulator::CellAccumulator() {
+  joint_slot_.fill(-1);
+  // Reserve every slot up front: references stay valid, and untouched
+  // pages of the reservation cost no memory.
+  slots_.reserve(kDistanceBands + kJointBands);
+  slots_.resize(kDistanceBands);
+}
+
+CellAccumulator::Slot& CellAccumulator::NewJoint(int band) {
+  joint_slot_[band] = static_cast<int>(slots_.size());
+  return slots_.emplace_back();
+}
+
+namespace {
+
+inline void Record(CellAccumulator::Slot& slot, std::uint64_t index,
+                   const std::array<double, kMetricCount>& squares, const std::array<int, kMetricCount>& bins) {
+  ++slot.finite;
+  for (int m = 0; m < kMetricCount; ++m) {
+    ++slot.bins[m][bins[m]];
+    if (squares[m] > slot.max_square[m] ||
+        (squares[m] == slot.max_square[m] && index < slot.worst_index[m])) {
+      slot.max_square[m] = squares[m];
+      slot.worst_index[m] = index;
+    }
+  }
+}
+
+}  // namespace
+
+void CellAccumulator::AddFinite(int joint_band, int distance_band, std::uint64_t index,
+                                const std::array<double, kMetricCount>& squares) {
+  std::array<int, kMetricCount> bins;
+  for (int m = 0; m < kMetricCount; ++m) bins[m] = DenseBinOfSquare(squares[m], kLowestOctave[m]);
+  Record(Joint(joint_band), index, squares, bins);
+  Record(Distance(distance_band), index, squares, bins);
+  ++pending_;
+}
+
+void CellAccumulator::AddNonFinite(int joint_band, int distance_band, std::uint64_t index, bool nan) {
+  for (Slot* slot : {&Joint(joint_band), &Distance(distance_band)}) {
+    ++(nan ? slot->nan : slot->inf);
+    slot->first_nonfinite_index = std::min(slot->first_nonfinite_index, index);
+  }
+  ++pending_;
+}
+
+void CellAccumulator::AddDegenerate(int joint_band, int distance_band) {
+  ++Joint(joint_band).degenerate;
+  ++Distance(distance_band).degenerate;
+  ++pending_;
+}
+
+void CellAccumulator::FlushInto(CellStats& out) {
+  auto flush = [](Slot& slot, BandStats& band) {
+    BandStats add;
+    add.finite = slot.finite;
+    add.nan = slot.nan;
+    add.inf = slot.inf;
+    add.degenerate = slot.degenerate;
+    add.first_nonfinite_index = slot.first_nonfinite_index;
+    for (int m = 0; m < kMetricCount; ++m) {
+      MetricStats& ms = add.metrics[m];
+      for (int b = 0; b < kDenseBins; ++b)
+        if (slot.bins[m][b] != 0) ms.bins[b] = slot.bins[m][b];
+      ms.max = std::sqrt(slot.max_square[m]);
+      ms.worst_index = slot.worst_index[m];
+    }
+    band.Merge(add);
+    slot = Slot();
+  };
+  for (int band = 0; band < kDistanceBands; ++band) {
+    if (slots_[band].finite + slots_[band].nan + slots_[band].inf + slots_[band].degenerate > 0)
+      flush(slots_[band], out.distance[band]);
+  }
+  for (int band = 0; band < kJointBands; ++band) {
+    int s = joint_slot_[band];
+    if (s >= 0) flush(slots_[s], out.joint[band]);
+  }
+  pending_ = 0;
+}
+
+}  // namespace depthbench

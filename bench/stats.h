@@ -1,0 +1,155 @@
+// Stats: streaming, exactly mergeable error statistics.
+//
+// Every error value x > 0 falls into a quarter-octave bin k = floor(4 log2 x),
+// decided exactly from the bits of x^2 (no logarithm is evaluated). Bins
+// are plain counts, so statistics of shards, batches and threads add up to
+// exactly the statistics of the whole; the maximum is kept exactly, with the
+// index of the sample that reached it (ties: the smallest index).
+// Quantiles are read from the bins, interpolated within a bin.
+//
+// Four metrics per sample (relative ones are over the distance from the
+// camera to the true point):
+//   total    |p - truth| / distance       what the engine gets
+//   arith    |p - denoted| / distance     the variant's arithmetic alone
+//   storage  |denoted - truth| / distance what the format's rounding costs
+//   absolute |p - truth|                  in world units
+// Bits lost = max(0, log2(relative error / 2^-24)).
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "bench/bands.h"
+
+namespace depthbench {
+
+enum class Metric : int { kTotal = 0, kArith = 1, kStorage = 2, kAbsolute = 3 };
+inline constexpr int kMetricCount = 4;
+const char* MetricName(Metric m);
+
+inline constexpr int kBinsPerOctave = 4;
+inline constexpr int kOctavesKept = 64;
+inline constexpr int kBinsKept = kBinsPerOctave * kOctavesKept;
+// Lowest kept octave per metric: relative errors from 2^-56 (32 bits below
+// float32's rounding, where every bit-lost figure is 0 anyway) up to 2^8;
+// absolute errors from 2^-48 to 2^16 world units. Values outside fall into
+// an underflow or overflow bin; exact zeros into the underflow bin.
+inline constexpr std::array<int, kMetricCount> kLowestOctave = {-56, -56, -56, -48};
+
+// floor(4 * log2(sqrt(q))) for q > 0 finite, from q's bits: the exponent
+// gives whole octaves of q (half octaves of sqrt(q)); the significand is
+// compared with sqrt(2)'s, which splits an octave of q in two.
+inline int QuarterOctaveOfSqrt(double q) {
+  constexpr std::uint64_t kSqrt2Fraction = 0x6A09E667F3BCDull;  // ceil(frac(sqrt 2) * 2^52)
+  std::uint64_t bits = std::bit_cast<std::uint64_t>(q);
+  int exponent = static_cast<int>(bits >> 52) - 1023;
+  int upper = (bits & 0xFFFFFFFFFFFFFull) >= kSqrt2Fraction ? 1 : 0;
+  return 2 * exponent + upper;
+}
+
+// Bin slot of a squared error value in a dense histogram: 0 underflow
+// (including 0 and subnormal squares), 1..kBinsKept kept bins, kBinsKept + 1
+// overflow.
+inline int DenseBinOfSquare(double q, int lowest_octave) {
+  if (!(q >= 0x1p-1022)) return 0;
+  int slot = QuarterOctaveOfSqrt(q) - lowest_octave * kBinsPerOctave + 1;
+  return slot < 0 ? 0 : (slot > kBinsKept + 1 ? kBinsKept + 1 : slot);
+}
+inline constexpr int kDenseBins = kBinsKept + 2;
+
+// Statistics of one metric in one band: sparse bins keyed by dense slot.
+struct MetricStats {
+  std::map<int, std::uint64_t> bins;  // dense slot -> count
+  double max = 0.0;                   // exact largest value (not squared)
+  std::uint64_t worst_index = std::numeric_limits<std::uint64_t>::max();
+
+  std::uint64_t Count() const;
+  void Merge(const MetricStats& other);
+  // The q-quantile (q in [0, 1]) of the metric's value; 0 when empty.
+  // Underflow reads as the lowest kept edge, overflow as the exact max.
+  double Quantile(double q, int lowest_octave) const;
+  friend bool operator==(const MetricStats&, const MetricStats&) = default;
+};
+
+// Statistics of one band of one cell.
+struct BandStats {
+  std::uint64_t finite = 0;      // samples with a finite output and a finite reference
+  std::uint64_t nan = 0;         // outputs with a NaN component (reference finite)
+  std::uint64_t inf = 0;         // outputs with an infinite component and no NaN
+  std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
+  std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
+  std::array<MetricStats, kMetricCount> metrics;
+
+  void Merge(const BandStats& other);
+  std::uint64_t judged() const { return finite + nan + inf; }
+  const MetricStats& operator[](Metric m) const { return metrics[static_cast<int>(m)]; }
+  friend bool operator==(const BandStats&, const BandStats&) = default;
+};
+
+// The quantile summary a table row shows.
+struct Summary {
+  double p50 = 0, p99 = 0, p999 = 0, max = 0;
+  std::uint64_t worst_index = 0;
+};
+Summary Summarize(const BandStats& band, Metric metric);
+// Bits lost of a relative error: max(0, log2(x / 2^-24)).
+double BitsLost(double relative_error);
+
+// All statistics of one cell on one backend.
+struct CellStats {
+  std::map<int, BandStats> joint;     // JointBand(ratio, depth) -> stats
+  std::map<int, BandStats> distance;  // DistanceBand -> stats
+
+  void Merge(const CellStats& other);
+  BandStats All() const;
+  BandStats ForRatio(int ratio_band) const;
+  BandStats ForDepth(int depth_band) const;
+  BandStats ForDistance(int distance_band) const;
+  friend bool operator==(const CellStats&, const CellStats&) = default;
+};
+
+// The hot accumulator for one cell: dense 32-bit bins for the joint bands a
+// run touches (allocated on first use) and the distance bands. Flush() moves
+// everything into a CellStats; the sweep flushes well before a 32-bit count
+// could overflow.
+class CellAccumulator {
+ public:
+  CellAccumulator();
+
+  struct Slot {
+    std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins{};
+    std::array<double, kMetricCount> max_square{};
+    std::array<std::uint64_t, kMetricCount> worst_index{};
+    std::uint64_t finite = 0, nan = 0, inf = 0, degenerate = 0;
+    std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
+    Slot() { worst_index.fill(std::numeric_limits<std::uint64_t>::max()); }
+  };
+
+  Slot& Joint(int band) {
+    int s = joint_slot_[band];
+    return s >= 0 ? slots_[s] : NewJoint(band);
+  }
+  Slot& Distance(int band) { return slots_[band]; }
+
+  // Records one judged sample's values (squares) in both of its bands.
+  void AddFinite(int joint_band, int distance_band, std::uint64_t index,
+                 const std::array<double, kMetricCount>& squares);
+  void AddNonFinite(int joint_band, int distance_band, std::uint64_t index, bool nan);
+  void AddDegenerate(int joint_band, int distance_band);
+
+  void FlushInto(CellStats& out);
+  std::uint64_t pending() const { return pending_; }
+
+ private:
+  Slot& NewJoint(int band);
+  std::array<int, kJointBands> joint_slot_;
+  std::vector<Slot> slots_;  // [0, kDistanceBands): distance bands; then joint bands
+  std::uint64_t pending_ = 0;
+};
+
+}  // namespace depthbench

@@ -1,0 +1,29 @@
+// The compute form of a reconstruction pass: one invocation per sample, the
+// ray-based variants' interpolated inputs computed per pixel (screen.h).
+// The including shader defines RECONSTRUCT as its variant's
+// <variant>_world_position function from shared/variants/.
+layout(local_size_x = 64) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer Frames { FrameParams frames[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_params[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };
+layout(std430, set = 0, binding = 3) readonly buffer StoredDepths { float stored_depths[]; };
+layout(std430, set = 0, binding = 4) writeonly buffer Positions { float positions[]; };
+layout(push_constant) uniform Pass { PassConstants pass; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pass.sample_count) {
+    return;
+  }
+  uint frame_index = (i + pass.first_sample_in_frame) / pass.samples_per_frame;
+  FrameParams frame = frames[frame_index];
+  DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
+  uint pixel = pixels[i];
+  vec2 uv = uv_from_pixel(pixel & 0xffffu, pixel >> 16u, frame.resolution);
+  vec3 p = RECONSTRUCT(frame, depth, uv, stored_depths[pass.depth_offset + i]);
+  uint o = pass.output_offset + 3u * i;
+  positions[o] = p.x;
+  positions[o + 1u] = p.y;
+  positions[o + 2u] = p.z;
+}

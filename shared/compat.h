@@ -1,0 +1,39 @@
+// The one file of shared/ that knows whether it is being compiled as GLSL 450
+// or as C++. Everything else in shared/ is written in the common subset:
+//   - scalars are `real` (float in GLSL and in the CPU backend, a double-double
+//     in the high-precision reference) and `uint`;
+//   - vectors and matrices are vec2/vec3/vec4/mat4 (GLM types in C++);
+//   - functions are declared with DB_FN, take their arguments by value and
+//     return one value (no out/inout), use no swizzles, and use only
+//     built-ins that GLM also has;
+//   - literals are f-suffixed and exactly representable, and are wrapped in
+//     real(...) where they meet a vector, so that every instantiation rounds
+//     them the same way (not at all).
+// Formula headers carry no include guard: C++ includes each of them once per
+// precision namespace (see bench/formulas.h), GLSL once per shader.
+#ifndef DEPTHBENCH_SHARED_COMPAT_H
+#define DEPTHBENCH_SHARED_COMPAT_H
+
+#ifdef __cplusplus
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#define DB_FN inline
+// Carries its own ';' in C++; expands to nothing in GLSL, where a stray ';'
+// at file scope is an error. Use it without a trailing ';'.
+#define DB_STATIC_ASSERT(condition, message) static_assert(condition, message);
+// A named integer constant: `const uint` in both languages.
+#define DB_CONST_UINT(name, value) [[maybe_unused]] constexpr std::uint32_t name = value;
+
+#else  // GLSL
+
+#define DB_FN
+#define DB_STATIC_ASSERT(condition, message)
+#define DB_CONST_UINT(name, value) const uint name = value;
+#define real float
+
+#endif
+
+#endif  // DEPTHBENCH_SHARED_COMPAT_H

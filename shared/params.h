@@ -1,0 +1,65 @@
+// Parameter blocks shared by the shaders and the host, laid out for std430.
+//
+// Layout rules that keep C++ and GLSL in agreement (checked member by member
+// against glslang's reflection in tests/layout_test.cc):
+//   - only vec4, mat4 and uint members; uints come in groups of four;
+//   - no vec3, no mat3, no bool, no arrays;
+//   - every struct is a multiple of 16 bytes.
+// In C++ these structs are instantiated with float (the backends' view, and
+// the bytes uploaded to the GPU) and with a double-double `real` (the exact
+// constants the reference and the formula tests use).
+// No include guard: see compat.h.
+
+// Bits of DepthParams.convention. A depth convention is a combination of
+// these three choices.
+DB_CONST_UINT(DB_CONVENTION_REVERSED, 1u)        // near maps to 1, far to 0
+DB_CONST_UINT(DB_CONVENTION_INFINITE, 2u)        // the far plane is at infinity
+DB_CONST_UINT(DB_CONVENTION_CLIP_MINUS_ONE, 4u)  // GL clip depth: NDC z in [-1, 1]
+
+// Everything about one frame that does not depend on the depth convention:
+// the camera, the lens, the render target, and the per-vertex values that the
+// rasterizer would interpolate for the ray-based variants. All "origin"
+// members are the attribute's value at uv (0, 0) (the top-left corner of the
+// screen); "du"/"dv" are its change from uv (0, 0) to uv (1, 0) and (0, 1).
+struct FrameParams {
+  mat4 camera_world;             // view space -> world space (rotation + translation)
+  vec4 camera_position;          // xyz: camera position in world space; w: far plane distance (0 when infinite)
+  vec4 lens;                     // x: tan(fovY/2)*aspect, y: tan(fovY/2), z: H = 1/x, w: V = 1/y
+  vec4 resolution;               // x: width, y: height, z: 1/width, w: 1/height (pixels)
+  vec4 frustum_ray_origin;       // seed 000: world-space camera->far-plane ray, full-screen pass
+  vec4 frustum_ray_du;
+  vec4 frustum_ray_dv;
+  vec4 volume_position_origin;   // seed 000: view-space position on a light volume's surface
+  vec4 volume_position_du;
+  vec4 volume_position_dv;
+  vec4 eye_ray_view_origin;      // seed 003: view-space eye ray (x*tan*aspect, y*tan, -w)
+  vec4 eye_ray_view_du;
+  vec4 eye_ray_view_dv;
+  vec4 eye_ray_world_origin;     // seed 003: the same ray rotated by the inverse view matrix
+  vec4 eye_ray_world_du;
+  vec4 eye_ray_world_dv;
+};
+
+// What one depth convention adds to a frame: the mapping between eye depth
+// z (= -view.z > 0) and NDC depth, which is  ndc_z = A + B / z.
+struct DepthParams {
+  mat4 inverse_view_projection;  // seed 002: NDC (x, y, ndc_z, 1) -> homogeneous world position
+  vec4 coefficients;             // x: A, y: B, z: P = 1/B, w: Q = -A/B (seed 004)
+  uint convention;               // DB_CONVENTION_* bits
+  uint reserved0;
+  uint reserved1;
+  uint reserved2;
+};
+
+// Push constants of one compute dispatch: which slice of the batch's buffers
+// one cell reads and writes.
+struct PassConstants {
+  uint sample_count;        // samples in the batch
+  uint samples_per_frame;   // sample i uses frame i / samples_per_frame
+  uint convention_slot;     // index of this cell's convention within a frame's DepthParams
+  uint conventions_per_frame;
+  uint depth_offset;        // first element of this cell's stored depths in the depth buffer
+  uint output_offset;       // first float of this cell's output positions (3 floats per sample)
+  uint first_sample_in_frame;  // index of the batch's first sample within its frame
+  uint reserved0;
+};
