@@ -1,5 +1,8 @@
 #include "bench/backend_cpu.h"
 
+#include <cstddef>
+#include <cstring>
+
 #include <fmt/format.h>
 
 #include "bench/formulas.h"
@@ -9,20 +12,61 @@ namespace {
 
 // One cell over a batch. The formula is a template argument so that it is
 // inlined into the loop, as a shader compiler inlines it.
-template <f32::WorldPositionFn Reconstruct>
+// The frame's constants, the same in every lane. The parameter blocks hold
+// their float members first, in the same order in both widths.
+template <class Wide, class Narrow>
+void BroadcastFloats(const Narrow& narrow, Wide& wide, std::size_t floats) {
+  const auto* from = reinterpret_cast<const float*>(&narrow);
+  auto* to = reinterpret_cast<Float8*>(&wide);
+  for (std::size_t k = 0; k < floats; ++k) to[k] = Float8(from[k]);
+}
+
+f32x8::FrameParams Widen(const f32::FrameParams& narrow) {
+  f32x8::FrameParams wide;
+  BroadcastFloats(narrow, wide, sizeof(narrow) / sizeof(float));
+  return wide;
+}
+
+f32x8::DepthParams Widen(const f32::DepthParams& narrow) {
+  f32x8::DepthParams wide;
+  BroadcastFloats(narrow, wide, offsetof(f32::DepthParams, convention) / sizeof(float));
+  wide.convention = narrow.convention;
+  wide.reserved0 = wide.reserved1 = wide.reserved2 = 0;
+  return wide;
+}
+
+// Frame by frame (the frame's constants are uniform), eight samples at a
+// time in the lanes of the f32x8 instantiation.
+template <f32x8::WorldPositionFn Reconstruct>
 void RunCell(const Batch& batch, const CellPlan& plan, float* out) {
+  constexpr int kLanes = Float8::kLanes;
   const float* depths = batch.depths.data() + static_cast<std::size_t>(plan.depth_slot) * batch.count;
-  for (std::uint32_t i = 0; i < batch.count; ++i) {
-    const std::uint32_t frame_index = batch.FrameOf(i);
-    const f32::FrameParams& frame = batch.frame_params[frame_index];
-    const f32::DepthParams& depth =
-        batch.depth_params[frame_index * kHardwareConventionCount + plan.convention_slot];
-    const std::uint32_t pixel = batch.pixels[i];
-    glm::vec2 uv = f32::uv_from_pixel(pixel & 0xffffu, pixel >> 16, frame.resolution);
-    glm::vec3 p = Reconstruct(frame, depth, uv, depths[i]);
-    out[3 * i + 0] = p.x;
-    out[3 * i + 1] = p.y;
-    out[3 * i + 2] = p.z;
+  for (std::uint32_t begin = 0; begin < batch.count;) {
+    const std::uint32_t frame_index = batch.FrameOf(begin);
+    const std::uint32_t end =
+        std::min<std::uint32_t>(batch.count, (frame_index + 1) * kSamplesPerFrame - batch.first_offset);
+    const f32x8::FrameParams frame = Widen(batch.frame_params[frame_index]);
+    const f32x8::DepthParams depth =
+        Widen(batch.depth_params[frame_index * kHardwareConventionCount + plan.convention_slot]);
+    for (std::uint32_t i = begin; i < end; i += kLanes) {
+      const int n = static_cast<int>(std::min<std::uint32_t>(kLanes, end - i));
+      Float8::Lanes x, y, stored;
+      for (int lane = 0; lane < kLanes; ++lane) {
+        const std::uint32_t k = i + static_cast<std::uint32_t>(lane < n ? lane : n - 1);  // pad the tail
+        x[lane] = static_cast<float>(batch.pixels[k] & 0xffffu);
+        y[lane] = static_cast<float>(batch.pixels[k] >> 16);
+        stored[lane] = depths[k];
+      }
+      const f32x8::vec2 uv =
+          f32x8::uv_from_pixel(Float8::FromLanes(x), Float8::FromLanes(y), frame.resolution);
+      const f32x8::vec3 p = Reconstruct(frame, depth, uv, Float8::FromLanes(stored));
+      for (int lane = 0; lane < n; ++lane) {
+        out[3 * (i + lane) + 0] = p.x[lane];
+        out[3 * (i + lane) + 1] = p.y[lane];
+        out[3 * (i + lane) + 2] = p.z[lane];
+      }
+    }
+    begin = end;
   }
 }
 
@@ -30,14 +74,14 @@ using CellRunner = void (*)(const Batch&, const CellPlan&, float*);
 
 CellRunner RunnerFor(Variant v) {
   switch (v) {
-    case Variant::kFrustumRay: return RunCell<f32::frustum_ray_world_position>;
-    case Variant::kVolumeRay: return RunCell<f32::volume_ray_world_position>;
-    case Variant::kTanAspect: return RunCell<f32::tan_aspect_world_position>;
-    case Variant::kEyeRay: return RunCell<f32::eye_ray_world_position>;
-    case Variant::kInverseVp: return RunCell<f32::inverse_vp_world_position>;
-    case Variant::kDivide: return RunCell<f32::divide_world_position>;
-    case Variant::kReciprocal: return RunCell<f32::reciprocal_world_position>;
-    case Variant::kPq: return RunCell<f32::pq_world_position>;
+    case Variant::kFrustumRay: return RunCell<f32x8::frustum_ray_world_position>;
+    case Variant::kVolumeRay: return RunCell<f32x8::volume_ray_world_position>;
+    case Variant::kTanAspect: return RunCell<f32x8::tan_aspect_world_position>;
+    case Variant::kEyeRay: return RunCell<f32x8::eye_ray_world_position>;
+    case Variant::kInverseVp: return RunCell<f32x8::inverse_vp_world_position>;
+    case Variant::kDivide: return RunCell<f32x8::divide_world_position>;
+    case Variant::kReciprocal: return RunCell<f32x8::reciprocal_world_position>;
+    case Variant::kPq: return RunCell<f32x8::pq_world_position>;
   }
   return nullptr;
 }

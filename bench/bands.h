@@ -17,10 +17,13 @@ inline constexpr int kDepthBands = 10;  // z/n in 1e0.., ..., 1e9 and above
 inline constexpr int kJointBands = kRatioBands * kDepthBands;
 inline constexpr int kDistanceBands = 5;  // [0,1), [1,1e2), [1e2,1e4), [1e4,1e6), 1e6 and above
 
+// floor(log10(x)) clamped to [0, count), by comparison with exact powers of
+// ten (cheaper than a logarithm, and exact at the edges).
 inline int DecadeBand(double x, int count) {
-  if (!(x >= 10.0)) return 0;
-  int decade = static_cast<int>(std::floor(std::log10(x)));
-  return decade < count - 1 ? decade : count - 1;
+  constexpr double kPowers[] = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12};
+  int band = 0;
+  while (band < count - 1 && x >= kPowers[band]) ++band;
+  return band;
 }
 
 inline int RatioBand(double ratio) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "bench/bands.h"
 #include "bench/encode.h"
 #include "bench/shader_constants.h"
 
@@ -21,7 +22,18 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
 }
 
 BatchBuilder::BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings)
-    : sampler_(sampler), encodings_(std::move(encodings)) {}
+    : sampler_(sampler), encodings_(std::move(encodings)) {
+  for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
+    auto shares = [&](std::uint32_t k) {
+      const Encoding a = encodings_[pipeline_slots_[k]], b = encodings_[s];
+      return a.convention == b.convention && Info(a.format).stores == Info(b.format).stores;
+    };
+    std::uint32_t k = 0;
+    while (k < pipeline_slots_.size() && !shares(k)) ++k;
+    if (k == pipeline_slots_.size()) pipeline_slots_.push_back(s);
+    pipeline_of_slot_.push_back(k);
+  }
+}
 
 void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const {
   const std::size_t slots = encodings_.size();
@@ -32,30 +44,34 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   const std::size_t frames =
       count == 0 ? 0 : static_cast<std::size_t>((first + count - 1) / kSamplesPerFrame - first_frame + 1);
 
+  // Frames: exact parameters and the shader constants rounded from them.
   batch.frames.resize(frames);
+  batch.distance_bands.resize(frames);
   batch.frame_params.resize(frames);
   batch.depth_params.resize(frames * kHardwareConventionCount);
   pool.ParallelFor(frames, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t f = begin; f < end; ++f) {
       Frame& frame = batch.frames[f];
       frame = sampler_.FrameAt(first_frame + f);
+      batch.distance_bands[f] = static_cast<std::uint8_t>(DistanceBand(frame.camera_distance()));
       hp::FrameParams exact = BuildFrameParams(frame);
       batch.frame_params[f] = RoundToFloat(exact);
       for (int c = 0; c < kHardwareConventionCount; ++c) {
+        const auto convention = static_cast<Convention>(c);
         f32::DepthParams& out = batch.depth_params[f * kHardwareConventionCount + c];
         // Conventions with a finite far plane have no constants on frames
         // that have none (infinite-only domains); their cells do not run.
-        bool needs_far = (Info(static_cast<Convention>(c)).bits & f32::DB_CONVENTION_INFINITE) == 0u;
+        bool needs_far = (Info(convention).bits & f32::DB_CONVENTION_INFINITE) == 0u;
         out = needs_far && !frame.finite() ? f32::DepthParams{}
-                                           : RoundToFloat(BuildDepthParams(frame, exact, static_cast<Convention>(c)));
+                                           : RoundToFloat(BuildDepthParams(frame, exact, convention));
       }
     }
   });
 
+  // Samples: pixel, ray and depth pick.
   batch.pixels.resize(count);
-  batch.depths.resize(slots * count);
-  batch.codes.resize(slots * count);
-  batch.reference.resize(slots * count);
+  batch.rays.resize(count);
+  batch.facts.resize(count);
   pool.ParallelFor(
       count,
       [&](std::size_t begin, std::size_t end, unsigned) {
@@ -63,20 +79,55 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
           const PixelSample sample = sampler_.SampleAt(first + i, frame);
           batch.pixels[i] = sample.x | (sample.y << 16);
-          const SampleReference reference(frame, sample);
-          for (std::size_t s = 0; s < slots; ++s) {
-            const Encoding encoding = encodings_[s];
-            StoredDepth stored = sample.pick == DepthPick::kEyeDepth
-                                     ? EncodeEyeDepth(encoding, frame, sample.eye_depth)
-                                     : EncodeEdge(encoding, frame, sample.pick);
-            const std::size_t at = s * count + i;
-            batch.depths[at] = stored.fetched;
-            batch.codes[at] = stored.code;
-            batch.reference[at] = reference.For(encoding, stored.code);
-          }
+          batch.rays[i] = PixelRay(frame, sample.x, sample.y);
+          batch.facts[i] = FactsOf(frame, sample, batch.rays[i]);
         }
       },
       256);
+
+  // Encodings, one depth slot at a time so that every loop writes one
+  // array in order: the pipeline's floats (shared by a convention's
+  // formats), then the stored texels and the reference.
+  const std::size_t pipelines = pipeline_slots_.size();
+  pipeline_floats_.resize(pipelines * count);
+  constexpr std::size_t kChunk = 1024;
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      const std::size_t k = job / chunks;
+      const Encoding encoding = encodings_[pipeline_slots_[k]];
+      float* out = pipeline_floats_.data() + k * count;
+      const std::size_t lo = (job % chunks) * kChunk, hi = std::min<std::size_t>(count, lo + kChunk);
+      for (std::size_t i = lo; i < hi; ++i) {
+        const SampleFacts& facts = batch.facts[i];
+        if (facts.pick != DepthPick::kEyeDepth) continue;
+        out[i] = PipelineFloat(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], facts.eye_depth);
+      }
+    }
+  });
+
+  batch.depths.resize(slots * count);
+  batch.codes.resize(slots * count);
+  batch.reference.resize(slots * count);
+  batch.storage_squares.resize(slots * count);
+  pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      const std::size_t s = job / chunks;
+      const Encoding encoding = encodings_[s];
+      const float* pipeline = pipeline_floats_.data() + pipeline_of_slot_[s] * count;
+      const std::size_t lo = (job % chunks) * kChunk, hi = std::min<std::size_t>(count, lo + kChunk);
+      for (std::size_t i = lo; i < hi; ++i) {
+        const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
+        const SampleFacts& facts = batch.facts[i];
+        const StoredDepth stored = facts.pick == DepthPick::kEyeDepth ? StoreFloat(encoding.format, pipeline[i])
+                                                                      : EncodeEdge(encoding, frame, facts.pick);
+        const std::size_t at = s * count + i;
+        batch.depths[at] = stored.fetched;
+        batch.codes[at] = stored.code;
+        batch.reference[at] = ReferenceFor(frame, facts, encoding, stored.code, batch.storage_squares[at]);
+      }
+    }
+  });
 }
 
 }  // namespace depthbench

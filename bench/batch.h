@@ -31,8 +31,12 @@ struct Batch {
 
   // Judge inputs.
   std::vector<Frame> frames;                   // [frame]: exact parameters
+  std::vector<std::uint8_t> distance_bands;    // [frame]: DistanceBand of the camera
+  std::vector<glm::dvec3> rays;                // [sample]: world-space ray at unit eye depth
   std::vector<ReferenceSample> reference;      // [depth slot * count + sample]
+  std::vector<double> storage_squares;         // [depth slot * count + sample]
   std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: stored texel bits
+  std::vector<SampleFacts> facts;              // [sample]: the depth pick and what the reference needs
 
   std::uint32_t FrameOf(std::uint32_t sample) const {
     return (sample + first_offset) / kSamplesPerFrame;
@@ -64,6 +68,12 @@ class BatchBuilder {
  private:
   const Sampler& sampler_;
   std::vector<Encoding> encodings_;
+  // The formats of one convention share the pipeline's float (encode.h):
+  // encodings_[s] reads pipeline value pipeline_of_slot_[s], which is
+  // computed for encodings_[pipeline_slots_[k]].
+  std::vector<std::uint32_t> pipeline_of_slot_;
+  std::vector<std::uint32_t> pipeline_slots_;
+  mutable std::vector<float> pipeline_floats_;  // [pipeline * count + sample], reused across batches
 };
 
 }  // namespace depthbench

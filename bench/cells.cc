@@ -6,65 +6,15 @@
 #include "bench/formulas.h"
 
 namespace depthbench {
+
+static_assert(catalog::kRev == f32::DB_CONVENTION_REVERSED && catalog::kInf == f32::DB_CONVENTION_INFINITE &&
+                  catalog::kGl == f32::DB_CONVENTION_CLIP_MINUS_ONE,
+              "convention bits must match shared/params.h");
+
 namespace {
-
-constexpr std::array<VariantInfo, kVariantCount> kVariants = {{
-    {Variant::kFrustumRay, "frustum_ray", "000", DepthInput::kLinear,
-     "full-screen pass: world-space far-plane frustum ray, interpolated; camera + depth * ray"},
-    {Variant::kVolumeRay, "volume_ray", "000", DepthInput::kLinear,
-     "light-volume geometry: ray = view position * (far / -view.z); view = depth * ray"},
-    {Variant::kTanAspect, "tan_aspect", "001", DepthInput::kLinear,
-     "similar triangles: view.xy = (tan*aspect, tan) * ndc.xy * z, no matrix"},
-    {Variant::kEyeRay, "eye_ray", "003", DepthInput::kViewZ,
-     "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside"},
-    {Variant::kInverseVp, "inverse_vp", "002", DepthInput::kHardware,
-     "inverse view-projection times (ndc, depth, 1), divide by w"},
-    {Variant::kDivide, "divide", "004", DepthInput::kHardware,
-     "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
-    {Variant::kReciprocal, "reciprocal", "004", DepthInput::kHardware,
-     "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW"},
-    {Variant::kPq, "pq", "004", DepthInput::kHardware,
-     "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
-}};
-
-constexpr std::uint32_t kRev = f32::DB_CONVENTION_REVERSED;
-constexpr std::uint32_t kInf = f32::DB_CONVENTION_INFINITE;
-constexpr std::uint32_t kGl = f32::DB_CONVENTION_CLIP_MINUS_ONE;
-
-constexpr std::array<ConventionInfo, kConventionCount> kConventions = {{
-    {Convention::kStandard, "standard", 0, true, "near -> 0, far -> 1, clip depth [0,1]"},
-    {Convention::kReversed, "reversed", kRev, true, "near -> 1, far -> 0, clip depth [0,1]"},
-    {Convention::kStandardInf, "standard-inf", kInf, true,
-     "near -> 0, infinite far -> 1, clip depth [0,1]"},
-    {Convention::kReversedInf, "reversed-inf", kRev | kInf, true,
-     "near -> 1, infinite far -> 0, clip depth [0,1]"},
-    {Convention::kStandardGl, "standard-gl", kGl, true, "near -> -1, far -> 1, clip depth [-1,1]"},
-    {Convention::kReversedGl, "reversed-gl", kRev | kGl, true,
-     "near -> 1, far -> -1, clip depth [-1,1]"},
-    {Convention::kStandardInfGl, "standard-inf-gl", kInf | kGl, true,
-     "near -> -1, infinite far -> 1, clip depth [-1,1]"},
-    {Convention::kReversedInfGl, "reversed-inf-gl", kRev | kInf | kGl, true,
-     "near -> 1, infinite far -> -1, clip depth [-1,1]"},
-    {Convention::kLinear, "linear", 0, false,
-     "no projective mapping: the stored value is linear in eye depth"},
-}};
-
-constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
-    {Format::kD16Unorm, "d16_unorm", "d16", "VK_FORMAT_D16_UNORM", DepthInput::kHardware,
-     TexelKind::kUnorm, 16},
-    {Format::kX8D24Unorm, "x8_d24_unorm", "d24", "VK_FORMAT_X8_D24_UNORM_PACK32",
-     DepthInput::kHardware, TexelKind::kUnorm, 24},
-    {Format::kD32Sfloat, "d32_sfloat", "d32f", "VK_FORMAT_D32_SFLOAT", DepthInput::kHardware,
-     TexelKind::kFloat32, 32},
-    {Format::kR32Sfloat, "r32_sfloat", "r32f", "VK_FORMAT_R32_SFLOAT", DepthInput::kLinear,
-     TexelKind::kFloat32, 32},
-    {Format::kR16Sfloat, "r16_sfloat", "r16f", "VK_FORMAT_R16_SFLOAT", DepthInput::kLinear,
-     TexelKind::kFloat16, 16},
-    {Format::kR16Unorm, "r16_unorm", "r16", "VK_FORMAT_R16_UNORM", DepthInput::kLinear,
-     TexelKind::kUnorm, 16},
-    {Format::kR32SfloatViewZ, "r32_sfloat_viewz", "viewz", "VK_FORMAT_R32_SFLOAT",
-     DepthInput::kViewZ, TexelKind::kFloat32, 32},
-}};
+using catalog::kConventions;
+using catalog::kFormats;
+using catalog::kVariants;
 
 std::string Lower(std::string_view s) {
   std::string out(s);
@@ -85,12 +35,6 @@ std::string JoinNames(const Table& table, NameOf name_of) {
 
 }  // namespace
 
-const VariantInfo& Info(Variant v) { return kVariants[static_cast<int>(v)]; }
-const ConventionInfo& Info(Convention c) { return kConventions[static_cast<int>(c)]; }
-const FormatInfo& Info(Format f) { return kFormats[static_cast<int>(f)]; }
-std::span<const VariantInfo> AllVariants() { return kVariants; }
-std::span<const ConventionInfo> AllConventions() { return kConventions; }
-std::span<const FormatInfo> AllFormats() { return kFormats; }
 
 bool Reads(Variant v, Convention c, Format f) {
   DepthInput input = Info(v).input;

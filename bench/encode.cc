@@ -3,7 +3,9 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <limits>
 
+#include "bench/double_double.h"
 #include "bench/formulas.h"
 #include "bench/formulas_mpfr.h"
 
@@ -12,73 +14,81 @@ namespace {
 
 using DD = DoubleDouble;
 
-// Bound on the relative error of the double-double depth formulas (a few
-// operations of error below 2^-102 each; tests/reference_test.cc measures
-// it against MPFR). Values closer than this to a float rounding boundary are
-// rounded from an MPFR evaluation instead.
+// Relative error bounds of the step-2 evaluations: a handful of correctly
+// rounded operations, each below 2^-64 (long double) or 2^-104
+// (double-double); the bounds leave a wide margin.
+constexpr long double kLongDoubleError = 0x1p-59L;
 constexpr double kDoubleDoubleError = 0x1p-96;
 
+std::atomic<std::uint64_t> double_double_fallbacks{0};
 std::atomic<std::uint64_t> mpfr_fallbacks{0};
 
-bool NearFloatRoundingBoundary(DD x) {
-  float f = RoundToFloat(x);
+// Whether some value within `relative_error` of x rounds to a different
+// float than x: i.e. x is that close to a midpoint between two floats.
+template <class T, class ToFloat>
+bool NearFloatBoundary(T x, T relative_error, ToFloat to_float) {
+  float f = to_float(x);
   if (!std::isfinite(f)) return false;
-  double tolerance = std::fabs(x.hi()) * kDoubleDoubleError + 0x1p-1074;
+  T tolerance = (x < T(0.0) ? -x : x) * relative_error + T(0x1p-1074);
   for (float neighbour : {std::nextafter(f, -INFINITY), std::nextafter(f, INFINITY)}) {
-    double midpoint = (static_cast<double>(f) + static_cast<double>(neighbour)) * 0.5;
-    if (std::fabs((DD(midpoint) - x).hi()) <= tolerance) return true;
+    T midpoint = (T(static_cast<double>(f)) + T(static_cast<double>(neighbour))) * T(0.5);  // exact
+    T distance = midpoint - x;
+    if ((distance < T(0.0) ? -distance : distance) <= tolerance) return true;
   }
   return false;
 }
 
-// The float nearest to the exact value that `approx` approximates; `exact`
-// evaluates it in MPFR and is called only for near-ties.
-template <class ExactFn>
-float RoundExactly(DD approx, ExactFn exact) {
-  if (!NearFloatRoundingBoundary(approx)) return RoundToFloat(approx);
+// The float nearest to an exact value, evaluated as cheaply as the value
+// allows: long double first, double-double and MPFR only near a tie.
+template <class Fast, class Precise, class Exact>
+float RoundExactly(Fast fast, Precise precise, Exact exact) {
+  long double x = fast();
+  auto ld_to_float = [](long double v) { return static_cast<float>(v); };
+  if (!NearFloatBoundary(x, kLongDoubleError, ld_to_float)) return static_cast<float>(x);
+  double_double_fallbacks.fetch_add(1, std::memory_order_relaxed);
+  DD y = precise();
+  if (!NearFloatBoundary(y, DD(kDoubleDoubleError), [](DD v) { return RoundToFloat(v); })) {
+    return RoundToFloat(y);
+  }
   mpfr_fallbacks.fetch_add(1, std::memory_order_relaxed);
   return exact().ToFloat();
 }
 
-mp::real Mp(double x) { return mp::real(x); }
-
 double FarOrZero(const Frame& frame) { return frame.finite() ? frame.far : 0.0; }
+constexpr double UnormScale(int bits) { return static_cast<double>((std::uint64_t{1} << bits) - 1); }
 
-// Steps 1 and 2 of the pipeline for hardware depth: the float32 window depth.
+// Step 2 for hardware depth: the float32 window depth.
 float WindowDepthAsFloat(Convention convention, const Frame& frame, double z) {
   const std::uint32_t bits = Info(convention).bits;
-  const double far = FarOrZero(frame);
-  DD window = hp::window_depth_from_eye_depth(DD(frame.near), DD(far), bits, DD(z));
-  auto exact_window = [&] { return mp::window_depth_from_eye_depth(Mp(frame.near), Mp(far), bits, Mp(z)); };
-  if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) return RoundExactly(window, exact_window);
+  const double n = frame.near, f = FarOrZero(frame);
+  auto fast = [&] { return ld::window_depth_from_eye_depth(n, f, bits, z); };
+  auto precise = [&] { return hp::window_depth_from_eye_depth(DD(n), DD(f), bits, DD(z)); };
+  auto exact = [&] { return mp::window_depth_from_eye_depth(n, f, bits, z); };
+  if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) return RoundExactly(fast, precise, exact);
   // GL-style: the rasterizer's float32 is NDC depth, then the viewport
   // transform maps it back to [0, 1] in float32 (exact in double, one rounding).
-  float ndc = RoundExactly(window * DD(2.0) - DD(1.0),
-                           [&] { return exact_window() * Mp(2.0) - Mp(1.0); });
+  float ndc = RoundExactly([&] { return fast() * 2.0L - 1.0L; }, [&] { return precise() * DD(2.0) - DD(1.0); },
+                           [&] { return exact() * mp::real(2.0) - mp::real(1.0); });
   return static_cast<float>(0.5 * static_cast<double>(ndc) + 0.5);
 }
 
-// Step 3: the format's conversion of a float32 value.
-std::uint32_t ConvertFloat(Format format, float value) {
-  const FormatInfo& info = Info(format);
-  switch (info.texel) {
-    case TexelKind::kUnorm:
-      return FloatToUnorm(value, info.bits);
-    case TexelKind::kFloat16:
-      return FloatToHalf(value);
-    case TexelKind::kFloat32:
-      return std::bit_cast<std::uint32_t>(value);
-  }
-  return 0;
-}
-
-StoredDepth Stored(Format format, std::uint32_t code) { return {code, FetchTexel(format, code)}; }
-
-double UnormScale(int bits) { return std::ldexp(1.0, bits) - 1.0; }
-
 }  // namespace
 
-std::uint64_t MpfrFallbackCount() { return mpfr_fallbacks.load(); }
+EncodeFallbacks EncodeFallbackCounts() { return {double_double_fallbacks.load(), mpfr_fallbacks.load()}; }
+
+float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth) {
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware:
+      return WindowDepthAsFloat(encoding.convention, frame, eye_depth);
+    case DepthInput::kLinear:
+      return RoundExactly([&] { return static_cast<long double>(eye_depth) / frame.far; },
+                          [&] { return DD(eye_depth) / DD(frame.far); },
+                          [&] { return mp::real(eye_depth) / mp::real(frame.far); });
+    case DepthInput::kViewZ:
+      return static_cast<float>(-eye_depth);
+  }
+  return 0.0f;
+}
 
 std::uint32_t FloatToUnorm(float value, int bits) {
   double clamped = std::fmin(1.0, std::fmax(0.0, static_cast<double>(value)));
@@ -97,7 +107,7 @@ std::uint16_t FloatToHalf(float value) {
   }
   int exponent;
   double mantissa = std::frexp(v, &exponent);  // v = mantissa * 2^exponent, mantissa in [0.5, 1)
-  // Significand in [1024, 2048): ten fraction bits, rounded half to even;
+  // Significand in [1024, 2048]: ten fraction bits, rounded half to even;
   // a carry to 2048 lands on the next binade, which the packing absorbs.
   auto significand = static_cast<std::uint32_t>(std::nearbyint(mantissa * 2048.0));
   std::uint32_t biased = static_cast<std::uint32_t>(exponent - 1 + 15);
@@ -119,51 +129,33 @@ float HalfToFloat(std::uint16_t half) {
   return static_cast<float>(negative ? -magnitude : magnitude);
 }
 
-DD TexelValue(Format format, std::uint32_t code) {
-  const FormatInfo& info = Info(format);
-  switch (info.texel) {
-    case TexelKind::kUnorm:
-      return DD(static_cast<double>(code)) / DD(UnormScale(info.bits));
-    case TexelKind::kFloat16:
-      return DD(HalfToFloat(static_cast<std::uint16_t>(code)));
-    case TexelKind::kFloat32:
-      return DD(std::bit_cast<float>(code));
-  }
-  return DD(NAN);
-}
-
 float FetchTexel(Format format, std::uint32_t code) {
   const FormatInfo& info = Info(format);
-  if (info.texel != TexelKind::kUnorm) return static_cast<float>(TexelValue(format, code).hi());
-  // code / (2^b - 1) correctly rounded: |g * (2^b - 1) - code| is exact in
-  // double for any float g, so the nearest float can be picked exactly.
-  const double scale = UnormScale(info.bits);
-  const double c = code;
-  float best = static_cast<float>(c / scale);
-  auto error = [&](float g) { return std::fabs(static_cast<double>(g) * scale - c); };
-  for (float g : {std::nextafter(best, -INFINITY), std::nextafter(best, INFINITY)}) {
-    bool even = (std::bit_cast<std::uint32_t>(g) & 1u) == 0u;
-    if (error(g) < error(best) || (error(g) == error(best) && even)) best = g;
+  switch (info.texel) {
+    case TexelKind::kFloat32:
+      return std::bit_cast<float>(code);
+    case TexelKind::kFloat16:
+      return HalfToFloat(static_cast<std::uint16_t>(code));
+    case TexelKind::kUnorm:
+      break;
   }
-  return best;
+  // code / (2^b - 1) rounded to double and then to float is correctly
+  // rounded for b <= 24: the exact quotient's binary expansion repeats with
+  // period b, so it never lies within the double's 29 extra bits of a float
+  // midpoint unless it is exactly representable. tests/encode_test.cc
+  // checks every 16- and 24-bit code against an exact rounding.
+  return static_cast<float>(static_cast<double>(code) / UnormScale(info.bits));
 }
 
-StoredDepth EncodeEyeDepth(Encoding encoding, const Frame& frame, double eye_depth) {
-  const Format format = encoding.format;
-  float value = 0.0f;
-  switch (Info(format).stores) {
-    case DepthInput::kHardware:
-      value = WindowDepthAsFloat(encoding.convention, frame, eye_depth);
-      break;
-    case DepthInput::kLinear:
-      value = RoundExactly(DD(eye_depth) / DD(frame.far),
-                           [&] { return Mp(eye_depth) / Mp(frame.far); });
-      break;
-    case DepthInput::kViewZ:
-      value = static_cast<float>(-eye_depth);
-      break;
+StoredDepth StoreFloat(Format format, float value) {
+  const FormatInfo& info = Info(format);
+  std::uint32_t code = 0;
+  switch (info.texel) {
+    case TexelKind::kUnorm: code = FloatToUnorm(value, info.bits); break;
+    case TexelKind::kFloat16: code = FloatToHalf(value); break;
+    case TexelKind::kFloat32: code = std::bit_cast<std::uint32_t>(value); break;
   }
-  return Stored(format, ConvertFloat(format, value));
+  return {code, FetchTexel(format, code)};
 }
 
 StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
@@ -180,7 +172,7 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
       case DepthPick::kStoredBeforeOne: value = std::nextafter(far_z, 0.0f); break;
       case DepthPick::kEyeDepth: break;
     }
-    return Stored(format, std::bit_cast<std::uint32_t>(value));
+    return StoreFloat(format, value);
   }
   std::uint32_t one = 0;
   switch (info.texel) {
@@ -198,21 +190,31 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
     case DepthPick::kStoredBeforeOne: code = one - 1; break;
     case DepthPick::kEyeDepth: break;
   }
-  return Stored(format, code);
+  return {code, FetchTexel(format, code)};
 }
 
-DD DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code) {
-  DD value = TexelValue(encoding.format, code);
-  switch (Info(encoding.format).stores) {
+long double DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code) {
+  const FormatInfo& info = Info(encoding.format);
+  // The code's exact value v and 1 - v, each rounded once.
+  long double value, complement;
+  if (info.texel == TexelKind::kUnorm) {
+    const long double scale = UnormScale(info.bits);
+    value = static_cast<long double>(code) / scale;
+    complement = static_cast<long double>(scale - code) / scale;
+  } else {
+    value = FetchTexel(encoding.format, code);  // exact for float formats
+    complement = 1.0L - value;                  // exact unless value < 2^-40, then harmless
+  }
+  switch (info.stores) {
     case DepthInput::kHardware:
-      return hp::eye_depth_from_window_depth(DD(frame.near), DD(FarOrZero(frame)),
-                                             Info(encoding.convention).bits, value);
+      return ld::eye_depth_from_window_depth(frame.near, FarOrZero(frame), Info(encoding.convention).bits, value,
+                                             complement);
     case DepthInput::kLinear:
-      return value * DD(frame.far);
+      return value * frame.far;
     case DepthInput::kViewZ:
       return -value;
   }
-  return DD(NAN);
+  return NAN;
 }
 
 }  // namespace depthbench

@@ -13,12 +13,15 @@
 // A texture fetch returns the texel as float32: the correctly rounded value
 // of the code (exact for float formats). Backends read the fetched float;
 // the reference reads the exact value of the code.
+//
+// "Correctly rounded" is meant literally: step 2 evaluates the exact value
+// in long double, and where that lies too close to a float rounding
+// boundary to decide, again in double-double, and then in MPFR.
 #pragma once
 
 #include <cstdint>
 
 #include "bench/cells.h"
-#include "bench/double_double.h"
 #include "bench/sampler.h"
 
 namespace depthbench {
@@ -28,22 +31,35 @@ struct StoredDepth {
   float fetched = 0.0f;    // what a texture fetch returns for it
 };
 
-StoredDepth EncodeEyeDepth(Encoding encoding, const Frame& frame, double eye_depth);
+// Steps 1 and 2: the float32 the pipeline produces for eye depth z. It
+// depends only on the convention and on what the format stores, so the
+// formats of one convention share it.
+float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth);
+// Step 3 and the fetch.
+StoredDepth StoreFloat(Format format, float value);
+
+inline StoredDepth EncodeEyeDepth(Encoding encoding, const Frame& frame, double eye_depth) {
+  return StoreFloat(encoding.format, PipelineFloat(encoding, frame, eye_depth));
+}
 StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick);
 
-// Eye depth the code denotes, exact to double-double precision. Zero, a
-// negative value or +infinity for codes that denote the camera or infinity.
-DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code);
+// Eye depth the code denotes, in long double through the cancellation-free
+// decode of shared/depth_mapping.h (relative error below 2^-60; see
+// tests/reference_test.cc). Zero or +infinity for codes that denote the
+// camera or infinity; negative never.
+long double DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code);
 
-// The exact value of a texel code, and the float32 a fetch returns for it.
-DoubleDouble TexelValue(Format format, std::uint32_t code);
+// Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);
-
-// Format conversions of step 3, exposed for tests.
-std::uint32_t FloatToUnorm(float value, int bits);     // clamps to [0, 1] first
-std::uint16_t FloatToHalf(float value);                 // round to nearest even
+std::uint32_t FloatToUnorm(float value, int bits);  // clamps to [0, 1] first
+std::uint16_t FloatToHalf(float value);              // round to nearest even
 float HalfToFloat(std::uint16_t half);
-// Counts how often the encoder needed MPFR to decide a rounding (tests).
-std::uint64_t MpfrFallbackCount();
+
+// How often rounding needed double-double, and MPFR (for tests and notes).
+struct EncodeFallbacks {
+  std::uint64_t double_double = 0;
+  std::uint64_t mpfr = 0;
+};
+EncodeFallbacks EncodeFallbackCounts();
 
 }  // namespace depthbench

@@ -1,7 +1,15 @@
 // The shared/ formulas compiled as C++, twice:
-//   depthbench::f32  float32 with GLM: what the CPU backend runs (built with
-//                    -ffp-contract=off, so every operation rounds as written);
-//   depthbench::hp   DoubleDouble: the exact constants and the reference.
+//   depthbench::f32  float32 with GLM: the CPU backend's arithmetic (built
+//                    with -ffp-contract=off, so every operation rounds as
+//                    written);
+//   depthbench::f32x8  the same with eight float32 lanes per `real`: what
+//                    the CPU backend runs, bit for bit equal to f32 per lane;
+//   depthbench::ld   long double (64-bit significand on x86-64): the
+//                    reference's per-sample work, which needs more than
+//                    double but must stay fast;
+//   depthbench::hp   DoubleDouble (about 106 bits): the exact shader
+//                    constants, rounding decisions too close to call in
+//                    long double, and the formula tests.
 // The third compilation is GLSL (shaders/, through glslang at run time).
 #pragma once
 
@@ -10,6 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "bench/double_double.h"
+#include "bench/simd.h"
 #include "shared/compat.h"
 
 // Formulas take parameters they do not all use (one signature for all
@@ -26,6 +35,26 @@ using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 #include "bench/formulas_body.inc"
 }  // namespace depthbench::f32
+
+namespace depthbench::f32x8 {
+using real = Float8;
+using uint = std::uint32_t;
+using vec2 = glm::vec<2, Float8>;
+using vec3 = glm::vec<3, Float8>;
+using vec4 = glm::vec<4, Float8>;
+using mat4 = glm::mat<4, 4, Float8>;
+#include "bench/formulas_body.inc"
+}  // namespace depthbench::f32x8
+
+namespace depthbench::ld {
+using real = long double;
+using uint = std::uint32_t;
+using vec2 = glm::vec<2, long double>;
+using vec3 = glm::vec<3, long double>;
+using vec4 = glm::vec<4, long double>;
+using mat4 = glm::mat<4, 4, long double>;
+#include "bench/formulas_body.inc"
+}  // namespace depthbench::ld
 
 namespace depthbench::hp {
 using real = DoubleDouble;

@@ -1,13 +1,15 @@
 // Reference: for each sample, the true scene point and the point that the
 // stored depth value denotes, from the frame's exact parameters.
 //
-// Everything that can cancel is evaluated in double-double through the
-// hp:: instantiation of shared/ (pixel centre, NDC, the depth decode, the
-// ray); the final camera-relative points are rounded to double, 29 bits below
-// float32's rounding. Points are kept relative to the camera: the judge
-// subtracts the (float32-exact) camera position from a backend's world
-// position in double, which is exact, so no large world coordinate ever
-// enters the reference's own rounding.
+// Both points lie on the pixel's ray through the camera, so the reference
+// keeps, per sample, the world-space ray at unit eye depth, and per
+// (encoding, sample) two eye depths: the true one and the denoted one.
+// The ray and the decode run in long double through the ld:: instantiation
+// of shared/ (pixel centre, NDC, the cancellation-free depth decode), so
+// every figure is accurate to about 2^-60 before the final rounding to
+// double; tests/reference_test.cc checks this against MPFR at far/near up to
+// 1e12. The judge then forms camera-relative positions in double, where a
+// float32 output minus the float32 camera position is exact.
 #pragma once
 
 #include <cstdint>
@@ -15,37 +17,44 @@
 #include <glm/glm.hpp>
 
 #include "bench/cells.h"
-#include "bench/formulas.h"
 #include "bench/sampler.h"
 
 namespace depthbench {
 
+enum class ReferenceStatus : std::uint8_t {
+  kJudged,      // a finite point inside the frustum
+  kDegenerate,  // the point is the camera or at infinity: nothing to measure
+  kOutside,     // a finite point outside the frustum (nearer than near, or
+                // beyond a finite far plane): only NaN/Inf outputs count
+};
+
 struct ReferenceSample {
-  glm::dvec3 truth{0.0};    // true point - camera position
-  glm::dvec3 denoted{0.0};  // point the stored value denotes - camera position
-  // 1 / |truth|^2; 0 marks a degenerate sample (the true point at the camera
-  // or at infinity, e.g. stored 1 under standard Z with an infinite far
-  // plane), which is counted but not judged.
-  double inverse_distance_sq = 0.0;
-  double storage_square = 0.0;  // (|denoted - truth| / |truth|)^2
+  double true_depth = 0.0;     // eye depth of the true point
+  double denoted_depth = 0.0;  // eye depth the stored value denotes (DBL_MAX for infinity)
+  double inverse_distance_sq = 0.0;  // 1 / |true point - camera|^2 (0 unless judged)
   std::uint8_t joint_band = 0;
-  std::uint8_t distance_band = 0;
+  ReferenceStatus status = ReferenceStatus::kDegenerate;
 };
 
-class SampleReference {
- public:
-  SampleReference(const Frame& frame, const PixelSample& sample);
+// World-space ray through the pixel centre at unit eye depth:
+// R * (ndc.x * tan_x, ndc.y * tan_y, -1).
+glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
-  // The reference under an encoding that stored `code` for this sample.
-  ReferenceSample For(Encoding encoding, std::uint32_t code) const;
-
-  const hp::vec3& ray() const { return ray_; }
-
- private:
-  const Frame& frame_;
-  const PixelSample& sample_;
-  hp::vec3 ray_;  // world-space ray at unit eye depth through the pixel centre
-  int distance_band_;
+// What the reference needs of one sample, whatever the encoding.
+struct SampleFacts {
+  DepthPick pick = DepthPick::kEyeDepth;
+  double eye_depth = 0.0;       // for eye-depth picks
+  double ray_length_sq = 0.0;   // |PixelRay|^2
+  // For eye-depth picks, shared by every encoding: 1 / (eye depth * |ray|)^2
+  // and the eye-depth band.
+  double inverse_distance_sq = 0.0;
+  std::uint8_t depth_band = 0;
 };
+SampleFacts FactsOf(const Frame& frame, const PixelSample& sample, const glm::dvec3& ray);
+
+// The reference of a sample under an encoding that stored `code`, and the
+// square of its relative storage error |denoted - true| / |true|.
+ReferenceSample ReferenceFor(const Frame& frame, const SampleFacts& sample, Encoding encoding,
+                             std::uint32_t code, double& storage_square);
 
 }  // namespace depthbench

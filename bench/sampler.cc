@@ -77,6 +77,7 @@ Frame Sampler::FrameAt(std::uint64_t frame_index) const {
     f.eye_depth_min = std::clamp(d.eye_depth->min, f.near, f.depth_limit);
     f.eye_depth_max = std::clamp(d.eye_depth->max, f.eye_depth_min, f.depth_limit);
   }
+  f.log_eye_depth_span = std::log(f.eye_depth_max / f.eye_depth_min);
 
   // A uniformly random orientation (Shoemake's construction from three
   // uniforms).
@@ -130,11 +131,11 @@ PixelSample Sampler::SampleAt(std::uint64_t index, const Frame& frame) const {
                                             DepthPick::kStoredAfterZero, DepthPick::kStoredBeforeOne};
     s.pick = kEdges[std::min(3, static_cast<int>(pick / 0.05 * 4.0))];
   } else if (pick < 0.15) {  // near band: the first doubling of depth
-    s.eye_depth = std::min(hi, LogUniform(u, lo, std::min(hi, 2.0 * lo)));
+    s.eye_depth = std::min(hi, lo * std::exp2(u));
   } else if (pick < 0.25) {  // far band: the last doubling
-    s.eye_depth = std::max(lo, LogUniform(u, std::max(lo, 0.5 * hi), hi));
+    s.eye_depth = std::max(lo, hi * std::exp2(-u));
   } else {
-    s.eye_depth = LogUniform(u, lo, hi);
+    s.eye_depth = std::min(hi, lo * std::exp(u * frame.log_eye_depth_span));
   }
 
   // Pixel: mostly uniform over the render target, with its exact corners

@@ -126,13 +126,4 @@ f32::DepthParams RoundToFloat(const hp::DepthParams& p) {
   return o;
 }
 
-hp::vec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
-  const DD tan_y(frame.tan_half_fov_y);
-  const DD tan_x = DD(frame.aspect) * tan_y;
-  hp::vec4 resolution(DD(frame.width), DD(frame.height), DD(1.0) / DD(frame.width),
-                      DD(1.0) / DD(frame.height));
-  hp::vec2 ndc = hp::ndc_from_uv(hp::uv_from_pixel(x, y, resolution));
-  return Rotate(frame.rotation, hp::vec3(ndc.x * tan_x, ndc.y * tan_y, DD(-1.0)));
-}
-
 }  // namespace depthbench

@@ -20,9 +20,4 @@ hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& fram
 f32::FrameParams RoundToFloat(const hp::FrameParams& params);
 f32::DepthParams RoundToFloat(const hp::DepthParams& params);
 
-// The exact world-space direction of the pixel's ray scaled to unit eye
-// depth: R * (ndc.x * tan_x, ndc.y * tan_y, -1). A point at eye depth z on
-// it is camera + z * ray.
-hp::vec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
-
 }  // namespace depthbench

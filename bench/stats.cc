@@ -73,6 +73,7 @@ void BandStats::Merge(const BandStats& other) {
   nan += other.nan;
   inf += other.inf;
   degenerate += other.degenerate;
+  outside += other.outside;
   first_nonfinite_index = std::min(first_nonfinite_index, other.first_nonfinite_index);
   for (int m = 0; m < kMetricCount; ++m) metrics[m].Merge(other.metrics[m]);
 }
@@ -137,46 +138,6 @@ CellAccumulator::Slot& CellAccumulator::NewJoint(int band) {
   return slots_.emplace_back();
 }
 
-namespace {
-
-inline void Record(CellAccumulator::Slot& slot, std::uint64_t index,
-                   const std::array<double, kMetricCount>& squares, const std::array<int, kMetricCount>& bins) {
-  ++slot.finite;
-  for (int m = 0; m < kMetricCount; ++m) {
-    ++slot.bins[m][bins[m]];
-    if (squares[m] > slot.max_square[m] ||
-        (squares[m] == slot.max_square[m] && index < slot.worst_index[m])) {
-      slot.max_square[m] = squares[m];
-      slot.worst_index[m] = index;
-    }
-  }
-}
-
-}  // namespace
-
-void CellAccumulator::AddFinite(int joint_band, int distance_band, std::uint64_t index,
-                                const std::array<double, kMetricCount>& squares) {
-  std::array<int, kMetricCount> bins;
-  for (int m = 0; m < kMetricCount; ++m) bins[m] = DenseBinOfSquare(squares[m], kLowestOctave[m]);
-  Record(Joint(joint_band), index, squares, bins);
-  Record(Distance(distance_band), index, squares, bins);
-  ++pending_;
-}
-
-void CellAccumulator::AddNonFinite(int joint_band, int distance_band, std::uint64_t index, bool nan) {
-  for (Slot* slot : {&Joint(joint_band), &Distance(distance_band)}) {
-    ++(nan ? slot->nan : slot->inf);
-    slot->first_nonfinite_index = std::min(slot->first_nonfinite_index, index);
-  }
-  ++pending_;
-}
-
-void CellAccumulator::AddDegenerate(int joint_band, int distance_band) {
-  ++Joint(joint_band).degenerate;
-  ++Distance(distance_band).degenerate;
-  ++pending_;
-}
-
 void CellAccumulator::FlushInto(CellStats& out) {
   auto flush = [](Slot& slot, BandStats& band) {
     BandStats add;
@@ -184,6 +145,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
     add.nan = slot.nan;
     add.inf = slot.inf;
     add.degenerate = slot.degenerate;
+    add.outside = slot.outside;
     add.first_nonfinite_index = slot.first_nonfinite_index;
     for (int m = 0; m < kMetricCount; ++m) {
       MetricStats& ms = add.metrics[m];
@@ -196,7 +158,11 @@ void CellAccumulator::FlushInto(CellStats& out) {
     slot = Slot();
   };
   for (int band = 0; band < kDistanceBands; ++band) {
-    if (slots_[band].finite + slots_[band].nan + slots_[band].inf + slots_[band].degenerate > 0)
+    const Slot& d = slots_[band];
+    bool used = d.finite + d.nan + d.inf + d.degenerate + d.outside > 0;
+    for (const auto& bins : d.bins)
+      for (std::uint32_t n : bins) used = used || n != 0;
+    if (used)
       flush(slots_[band], out.distance[band]);
   }
   for (int band = 0; band < kJointBands; ++band) {

@@ -55,10 +55,13 @@ inline int QuarterOctaveOfSqrt(double q) {
 // Bin slot of a squared error value in a dense histogram: 0 underflow
 // (including 0 and subnormal squares), 1..kBinsKept kept bins, kBinsKept + 1
 // overflow.
+// Branch-free, so that loops over samples vectorize; NaN lands in the
+// overflow bin (callers keep NaN outputs out).
 inline int DenseBinOfSquare(double q, int lowest_octave) {
-  if (!(q >= 0x1p-1022)) return 0;
   int slot = QuarterOctaveOfSqrt(q) - lowest_octave * kBinsPerOctave + 1;
-  return slot < 0 ? 0 : (slot > kBinsKept + 1 ? kBinsKept + 1 : slot);
+  slot = slot < 0 ? 0 : slot;
+  slot = slot > kBinsKept + 1 ? kBinsKept + 1 : slot;
+  return q >= 0x1p-1022 ? slot : 0;
 }
 inline constexpr int kDenseBins = kBinsKept + 2;
 
@@ -82,6 +85,7 @@ struct BandStats {
   std::uint64_t nan = 0;         // outputs with a NaN component (reference finite)
   std::uint64_t inf = 0;         // outputs with an infinite component and no NaN
   std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
+  std::uint64_t outside = 0;     // finite point outside the frustum: only NaN/Inf judged
   std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
   std::array<MetricStats, kMetricCount> metrics;
 
@@ -125,9 +129,28 @@ class CellAccumulator {
     std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins{};
     std::array<double, kMetricCount> max_square{};
     std::array<std::uint64_t, kMetricCount> worst_index{};
-    std::uint64_t finite = 0, nan = 0, inf = 0, degenerate = 0;
+    std::uint64_t finite = 0, nan = 0, inf = 0, degenerate = 0, outside = 0;
     std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
     Slot() { worst_index.fill(std::numeric_limits<std::uint64_t>::max()); }
+
+    // One value (squared) of one metric, in dense bin `bin`. Samples come
+    // in increasing index order, so on a tie the earlier sample stays the
+    // worst, as MetricStats::Merge decides across shards.
+    void Record(Metric metric, int bin, double square, std::uint64_t index) {
+      const int m = static_cast<int>(metric);
+      ++bins[m][bin];
+      if (square > max_square[m]) {
+        max_square[m] = square;
+        worst_index[m] = index;
+      }
+    }
+    void Record(Metric metric, double square, std::uint64_t index) {
+      Record(metric, DenseBinOfSquare(square, kLowestOctave[static_cast<int>(metric)]), square, index);
+    }
+    void RecordNonFinite(bool is_nan, std::uint64_t index) {
+      ++(is_nan ? nan : inf);
+      if (index < first_nonfinite_index) first_nonfinite_index = index;
+    }
   };
 
   Slot& Joint(int band) {
@@ -136,14 +159,10 @@ class CellAccumulator {
   }
   Slot& Distance(int band) { return slots_[band]; }
 
-  // Records one judged sample's values (squares) in both of its bands.
-  void AddFinite(int joint_band, int distance_band, std::uint64_t index,
-                 const std::array<double, kMetricCount>& squares);
-  void AddNonFinite(int joint_band, int distance_band, std::uint64_t index, bool nan);
-  void AddDegenerate(int joint_band, int distance_band);
-
-  void FlushInto(CellStats& out);
+  // Samples recorded since the last flush (the caller counts them).
+  void Count(std::uint64_t samples) { pending_ += samples; }
   std::uint64_t pending() const { return pending_; }
+  void FlushInto(CellStats& out);
 
  private:
   Slot& NewJoint(int band);

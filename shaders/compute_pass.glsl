@@ -20,7 +20,7 @@ void main() {
   FrameParams frame = frames[frame_index];
   DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
   uint pixel = pixels[i];
-  vec2 uv = uv_from_pixel(pixel & 0xffffu, pixel >> 16u, frame.resolution);
+  vec2 uv = uv_from_pixel(float(pixel & 0xffffu), float(pixel >> 16u), frame.resolution);
   vec3 p = RECONSTRUCT(frame, depth, uv, stored_depths[pass.depth_offset + i]);
   uint o = pass.output_offset + 3u * i;
   positions[o] = p.x;

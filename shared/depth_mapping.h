@@ -30,16 +30,19 @@ DB_FN real window_depth_from_eye_depth(real near, real far, uint convention, rea
 }
 
 // Eye depth that window depth d denotes (+infinity for the far plane of an
-// infinite projection).
-DB_FN real eye_depth_from_window_depth(real near, real far, uint convention, real d) {
+// infinite projection). The caller passes 1 - d as well: near the far plane
+// of a standard-Z projection it is the small quantity everything hinges
+// on, and a caller that knows it exactly (a unorm code c gives
+// (2^b - 1 - c) / (2^b - 1)) must not lose it to the subtraction.
+DB_FN real eye_depth_from_window_depth(real near, real far, uint convention, real d, real one_minus_d) {
   bool reversed = (convention & DB_CONVENTION_REVERSED) != 0u;
   if ((convention & DB_CONVENTION_INFINITE) != 0u) {
-    return reversed ? near / d : near / (1.0f - d);
+    return reversed ? near / d : near / one_minus_d;
   }
   if (reversed) {
-    return (near * far) / (near * (1.0f - d) + far * d);
+    return (near * far) / (near * one_minus_d + far * d);
   }
-  return (near * far) / (far * (1.0f - d) + near * d);
+  return (near * far) / (far * one_minus_d + near * d);
 }
 
 // NDC depth coefficients (A, B) with ndc_z = A + B / z, for the convention's

@@ -9,9 +9,11 @@ DB_FN vec3 db_xyz(vec4 v) { return vec3(v.x, v.y, v.z); }
 
 // Texture coordinate of a pixel's centre, v growing downwards, as a
 // full-screen pass computes it from the fragment position (seed 002 divides
-// the pixel position by the render-target size).
-DB_FN vec2 uv_from_pixel(uint pixel_x, uint pixel_y, vec4 resolution) {
-  return vec2((real(pixel_x) + 0.5f) / resolution.x, (real(pixel_y) + 0.5f) / resolution.y);
+// the pixel position by the render-target size). The pixel's integer
+// coordinates come as reals (exact below 2^24), so that a SIMD
+// instantiation can hold a different pixel in every lane.
+DB_FN vec2 uv_from_pixel(real pixel_x, real pixel_y, vec4 resolution) {
+  return vec2((pixel_x + 0.5f) / resolution.x, (pixel_y + 0.5f) / resolution.y);
 }
 
 // Normalized device coordinates with y up: uv (0, 0) is NDC (-1, 1).

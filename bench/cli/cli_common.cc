@@ -1,0 +1,161 @@
+#include "bench/cli/cli_common.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+
+#include <fmt/format.h>
+
+namespace depthbench::cli {
+
+void DomainFlags::Add(CLI::App& app) {
+  app.add_option("--near", near, "near plane: VALUE or MIN:MAX (default 1e-4:10, log-uniform)")
+      ->group("Domain");
+  app.add_option("--far", far, "far plane: VALUE or MIN:MAX, instead of --ratio")->group("Domain");
+  app.add_option("--ratio", ratio,
+                 "far/near ratio: VALUE, MIN:MAX, inf, or MIN:MAX,inf (default 1e1:1e8,inf). Infinite-far "
+                 "conventions run when inf is allowed")
+      ->group("Domain");
+  app.add_option("--fov", fov, "vertical field of view in degrees: VALUE or MIN:MAX, in (0, 180) (default 1:179)")
+      ->group("Domain");
+  app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (default 0.1:10)")
+      ->group("Domain");
+  app.add_option("--camera-distance", camera_distance,
+                 "camera distance from the world origin: VALUE or MIN:MAX (default 0:1e6; 0 puts the camera at "
+                 "the origin)")
+      ->group("Domain");
+  app.add_option("--depth", eye_depth, "eye-depth range of interest in world units: VALUE or MIN:MAX")
+      ->group("Domain");
+  app.add_option("--resolution", resolution, "render target WIDTHxHEIGHT (default: a mix of common sizes)")
+      ->group("Domain");
+}
+
+Expected<Domain> DomainFlags::Apply(Domain d) const {
+  if (!near.empty()) DB_ASSIGN_OR_RETURN(d.near, ParseRange(near, "--near", kNearLimits));
+  if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");
+  if (!far.empty()) {
+    DB_ASSIGN_OR_RETURN(Range f, ParseRange(far, "--far", kFarLimits));
+    d.far = f;
+    d.finite_far = true;
+    d.infinite_far = false;
+  }
+  if (!ratio.empty()) DB_RETURN_IF_ERROR(ParseRatioInto(ratio, d));
+  if (!fov.empty()) DB_ASSIGN_OR_RETURN(d.fov_degrees, ParseRange(fov, "--fov", kFovLimits));
+  if (!aspect.empty()) DB_ASSIGN_OR_RETURN(d.aspect, ParseRange(aspect, "--aspect", kAspectLimits));
+  if (!camera_distance.empty()) {
+    DB_ASSIGN_OR_RETURN(d.camera_distance,
+                        ParseRange(camera_distance, "--camera-distance", kCameraDistanceLimits));
+  }
+  if (!eye_depth.empty()) {
+    DB_ASSIGN_OR_RETURN(Range z, ParseRange(eye_depth, "--depth", kEyeDepthLimits));
+    d.eye_depth = z;
+  }
+  if (!resolution.empty()) {
+    unsigned w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(resolution.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
+      return InvalidArgument(fmt::format("--resolution: '{}' is not WIDTHxHEIGHT (e.g. 1920x1080)", resolution));
+    }
+    d.resolutions = {{w, h}};
+  }
+  Status valid = d.Validate();
+  if (!valid.ok()) return valid;
+  return d;
+}
+
+void CellFlags::Add(CLI::App& app) {
+  app.add_option("--variant", variants, "variants to run (several, or comma-separated; default all)")
+      ->delimiter(',')
+      ->group("Cells");
+  app.add_option("--convention", conventions, "depth conventions to run (default all)")
+      ->delimiter(',')
+      ->group("Cells");
+  app.add_option("--format", formats, "storage formats to run (default all)")->delimiter(',')->group("Cells");
+}
+
+Expected<std::vector<Cell>> CellFlags::Select() const {
+  CellFilter filter;
+  for (const auto& v : variants) DB_ASSIGN_OR_RETURN(filter.variants.emplace_back(), ParseVariant(v));
+  for (const auto& c : conventions) DB_ASSIGN_OR_RETURN(filter.conventions.emplace_back(), ParseConvention(c));
+  for (const auto& f : formats) DB_ASSIGN_OR_RETURN(filter.formats.emplace_back(), ParseFormat(f));
+  std::vector<Cell> cells;
+  for (const Cell& cell : AllCells())
+    if (filter.Keeps(cell)) cells.push_back(cell);
+  if (cells.empty()) {
+    return InvalidArgument(
+        "no cell matches these filters: hardware-depth variants (inverse_vp, divide, reciprocal, pq) read "
+        "d16_unorm/x8_d24_unorm/d32_sfloat under the eight projective conventions; frustum_ray, volume_ray "
+        "and tan_aspect read r32_sfloat/r16_sfloat/r16_unorm under 'linear'; eye_ray reads r32_sfloat_viewz "
+        "under 'linear' (see 'depthbench list')");
+  }
+  return cells;
+}
+
+void BackendFlags::Add(CLI::App& app, bool allow_several) {
+  auto* option = app.add_option("--backend", backends,
+                                allow_several ? "backends to run: cpu, vulkan (default both)"
+                                              : "backend to run: cpu or vulkan");
+  option->delimiter(',')->group("Backends");
+  if (!allow_several) option->expected(1);
+  app.add_option("--device", device,
+                 "Vulkan device: a case-insensitive part of its name (default: Mesa lavapipe, 'llvmpipe'); "
+                 "'depthbench list' shows the devices")
+      ->group("Backends");
+  app.add_option("--shaders", shaders,
+                 "directory of the reconstruction shaders, compiled at run time (default: the source tree's "
+                 "shaders/); an edited copy runs with no rebuild")
+      ->group("Backends");
+  app.add_flag("--validate", validate, "enable the Vulkan validation layer and fail on its messages")
+      ->group("Backends");
+}
+
+Expected<std::vector<std::unique_ptr<Backend>>> BackendFlags::Make() const {
+  std::vector<std::unique_ptr<Backend>> out;
+  BackendOptions options{device, shaders, validate};
+  for (const std::string& name : backends) {
+    for (const auto& existing : out) {
+      if (existing->name() == name) return InvalidArgument(fmt::format("--backend {} is given twice", name));
+    }
+    DB_ASSIGN_OR_RETURN(auto backend, MakeBackend(name, options));
+    out.push_back(std::move(backend));
+  }
+  if (out.empty()) return InvalidArgument("--backend: no backend given; allowed: cpu, vulkan");
+  return out;
+}
+
+Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !(value >= 1.0) || value > 1e15 ||
+      value != std::floor(value)) {
+    return InvalidArgument(fmt::format("{}: '{}' is not a whole number from 1 to 1e15", what, text));
+  }
+  return static_cast<std::uint64_t>(value);
+}
+
+Status CheckWritable(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path target = fs::absolute(path, ec);
+  if (ec || path.empty()) return InvalidArgument(fmt::format("{}: '{}' is not a usable path", what, path));
+  if (fs::is_directory(target, ec)) return IoError(fmt::format("{}: '{}' is a directory", what, path));
+  fs::path dir = target.parent_path();
+  if (!fs::is_directory(dir, ec)) {
+    return IoError(fmt::format("{}: cannot write '{}': directory '{}' does not exist", what, path, dir.string()));
+  }
+  if (::access(dir.c_str(), W_OK) != 0) {
+    return IoError(fmt::format("{}: cannot write '{}': directory '{}' is not writable", what, path, dir.string()));
+  }
+  return Status::Ok();
+}
+
+bool StderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+int ReportError(const Status& status) {
+  std::cerr << "depthbench: error: " << status.message() << "\n";
+  return kExitCannotRun;
+}
+
+}  // namespace depthbench::cli

@@ -1,0 +1,56 @@
+// Flags several subcommands share (domain, cell filters, backends), and the
+// conversion of their strings into the bench's types with clear messages.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/backend.h"
+#include "bench/cells.h"
+#include "bench/domain.h"
+#include "bench/status.h"
+
+namespace depthbench::cli {
+
+// Exit codes of every subcommand.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFinding = 1;
+inline constexpr int kExitCannotRun = 2;
+
+struct DomainFlags {
+  std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution;
+  void Add(CLI::App& app);
+  // Applies the given flags on top of `base`.
+  Expected<Domain> Apply(Domain base) const;
+};
+
+struct CellFlags {
+  std::vector<std::string> variants, conventions, formats;
+  void Add(CLI::App& app);
+  Expected<std::vector<Cell>> Select() const;  // the catalog's cells the filters keep
+};
+
+struct BackendFlags {
+  std::vector<std::string> backends{"cpu", "vulkan"};
+  std::string device;
+  std::string shaders;
+  bool validate = false;
+  void Add(CLI::App& app, bool allow_several = true);
+  Expected<std::vector<std::unique_ptr<Backend>>> Make() const;
+};
+
+// "1e6", "1000000" -> a positive count.
+Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what);
+// Checks that an output file can be created, before a long run starts.
+Status CheckWritable(const std::string& path, const std::string& what);
+
+// True when stderr is a terminal (progress lines are shown only then).
+bool StderrIsTerminal();
+
+// Prints a Status as "depthbench: error: ..." and returns its exit code.
+int ReportError(const Status& status);
+
+}  // namespace depthbench::cli

@@ -1,0 +1,66 @@
+// depthbench list: the catalog (variants with their seeds, conventions,
+// formats, cells) and the Vulkan devices this machine has.
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "bench/cli/cli_common.h"
+#include "bench/cli/commands.h"
+#include "bench/text_table.h"
+#include "bench/vulkan/vulkan_context.h"
+
+namespace depthbench::cli {
+namespace {
+
+const char* InputName(DepthInput input) {
+  switch (input) {
+    case DepthInput::kHardware: return "hardware depth";
+    case DepthInput::kLinear: return "linear depth z/far";
+    case DepthInput::kViewZ: return "view-space z";
+  }
+  return "?";
+}
+
+int List() {
+  using Align = TextTable::Align;
+  TextTable variants({{"variant", Align::kLeft}, {"seed", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
+  for (const auto& v : AllVariants()) {
+    variants.AddRow({std::string(v.name), std::string(v.seed), InputName(v.input), std::string(v.idea)});
+  }
+  std::cout << "Variants (seeds: ../shared/seeds/NNN_*.txt)\n";
+  variants.Print(std::cout);
+
+  TextTable conventions({{"convention", Align::kLeft}, {"meaning", Align::kLeft}});
+  for (const auto& c : AllConventions()) conventions.AddRow({std::string(c.name), std::string(c.description)});
+  std::cout << "\nDepth conventions\n";
+  conventions.Print(std::cout);
+
+  TextTable formats({{"format", Align::kLeft}, {"short", Align::kLeft}, {"Vulkan", Align::kLeft}, {"stores", Align::kLeft}});
+  for (const auto& f : AllFormats()) {
+    formats.AddRow({std::string(f.name), std::string(f.short_name), std::string(f.vulkan_name), InputName(f.stores)});
+  }
+  std::cout << "\nStorage formats\n";
+  formats.Print(std::cout);
+  std::cout << fmt::format("\n{} cells (variant/convention/format) per backend; backends: cpu, vulkan\n",
+                           AllCells().size());
+
+  std::cout << "\nVulkan devices\n";
+  auto devices = ListVulkanDevices();
+  if (!devices.ok()) {
+    std::cout << "  none usable: " << devices.status().message() << "\n";
+    return kExitOk;
+  }
+  TextTable table({{"name", Align::kLeft}, {"type", Align::kLeft}, {"driver", Align::kLeft}, {"api", Align::kLeft}});
+  for (const auto& d : *devices) table.AddRow({d.name, d.type, d.driver, d.api});
+  table.Print(std::cout);
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddListCommand(CLI::App& app, std::function<int()>& action) {
+  CLI::App* cmd = app.add_subcommand("list", "List variants (with their seeds), conventions, formats and Vulkan devices");
+  cmd->callback([&action] { action = [] { return List(); }; });
+}
+
+}  // namespace depthbench::cli

@@ -1,0 +1,30 @@
+// depthbench: a test bench and fuzzer for the shader code that
+// reconstructs view- and world-space position from a depth buffer.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/cli/cli_common.h"
+#include "bench/cli/commands.h"
+
+int main(int argc, char** argv) {
+  using namespace depthbench::cli;
+  CLI::App app("depthbench: measures how precisely shader code reconstructs view- and world-space position "
+               "from a depth buffer, for every variant, depth convention and storage format, on the GPU "
+               "(Vulkan) and the CPU",
+               "depthbench");
+  app.require_subcommand(1);
+  app.footer("Run 'depthbench SUBCOMMAND --help' for a subcommand's flags.\n"
+             "Exit codes: 0 success, 1 a finding (a gate that fails, a fuzz finding), 2 could not run.");
+  std::function<int()> action;
+  AddListCommand(app, action);
+  AddRunCommand(app, action);
+  AddMergeCommand(app, action);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitCannotRun;
+  }
+  return action ? action() : kExitCannotRun;
+}

@@ -1,0 +1,47 @@
+// Float8: eight float32 lanes, the `real` of the CPU backend's SIMD
+// instantiation of shared/ (namespace f32x8 in formulas.h). Every operator
+// is one IEEE single-precision operation per lane (GCC vector extensions;
+// with -ffp-contract=off nothing is fused), so each lane computes bit for
+// bit what the scalar float32 formula computes: the CPU backend runs eight
+// pixels at a time, the way a GPU runs a wave, without changing a result.
+// The formulas branch only on uint values (uniform across the lanes), as
+// shader code over a frame's constants does.
+#pragma once
+
+#include <type_traits>
+
+namespace depthbench {
+
+class Float8 {
+ public:
+  using Lanes = float __attribute__((vector_size(32)));
+  static constexpr int kLanes = 8;
+
+  Float8() = default;  // trivial, as GLM's component unions need
+  // Broadcast: literals, uniforms and integer constants GLM builds.
+  template <class T, class = std::enable_if_t<std::is_arithmetic_v<T>>>
+  Float8(T scalar) : v_(Lanes{} + static_cast<float>(scalar)) {}  // NOLINT: implicit by design
+  static Float8 FromLanes(Lanes lanes) {
+    Float8 r;
+    r.v_ = lanes;
+    return r;
+  }
+
+  Lanes lanes() const { return v_; }
+  float operator[](int lane) const { return v_[lane]; }
+
+  friend Float8 operator+(Float8 a, Float8 b) { return FromLanes(a.v_ + b.v_); }
+  friend Float8 operator-(Float8 a, Float8 b) { return FromLanes(a.v_ - b.v_); }
+  friend Float8 operator*(Float8 a, Float8 b) { return FromLanes(a.v_ * b.v_); }
+  friend Float8 operator/(Float8 a, Float8 b) { return FromLanes(a.v_ / b.v_); }
+  friend Float8 operator-(Float8 a) { return FromLanes(-a.v_); }
+  Float8& operator+=(Float8 b) { return *this = *this + b; }
+  Float8& operator-=(Float8 b) { return *this = *this - b; }
+  Float8& operator*=(Float8 b) { return *this = *this * b; }
+  Float8& operator/=(Float8 b) { return *this = *this / b; }
+
+ private:
+  Lanes v_;
+};
+
+}  // namespace depthbench

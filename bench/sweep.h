@@ -1,0 +1,45 @@
+// Sweep: the run loop. Draws the samples of a shard in batches, runs every
+// cell on every backend, judges the outputs against the reference, and
+// streams the errors into fixed-size statistics, so memory stays flat
+// however many samples run.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "bench/backend.h"
+#include "bench/cells.h"
+#include "bench/domain.h"
+#include "bench/results.h"
+
+namespace depthbench {
+
+struct SweepProgress {
+  std::uint64_t samples_done = 0;
+  std::uint64_t samples_total = 0;
+  std::uint64_t reconstructions_done = 0;
+  double seconds = 0.0;
+};
+
+struct SweepOptions {
+  std::uint64_t seed = 1;
+  std::uint64_t samples = 1'000'000;  // of the whole sweep (all shards)
+  Shard shard;
+  Domain domain;
+  std::vector<Cell> cells;            // empty: every cell the domain allows
+  std::uint32_t batch_size = 16384;
+  unsigned threads = 0;               // 0: one per hardware thread
+  std::function<void(const SweepProgress&)> progress;  // called after every batch
+};
+
+// The cells of `cells` that the domain can exercise (finite-far cells need
+// finite frames, infinite-far cells need the domain to allow them).
+std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& domain);
+
+// Runs the sweep on each backend (prepared by this call) and returns the
+// results, one CellResult per (cell, backend).
+Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const> backends);
+
+}  // namespace depthbench

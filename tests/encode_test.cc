@@ -1,0 +1,154 @@
+// The encoder rounds exactly as the formats and an ideal pipeline do.
+#include <bit>
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "bench/encode.h"
+#include "bench/formulas_mpfr.h"
+
+namespace depthbench {
+namespace {
+
+// The float nearest to code / (2^bits - 1), by exact comparison of
+// neighbours (|g * scale - code| is exact in double): the slow definition.
+float ExactUnormFetch(std::uint32_t code, int bits) {
+  const double scale = std::ldexp(1.0, bits) - 1.0;
+  float best = static_cast<float>(code / scale);
+  auto error = [&](float g) { return std::fabs(static_cast<double>(g) * scale - code); };
+  for (float g : {std::nextafter(best, -INFINITY), std::nextafter(best, INFINITY)}) {
+    if (error(g) < error(best) || (error(g) == error(best) && (std::bit_cast<std::uint32_t>(g) & 1u) == 0)) best = g;
+  }
+  return best;
+}
+
+TEST(EncodeTest, UnormFetchIsCorrectlyRoundedForEveryCode) {
+  for (std::uint32_t c = 0; c <= 0xffffu; ++c) ASSERT_EQ(FetchTexel(Format::kD16Unorm, c), ExactUnormFetch(c, 16)) << c;
+  for (std::uint32_t c = 0; c <= 0xffffffu; ++c) {
+    ASSERT_EQ(FetchTexel(Format::kX8D24Unorm, c), ExactUnormFetch(c, 24)) << c;
+  }
+}
+
+TEST(EncodeTest, UnormConversionRoundsToNearestEven) {
+  EXPECT_EQ(FloatToUnorm(0.0f, 16), 0u);
+  EXPECT_EQ(FloatToUnorm(1.0f, 16), 65535u);
+  EXPECT_EQ(FloatToUnorm(1.5f, 16), 65535u);  // clamped
+  EXPECT_EQ(FloatToUnorm(-0.5f, 24), 0u);
+  // 0.5 * 65535 = 32767.5: a tie, to the even code 32768.
+  EXPECT_EQ(FloatToUnorm(0.5f, 16), 32768u);
+  // 0.5 * (2^24 - 1) = 8388607.5: a tie, to the even code 8388608.
+  EXPECT_EQ(FloatToUnorm(0.5f, 24), 8388608u);
+}
+
+TEST(EncodeTest, HalfConversionRoundTripsAndTiesToEven) {
+  for (std::uint32_t h = 0; h < 0x10000u; ++h) {
+    const auto half = static_cast<std::uint16_t>(h);
+    const float f = HalfToFloat(half);
+    if (std::isnan(f)) continue;
+    ASSERT_EQ(FloatToHalf(f), half) << h;
+  }
+  // 1 + 2^-11 lies halfway between 1 and 1 + 2^-10: to even (1.0).
+  EXPECT_EQ(FloatToHalf(1.0f + std::ldexp(1.0f, -11)), 0x3c00);
+  // 1 + 3 * 2^-11 lies halfway between 1 + 2^-10 and 1 + 2^-9: to even.
+  EXPECT_EQ(FloatToHalf(1.0f + 3.0f * std::ldexp(1.0f, -11)), 0x3c02);
+  EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25)), 0x0000);          // half the smallest subnormal: to even (0)
+  EXPECT_EQ(FloatToHalf(std::ldexp(1.5f, -25)), 0x0001);          // above the tie
+  EXPECT_EQ(FloatToHalf(65520.0f), 0x7c00);                        // rounds to infinity
+  EXPECT_EQ(FloatToHalf(65519.0f), 0x7bff);
+}
+
+Frame TestFrame(double near, double far) {
+  Frame f;
+  f.near = near;
+  f.far = far;
+  f.depth_limit = std::isinf(far) ? near * Domain::kInfiniteDepthSpan : far;
+  return f;
+}
+
+// The float the pipeline must produce for eye depth z, from MPFR.
+float ExactPipelineFloat(Encoding e, const Frame& frame, double z) {
+  const std::uint32_t bits = Info(e.convention).bits;
+  const double far = frame.finite() ? frame.far : 0.0;
+  mp::real window = mp::window_depth_from_eye_depth(frame.near, far, bits, z);
+  if ((bits & 4u) == 0u) return window.ToFloat();
+  float ndc = (window * mp::real(2.0) - mp::real(1.0)).ToFloat();
+  return static_cast<float>(0.5 * static_cast<double>(ndc) + 0.5);
+}
+
+TEST(EncodeTest, PipelineFloatIsCorrectlyRoundedEverywhere) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Convention c : {Convention::kStandard, Convention::kReversed, Convention::kStandardInf,
+                       Convention::kReversedInf, Convention::kStandardGl, Convention::kReversedGl,
+                       Convention::kStandardInfGl, Convention::kReversedInfGl}) {
+    const Encoding e{c, Format::kD32Sfloat};
+    for (int k = 0; k < 3000; ++k) {
+      const double near = std::exp(std::log(1e-6) + unit(rng) * std::log(1e7));
+      const double ratio = std::exp(std::log(10.0) + unit(rng) * std::log(1e11));  // up to 1e12
+      const bool infinite = (Info(c).bits & 2u) != 0u;
+      const Frame frame = TestFrame(near, infinite ? INFINITY : near * ratio);
+      // Depths spread log-uniformly, and bunched against the far plane.
+      double z = k % 3 == 0 ? near * ratio * (1.0 - std::ldexp(unit(rng), -20))
+                            : near * std::exp(unit(rng) * std::log(ratio));
+      ASSERT_EQ(PipelineFloat(e, frame, z), ExactPipelineFloat(e, frame, z))
+          << Info(c).name << " near " << near << " ratio " << ratio << " z " << z;
+    }
+  }
+}
+
+TEST(EncodeTest, ExactTiesAreSettledByMpfr) {
+  // Standard Z with an infinite far plane: d = 1 - n/z. With z = 1 and
+  // n = 1/2 - 2^-25, d = 1/2 + 2^-25 exactly: the midpoint between the
+  // floats 1/2 and 1/2 + 2^-24. Ties go to even: 1/2.
+  const Frame frame = TestFrame(0.5 - std::ldexp(1.0, -25), INFINITY);
+  const EncodeFallbacks before = EncodeFallbackCounts();
+  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, frame, 1.0), 0.5f);
+  const EncodeFallbacks after = EncodeFallbackCounts();
+  EXPECT_EQ(after.double_double, before.double_double + 1);
+  EXPECT_EQ(after.mpfr, before.mpfr + 1);
+  // Just beyond the tie the answer moves up.
+  const Frame nearer = TestFrame(std::nextafter(0.5 - std::ldexp(1.0, -25), 0.0), INFINITY);
+  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, nearer, 1.0), 0.5f + std::ldexp(1.0f, -24));
+}
+
+TEST(EncodeTest, EdgeValuesAreTheFormatsExtremeCodes) {
+  const Frame frame = TestFrame(0.1, 1000.0);
+  const Encoding d24{Convention::kStandard, Format::kX8D24Unorm};
+  EXPECT_EQ(EncodeEdge(d24, frame, DepthPick::kStoredZero).code, 0u);
+  EXPECT_EQ(EncodeEdge(d24, frame, DepthPick::kStoredOne).code, 0xffffffu);
+  EXPECT_EQ(EncodeEdge(d24, frame, DepthPick::kStoredBeforeOne).code, 0xfffffeu);
+  EXPECT_EQ(EncodeEdge(d24, frame, DepthPick::kStoredAfterZero).code, 1u);
+  const Encoding d32{Convention::kReversed, Format::kD32Sfloat};
+  EXPECT_EQ(EncodeEdge(d32, frame, DepthPick::kStoredBeforeOne).fetched, std::nextafter(1.0f, 0.0f));
+  EXPECT_EQ(EncodeEdge(d32, frame, DepthPick::kStoredAfterZero).fetched, std::numeric_limits<float>::denorm_min());
+  const Encoding half{Convention::kLinear, Format::kR16Sfloat};
+  EXPECT_EQ(EncodeEdge(half, frame, DepthPick::kStoredBeforeOne).fetched, 1.0f - std::ldexp(1.0f, -11));
+}
+
+TEST(EncodeTest, StoredPlanesDecodeToThePlanes) {
+  const Frame finite = TestFrame(0.25, 4000.0);
+  const Frame infinite = TestFrame(0.25, INFINITY);
+  for (Format f : {Format::kD16Unorm, Format::kX8D24Unorm, Format::kD32Sfloat}) {
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero).code), 0.25L);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne).code), 4000.0L);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne).code), 0.25L);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero).code), 4000.0L);
+    EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kStandardInf, f}, infinite,
+                                          EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne).code)));
+    EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kReversedInf, f}, infinite,
+                                          EncodeEdge({Convention::kReversedInf, f}, infinite, DepthPick::kStoredZero).code)));
+  }
+}
+
+TEST(EncodeTest, LinearDepthUnderflowsInHalfFloatAtLargeRatios) {
+  // z/far = 1e-8 is below half float's smallest subnormal (2^-24 = 6e-8):
+  // the stored value is 0 and denotes the camera.
+  const Frame frame = TestFrame(1.0, 1e8);
+  const StoredDepth s = EncodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, 1.0);
+  EXPECT_EQ(s.fetched, 0.0f);
+  EXPECT_EQ(DecodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, s.code), 0.0L);
+}
+
+}  // namespace
+}  // namespace depthbench

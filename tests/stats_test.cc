@@ -1,0 +1,102 @@
+// Binning, quantiles and merging of the streaming statistics.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "bench/stats.h"
+
+namespace depthbench {
+namespace {
+
+// The quarter-octave bin of x, computed slowly with a logarithm, for values
+// not on a boundary.
+int SlowQuarterOctave(double x) { return static_cast<int>(std::floor(4.0 * std::log2(x))); }
+
+TEST(StatsTest, QuarterOctaveMatchesLogarithmAwayFromBoundaries) {
+  for (double x = 1e-30; x < 1e30; x *= 1.0137) {
+    ASSERT_EQ(QuarterOctaveOfSqrt(x * x), SlowQuarterOctave(x)) << x;
+  }
+}
+
+TEST(StatsTest, QuarterOctaveIsExactAtBoundaries) {
+  // sqrt(q) == 2^(k/4) exactly for q == 2^(k/2) when k is even; for odd k the
+  // boundary sqrt(2)*2^j is irrational and the double just below/above it
+  // must fall on either side.
+  for (int k = -40; k <= 40; k += 2) {
+    double q = std::ldexp(1.0, k / 2);
+    EXPECT_EQ(QuarterOctaveOfSqrt(q), 2 * (k / 2)) << k;
+    EXPECT_EQ(QuarterOctaveOfSqrt(std::nextafter(q, 0.0)), 2 * (k / 2) - 1) << k;
+  }
+  // The double nearest to sqrt(2) lies just above it, so its square root
+  // lies above 2^(1/4) (bin 1); the double below it lies below (bin 0).
+  const double sqrt2 = std::sqrt(2.0);
+  EXPECT_EQ(QuarterOctaveOfSqrt(sqrt2), 1);
+  EXPECT_EQ(QuarterOctaveOfSqrt(std::nextafter(sqrt2, 0.0)), 0);
+}
+
+TEST(StatsTest, DenseBinsClampAndKeepZeroAndNanApart) {
+  const int low = kLowestOctave[0];
+  EXPECT_EQ(DenseBinOfSquare(0.0, low), 0);
+  EXPECT_EQ(DenseBinOfSquare(1e-300, low), 0);  // far below the kept range
+  EXPECT_EQ(DenseBinOfSquare(1e300, low), kBinsKept + 1);
+  EXPECT_EQ(DenseBinOfSquare(INFINITY, low), kBinsKept + 1);
+  // 2^-24 relative error (bits lost 0) is bin (-24 - low) * 4 + 1.
+  EXPECT_EQ(DenseBinOfSquare(std::ldexp(1.0, -48), low), (-24 - low) * kBinsPerOctave + 1);
+}
+
+MetricStats Fill(const std::vector<double>& values, int low) {
+  CellAccumulator acc;
+  std::uint64_t index = 0;
+  for (double v : values) acc.Joint(0).Record(Metric::kTotal, v * v, index++);
+  CellStats stats;
+  acc.FlushInto(stats);
+  (void)low;
+  return stats.joint[0][Metric::kTotal];
+}
+
+TEST(StatsTest, QuantilesFallInTheRightQuarterOctave) {
+  // 1000 values: 990 at 2^-20, 9 at 2^-10, 1 at 2^-4.
+  std::vector<double> values(990, std::ldexp(1.0, -20));
+  values.insert(values.end(), 9, std::ldexp(1.0, -10));
+  values.push_back(std::ldexp(1.0, -4));
+  const int low = kLowestOctave[0];
+  MetricStats m = Fill(values, low);
+  EXPECT_EQ(m.Count(), 1000u);
+  EXPECT_EQ(m.max, std::ldexp(1.0, -4));
+  EXPECT_EQ(m.worst_index, 999u);
+  // A quantile is interpolated inside its bin: within a quarter octave.
+  auto within_bin = [](double got, double want) { return got >= want && got <= want * std::exp2(0.25); };
+  EXPECT_TRUE(within_bin(m.Quantile(0.5, low), std::ldexp(1.0, -20))) << m.Quantile(0.5, low);
+  EXPECT_TRUE(within_bin(m.Quantile(0.99, low), std::ldexp(1.0, -20))) << m.Quantile(0.99, low);
+  EXPECT_TRUE(within_bin(m.Quantile(0.995, low), std::ldexp(1.0, -10))) << m.Quantile(0.995, low);
+  EXPECT_TRUE(within_bin(m.Quantile(0.9995, low), std::ldexp(1.0, -4)));
+  EXPECT_EQ(m.Quantile(1.0, low), std::ldexp(1.0, -4));
+}
+
+TEST(StatsTest, BitsLost) {
+  EXPECT_EQ(BitsLost(std::ldexp(1.0, -24)), 0.0);
+  EXPECT_EQ(BitsLost(std::ldexp(1.0, -30)), 0.0);  // floored at zero
+  EXPECT_DOUBLE_EQ(BitsLost(std::ldexp(1.0, -14)), 10.0);
+  EXPECT_EQ(BitsLost(0.0), 0.0);
+}
+
+TEST(StatsTest, MergeIsExactAndKeepsTheEarliestWorstSample) {
+  CellAccumulator a, b, whole;
+  for (std::uint64_t i = 0; i < 100; ++i) {
+    double v = std::ldexp(1.0 + (i % 7), -30 + static_cast<int>(i % 13));
+    (i < 60 ? a : b).Joint(3).Record(Metric::kArith, v * v, i);
+    whole.Joint(3).Record(Metric::kArith, v * v, i);
+  }
+  CellStats sa, sb, sw;
+  a.FlushInto(sa);
+  b.FlushInto(sb);
+  whole.FlushInto(sw);
+  CellStats merged = sb;  // order must not matter
+  merged.Merge(sa);
+  EXPECT_EQ(merged.joint[3][Metric::kArith].bins, sw.joint[3][Metric::kArith].bins);
+  EXPECT_EQ(merged.joint[3][Metric::kArith].max, sw.joint[3][Metric::kArith].max);
+  EXPECT_EQ(merged.joint[3][Metric::kArith].worst_index, sw.joint[3][Metric::kArith].worst_index);
+}
+
+}  // namespace
+}  // namespace depthbench
