@@ -52,7 +52,10 @@ json RangeToJson(const Range& r) { return json::array({r.min, r.max}); }
 json MetricToJson(const MetricStats& m) {
   json bins = json::array();
   for (const auto& [slot, count] : m.bins) bins.push_back(json::array({slot, count}));
-  return {{"max", JsonNumber(m.max)}, {"worst_index", JsonIndex(m.worst_index)}, {"bins", bins}};
+  return {{"max_square", JsonNumber(m.max_square)},
+          {"max", JsonNumber(m.max())},  // for readers; max_square is the exact record
+          {"worst_index", JsonIndex(m.worst_index)},
+          {"bins", bins}};
 }
 
 json BandToJson(const BandStats& b) {
@@ -62,6 +65,7 @@ json BandToJson(const BandStats& b) {
           {"nan", b.nan},
           {"inf", b.inf},
           {"degenerate", b.degenerate},
+          {"outside", b.outside},
           {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
           {"metrics", metrics}};
 }
@@ -145,6 +149,7 @@ json ToJson(const Results& results) {
                        {"nan", all.nan},
                        {"inf", all.inf},
                        {"degenerate", all.degenerate},
+                       {"outside", all.outside},
                        {"first_nonfinite_index", JsonIndex(all.first_nonfinite_index)}}},
                      {"summary", SummaryToJson(all)},
                      {"bands", {{"joint", joint}, {"distance", distance}}}});
@@ -188,7 +193,7 @@ Expected<Range> RangeFrom(const JsonReader& r) {
 
 Expected<MetricStats> MetricFrom(const JsonReader& r) {
   MetricStats m;
-  DB_ASSIGN_OR_RETURN(m.max, r.Number("max"));
+  DB_ASSIGN_OR_RETURN(m.max_square, r.Number("max_square"));
   DB_ASSIGN_OR_RETURN(m.worst_index, r.Unsigned("worst_index"));
   DB_ASSIGN_OR_RETURN(JsonReader bins, r.Field("bins"));
   DB_ASSIGN_OR_RETURN(std::size_t n, bins.ArraySize());
@@ -210,6 +215,7 @@ Expected<BandStats> BandFrom(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(b.nan, r.Unsigned("nan"));
   DB_ASSIGN_OR_RETURN(b.inf, r.Unsigned("inf"));
   DB_ASSIGN_OR_RETURN(b.degenerate, r.Unsigned("degenerate"));
+  DB_ASSIGN_OR_RETURN(b.outside, r.Unsigned("outside"));
   DB_ASSIGN_OR_RETURN(b.first_nonfinite_index, r.Unsigned("first_nonfinite_index"));
   DB_ASSIGN_OR_RETURN(JsonReader metrics, r.Field("metrics"));
   for (int m = 0; m < kMetricCount; ++m) {

@@ -42,8 +42,8 @@ std::uint64_t MetricStats::Count() const {
 
 void MetricStats::Merge(const MetricStats& other) {
   for (const auto& [slot, count] : other.bins) bins[slot] += count;
-  if (other.max > max || (other.max == max && other.worst_index < worst_index)) {
-    max = other.max;
+  if (other.max_square > max_square || (other.max_square == max_square && other.worst_index < worst_index)) {
+    max_square = other.max_square;
     worst_index = other.worst_index;
   }
 }
@@ -58,14 +58,14 @@ double MetricStats::Quantile(double q, int lowest_octave) const {
   for (const auto& [slot, count] : bins) {
     if (static_cast<double>(below + count) >= rank && count > 0) {
       if (slot == 0) return std::ldexp(1.0, lowest_octave);
-      if (slot == kBinsKept + 1) return max;
+      if (slot == kBinsKept + 1) return max();
       double fraction = std::clamp((rank - static_cast<double>(below)) / static_cast<double>(count), 0.0, 1.0);
       double log2_value = lowest_octave + (slot - 1 + fraction) / kBinsPerOctave;
-      return std::min(std::exp2(log2_value), max);
+      return std::min(std::exp2(log2_value), max());
     }
     below += count;
   }
-  return max;
+  return max();
 }
 
 void BandStats::Merge(const BandStats& other) {
@@ -90,7 +90,7 @@ Summary Summarize(const BandStats& band, Metric metric) {
   s.p50 = m.Quantile(0.5, low);
   s.p99 = m.Quantile(0.99, low);
   s.p999 = m.Quantile(0.999, low);
-  s.max = m.max;
+  s.max = m.max();
   s.worst_index = m.worst_index;
   return s;
 }
@@ -151,7 +151,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
       MetricStats& ms = add.metrics[m];
       for (int b = 0; b < kDenseBins; ++b)
         if (slot.bins[m][b] != 0) ms.bins[b] = slot.bins[m][b];
-      ms.max = std::sqrt(slot.max_square[m]);
+      ms.max_square = slot.max_square[m];
       ms.worst_index = slot.worst_index[m];
     }
     band.Merge(add);

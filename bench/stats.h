@@ -18,6 +18,7 @@
 
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -68,7 +69,10 @@ inline constexpr int kDenseBins = kBinsKept + 2;
 // Statistics of one metric in one band: sparse bins keyed by dense slot.
 struct MetricStats {
   std::map<int, std::uint64_t> bins;  // dense slot -> count
-  double max = 0.0;                   // exact largest value (not squared)
+  // The largest value's square, exactly as recorded: squares are what the
+  // judge compares, and the square root would merge values that differ.
+  double max_square = 0.0;
+  double max() const { return std::sqrt(max_square); }
   std::uint64_t worst_index = std::numeric_limits<std::uint64_t>::max();
 
   std::uint64_t Count() const;

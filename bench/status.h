@@ -77,6 +77,15 @@ class [[nodiscard]] Expected {
   std::variant<T, Status> state_;
 };
 
+// Moves an Expected's value into `target`, or returns its Status: the
+// single-statement form for assignments that are conditional.
+template <class T, class U>
+Status StoreInto(Expected<U> from, T& target) {
+  if (!from.ok()) return from.status();
+  target = std::move(from).value();
+  return Status::Ok();
+}
+
 }  // namespace depthbench
 
 // Returns early with the Status of an expression that failed.
@@ -88,7 +97,8 @@ class [[nodiscard]] Expected {
 
 #define DB_CONCAT_INNER(a, b) a##b
 #define DB_CONCAT(a, b) DB_CONCAT_INNER(a, b)
-// Declares `lhs` from an Expected, or returns its Status.
+// Declares `lhs` from an Expected, or returns its Status. Several
+// statements: never the body of an unbraced if or loop (use StoreInto).
 #define DB_ASSIGN_OR_RETURN(lhs, expr)                               \
   auto DB_CONCAT(db_expected_, __LINE__) = (expr);                   \
   if (!DB_CONCAT(db_expected_, __LINE__).ok())                       \

@@ -62,7 +62,7 @@ TEST(StatsTest, QuantilesFallInTheRightQuarterOctave) {
   const int low = kLowestOctave[0];
   MetricStats m = Fill(values, low);
   EXPECT_EQ(m.Count(), 1000u);
-  EXPECT_EQ(m.max, std::ldexp(1.0, -4));
+  EXPECT_EQ(m.max(), std::ldexp(1.0, -4));
   EXPECT_EQ(m.worst_index, 999u);
   // A quantile is interpolated inside its bin: within a quarter octave.
   auto within_bin = [](double got, double want) { return got >= want && got <= want * std::exp2(0.25); };
@@ -94,7 +94,7 @@ TEST(StatsTest, MergeIsExactAndKeepsTheEarliestWorstSample) {
   CellStats merged = sb;  // order must not matter
   merged.Merge(sa);
   EXPECT_EQ(merged.joint[3][Metric::kArith].bins, sw.joint[3][Metric::kArith].bins);
-  EXPECT_EQ(merged.joint[3][Metric::kArith].max, sw.joint[3][Metric::kArith].max);
+  EXPECT_EQ(merged.joint[3][Metric::kArith].max_square, sw.joint[3][Metric::kArith].max_square);
   EXPECT_EQ(merged.joint[3][Metric::kArith].worst_index, sw.joint[3][Metric::kArith].worst_index);
 }
 

@@ -33,7 +33,7 @@ void DomainFlags::Add(CLI::App& app) {
 }
 
 Expected<Domain> DomainFlags::Apply(Domain d) const {
-  if (!near.empty()) DB_ASSIGN_OR_RETURN(d.near, ParseRange(near, "--near", kNearLimits));
+  if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");
   if (!far.empty()) {
     DB_ASSIGN_OR_RETURN(Range f, ParseRange(far, "--far", kFarLimits));
@@ -42,11 +42,11 @@ Expected<Domain> DomainFlags::Apply(Domain d) const {
     d.infinite_far = false;
   }
   if (!ratio.empty()) DB_RETURN_IF_ERROR(ParseRatioInto(ratio, d));
-  if (!fov.empty()) DB_ASSIGN_OR_RETURN(d.fov_degrees, ParseRange(fov, "--fov", kFovLimits));
-  if (!aspect.empty()) DB_ASSIGN_OR_RETURN(d.aspect, ParseRange(aspect, "--aspect", kAspectLimits));
+  if (!fov.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(fov, "--fov", kFovLimits), d.fov_degrees));
+  if (!aspect.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(aspect, "--aspect", kAspectLimits), d.aspect));
   if (!camera_distance.empty()) {
-    DB_ASSIGN_OR_RETURN(d.camera_distance,
-                        ParseRange(camera_distance, "--camera-distance", kCameraDistanceLimits));
+    DB_RETURN_IF_ERROR(StoreInto(ParseRange(camera_distance, "--camera-distance", kCameraDistanceLimits),
+                                 d.camera_distance));
   }
   if (!eye_depth.empty()) {
     DB_ASSIGN_OR_RETURN(Range z, ParseRange(eye_depth, "--depth", kEyeDepthLimits));
@@ -77,9 +77,11 @@ void CellFlags::Add(CLI::App& app) {
 
 Expected<std::vector<Cell>> CellFlags::Select() const {
   CellFilter filter;
-  for (const auto& v : variants) DB_ASSIGN_OR_RETURN(filter.variants.emplace_back(), ParseVariant(v));
-  for (const auto& c : conventions) DB_ASSIGN_OR_RETURN(filter.conventions.emplace_back(), ParseConvention(c));
-  for (const auto& f : formats) DB_ASSIGN_OR_RETURN(filter.formats.emplace_back(), ParseFormat(f));
+  for (const auto& v : variants) DB_RETURN_IF_ERROR(StoreInto(ParseVariant(v), filter.variants.emplace_back()));
+  for (const auto& c : conventions) {
+    DB_RETURN_IF_ERROR(StoreInto(ParseConvention(c), filter.conventions.emplace_back()));
+  }
+  for (const auto& f : formats) DB_RETURN_IF_ERROR(StoreInto(ParseFormat(f), filter.formats.emplace_back()));
   std::vector<Cell> cells;
   for (const Cell& cell : AllCells())
     if (filter.Keeps(cell)) cells.push_back(cell);

@@ -1,0 +1,430 @@
+#include "bench/vulkan/vulkan_backend.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "bench/formulas.h"
+#include "bench/vulkan/shader_compiler.h"
+
+namespace depthbench {
+namespace {
+
+// local_size_x of shaders/compute_pass.glsl.
+constexpr std::uint32_t kWorkgroupSize = 64;
+
+// The storage buffers of shaders/compute_pass.glsl, by binding number.
+enum Binding : std::uint32_t {
+  kFrames,
+  kDepthParams,
+  kPixels,
+  kStoredDepths,
+  kPositions,  // the only output
+  kBindingCount,
+};
+using BindingBytes = std::array<VkDeviceSize, kBindingCount>;
+
+// Bytes each binding holds for a batch; positions are `output_floats`.
+BindingBytes BytesFor(const Batch& batch, std::size_t output_floats) {
+  return {batch.frame_params.size() * sizeof(f32::FrameParams), batch.depth_params.size() * sizeof(f32::DepthParams),
+          std::size_t{batch.count} * sizeof(std::uint32_t), batch.depths.size() * sizeof(float),
+          output_floats * sizeof(float)};
+}
+
+// The k-th listed cell's slice of the batch, as compute_pass.glsl reads it.
+f32::PassConstants PassConstantsFor(const Batch& batch, const CellPlan& plan, std::size_t k) {
+  return {.sample_count = batch.count,
+          .samples_per_frame = kSamplesPerFrame,
+          .convention_slot = plan.convention_slot,
+          .conventions_per_frame = kHardwareConventionCount,
+          .depth_offset = plan.depth_slot * batch.count,
+          .output_offset = static_cast<std::uint32_t>(k * batch.count * 3),
+          .first_sample_in_frame = batch.first_offset,
+          .reserved0 = 0};
+}
+
+std::size_t VariantIndex(Variant variant) { return static_cast<std::size_t>(variant); }
+
+class VulkanBackend final : public Backend {
+ public:
+  static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
+                                                   const BackendOptions& options);
+  ~VulkanBackend() override;
+
+  std::string name() const override { return "vulkan"; }
+  const DeviceInfo& device() const override { return device_; }
+  // One command buffer, one fence and one set of buffers: one Run at a time.
+  bool concurrent() const override { return false; }
+
+  Status Prepare(std::span<const CellPlan> cells, PassKind pass) override;
+  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                       std::vector<float>& scratch) override;
+
+ private:
+  VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
+
+  VkDevice vk_device() const { return context_->device(); }
+  std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
+
+  // The objects every run uses, whatever the cells.
+  Status CreateDescriptorObjects();
+  Status CreateCommandObjects();
+
+  Status PrepareOnDevice(std::span<const CellPlan> cells);
+  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant) const;
+
+  Expected<std::span<const float>> RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which);
+  Status CheckRun(const Batch& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
+  Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
+  Status Upload(const Batch& batch, const BindingBytes& bytes);
+  void BindBuffers(const BindingBytes& bytes);
+  Status Record(const Batch& batch, std::span<const std::uint32_t> which);
+  Status SubmitAndWait();
+  // Internal when the validation layer reported errors since `errors_before`.
+  Status CheckValidation(std::uint64_t errors_before, std::string_view during) const;
+
+  std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
+  std::filesystem::path shader_dir_;
+  DeviceInfo device_;
+  std::vector<CellPlan> cells_;
+
+  DeviceObject<VkDescriptorSetLayout> set_layout_;
+  DeviceObject<VkPipelineLayout> pipeline_layout_;
+  DeviceObject<VkDescriptorPool> descriptor_pool_;
+  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;  // freed with the pool
+  DeviceObject<VkFence> fence_;
+  // From the context's pool; the destructor frees it.
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  // Indexed by Variant; null for variants no prepared cell uses.
+  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines_;
+  std::array<VulkanBuffer, kBindingCount> buffers_;
+};
+
+VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir)
+    : context_(std::move(context)), shader_dir_(std::move(shader_dir)) {
+  const VulkanDeviceProperties& properties = context_->properties();
+  device_.name = properties.name;
+  device_.driver = properties.DriverString();
+  device_.api = "Vulkan " + VulkanVersionString(properties.api_version);
+  device_.kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu";
+  device_.compiler = GlslangVersion();
+}
+
+Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanContext> context,
+                                                         const BackendOptions& options) {
+  if (context == nullptr) return InvalidArgument("the Vulkan backend needs a Vulkan context");
+  std::filesystem::path shader_dir = options.shader_dir.empty()
+                                         ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
+                                         : std::filesystem::path(options.shader_dir);
+  std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir)));
+  const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
+  Status status = backend->CreateDescriptorObjects();
+  if (status.ok()) status = backend->CreateCommandObjects();
+  if (status.ok()) status = backend->CheckValidation(errors_before, "backend creation");
+  if (!status.ok()) return status.WithContext(backend->DeviceContext());
+  return std::unique_ptr<Backend>(std::move(backend));
+}
+
+VulkanBackend::~VulkanBackend() {
+  // A run that failed after submitting may still be executing.
+  if (context_->queue() != VK_NULL_HANDLE) vkQueueWaitIdle(context_->queue());
+  if (command_buffer_ != VK_NULL_HANDLE) {
+    vkFreeCommandBuffers(vk_device(), context_->command_pool(), 1, &command_buffer_);
+  }
+}
+
+Status VulkanBackend::CreateDescriptorObjects() {
+  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  }
+  VkDescriptorSetLayoutCreateInfo set_layout_info{};
+  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  set_layout_info.bindingCount = kBindingCount;
+  set_layout_info.pBindings = bindings.data();
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(vk_device(), &set_layout_info, nullptr, &set_layout),
+                             "vkCreateDescriptorSetLayout"));
+  set_layout_ = DeviceObject<VkDescriptorSetLayout>(vk_device(), set_layout, vkDestroyDescriptorSetLayout);
+
+  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(f32::PassConstants)};
+  VkPipelineLayoutCreateInfo pipeline_layout_info{};
+  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pipeline_layout_info.setLayoutCount = 1;
+  pipeline_layout_info.pSetLayouts = &set_layout;
+  pipeline_layout_info.pushConstantRangeCount = 1;
+  pipeline_layout_info.pPushConstantRanges = &push_constants;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(vk_device(), &pipeline_layout_info, nullptr, &pipeline_layout),
+                             "vkCreatePipelineLayout"));
+  pipeline_layout_ = DeviceObject<VkPipelineLayout>(vk_device(), pipeline_layout, vkDestroyPipelineLayout);
+
+  const VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
+  VkDescriptorPoolCreateInfo pool_info{};
+  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &pool_size;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateDescriptorPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
+  descriptor_pool_ = DeviceObject<VkDescriptorPool>(vk_device(), pool, vkDestroyDescriptorPool);
+
+  VkDescriptorSetAllocateInfo set_info{};
+  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  set_info.descriptorPool = pool;
+  set_info.descriptorSetCount = 1;
+  set_info.pSetLayouts = &set_layout;
+  return CheckVk(vkAllocateDescriptorSets(vk_device(), &set_info, &descriptor_set_), "vkAllocateDescriptorSets");
+}
+
+Status VulkanBackend::CreateCommandObjects() {
+  VkCommandBufferAllocateInfo command_info{};
+  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  command_info.commandPool = context_->command_pool();
+  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  command_info.commandBufferCount = 1;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkAllocateCommandBuffers(vk_device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
+
+  VkFenceCreateInfo fence_info{};
+  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VkFence fence = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(vk_device(), &fence_info, nullptr, &fence), "vkCreateFence"));
+  fence_ = DeviceObject<VkFence>(vk_device(), fence, vkDestroyFence);
+  return Status::Ok();
+}
+
+Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  Status status = PrepareOnDevice(cells);
+  if (status.ok()) status = CheckValidation(errors_before, "Prepare");
+  return status.WithContext(DeviceContext());
+}
+
+Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(shader_dir_, error)) {
+    return NotFound(fmt::format("shader directory '{}' does not exist", shader_dir_.string()));
+  }
+  // Built aside so that a failure leaves the previous preparation intact.
+  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
+  for (const CellPlan& plan : cells) {
+    DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
+    if (pipeline.get() != VK_NULL_HANDLE) continue;
+    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant));
+  }
+  pipelines_ = std::move(pipelines);
+  cells_.assign(cells.begin(), cells.end());
+  return Status::Ok();
+}
+
+Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant) const {
+  const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
+
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+  module_info.pCode = spirv.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(vk_device(), &module_info, nullptr, &module),
+                             fmt::format("vkCreateShaderModule for '{}'", path.string())));
+  // The pipeline keeps what it needs; the module goes when this returns.
+  const DeviceObject<VkShaderModule> module_owner(vk_device(), module, vkDestroyShaderModule);
+
+  VkComputePipelineCreateInfo pipeline_info{};
+  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeline_info.stage.module = module;
+  pipeline_info.stage.pName = "main";
+  pipeline_info.layout = pipeline_layout_.get();
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateComputePipelines(vk_device(), VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
+              fmt::format("vkCreateComputePipelines for '{}'", path.string())));
+  return DeviceObject<VkPipeline>(vk_device(), pipeline, vkDestroyPipeline);
+}
+
+// The positions stay in the mapped readback buffer; `scratch` is not needed.
+Expected<std::span<const float>> VulkanBackend::Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                                    std::vector<float>& /*scratch*/) {
+  Expected<std::span<const float>> positions = RunOnDevice(batch, which);
+  if (!positions.ok()) return positions.status().WithContext(DeviceContext());
+  return positions;
+}
+
+Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which) {
+  const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
+  if (output_floats == 0) return std::span<const float>();
+  const BindingBytes bytes = BytesFor(batch, output_floats);
+  DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  DB_RETURN_IF_ERROR(Upload(batch, bytes));
+  DB_RETURN_IF_ERROR(Record(batch, which));
+  DB_RETURN_IF_ERROR(SubmitAndWait());
+  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "Run"));
+  return std::span<const float>(static_cast<const float*>(buffers_[kPositions].mapped()), output_floats);
+}
+
+// What the shaders would otherwise read or write out of bounds, and what
+// the device cannot address or dispatch.
+Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t> which,
+                               const BindingBytes& bytes) const {
+  const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
+  if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
+      batch.pixels.size() < batch.count) {
+    return InvalidArgument(
+        fmt::format("batch of {} samples has {} frame parameters, {} depth parameters and {} "
+                    "pixels; it needs {}, {} and {}",
+                    batch.count, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(), frames,
+                    frames * kHardwareConventionCount, batch.count));
+  }
+  for (std::uint32_t index : which) {
+    if (index >= cells_.size()) {
+      return InvalidArgument(fmt::format("cell index {} out of range; {} cells prepared", index, cells_.size()));
+    }
+    const std::size_t depths_needed = (std::size_t{cells_[index].depth_slot} + 1) * batch.count;
+    if (batch.depths.size() < depths_needed) {
+      return InvalidArgument(fmt::format("cell {} reads {} stored depths; the batch has {}", cells_[index].cell.Name(),
+                                         depths_needed, batch.depths.size()));
+    }
+  }
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  if (groups > limits.maxComputeWorkGroupCount[0]) {
+    return InvalidArgument(fmt::format("a batch of {} samples needs {} workgroups; the device dispatches at most {}",
+                                       batch.count, groups, limits.maxComputeWorkGroupCount[0]));
+  }
+  // Within this limit every element offset also fits the shaders' uints.
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    if (bytes[binding] > limits.maxStorageBufferRange) {
+      return InvalidArgument(
+          fmt::format("binding {} needs {} bytes; the device binds at most {} (run fewer samples "
+                      "or cells at once)",
+                      binding, bytes[binding], limits.maxStorageBufferRange));
+    }
+  }
+  return Status::Ok();
+}
+
+Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
+  VulkanBuffer& buffer = buffers_[binding];
+  if (buffer.size() >= bytes) return Status::Ok();
+  // Growing geometrically keeps reallocations rare when batches vary a little.
+  const VkDeviceSize size = std::max(bytes, buffer.size() + buffer.size() / 2);
+  const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
+  // The previous run has completed (Run waits), so the old buffer can go.
+  buffer = VulkanBuffer();
+  DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, access));
+  return Status::Ok();
+}
+
+Status VulkanBackend::Upload(const Batch& batch, const BindingBytes& bytes) {
+  const std::array<const void*, kPositions> inputs = {batch.frame_params.data(), batch.depth_params.data(),
+                                                      batch.pixels.data(), batch.depths.data()};
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
+  }
+  for (std::uint32_t binding = 0; binding < kPositions; ++binding) {
+    std::memcpy(buffers_[binding].mapped(), inputs[binding], bytes[binding]);
+    DB_RETURN_IF_ERROR(buffers_[binding].FlushHostWrites());
+  }
+  BindBuffers(bytes);
+  return Status::Ok();
+}
+
+// Points the descriptors at exactly the bytes this run uses: buffers may
+// have been reallocated, and a range past the data would hide overruns.
+void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
+  std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
+  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    infos[binding] = {buffers_[binding].handle(), 0, bytes[binding]};
+    writes[binding].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[binding].dstSet = descriptor_set_;
+    writes[binding].dstBinding = binding;
+    writes[binding].descriptorCount = 1;
+    writes[binding].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[binding].pBufferInfo = &infos[binding];
+  }
+  vkUpdateDescriptorSets(vk_device(), kBindingCount, writes.data(), 0, nullptr);
+}
+
+Status VulkanBackend::Record(const Batch& batch, std::span<const std::uint32_t> which) {
+  VkCommandBufferBeginInfo begin_info{};
+  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
+                          &descriptor_set_, 0, nullptr);
+  const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  VkPipeline bound = VK_NULL_HANDLE;
+  // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const CellPlan& plan = cells_[which[k]];
+    const VkPipeline pipeline = pipelines_[VariantIndex(plan.cell.variant)].get();
+    if (pipeline != bound) {
+      vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+      bound = pipeline;
+    }
+    const f32::PassConstants constants = PassConstantsFor(batch, plan, k);
+    vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(constants),
+                       &constants);
+    vkCmdDispatch(command_buffer_, groups, 1, 1);
+  }
+  // The host reads the positions once the fence signals.
+  VkMemoryBarrier to_host{};
+  to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
+  return CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer");
+}
+
+Status VulkanBackend::SubmitAndWait() {
+  const VkFence fence = fence_.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(vk_device(), 1, &fence), "vkResetFences"));
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer_;
+  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
+  DB_RETURN_IF_ERROR(CheckVk(
+      vkWaitForFences(vk_device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()), "vkWaitForFences"));
+  return buffers_[kPositions].InvalidateForHostReads();
+}
+
+Status VulkanBackend::CheckValidation(std::uint64_t errors_before, std::string_view during) const {
+  const std::shared_ptr<ValidationLog> log = context_->validation_log();
+  const std::uint64_t errors = log->error_count() - errors_before;
+  if (errors == 0) return Status::Ok();
+  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) during {}; the last: {}", errors,
+                              during, log->last_error()));
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {
+  VulkanContextOptions context_options;
+  context_options.device = options.device;
+  context_options.validation = options.validation;
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> context, VulkanContext::Create(context_options));
+  return VulkanBackend::Create(std::move(context), options);
+}
+
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanContext> context,
+                                                     const BackendOptions& options) {
+  return VulkanBackend::Create(std::move(context), options);
+}
+
+}  // namespace depthbench

@@ -1,0 +1,94 @@
+// Determinism, shard additivity and the results file.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "bench/backend_cpu.h"
+#include "bench/results.h"
+#include "bench/sweep.h"
+
+namespace depthbench {
+namespace {
+
+Results RunCpu(std::uint64_t seed, std::uint64_t samples, Shard shard, std::uint32_t batch = 4096,
+               unsigned threads = 2) {
+  SweepOptions options;
+  options.seed = seed;
+  options.samples = samples;
+  options.shard = shard;
+  options.batch_size = batch;
+  options.threads = threads;
+  auto cpu = MakeCpuBackend();
+  Backend* backends[] = {cpu.get()};
+  auto results = RunSweep(options, backends);
+  EXPECT_TRUE(results.ok()) << results.status().message();
+  return std::move(results).value();
+}
+
+void ExpectSameStats(const Results& a, const Results& b) {
+  ASSERT_EQ(a.cells.size(), b.cells.size());
+  for (std::size_t i = 0; i < a.cells.size(); ++i) {
+    EXPECT_EQ(a.cells[i].cell, b.cells[i].cell);
+    const CellStats& x = a.cells[i].stats;
+    const CellStats& y = b.cells[i].stats;
+    EXPECT_TRUE(x == y) << a.cells[i].cell.Name();
+  }
+}
+
+TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
+  Results a = RunCpu(42, 20000, {});
+  Results b = RunCpu(42, 20000, {}, /*batch=*/777, /*threads=*/1);
+  ExpectSameStats(a, b);
+  EXPECT_EQ(a.run.reconstructions, 20000u * AllCells().size());
+  Results other = RunCpu(43, 20000, {});
+  EXPECT_FALSE(a.cells[0].stats == other.cells[0].stats);  // the seed matters
+}
+
+TEST(SweepTest, ShardsAddUpToTheWhole) {
+  Results whole = RunCpu(7, 30001, {});
+  std::vector<Results> parts;
+  for (std::uint32_t k = 1; k <= 3; ++k) parts.push_back(RunCpu(7, 30001, {k, 3}));
+  // Merge in a scrambled order: addition must not care.
+  auto merged = MergeResults({parts[2], parts[0], parts[1]});
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  ExpectSameStats(whole, *merged);
+  EXPECT_EQ(merged->run.shards.size(), 3u);
+}
+
+TEST(SweepTest, MergeRefusesOverlappingOrForeignShards) {
+  Results a = RunCpu(7, 2000, {1, 2});
+  Results b = RunCpu(7, 2000, {1, 2});
+  EXPECT_FALSE(MergeResults({a, b}).ok());
+  Results c = RunCpu(8, 2000, {2, 2});
+  auto merged = MergeResults({a, c});
+  ASSERT_FALSE(merged.ok());
+  EXPECT_NE(merged.status().message().find("same sweep"), std::string::npos);
+}
+
+TEST(SweepTest, ResultsSurviveTheJsonRoundTrip) {
+  Results original = RunCpu(9, 5000, {});
+  const auto path = std::filesystem::temp_directory_path() / "depthbench_sweep_test.json";
+  ASSERT_TRUE(WriteResults(path, original).ok());
+  auto read = ReadResults(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ExpectSameStats(original, *read);
+  EXPECT_EQ(read->run.seed, 9u);
+  EXPECT_EQ(read->run.domain.near, original.run.domain.near);
+  std::filesystem::remove(path);
+}
+
+TEST(SweepTest, BadResultsFilesNameTheFieldThatIsWrong) {
+  nlohmann::json j = ToJson(RunCpu(1, 500, {}));
+  j["cells"][2]["bands"]["joint"][0]["finite"] = "many";
+  auto bad = ResultsFromJson(j, "bad.json");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("bad.json: cells[2].bands.joint[0].finite"), std::string::npos)
+      << bad.status().message();
+  j = ToJson(RunCpu(1, 500, {}));
+  j["schema_version"] = 99;
+  EXPECT_NE(ResultsFromJson(j, "x.json").status().message().find("schema_version 99"), std::string::npos);
+}
+
+
+}  // namespace
+}  // namespace depthbench

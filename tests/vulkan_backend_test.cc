@@ -1,0 +1,300 @@
+// The Vulkan backend on lavapipe against the CPU backend: the same formulas
+// on the same float32 inputs give the same positions up to the evaluation
+// order GLSL leaves to the driver (lavapipe sums the columns of a
+// matrix-vector product in another order than GLM). Runs with the validation
+// layer on and fails on anything it reports.
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bench/backend.h"
+#include "bench/backend_cpu.h"
+#include "bench/batch.h"
+#include "bench/cells.h"
+#include "bench/sampler.h"
+#include "bench/thread_pool.h"
+#include "bench/vulkan/vulkan_backend.h"
+#include "bench/vulkan/vulkan_context.h"
+
+namespace depthbench {
+namespace {
+
+constexpr std::uint64_t kSeed = 20240611;
+// Relative to the distance from the camera: float32 formulas evaluated in
+// different valid orders agree to a few ulps of that distance (lavapipe:
+// at most 4) when the projection is well conditioned.
+constexpr double kRelativeTolerance = 1e-5;
+
+// Well-conditioned frames: the camera at the origin (no large translation
+// to cancel) and moderate far/near ratios.
+Domain WellConditionedDomain() {
+  Domain domain;
+  domain.camera_distance = {0.0, 0.0};
+  domain.ratio = {10.0, 1000.0};
+  return domain;
+}
+
+Batch BuildBatch(const RunLayout& layout, std::uint64_t first, std::uint32_t count) {
+  const Sampler sampler(kSeed, WellConditionedDomain());
+  const BatchBuilder builder(sampler, layout.encodings);
+  ThreadPool pool;
+  Batch batch;
+  builder.Build(first, count, batch, pool);
+  return batch;
+}
+
+// Sets an environment variable for one scope; the Vulkan loader reads
+// VK_ICD_FILENAMES and VK_LAYER_PATH whenever an instance is created.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(std::string name, const std::string& value) : name_(std::move(name)) {
+    if (const char* previous = std::getenv(name_.c_str())) previous_ = previous;
+    setenv(name_.c_str(), value.c_str(), 1);
+  }
+  ~ScopedEnvironment() {
+    if (previous_) {
+      setenv(name_.c_str(), previous_->c_str(), 1);
+    } else {
+      unsetenv(name_.c_str());
+    }
+  }
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> previous_;
+};
+
+std::vector<std::uint32_t> AllIndices(const RunLayout& layout) {
+  std::vector<std::uint32_t> which(layout.cells.size());
+  std::iota(which.begin(), which.end(), 0u);
+  return which;
+}
+
+class VulkanBackendTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    VulkanContextOptions options;
+    options.validation = true;
+    auto context = VulkanContext::Create(options);
+    ASSERT_TRUE(context.ok()) << context.status().message();
+    context_ = std::move(context).value();
+    auto backend = MakeVulkanBackend(context_, BackendOptions{});
+    ASSERT_TRUE(backend.ok()) << backend.status().message();
+    vulkan_ = std::move(backend).value();
+    cpu_ = MakeCpuBackend();
+  }
+
+  void TearDown() override {
+    if (context_ == nullptr) return;
+    // Destroying the device reports every object the backend leaked.
+    const std::shared_ptr<ValidationLog> log = context_->validation_log();
+    vulkan_.reset();
+    context_.reset();
+    for (const std::string& message : log->TakeMessages()) ADD_FAILURE() << message;
+  }
+
+  void PrepareBoth(const RunLayout& layout) {
+    Status status = vulkan_->Prepare(layout.cells);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_TRUE(cpu_->Prepare(layout.cells).ok());
+  }
+
+  // Runs `which` on both backends and compares every finite CPU position.
+  void ExpectBackendsAgree(const RunLayout& layout, const Batch& batch, const std::vector<std::uint32_t>& which) {
+    std::vector<float> cpu_scratch;
+    std::vector<float> vulkan_scratch;
+    auto expected = cpu_->Run(batch, which, cpu_scratch);
+    ASSERT_TRUE(expected.ok()) << expected.status().message();
+    auto actual = vulkan_->Run(batch, which, vulkan_scratch);
+    ASSERT_TRUE(actual.ok()) << actual.status().message();
+    ASSERT_EQ(actual->size(), expected->size());
+
+    std::size_t compared = 0;
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      const Cell& cell = layout.cells[which[k]].cell;
+      for (std::uint32_t i = 0; i < batch.count; ++i) {
+        const float* want = expected->data() + (k * batch.count + i) * 3;
+        const float* got = actual->data() + (k * batch.count + i) * 3;
+        if (!std::isfinite(want[0]) || !std::isfinite(want[1]) || !std::isfinite(want[2])) continue;
+        // The camera sits at the origin: the position is its distance.
+        const double distance = std::hypot(want[0], want[1], want[2]);
+        const double error = std::hypot(double{got[0]} - want[0], double{got[1]} - want[1], double{got[2]} - want[2]);
+        ASSERT_LE(error, kRelativeTolerance * distance)
+            << cell.Name() << " sample " << i << ": cpu (" << want[0] << ", " << want[1] << ", " << want[2]
+            << ") vulkan (" << got[0] << ", " << got[1] << ", " << got[2] << ")";
+        ++compared;
+      }
+    }
+    EXPECT_GT(compared, which.size() * batch.count / 2) << "too few finite positions to compare";
+  }
+
+  std::shared_ptr<VulkanContext> context_;
+  std::unique_ptr<Backend> vulkan_;
+  std::unique_ptr<Backend> cpu_;
+};
+
+TEST_F(VulkanBackendTest, DescribesLavapipe) {
+  const DeviceInfo& device = vulkan_->device();
+  EXPECT_EQ(vulkan_->name(), "vulkan");
+  EXPECT_FALSE(vulkan_->concurrent());
+  EXPECT_NE(device.name.find("llvmpipe"), std::string::npos) << device.name;
+  EXPECT_EQ(device.kind, "cpu");
+  EXPECT_EQ(device.api.rfind("Vulkan 1.", 0), 0u) << device.api;
+  EXPECT_EQ(device.compiler.rfind("glslang ", 0), 0u) << device.compiler;
+  EXPECT_NE(device.driver.find("Mesa"), std::string::npos) << device.driver;
+  EXPECT_TRUE(context_->validation_enabled());
+}
+
+// The checks for an empty validation log mean something only if misuse
+// does get recorded.
+TEST_F(VulkanBackendTest, ValidationLayerRecordsMisuse) {
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  VkBufferCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  info.size = 16;
+  info.usage = 0;  // invalid: at least one usage bit is required
+  VkBuffer buffer = VK_NULL_HANDLE;
+  if (vkCreateBuffer(context_->device(), &info, nullptr, &buffer) == VK_SUCCESS) {
+    vkDestroyBuffer(context_->device(), buffer, nullptr);
+  }
+  EXPECT_GT(context_->validation_log()->error_count(), errors_before);
+  const std::vector<std::string> messages = context_->TakeValidationMessages();
+  ASSERT_FALSE(messages.empty());
+  EXPECT_NE(messages.front().find("VUID-VkBufferCreateInfo-usage-requiredbitmask"), std::string::npos)
+      << messages.front();
+}
+
+TEST_F(VulkanBackendTest, AllCellsMatchCpuBackend) {
+  const RunLayout layout = MakeRunLayout(AllCells());
+  PrepareBoth(layout);
+  // A batch that starts and ends inside a frame and is not a whole number
+  // of workgroups.
+  const Batch batch = BuildBatch(layout, 4101, 1000);
+  ExpectBackendsAgree(layout, batch, AllIndices(layout));
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
+}
+
+TEST_F(VulkanBackendTest, SubsetsInAnyOrderAndGrowingBatches) {
+  const RunLayout layout = MakeRunLayout(AllCells());
+  PrepareBoth(layout);
+  const std::uint32_t last = static_cast<std::uint32_t>(layout.cells.size() - 1);
+  ExpectBackendsAgree(layout, BuildBatch(layout, 0, 100), {last, 0, 17});
+  // Larger buffers than the first run needed: the backend reallocates.
+  ExpectBackendsAgree(layout, BuildBatch(layout, 64, 3000), {3, last, 40, 3});
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
+}
+
+TEST_F(VulkanBackendTest, EmptyRunsReturnNothing) {
+  const RunLayout layout = MakeRunLayout(AllCells());
+  PrepareBoth(layout);
+  std::vector<float> scratch;
+  const Batch empty = BuildBatch(layout, 0, 0);
+  auto none = vulkan_->Run(empty, AllIndices(layout), scratch);
+  ASSERT_TRUE(none.ok()) << none.status().message();
+  EXPECT_TRUE(none->empty());
+  auto no_cells = vulkan_->Run(BuildBatch(layout, 0, 10), {}, scratch);
+  ASSERT_TRUE(no_cells.ok()) << no_cells.status().message();
+  EXPECT_TRUE(no_cells->empty());
+}
+
+TEST_F(VulkanBackendTest, CellIndexOutOfRangeIsInvalidArgument) {
+  const RunLayout layout = MakeRunLayout(AllCells());
+  PrepareBoth(layout);
+  std::vector<float> scratch;
+  const std::vector<std::uint32_t> which = {static_cast<std::uint32_t>(layout.cells.size())};
+  auto result = vulkan_->Run(BuildBatch(layout, 0, 10), which, scratch);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST_F(VulkanBackendTest, MissingShaderDirectoryIsNotFound) {
+  BackendOptions options;
+  options.shader_dir = "/nonexistent/depthbench/shaders";
+  auto backend = MakeVulkanBackend(context_, options);
+  ASSERT_TRUE(backend.ok()) << backend.status().message();
+  const RunLayout layout = MakeRunLayout(AllCells());
+  Status status = (*backend)->Prepare(layout.cells);
+  EXPECT_EQ(status.code(), StatusCode::kNotFound);
+  EXPECT_NE(status.message().find("shader directory '/nonexistent/depthbench/shaders' does not exist"),
+            std::string::npos)
+      << status.message();
+}
+
+TEST_F(VulkanBackendTest, UnknownDeviceIsNotFoundAndListsDevices) {
+  VulkanContextOptions options;
+  options.device = "no-such-gpu";
+  auto context = VulkanContext::Create(options);
+  ASSERT_FALSE(context.ok());
+  EXPECT_EQ(context.status().code(), StatusCode::kNotFound);
+  EXPECT_NE(context.status().message().find("no Vulkan device matches 'no-such-gpu'; available: "), std::string::npos)
+      << context.status().message();
+  EXPECT_NE(context.status().message().find("llvmpipe"), std::string::npos) << context.status().message();
+}
+
+TEST_F(VulkanBackendTest, NoDriverIsUnavailableWithHint) {
+  const ScopedEnvironment no_driver("VK_ICD_FILENAMES", "/nonexistent/depthbench_icd.json");
+  auto context = VulkanContext::Create(VulkanContextOptions{});
+  ASSERT_FALSE(context.ok());
+  EXPECT_EQ(context.status().code(), StatusCode::kUnavailable);
+  EXPECT_NE(context.status().message().find("mesa-vulkan-drivers"), std::string::npos) << context.status().message();
+  EXPECT_NE(context.status().message().find("VK_ICD_FILENAMES"), std::string::npos) << context.status().message();
+}
+
+TEST_F(VulkanBackendTest, MissingValidationLayerNamesThePackage) {
+  const ScopedEnvironment no_layers("VK_LAYER_PATH", "/nonexistent/depthbench_layers");
+  VulkanContextOptions options;
+  options.validation = true;
+  auto context = VulkanContext::Create(options);
+  ASSERT_FALSE(context.ok());
+  EXPECT_EQ(context.status().code(), StatusCode::kUnavailable);
+  EXPECT_NE(context.status().message().find("vulkan-validationlayers"), std::string::npos)
+      << context.status().message();
+}
+
+TEST_F(VulkanBackendTest, DeviceNamesMatchIgnoringCase) {
+  VulkanContextOptions options;
+  options.device = "LLVMPIPE";
+  auto context = VulkanContext::Create(options);
+  ASSERT_TRUE(context.ok()) << context.status().message();
+  EXPECT_NE((*context)->properties().name.find("llvmpipe"), std::string::npos);
+}
+
+TEST_F(VulkanBackendTest, ListsLavapipe) {
+  auto devices = ListVulkanDevices();
+  ASSERT_TRUE(devices.ok()) << devices.status().message();
+  ASSERT_FALSE(devices->empty());
+  bool found = false;
+  for (const VulkanDeviceSummary& device : *devices) {
+    if (device.name.find("llvmpipe") == std::string::npos) continue;
+    found = true;
+    EXPECT_EQ(device.type, "cpu");
+    EXPECT_FALSE(device.driver.empty());
+    EXPECT_EQ(device.api.rfind("1.", 0), 0u) << device.api;
+  }
+  EXPECT_TRUE(found);
+}
+
+TEST_F(VulkanBackendTest, FactoryKnowsBothBackends) {
+  auto cpu = MakeBackend("cpu", BackendOptions{});
+  ASSERT_TRUE(cpu.ok());
+  EXPECT_EQ((*cpu)->name(), "cpu");
+  auto vulkan = MakeBackend("vulkan", BackendOptions{});
+  ASSERT_TRUE(vulkan.ok()) << vulkan.status().message();
+  EXPECT_EQ((*vulkan)->name(), "vulkan");
+  auto unknown = MakeBackend("metal", BackendOptions{});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(unknown.status().message().find("cpu, vulkan"), std::string::npos) << unknown.status().message();
+}
+
+}  // namespace
+}  // namespace depthbench

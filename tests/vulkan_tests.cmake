@@ -1,0 +1,5 @@
+# Vulkan backend tests (owned by the Vulkan backend work): the std430 layout
+# contract, the glslang shader compiler, and the backend on lavapipe.
+depthbench_test(layout_test layout_test.cc LIBS depthbench_backends)
+depthbench_test(shader_compiler_test shader_compiler_test.cc LIBS depthbench_backends)
+depthbench_test(vulkan_backend_test vulkan_backend_test.cc LIBS depthbench_backends)
