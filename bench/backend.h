@@ -45,10 +45,10 @@ class Backend {
   virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
 
   // World positions of the prepared cells listed in `which` (indices into
-  // Prepare's list) for every sample of `batch`: element
-  // ((k * batch.count + i) * 3 + c) is component c of sample i for the k-th
-  // listed cell. The storage is `scratch` or the backend's own, valid until
-  // the next Run on the same thread.
+  // Prepare's list) for every sample of `batch`, component by component:
+  // element ((k * 3 + c) * batch.count + i) is component c (x, y, z) of
+  // sample i for the k-th listed cell. The storage is `scratch` or the
+  // backend's own, valid until the next Run on the same thread.
   virtual Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch) = 0;
 

@@ -50,20 +50,35 @@ void RunCell(const Batch& batch, const CellPlan& plan, float* out) {
         Widen(batch.depth_params[frame_index * kHardwareConventionCount + plan.convention_slot]);
     for (std::uint32_t i = begin; i < end; i += kLanes) {
       const int n = static_cast<int>(std::min<std::uint32_t>(kLanes, end - i));
-      Float8::Lanes x, y, stored;
-      for (int lane = 0; lane < kLanes; ++lane) {
-        const std::uint32_t k = i + static_cast<std::uint32_t>(lane < n ? lane : n - 1);  // pad the tail
-        x[lane] = static_cast<float>(batch.pixels[k] & 0xffffu);
-        y[lane] = static_cast<float>(batch.pixels[k] >> 16);
-        stored[lane] = depths[k];
+      using Words = std::uint32_t __attribute__((vector_size(32)));
+      Words pixels;
+      Float8::Lanes stored;
+      if (n == kLanes) {
+        std::memcpy(&pixels, batch.pixels.data() + i, sizeof(pixels));
+        std::memcpy(&stored, depths + i, sizeof(stored));
+      } else {
+        for (int lane = 0; lane < kLanes; ++lane) {
+          const std::uint32_t k = i + static_cast<std::uint32_t>(lane < n ? lane : n - 1);  // pad the tail
+          pixels[lane] = batch.pixels[k];
+          stored[lane] = depths[k];
+        }
       }
+      const Float8::Lanes x = __builtin_convertvector(pixels & 0xffffu, Float8::Lanes);
+      const Float8::Lanes y = __builtin_convertvector(pixels >> 16, Float8::Lanes);
       const f32x8::vec2 uv =
           f32x8::uv_from_pixel(Float8::FromLanes(x), Float8::FromLanes(y), frame.resolution);
       const f32x8::vec3 p = Reconstruct(frame, depth, uv, Float8::FromLanes(stored));
-      for (int lane = 0; lane < n; ++lane) {
-        out[3 * (i + lane) + 0] = p.x[lane];
-        out[3 * (i + lane) + 1] = p.y[lane];
-        out[3 * (i + lane) + 2] = p.z[lane];
+      const std::size_t count = batch.count;
+      if (n == kLanes) {
+        std::memcpy(out + i, &p.x, sizeof(Float8));
+        std::memcpy(out + count + i, &p.y, sizeof(Float8));
+        std::memcpy(out + 2 * count + i, &p.z, sizeof(Float8));
+      } else {
+        for (int lane = 0; lane < n; ++lane) {
+          out[i + lane] = p.x[lane];
+          out[count + i + lane] = p.y[lane];
+          out[2 * count + i + lane] = p.z[lane];
+        }
       }
     }
     begin = end;

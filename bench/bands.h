@@ -2,8 +2,9 @@
 //   far/near ratio (the frame's f/n; "inf" for infinite-far conventions),
 //   eye depth over near (z/n, where in the frustum the point lies),
 //   camera distance from the world origin (how large world coordinates are).
-// Ratio and depth are kept jointly (the error models need both at once);
-// camera distance separately.
+// Ratio and depth are kept jointly (the error models need both at once),
+// with every metric; camera distance separately, with the total and the
+// storage error (what camera distance does shows there whole).
 #pragma once
 
 #include <cmath>

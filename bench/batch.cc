@@ -21,6 +21,25 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
   return layout;
 }
 
+void ReferenceArrays::Resize(std::size_t n) {
+  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square}) v->resize(n);
+  joint_band.resize(n);
+  status.resize(n);
+}
+
+void ReferenceArrays::Set(std::size_t at, const ReferenceSample& r, double storage) {
+  true_depth[at] = r.true_depth;
+  denoted_depth[at] = r.denoted_depth;
+  inverse_distance_sq[at] = r.inverse_distance_sq;
+  storage_square[at] = storage;
+  joint_band[at] = r.joint_band;
+  status[at] = r.status;
+}
+
+ReferenceSample ReferenceArrays::Get(std::size_t at) const {
+  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at], joint_band[at], status[at]};
+}
+
 BatchBuilder::BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings)
     : sampler_(sampler), encodings_(std::move(encodings)) {
   for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
@@ -70,7 +89,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
 
   // Samples: pixel, ray and depth pick.
   batch.pixels.resize(count);
-  batch.rays.resize(count);
+  for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
   batch.facts.resize(count);
   pool.ParallelFor(
       count,
@@ -79,8 +98,11 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
           const PixelSample sample = sampler_.SampleAt(first + i, frame);
           batch.pixels[i] = sample.x | (sample.y << 16);
-          batch.rays[i] = PixelRay(frame, sample.x, sample.y);
-          batch.facts[i] = FactsOf(frame, sample, batch.rays[i]);
+          const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);
+          batch.ray_x[i] = ray.x;
+          batch.ray_y[i] = ray.y;
+          batch.ray_z[i] = ray.z;
+          batch.facts[i] = FactsOf(frame, sample, ray);
         }
       },
       256);
@@ -108,8 +130,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
 
   batch.depths.resize(slots * count);
   batch.codes.resize(slots * count);
-  batch.reference.resize(slots * count);
-  batch.storage_squares.resize(slots * count);
+  batch.reference.Resize(slots * count);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
@@ -124,7 +145,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         const std::size_t at = s * count + i;
         batch.depths[at] = stored.fetched;
         batch.codes[at] = stored.code;
-        batch.reference[at] = ReferenceFor(frame, facts, encoding, stored.code, batch.storage_squares[at]);
+        double storage_square = 0.0;
+        const ReferenceSample r = ReferenceFor(frame, facts, encoding, stored.code, storage_square);
+        batch.reference.Set(at, r, storage_square);
       }
     }
   });

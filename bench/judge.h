@@ -1,8 +1,8 @@
-// Judge: compares a backend's raw outputs for one cell with the reference
-// and records the errors. It works on host memory and knows nothing of
-// backends.
+// Judge: compares backends' raw outputs with the reference and records the
+// errors. It works on host memory and knows nothing of backends.
 #pragma once
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -11,24 +11,23 @@
 
 namespace depthbench {
 
-// Reusable per-thread buffers of the judge.
-struct JudgeScratch {
-  std::vector<double> total, arith, absolute;
-  std::vector<std::int16_t> total_bin, arith_bin, absolute_bin;
+// One cell's outputs to judge: world x, y and z of every sample of the
+// batch, and where its errors go.
+struct JudgedCell {
+  std::span<const float> positions;
+  CellAccumulator* accumulator;
 };
 
-// `positions` holds 3 floats (world x, y, z) per sample of the batch.
-// Records total, arithmetic and absolute errors (storage errors belong to
-// the encoding: RecordStorage).
-void JudgeCell(const Batch& batch, const CellPlan& plan, std::span<const float> positions,
-               CellAccumulator& accumulator, JudgeScratch& scratch);
+// Judges every listed cell that reads depth slot `depth_slot` (they share
+// the slot's reference, read once). Records total, arithmetic and absolute
+// errors; storage errors belong to the encoding (RecordStorage).
+void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells);
 
 // Records the storage error of one depth slot's samples.
 void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator);
 
 // The squared errors of one output (for reproducers and tests): relative
-// total, relative arithmetic, absolute total. NaN when the output is not
-// finite.
+// total, relative arithmetic, absolute total.
 struct SampleErrors {
   double total_sq = 0.0;
   double arith_sq = 0.0;

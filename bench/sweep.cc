@@ -104,7 +104,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   std::vector<CellAccumulator> storage_accumulators(slot_count);
   std::vector<CellStats> storage_stats(slot_count);
   std::vector<std::vector<float>> scratch(pool.size());
-  std::vector<JudgeScratch> judge_scratch(pool.size());
+  std::vector<std::vector<std::uint32_t>> cells_of_slot(slot_count);
+  for (std::uint32_t c = 0; c < cell_count; ++c) cells_of_slot[layout.cells[c].depth_slot].push_back(c);
   std::vector<std::uint32_t> every_cell(cell_count);
   std::iota(every_cell.begin(), every_cell.end(), 0u);
 
@@ -119,32 +120,39 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];
       CellAccumulator* acc = accumulators.data() + b * cell_count;
-      FirstError error;
+      // The cells are judged a depth slot at a time: those that read the
+      // same encoding share its reference.
+      auto judge = [&](std::size_t slot, auto positions_of) {
+        std::vector<JudgedCell> judged;
+        for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
+        JudgeSlot(batch, static_cast<std::uint32_t>(slot), judged);
+      };
+      const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (backend.concurrent()) {
-        pool.ParallelFor(cell_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
-          for (std::size_t c = lo; c < hi; ++c) {
-            const std::uint32_t which = static_cast<std::uint32_t>(c);
-            auto out = backend.Run(batch, {&which, 1}, scratch[worker]);
+        FirstError error;
+        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
+          for (std::size_t slot = lo; slot < hi; ++slot) {
+            auto out = backend.Run(batch, cells_of_slot[slot], scratch[worker]);
             if (!out.ok()) {
               error.Set(out.status());
               return;
             }
-            JudgeCell(batch, layout.cells[c], *out, acc[c], judge_scratch[worker]);
+            const std::span<const float> positions = *out;
+            std::size_t k = 0;
+            judge(slot, [&](std::uint32_t) { return positions.subspan(per_cell * k++, per_cell); });
           }
         });
+        DB_RETURN_IF_ERROR(error.Get().WithContext("running the " + backend.name() + " backend"));
       } else {
         auto out = backend.Run(batch, every_cell, scratch[0]);
         if (!out.ok()) return out.status().WithContext("running the " + backend.name() + " backend");
         const std::span<const float> positions = *out;
-        const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
-        pool.ParallelFor(cell_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
-          for (std::size_t c = lo; c < hi; ++c) {
-            JudgeCell(batch, layout.cells[c], positions.subspan(c * per_cell, per_cell), acc[c],
-                      judge_scratch[worker]);
+        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t slot = lo; slot < hi; ++slot) {
+            judge(slot, [&](std::uint32_t c) { return positions.subspan(c * per_cell, per_cell); });
           }
         });
       }
-      DB_RETURN_IF_ERROR(error.Get().WithContext("running the " + backend.name() + " backend"));
     }
     pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
       for (std::size_t e = lo; e < hi; ++e) RecordStorage(batch, static_cast<std::uint32_t>(e), storage_accumulators[e]);

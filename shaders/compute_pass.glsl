@@ -22,8 +22,9 @@ void main() {
   uint pixel = pixels[i];
   vec2 uv = uv_from_pixel(float(pixel & 0xffffu), float(pixel >> 16u), frame.resolution);
   vec3 p = RECONSTRUCT(frame, depth, uv, stored_depths[pass.depth_offset + i]);
-  uint o = pass.output_offset + 3u * i;
+  // Component by component: x of every sample, then y, then z.
+  uint o = pass.output_offset + i;
   positions[o] = p.x;
-  positions[o + 1u] = p.y;
-  positions[o + 2u] = p.z;
+  positions[o + pass.sample_count] = p.y;
+  positions[o + 2u * pass.sample_count] = p.z;
 }

@@ -59,7 +59,7 @@ struct PassConstants {
   uint convention_slot;     // index of this cell's convention within a frame's DepthParams
   uint conventions_per_frame;
   uint depth_offset;        // first element of this cell's stored depths in the depth buffer
-  uint output_offset;       // first float of this cell's output positions (3 floats per sample)
+  uint output_offset;       // first float of this cell's positions: x of every sample, then y, then z
   uint first_sample_in_frame;  // index of the batch's first sample within its frame
   uint reserved0;
 };
