@@ -1,6 +1,7 @@
 #include "bench/batch.h"
 
 #include <algorithm>
+#include <array>
 
 #include "bench/bands.h"
 #include "bench/encode.h"
@@ -19,25 +20,6 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
     layout.cells.push_back({cell, slot, convention_slot});
   }
   return layout;
-}
-
-void ReferenceArrays::Resize(std::size_t n) {
-  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square}) v->resize(n);
-  joint_band.resize(n);
-  status.resize(n);
-}
-
-void ReferenceArrays::Set(std::size_t at, const ReferenceSample& r, double storage) {
-  true_depth[at] = r.true_depth;
-  denoted_depth[at] = r.denoted_depth;
-  inverse_distance_sq[at] = r.inverse_distance_sq;
-  storage_square[at] = storage;
-  joint_band[at] = r.joint_band;
-  status[at] = r.status;
-}
-
-ReferenceSample ReferenceArrays::Get(std::size_t at) const {
-  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at], joint_band[at], status[at]};
 }
 
 BatchBuilder::BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings)
@@ -90,7 +72,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // Samples: pixel, ray and depth pick.
   batch.pixels.resize(count);
   for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
-  batch.facts.resize(count);
+  batch.samples.Resize(count);
   pool.ParallelFor(
       count,
       [&](std::size_t begin, std::size_t end, unsigned) {
@@ -102,14 +84,15 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           batch.ray_x[i] = ray.x;
           batch.ray_y[i] = ray.y;
           batch.ray_z[i] = ray.z;
-          batch.facts[i] = FactsOf(frame, sample, ray);
+          batch.samples.Set(i, frame, sample, ray);
         }
       },
       256);
 
-  // Encodings, one depth slot at a time so that every loop writes one
-  // array in order: the pipeline's floats (shared by a convention's
-  // formats), then the stored texels and the reference.
+  // Encodings, in chunks of samples, each loop over arrays: the pipeline's
+  // floats (shared by a convention's formats), then per depth slot the
+  // stored texels, their decode and the reference.
+  const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
   pipeline_floats_.resize(pipelines * count);
   constexpr std::size_t kChunk = 1024;
@@ -117,14 +100,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t k = job / chunks;
-      const Encoding encoding = encodings_[pipeline_slots_[k]];
-      float* out = pipeline_floats_.data() + k * count;
-      const std::size_t lo = (job % chunks) * kChunk, hi = std::min<std::size_t>(count, lo + kChunk);
-      for (std::size_t i = lo; i < hi; ++i) {
-        const SampleFacts& facts = batch.facts[i];
-        if (facts.pick != DepthPick::kEyeDepth) continue;
-        out[i] = PipelineFloat(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], facts.eye_depth);
-      }
+      const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
+      PipelineFloats(encodings_[pipeline_slots_[k]], samples.near.data() + lo, samples.far.data() + lo,
+                     samples.eye_depth.data() + lo, n, pipeline_floats_.data() + k * count + lo);
     }
   });
 
@@ -132,23 +110,24 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.codes.resize(slots * count);
   batch.reference.Resize(slots * count);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    std::array<double, kChunk> denoted_hi, denoted_lo;
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
       const Encoding encoding = encodings_[s];
-      const float* pipeline = pipeline_floats_.data() + pipeline_of_slot_[s] * count;
-      const std::size_t lo = (job % chunks) * kChunk, hi = std::min<std::size_t>(count, lo + kChunk);
-      for (std::size_t i = lo; i < hi; ++i) {
-        const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
-        const SampleFacts& facts = batch.facts[i];
-        const StoredDepth stored = facts.pick == DepthPick::kEyeDepth ? StoreFloat(encoding.format, pipeline[i])
-                                                                      : EncodeEdge(encoding, frame, facts.pick);
-        const std::size_t at = s * count + i;
-        batch.depths[at] = stored.fetched;
-        batch.codes[at] = stored.code;
-        double storage_square = 0.0;
-        const ReferenceSample r = ReferenceFor(frame, facts, encoding, stored.code, storage_square);
-        batch.reference.Set(at, r, storage_square);
+      const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
+      const std::size_t at = s * count + lo;
+      StoreFloats(encoding.format, pipeline_floats_.data() + pipeline_of_slot_[s] * count + lo, n,
+                  batch.codes.data() + at, batch.depths.data() + at);
+      for (std::size_t i = lo; i < lo + n; ++i) {
+        if (samples.pick[i] == DepthPick::kEyeDepth) continue;
+        const StoredDepth edge =
+            EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], samples.pick[i]);
+        batch.codes[s * count + i] = edge.code;
+        batch.depths[s * count + i] = edge.fetched;
       }
+      DecodeEyeDepths(encoding, samples.near.data() + lo, samples.far.data() + lo, batch.codes.data() + at,
+                      batch.depths.data() + at, n, denoted_hi.data(), denoted_lo.data());
+      References(encoding, samples, lo, n, denoted_hi.data(), denoted_lo.data(), batch.reference, at);
     }
   });
 }

@@ -18,17 +18,6 @@
 
 namespace depthbench {
 
-// ReferenceSample fields, one array each.
-struct ReferenceArrays {
-  std::vector<double> true_depth, denoted_depth, inverse_distance_sq, storage_square;
-  std::vector<std::uint8_t> joint_band;
-  std::vector<ReferenceStatus> status;
-
-  void Resize(std::size_t n);
-  void Set(std::size_t at, const ReferenceSample& r, double storage_square);
-  ReferenceSample Get(std::size_t at) const;
-};
-
 struct Batch {
   std::uint64_t first_index = 0;
   std::uint32_t count = 0;
@@ -45,9 +34,9 @@ struct Batch {
   std::vector<Frame> frames;                   // [frame]: exact parameters
   std::vector<std::uint8_t> distance_bands;    // [frame]: DistanceBand of the camera
   std::vector<double> ray_x, ray_y, ray_z;     // [sample]: world-space ray at unit eye depth
+  SampleArrays samples;                        // [sample]: the depth pick and what the reference needs
   ReferenceArrays reference;                   // [depth slot * count + sample]
   std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: stored texel bits
-  std::vector<SampleFacts> facts;              // [sample]: the depth pick and what the reference needs
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 

@@ -1,138 +1,175 @@
 // DoubleDouble: an unevaluated sum hi + lo of two doubles with |lo| <= ulp(hi)/2,
 // about 106 bits of significand. It is the `real` of the high-precision
-// instantiation of shared/ (the reference), where a plain double is not
-// enough: a decode near the far plane at far/near = 1e9 cancels 30 bits, and
-// the reference must stay far below float32 rounding (2^-24) after that.
+// instantiations of shared/: hp (exact shader constants, rounding decisions,
+// formula tests) and hp4, four lanes at once, where the reference decodes
+// stored depths. Near the far plane at far/near = 1e9 a decode can lose 30
+// bits to cancellation in any precision; the reference must stay far below
+// float32 rounding (2^-24) after that.
 //
 // The algorithms are the classical error-free transformations (Knuth's
 // two-sum, Dekker's fast two-sum, an FMA-based exact product) combined as in
 // Bailey's and Hida, Li & Bailey's double-double arithmetic; addition and
 // multiplication have relative error below 2^-103, division below 2^-102
-// (tests/reference_test.cc checks the composed formulas against MPFR).
-// They rely on IEEE double rounding with no contraction of a*b+c into an FMA
-// other than the explicit std::fma calls: the project builds with
-// -ffp-contract=off.
+// (tests/reference_test.cc checks them against MPFR). They rely on IEEE
+// double rounding with no contraction of a*b+c into an FMA other than the
+// explicit ones: the project builds with -ffp-contract=off.
+//
+// One template serves both widths: the lane type D is double or Double4
+// (four doubles, GCC vector extensions), and the code is branch-free
+// (special values are fixed up by selects), so every lane of the wide type
+// computes exactly what the scalar type computes.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 
+#if defined(__FMA__)
+#include <immintrin.h>
+#endif
+
 namespace depthbench {
 
-class DoubleDouble {
- public:
-  // Trivial, so that GLM can hold it in its component unions; like a
-  // double, a default-constructed value is uninitialized.
-  DoubleDouble() = default;
-  // Implicit: every double (and float, and integer up to 2^53) is exact.
-  constexpr DoubleDouble(double value) : hi_(value), lo_(0.0) {}  // NOLINT
-  static constexpr DoubleDouble FromParts(double hi, double lo) {
-    DoubleDouble r(hi);
-    r.hi_ = hi;
-    r.lo_ = lo;
-    return r;
-  }
-
-  constexpr double hi() const { return hi_; }
-  constexpr double lo() const { return lo_; }
-  // The nearest double (hi is already the rounded sum).
-  constexpr double ToDouble() const { return hi_; }
-
-  friend DoubleDouble operator+(DoubleDouble a, DoubleDouble b);
-  friend DoubleDouble operator-(DoubleDouble a, DoubleDouble b);
-  friend DoubleDouble operator*(DoubleDouble a, DoubleDouble b);
-  friend DoubleDouble operator/(DoubleDouble a, DoubleDouble b);
-  friend DoubleDouble operator-(DoubleDouble a) { return FromParts(-a.hi_, -a.lo_); }
-
-  DoubleDouble& operator+=(DoubleDouble b) { return *this = *this + b; }
-  DoubleDouble& operator-=(DoubleDouble b) { return *this = *this - b; }
-  DoubleDouble& operator*=(DoubleDouble b) { return *this = *this * b; }
-  DoubleDouble& operator/=(DoubleDouble b) { return *this = *this / b; }
-
-  friend bool operator==(DoubleDouble a, DoubleDouble b) { return a.hi_ == b.hi_ && a.lo_ == b.lo_; }
-  friend bool operator<(DoubleDouble a, DoubleDouble b) {
-    return a.hi_ < b.hi_ || (a.hi_ == b.hi_ && a.lo_ < b.lo_);
-  }
-  friend bool operator>(DoubleDouble a, DoubleDouble b) { return b < a; }
-  friend bool operator<=(DoubleDouble a, DoubleDouble b) { return !(b < a); }
-  friend bool operator>=(DoubleDouble a, DoubleDouble b) { return !(a < b); }
-
- private:
-  double hi_;
-  double lo_;
-};
+using Double4 = double __attribute__((vector_size(32)));
 
 namespace dd_detail {
 
+inline double Fma(double a, double b, double c) { return std::fma(a, b, c); }
+inline Double4 Fma(Double4 a, Double4 b, Double4 c) {
+#if defined(__FMA__)
+  return reinterpret_cast<Double4>(_mm256_fmadd_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b),
+                                                   reinterpret_cast<__m256d>(c)));
+#else
+  Double4 r;
+  for (int k = 0; k < 4; ++k) r[k] = std::fma(a[k], b[k], c[k]);
+  return r;
+#endif
+}
+
+// x is neither infinite nor NaN: a bool for double, a lane mask for Double4.
+template <class D>
+auto Finite(D x) {
+  return (x - x) == D{} * 0.0;
+}
+
+template <class D>
+D Broadcast(double x) {
+  return D{} * 0.0 + x;
+}
+
 // s + e == a + b exactly, s = fl(a + b).
-inline void TwoSum(double a, double b, double& s, double& e) {
+template <class D>
+void TwoSum(D a, D b, D& s, D& e) {
   s = a + b;
-  double bb = s - a;
+  D bb = s - a;
   e = (a - (s - bb)) + (b - bb);
 }
 
 // As TwoSum, valid when |a| >= |b| (or a == 0).
-inline void FastTwoSum(double a, double b, double& s, double& e) {
+template <class D>
+void FastTwoSum(D a, D b, D& s, D& e) {
   s = a + b;
   e = b - (s - a);
 }
 
 // p + e == a * b exactly (barring underflow), p = fl(a * b).
-inline void TwoProduct(double a, double b, double& p, double& e) {
+template <class D>
+void TwoProduct(D a, D b, D& p, D& e) {
   p = a * b;
-  e = std::fma(a, b, -p);
+  e = Fma(a, b, -p);
 }
 
 }  // namespace dd_detail
 
-inline DoubleDouble operator+(DoubleDouble a, DoubleDouble b) {
-  double s, e, t, f;
-  dd_detail::TwoSum(a.hi_, b.hi_, s, e);
-  if (!std::isfinite(s)) return DoubleDouble(s);
-  dd_detail::TwoSum(a.lo_, b.lo_, t, f);
-  e += t;
-  dd_detail::FastTwoSum(s, e, s, e);
-  e += f;
-  dd_detail::FastTwoSum(s, e, s, e);
-  return DoubleDouble::FromParts(s, e);
+template <class D>
+class BasicDoubleDouble {
+ public:
+  // Trivial, so that GLM can hold it in its component unions; like a
+  // double, a default-constructed value is uninitialized.
+  BasicDoubleDouble() = default;
+  // Implicit: every double (and float, and integer up to 2^53) is exact.
+  BasicDoubleDouble(double value)  // NOLINT
+      : hi_(dd_detail::Broadcast<D>(value)), lo_(dd_detail::Broadcast<D>(0.0)) {}
+  static BasicDoubleDouble FromParts(D hi, D lo) {
+    BasicDoubleDouble r;
+    r.hi_ = hi;
+    r.lo_ = lo;
+    return r;
+  }
+
+  D hi() const { return hi_; }
+  D lo() const { return lo_; }
+  // The nearest double (hi is already the rounded sum).
+  D ToDouble() const { return hi_; }
+
+  friend BasicDoubleDouble operator+(BasicDoubleDouble a, BasicDoubleDouble b) {
+    D s, e, t, f;
+    dd_detail::TwoSum(a.hi_, b.hi_, s, e);
+    dd_detail::TwoSum(a.lo_, b.lo_, t, f);
+    e += t;
+    D s2, e2;
+    dd_detail::FastTwoSum(s, e, s2, e2);
+    e2 += f;
+    D s3, e3;
+    dd_detail::FastTwoSum(s2, e2, s3, e3);
+    // An infinite or NaN sum: the error terms are meaningless.
+    const auto finite = dd_detail::Finite(s);
+    return FromParts(finite ? s3 : s, finite ? e3 : D{} * 0.0);
+  }
+  friend BasicDoubleDouble operator-(BasicDoubleDouble a) { return FromParts(-a.hi_, -a.lo_); }
+  friend BasicDoubleDouble operator-(BasicDoubleDouble a, BasicDoubleDouble b) { return a + (-b); }
+
+  friend BasicDoubleDouble operator*(BasicDoubleDouble a, BasicDoubleDouble b) {
+    D p, e;
+    dd_detail::TwoProduct(a.hi_, b.hi_, p, e);
+    e += a.hi_ * b.lo_ + a.lo_ * b.hi_;
+    D p2, e2;
+    dd_detail::FastTwoSum(p, e, p2, e2);
+    const auto finite = dd_detail::Finite(p);
+    return FromParts(finite ? p2 : p, finite ? e2 : D{} * 0.0);
+  }
+
+  friend BasicDoubleDouble operator/(BasicDoubleDouble a, BasicDoubleDouble b) {
+    // Long division: three quotient digits, each correcting the remainder
+    // of the previous ones. The digits need only be close (each remainder
+    // is exact), so one reciprocal serves all three and the chain holds one
+    // division instead of three.
+    const D inverse = dd_detail::Broadcast<D>(1.0) / b.hi_;
+    const D q1 = a.hi_ * inverse;
+    BasicDoubleDouble r = a - b * FromParts(q1, D{} * 0.0);
+    const D q2 = r.hi_ * inverse;
+    r = r - b * FromParts(q2, D{} * 0.0);
+    const D q3 = r.hi_ * inverse;
+    D s, e;
+    dd_detail::FastTwoSum(q1, q2, s, e);
+    BasicDoubleDouble q = FromParts(s, e) + FromParts(q3, D{} * 0.0);
+    // Division by zero, infinities, or an exact zero quotient: the first
+    // digit is the answer.
+    const auto plain = !dd_detail::Finite(q1) || q1 == D{} * 0.0;
+    return FromParts(plain ? q1 : q.hi_, plain ? D{} * 0.0 : q.lo_);
+  }
+
+  BasicDoubleDouble& operator+=(BasicDoubleDouble b) { return *this = *this + b; }
+  BasicDoubleDouble& operator-=(BasicDoubleDouble b) { return *this = *this - b; }
+  BasicDoubleDouble& operator*=(BasicDoubleDouble b) { return *this = *this * b; }
+  BasicDoubleDouble& operator/=(BasicDoubleDouble b) { return *this = *this / b; }
+
+ private:
+  D hi_;
+  D lo_;
+};
+
+using DoubleDouble = BasicDoubleDouble<double>;
+using DoubleDouble4 = BasicDoubleDouble<Double4>;
+
+// Scalar comparisons (only the narrow type is ever compared).
+inline bool operator==(DoubleDouble a, DoubleDouble b) { return a.hi() == b.hi() && a.lo() == b.lo(); }
+inline bool operator<(DoubleDouble a, DoubleDouble b) {
+  return a.hi() < b.hi() || (a.hi() == b.hi() && a.lo() < b.lo());
 }
+inline bool operator>(DoubleDouble a, DoubleDouble b) { return b < a; }
+inline bool operator<=(DoubleDouble a, DoubleDouble b) { return !(b < a); }
+inline bool operator>=(DoubleDouble a, DoubleDouble b) { return !(a < b); }
 
-inline DoubleDouble operator-(DoubleDouble a, DoubleDouble b) { return a + (-b); }
-
-inline DoubleDouble operator*(DoubleDouble a, DoubleDouble b) {
-  double p, e;
-  dd_detail::TwoProduct(a.hi_, b.hi_, p, e);
-  if (!std::isfinite(p)) return DoubleDouble(p);
-  e += a.hi_ * b.lo_ + a.lo_ * b.hi_;
-  dd_detail::FastTwoSum(p, e, p, e);
-  return DoubleDouble::FromParts(p, e);
-}
-
-inline DoubleDouble operator/(DoubleDouble a, DoubleDouble b) {
-  // Long division: three quotient digits, each correcting the remainder of
-  // the previous ones.
-  double q1 = a.hi_ / b.hi_;
-  if (!std::isfinite(q1) || q1 == 0.0) return DoubleDouble(q1);
-  DoubleDouble r = a - b * DoubleDouble(q1);
-  double q2 = r.hi_ / b.hi_;
-  r = r - b * DoubleDouble(q2);
-  double q3 = r.hi_ / b.hi_;
-  double s, e;
-  dd_detail::FastTwoSum(q1, q2, s, e);
-  return DoubleDouble::FromParts(s, e) + DoubleDouble(q3);
-}
-
-inline DoubleDouble Abs(DoubleDouble a) { return a.hi() < 0.0 ? -a : a; }
-
-inline DoubleDouble Sqrt(DoubleDouble a) {
-  if (a.hi() <= 0.0) return DoubleDouble(std::sqrt(a.hi()));
-  // One Newton step from the double square root doubles its precision.
-  double x = std::sqrt(a.hi());
-  DoubleDouble xx = DoubleDouble(x) * DoubleDouble(x);
-  return DoubleDouble(x) + (a - xx) / DoubleDouble(2.0 * x);
-}
-
-inline bool IsFinite(DoubleDouble a) { return std::isfinite(a.hi()); }
 
 // The float nearest to hi + lo (ties to even), without double rounding: a
 // rounding of hi to float can only be wrong when hi lies exactly halfway

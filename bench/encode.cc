@@ -1,9 +1,12 @@
 #include "bench/encode.h"
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "bench/double_double.h"
 #include "bench/formulas.h"
@@ -14,87 +17,119 @@ namespace {
 
 using DD = DoubleDouble;
 
-// Relative error bounds of the step-2 evaluations: a handful of correctly
-// rounded operations, each below 2^-64 (long double) or 2^-104
-// (double-double); the bounds leave a wide margin.
-constexpr long double kLongDoubleError = 0x1p-59L;
+// Relative error bound of the double-double evaluations of step 2: a
+// handful of operations, each below 2^-103.
 constexpr double kDoubleDoubleError = 0x1p-96;
 
-std::atomic<std::uint64_t> double_double_fallbacks{0};
+std::atomic<std::uint64_t> tie_fallbacks{0};
 std::atomic<std::uint64_t> mpfr_fallbacks{0};
-
-// Whether some value within `relative_error` of x rounds to a different
-// float than x: i.e. x is that close to a midpoint between two floats.
-template <class T, class ToFloat>
-bool NearFloatBoundary(T x, T relative_error, ToFloat to_float) {
-  float f = to_float(x);
-  if (!std::isfinite(f)) return false;
-  T tolerance = (x < T(0.0) ? -x : x) * relative_error + T(0x1p-1074);
-  for (float neighbour : {std::nextafter(f, -INFINITY), std::nextafter(f, INFINITY)}) {
-    T midpoint = (T(static_cast<double>(f)) + T(static_cast<double>(neighbour))) * T(0.5);  // exact
-    T distance = midpoint - x;
-    if ((distance < T(0.0) ? -distance : distance) <= tolerance) return true;
-  }
-  return false;
-}
-
-// The float nearest to an exact value, evaluated as cheaply as the value
-// allows: long double first, double-double and MPFR only near a tie.
-template <class Fast, class Precise, class Exact>
-float RoundExactly(Fast fast, Precise precise, Exact exact) {
-  long double x = fast();
-  auto ld_to_float = [](long double v) { return static_cast<float>(v); };
-  if (!NearFloatBoundary(x, kLongDoubleError, ld_to_float)) return static_cast<float>(x);
-  double_double_fallbacks.fetch_add(1, std::memory_order_relaxed);
-  DD y = precise();
-  if (!NearFloatBoundary(y, DD(kDoubleDoubleError), [](DD v) { return RoundToFloat(v); })) {
-    return RoundToFloat(y);
-  }
-  mpfr_fallbacks.fetch_add(1, std::memory_order_relaxed);
-  return exact().ToFloat();
-}
 
 double FarOrZero(const Frame& frame) { return frame.finite() ? frame.far : 0.0; }
 constexpr double UnormScale(int bits) { return static_cast<double>((std::uint64_t{1} << bits) - 1); }
 
-// Step 2 for hardware depth: the float32 window depth.
-float WindowDepthAsFloat(Convention convention, const Frame& frame, double z) {
-  const std::uint32_t bits = Info(convention).bits;
-  const double n = frame.near, f = FarOrZero(frame);
-  auto fast = [&] { return ld::window_depth_from_eye_depth(n, f, bits, z); };
-  auto precise = [&] { return hp::window_depth_from_eye_depth(DD(n), DD(f), bits, DD(z)); };
-  auto exact = [&] { return mp::window_depth_from_eye_depth(n, f, bits, z); };
-  if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) return RoundExactly(fast, precise, exact);
-  // GL-style: the rasterizer's float32 is NDC depth, then the viewport
-  // transform maps it back to [0, 1] in float32 (exact in double, one rounding).
-  float ndc = RoundExactly([&] { return fast() * 2.0L - 1.0L; }, [&] { return precise() * DD(2.0) - DD(1.0); },
-                           [&] { return exact() * mp::real(2.0) - mp::real(1.0); });
-  return static_cast<float>(0.5 * static_cast<double>(ndc) + 0.5);
+using Float4 = float __attribute__((vector_size(16)));
+using Bits4 = std::uint64_t __attribute__((vector_size(32)));
+
+// The float nearest to the exact value x that `v` approximates (relative
+// error below kDoubleDoubleError), four lanes at a time. float(hi) is right
+// unless hi lies exactly halfway between two floats: then the low 29 of its
+// 52 fraction bits read 1000...0 (in the normal range of floats). Those
+// lanes, and float subnormals and non-finite values, go through `scalar`,
+// which is given the lane's index. Only the first `lanes` lanes are real.
+template <class Scalar>
+Float4 RoundToFloat4(DoubleDouble4 v, int lanes, Scalar scalar) {
+  const Double4 hi = v.hi();
+  Float4 f = __builtin_convertvector(hi, Float4);
+  const Bits4 bits = reinterpret_cast<Bits4>(hi);
+  const Double4 magnitude = reinterpret_cast<Double4>(bits & 0x7fffffffffffffffull);
+  const auto midpoint = (bits & 0x1fffffffull) == 0x10000000ull;
+  const auto ordinary = magnitude >= 0x1p-126 && magnitude < 0x1p127;
+  const auto special = midpoint | !ordinary;
+  for (int k = 0; k < lanes; ++k) {
+    if (special[k]) f[k] = scalar(k, DoubleDouble::FromParts(hi[k], v.lo()[k]));
+  }
+  return f;
+}
+
+// A lane RoundToFloat4 could not settle: outside the normal range of
+// floats, or on a midpoint between two floats, where the low part decides
+// unless it is within the error bound (then MPFR does).
+template <class Exact>
+float SettleLane(DoubleDouble x, Exact exact) {
+  const double hi = x.hi();
+  const float f = static_cast<float>(hi);
+  if (!std::isfinite(f) || static_cast<double>(f) == hi) return f;
+  const float g = std::nextafter(f, hi > static_cast<double>(f) ? INFINITY : -INFINITY);
+  if (hi != (static_cast<double>(f) + static_cast<double>(g)) * 0.5) return f;  // not a tie
+  tie_fallbacks.fetch_add(1, std::memory_order_relaxed);
+  if (std::fabs(x.lo()) > std::fabs(hi) * kDoubleDoubleError) return RoundToFloat(x);
+  mpfr_fallbacks.fetch_add(1, std::memory_order_relaxed);
+  return exact().ToFloat();
+}
+
+// Steps 1 and 2 for four samples: the exact value in double-double, then
+// correctly rounded to float32 (GL-style clip depth: NDC depth, then the
+// viewport transform in float32, exact in double with one rounding).
+Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, const double* z, int lanes) {
+  const std::uint32_t bits = Info(encoding.convention).bits;
+  Double4 n, f, depth;
+  for (int k = 0; k < 4; ++k) {
+    n[k] = near[k];
+    f[k] = far[k];
+    depth[k] = z[k];
+  }
+  const auto wide = [](Double4 x) { return DoubleDouble4::FromParts(x, Double4{}); };
+  auto exact_window = [&](int k) { return mp::window_depth_from_eye_depth(near[k], far[k], bits, z[k]); };
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: {
+      const DoubleDouble4 window = hp4::window_depth_from_eye_depth(wide(n), wide(f), bits, wide(depth));
+      if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) {
+        return RoundToFloat4(window, lanes, [&](int k, DoubleDouble x) { return SettleLane(x, [&] { return exact_window(k); }); });
+      }
+      const Float4 ndc = RoundToFloat4(window * DoubleDouble4(2.0) - DoubleDouble4(1.0), lanes, [&](int k, DoubleDouble x) {
+        return SettleLane(x, [&] { return exact_window(k) * mp::real(2.0) - mp::real(1.0); });
+      });
+      return __builtin_convertvector(0.5 * __builtin_convertvector(ndc, Double4) + 0.5, Float4);
+    }
+    case DepthInput::kLinear:
+      return RoundToFloat4(wide(depth) / wide(f), lanes, [&](int k, DoubleDouble x) {
+        return SettleLane(x, [&] { return mp::real(z[k]) / mp::real(far[k]); });
+      });
+    case DepthInput::kViewZ:
+      return __builtin_convertvector(-depth, Float4);
+  }
+  return Float4{};
 }
 
 }  // namespace
 
-EncodeFallbacks EncodeFallbackCounts() { return {double_double_fallbacks.load(), mpfr_fallbacks.load()}; }
+EncodeFallbacks EncodeFallbackCounts() { return {tie_fallbacks.load(), mpfr_fallbacks.load()}; }
+
+void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth,
+                    std::size_t n, float* out) {
+  for (std::size_t i = 0; i < n; i += 4) {
+    double lanes[3][4];
+    for (std::size_t k = 0; k < 4; ++k) {
+      const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
+      lanes[0][k] = near[at];
+      lanes[1][k] = far[at];
+      lanes[2][k] = eye_depth[at];
+    }
+    const Float4 f = PipelineFloat4(encoding, lanes[0], lanes[1], lanes[2], static_cast<int>(std::min<std::size_t>(4, n - i)));
+    for (std::size_t k = 0; k < 4 && i + k < n; ++k) out[i + k] = f[k];
+  }
+}
 
 float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth) {
-  switch (Info(encoding.format).stores) {
-    case DepthInput::kHardware:
-      return WindowDepthAsFloat(encoding.convention, frame, eye_depth);
-    case DepthInput::kLinear:
-      return RoundExactly([&] { return static_cast<long double>(eye_depth) / frame.far; },
-                          [&] { return DD(eye_depth) / DD(frame.far); },
-                          [&] { return mp::real(eye_depth) / mp::real(frame.far); });
-    case DepthInput::kViewZ:
-      return static_cast<float>(-eye_depth);
-  }
-  return 0.0f;
+  const double far = FarOrZero(frame);
+  float out;
+  PipelineFloats(encoding, &frame.near, &far, &eye_depth, 1, &out);
+  return out;
 }
 
 std::uint32_t FloatToUnorm(float value, int bits) {
-  double clamped = std::fmin(1.0, std::fmax(0.0, static_cast<double>(value)));
-  // value * (2^b - 1) is exact in double (24 + 24 bits); nearbyint rounds
-  // half to even in the default rounding mode.
-  return static_cast<std::uint32_t>(std::nearbyint(clamped * UnormScale(bits)));
+  const Format format = bits == 16 ? Format::kD16Unorm : Format::kX8D24Unorm;
+  return StoreFloat(format, value).code;
 }
 
 std::uint16_t FloatToHalf(float value) {
@@ -144,18 +179,44 @@ float FetchTexel(Format format, std::uint32_t code) {
   // period b, so it never lies within the double's 29 extra bits of a float
   // midpoint unless it is exactly representable. tests/encode_test.cc
   // checks every 16- and 24-bit code against an exact rounding.
-  return static_cast<float>(static_cast<double>(code) / UnormScale(info.bits));
+  // (The product with the rounded reciprocal is within 2^-52 of the
+  // quotient: still 28 bits of room.)
+  return static_cast<float>(static_cast<double>(code) * (1.0 / UnormScale(info.bits)));
+}
+
+void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_t* codes, float* fetched) {
+  const FormatInfo& info = Info(format);
+  switch (info.texel) {
+    case TexelKind::kUnorm: {
+      // value * (2^b - 1) is exact in double (24 + 24 bits); rint rounds half
+      // to even in the default rounding mode. The fetch: see FetchTexel.
+      const double scale = UnormScale(info.bits), inverse = 1.0 / scale;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double code = std::rint(std::clamp(static_cast<double>(values[i]), 0.0, 1.0) * scale);
+        codes[i] = static_cast<std::uint32_t>(code);
+        fetched[i] = static_cast<float>(code * inverse);
+      }
+      return;
+    }
+    case TexelKind::kFloat16:
+      for (std::size_t i = 0; i < n; ++i) {
+        codes[i] = FloatToHalf(values[i]);
+        fetched[i] = HalfToFloat(static_cast<std::uint16_t>(codes[i]));
+      }
+      return;
+    case TexelKind::kFloat32:
+      for (std::size_t i = 0; i < n; ++i) {
+        codes[i] = std::bit_cast<std::uint32_t>(values[i]);
+        fetched[i] = values[i];
+      }
+      return;
+  }
 }
 
 StoredDepth StoreFloat(Format format, float value) {
-  const FormatInfo& info = Info(format);
-  std::uint32_t code = 0;
-  switch (info.texel) {
-    case TexelKind::kUnorm: code = FloatToUnorm(value, info.bits); break;
-    case TexelKind::kFloat16: code = FloatToHalf(value); break;
-    case TexelKind::kFloat32: code = std::bit_cast<std::uint32_t>(value); break;
-  }
-  return {code, FetchTexel(format, code)};
+  StoredDepth stored;
+  StoreFloats(format, &value, 1, &stored.code, &stored.fetched);
+  return stored;
 }
 
 StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
@@ -193,28 +254,75 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
   return {code, FetchTexel(format, code)};
 }
 
-long double DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code) {
+namespace {
+
+// The decode of four texels. `texel` is the unorm code itself or the
+// float's value: both exact.
+DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 far, DoubleDouble4 texel) {
+  using DD = DoubleDouble4;
   const FormatInfo& info = Info(encoding.format);
-  // The code's exact value v and 1 - v, each rounded once.
-  long double value, complement;
+  // The texel's value v and 1 - v, both exact to double-double precision;
+  // for unorm codes c, v = c / (2^b - 1) and 1 - v = (2^b - 1 - c) / (2^b - 1).
+  DD value, complement;
   if (info.texel == TexelKind::kUnorm) {
-    const long double scale = UnormScale(info.bits);
-    value = static_cast<long double>(code) / scale;
-    complement = static_cast<long double>(scale - code) / scale;
+    // Times the double-double reciprocal of 2^b - 1 (good to 2^-104): two
+    // multiplications instead of two divisions.
+    static const DoubleDouble kInverse16 = DoubleDouble(1.0) / DoubleDouble(UnormScale(16));
+    static const DoubleDouble kInverse24 = DoubleDouble(1.0) / DoubleDouble(UnormScale(24));
+    const DoubleDouble inverse = info.bits == 16 ? kInverse16 : kInverse24;
+    const DD scale(UnormScale(info.bits));
+    const DD inverse_lanes = DD::FromParts(inverse.hi() + texel.hi() * 0.0, inverse.lo() + texel.hi() * 0.0);
+    value = texel * inverse_lanes;
+    complement = (scale - texel) * inverse_lanes;
   } else {
-    value = FetchTexel(encoding.format, code);  // exact for float formats
-    complement = 1.0L - value;                  // exact unless value < 2^-40, then harmless
+    value = texel;
+    complement = DD(1.0) - texel;
   }
   switch (info.stores) {
     case DepthInput::kHardware:
-      return ld::eye_depth_from_window_depth(frame.near, FarOrZero(frame), Info(encoding.convention).bits, value,
-                                             complement);
+      return hp4::eye_depth_from_window_depth(near, far, Info(encoding.convention).bits, value, complement);
     case DepthInput::kLinear:
-      return value * frame.far;
+      return value * far;
     case DepthInput::kViewZ:
       return -value;
   }
-  return NAN;
+  return DD(NAN);
+}
+
+}  // namespace
+
+void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
+                     const float* fetched, std::size_t n, double* hi, double* lo) {
+  const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
+  // Two groups of four per step: their dependency chains interleave.
+  constexpr std::size_t kStep = 8;
+  for (std::size_t i = 0; i < n; i += kStep) {
+    Double4 n4[2], f4[2], texel[2];
+    for (std::size_t k = 0; k < kStep; ++k) {
+      const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
+      n4[k / 4][k % 4] = near[at];
+      f4[k / 4][k % 4] = far[at];
+      // The texel as an exact number: the unorm code, or the float's value.
+      texel[k / 4][k % 4] = unorm ? static_cast<double>(codes[at]) : static_cast<double>(fetched[at]);
+    }
+    DoubleDouble4 z[2];
+    for (int g = 0; g < 2; ++g) {
+      z[g] = DecodeTexel(encoding, DoubleDouble4::FromParts(n4[g], Double4{}),
+                                        DoubleDouble4::FromParts(f4[g], Double4{}),
+                                        DoubleDouble4::FromParts(texel[g], Double4{}));
+    }
+    for (std::size_t k = 0; k < kStep && i + k < n; ++k) {
+      hi[i + k] = z[k / 4].hi()[k % 4];
+      lo[i + k] = z[k / 4].lo()[k % 4];
+    }
+  }
+}
+
+DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored) {
+  const double far = FarOrZero(frame);
+  double hi, lo;
+  DecodeEyeDepths(encoding, &frame.near, &far, &stored.code, &stored.fetched, 1, &hi, &lo);
+  return DoubleDouble::FromParts(hi, lo);
 }
 
 }  // namespace depthbench

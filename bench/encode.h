@@ -15,13 +15,14 @@
 // the reference reads the exact value of the code.
 //
 // "Correctly rounded" is meant literally: step 2 evaluates the exact value
-// in long double, and where that lies too close to a float rounding
-// boundary to decide, again in double-double, and then in MPFR.
+// in double-double, and where that lies too close to a float rounding
+// boundary to decide, in MPFR.
 #pragma once
 
 #include <cstdint>
 
 #include "bench/cells.h"
+#include "bench/double_double.h"
 #include "bench/sampler.h"
 
 namespace depthbench {
@@ -35,19 +36,29 @@ struct StoredDepth {
 // depends only on the convention and on what the format stores, so the
 // formats of one convention share it.
 float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth);
-// Step 3 and the fetch.
+// The same for n samples, four lanes at a time (far is 0 for an infinite
+// far plane); every lane computes exactly what the scalar form does.
+void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth,
+                    std::size_t n, float* out);
+// Step 3 and the fetch, for one value and for n.
 StoredDepth StoreFloat(Format format, float value);
+void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_t* codes, float* fetched);
 
 inline StoredDepth EncodeEyeDepth(Encoding encoding, const Frame& frame, double eye_depth) {
   return StoreFloat(encoding.format, PipelineFloat(encoding, frame, eye_depth));
 }
 StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick);
 
-// Eye depth the code denotes, in long double through the cancellation-free
-// decode of shared/depth_mapping.h (relative error below 2^-60; see
-// tests/reference_test.cc). Zero or +infinity for codes that denote the
-// camera or infinity; negative never.
-long double DecodeEyeDepth(Encoding encoding, const Frame& frame, std::uint32_t code);
+// Eye depth a stored texel denotes, in double-double through the
+// cancellation-free decode of shared/depth_mapping.h (relative error below
+// 2^-100; tests/reference_test.cc checks it against MPFR). Zero or
+// +infinity for texels that denote the camera or infinity.
+DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored);
+// The same for n texels, four lanes at a time (far is 0 for an infinite far
+// plane), as the two parts of each double-double. Every lane computes
+// exactly what the scalar form does.
+void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
+                     const float* fetched, std::size_t n, double* hi, double* lo);
 
 // Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);
@@ -55,9 +66,10 @@ std::uint32_t FloatToUnorm(float value, int bits);  // clamps to [0, 1] first
 std::uint16_t FloatToHalf(float value);              // round to nearest even
 float HalfToFloat(std::uint16_t half);
 
-// How often rounding needed double-double, and MPFR (for tests and notes).
+// How often a value fell exactly on a tie between two floats, and how often
+// of those MPFR had to settle it (for tests and notes).
 struct EncodeFallbacks {
-  std::uint64_t double_double = 0;
+  std::uint64_t ties = 0;
   std::uint64_t mpfr = 0;
 };
 EncodeFallbacks EncodeFallbackCounts();

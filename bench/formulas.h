@@ -9,7 +9,10 @@
 //                    double but must stay fast;
 //   depthbench::hp   DoubleDouble (about 106 bits): the exact shader
 //                    constants, rounding decisions too close to call in
-//                    long double, and the formula tests.
+//                    long double, and the formula tests;
+//   depthbench::hp4  the depth mapping with four DoubleDouble lanes: the
+//                    reference's decode of stored depths, four samples at
+//                    a time.
 // The third compilation is GLSL (shaders/, through glslang at run time).
 #pragma once
 
@@ -65,6 +68,17 @@ using vec4 = glm::vec<4, DoubleDouble>;
 using mat4 = glm::mat<4, 4, DoubleDouble>;
 #include "bench/formulas_body.inc"
 }  // namespace depthbench::hp
+
+namespace depthbench::hp4 {
+using real = DoubleDouble4;
+using uint = std::uint32_t;
+using vec2 = glm::vec<2, DoubleDouble4>;
+using vec3 = glm::vec<3, DoubleDouble4>;
+using vec4 = glm::vec<4, DoubleDouble4>;
+using mat4 = glm::mat<4, 4, DoubleDouble4>;
+#include "shared/params.h"
+#include "shared/depth_mapping.h"
+}  // namespace depthbench::hp4
 
 #pragma GCC diagnostic pop
 

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "bench/bands.h"
-#include "bench/encode.h"
 #include "bench/formulas.h"
 
 namespace depthbench {
@@ -15,6 +14,36 @@ namespace {
 constexpr double kPlaneSlack = 0x1p-20;
 
 }  // namespace
+
+void ReferenceArrays::Resize(std::size_t n) {
+  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square}) v->resize(n);
+  joint_band.resize(n);
+  status.resize(n);
+}
+
+ReferenceSample ReferenceArrays::Get(std::size_t at) const {
+  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at], joint_band[at], status[at]};
+}
+
+void SampleArrays::Resize(std::size_t n) {
+  pick.resize(n);
+  for (auto* v : {&eye_depth, &near, &far, &depth_limit, &ray_length_sq, &inverse_distance_sq}) v->resize(n);
+  depth_band.resize(n);
+  ratio_band.resize(n);
+}
+
+void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
+  const bool eye = sample.pick == DepthPick::kEyeDepth;
+  pick[i] = sample.pick;
+  eye_depth[i] = eye ? sample.eye_depth : frame.near;
+  near[i] = frame.near;
+  far[i] = frame.finite() ? frame.far : 0.0;
+  depth_limit[i] = frame.depth_limit;
+  ray_length_sq[i] = glm::dot(ray, ray);
+  inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
+  depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
+  ratio_band[i] = static_cast<std::uint8_t>(RatioBand(frame.ratio()));
+}
 
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
   using L = long double;
@@ -31,59 +60,45 @@ glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
   return ray;
 }
 
-SampleFacts FactsOf(const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
-  SampleFacts facts;
-  facts.pick = sample.pick;
-  facts.eye_depth = sample.eye_depth;
-  facts.ray_length_sq = glm::dot(ray, ray);
-  if (sample.pick == DepthPick::kEyeDepth) {
-    facts.inverse_distance_sq = 1.0 / (sample.eye_depth * sample.eye_depth * facts.ray_length_sq);
-    facts.depth_band = static_cast<std::uint8_t>(DepthBand(sample.eye_depth / frame.near));
-  }
-  return facts;
-}
-
-ReferenceSample ReferenceFor(const Frame& frame, const SampleFacts& sample, Encoding encoding,
-                             std::uint32_t code, double& storage_square) {
-  const long double denoted = DecodeEyeDepth(encoding, frame, code);
-  // Stored-value picks have no scene point of their own: the truth is what
-  // the stored value denotes, and their storage error is zero.
-  const long double truth = sample.pick == DepthPick::kEyeDepth ? sample.eye_depth : denoted;
-
-  const bool eye_pick = sample.pick == DepthPick::kEyeDepth;
-
-  ReferenceSample r;
-  r.true_depth = static_cast<double>(truth);
-  r.denoted_depth = std::isfinite(denoted) ? static_cast<double>(denoted) : DBL_MAX;
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
+                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first) {
   const ConventionInfo& convention = Info(encoding.convention);
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
-  int depth_band = sample.depth_band;
-  if (!eye_pick) {
-    const double depth_over_near = r.true_depth / frame.near;
-    depth_band = DepthBand(std::isfinite(depth_over_near) ? depth_over_near : DBL_MAX);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = first + k, o = out_first + k;
+    // Stored-value picks have no scene point of their own: the truth is
+    // what the stored value denotes, and their storage error is zero.
+    const bool eye = samples.pick[i] == DepthPick::kEyeDepth;
+    const DoubleDouble denoted = DoubleDouble::FromParts(denoted_hi[k], denoted_lo[k]);
+    const DoubleDouble truth = eye ? DoubleDouble(samples.eye_depth[i]) : denoted;
+    const double t = truth.hi();
+    const double near = samples.near[i];
+    // (Stored-value picks are rare: their band and distance are worked out
+    // here, behind a branch that predicts well.)
+    int depth_band = samples.depth_band[i];
+    if (!eye) depth_band = DepthBand(t / near);
+    out.true_depth[o] = t;
+    out.denoted_depth[o] = std::isfinite(denoted.hi()) ? denoted.hi() : DBL_MAX;
+    out.joint_band[o] = static_cast<std::uint8_t>(
+        JointBand(infinite_far ? kInfiniteRatioBand : samples.ratio_band[i], depth_band));
+    const bool degenerate = !(t > 0.0) || !std::isfinite(t);
+    const double far = infinite_far ? INFINITY : samples.depth_limit[i];
+    const bool outside = t < near * (1.0 - kPlaneSlack) || t > far * (1.0 + kPlaneSlack);
+    const ReferenceStatus status =
+        degenerate ? ReferenceStatus::kDegenerate : outside ? ReferenceStatus::kOutside : ReferenceStatus::kJudged;
+    out.status[o] = status;
+    const double length_sq = samples.ray_length_sq[i];
+    double inverse_distance_sq = samples.inverse_distance_sq[i];
+    if (!eye) inverse_distance_sq = 1.0 / (t * t * length_sq);
+    if (status != ReferenceStatus::kJudged) inverse_distance_sq = 0.0;
+    out.inverse_distance_sq[o] = inverse_distance_sq;
+    // The difference of the two depths is taken in double-double (they may
+    // be close); its ratio to the distance needs no more than double. Both
+    // points lie on the same ray, so the relative error of the position is
+    // the relative error of the depth.
+    const double difference = (denoted - truth).hi();
+    out.storage_square[o] = difference * difference * inverse_distance_sq * length_sq;
   }
-  r.joint_band = static_cast<std::uint8_t>(
-      JointBand(infinite_far ? kInfiniteRatioBand : RatioBand(frame.ratio()), depth_band));
-  storage_square = 0.0;
-  if (!(truth > 0.0L) || !std::isfinite(truth)) {
-    r.status = ReferenceStatus::kDegenerate;
-    return r;
-  }
-  const double far = infinite_far ? INFINITY : frame.depth_limit;
-  if (r.true_depth < frame.near * (1.0 - kPlaneSlack) || r.true_depth > far * (1.0 + kPlaneSlack)) {
-    r.status = ReferenceStatus::kOutside;
-    return r;
-  }
-  r.status = ReferenceStatus::kJudged;
-  r.inverse_distance_sq =
-      eye_pick ? sample.inverse_distance_sq : 1.0 / (r.true_depth * r.true_depth * sample.ray_length_sq);
-  // The difference of the two depths is taken in long double (they may be
-  // close); its ratio to the distance needs no more than double. Both
-  // points lie on the same ray, so the relative error of the position is
-  // the relative error of the depth.
-  const double difference = static_cast<double>(denoted - truth);
-  storage_square = difference * difference * r.inverse_distance_sq * sample.ray_length_sq;
-  return r;
 }
 
 }  // namespace depthbench

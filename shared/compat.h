@@ -20,7 +20,9 @@
 
 #include <glm/glm.hpp>
 
-#define DB_FN inline
+// Inlined everywhere, as a shader compiler inlines: the SIMD
+// instantiations then keep their lanes in registers across calls.
+#define DB_FN inline __attribute__((always_inline))
 // Carries its own ';' in C++; expands to nothing in GLSL, where a stray ';'
 // at file scope is an error. Use it without a trailing ';'.
 #define DB_STATIC_ASSERT(condition, message) static_assert(condition, message);

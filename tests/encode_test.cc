@@ -105,7 +105,7 @@ TEST(EncodeTest, ExactTiesAreSettledByMpfr) {
   const EncodeFallbacks before = EncodeFallbackCounts();
   EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, frame, 1.0), 0.5f);
   const EncodeFallbacks after = EncodeFallbackCounts();
-  EXPECT_EQ(after.double_double, before.double_double + 1);
+  EXPECT_EQ(after.ties, before.ties + 1);
   EXPECT_EQ(after.mpfr, before.mpfr + 1);
   // Just beyond the tie the answer moves up.
   const Frame nearer = TestFrame(std::nextafter(0.5 - std::ldexp(1.0, -25), 0.0), INFINITY);
@@ -130,14 +130,16 @@ TEST(EncodeTest, StoredPlanesDecodeToThePlanes) {
   const Frame finite = TestFrame(0.25, 4000.0);
   const Frame infinite = TestFrame(0.25, INFINITY);
   for (Format f : {Format::kD16Unorm, Format::kX8D24Unorm, Format::kD32Sfloat}) {
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero).code), 0.25L);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne).code), 4000.0L);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne).code), 0.25L);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero).code), 4000.0L);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero)).hi(), 0.25);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne)).hi(), 4000.0);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne)).hi(), 0.25);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero)).hi(), 4000.0);
     EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kStandardInf, f}, infinite,
-                                          EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne).code)));
+                                          EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne))
+                               .hi()));
     EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kReversedInf, f}, infinite,
-                                          EncodeEdge({Convention::kReversedInf, f}, infinite, DepthPick::kStoredZero).code)));
+                                          EncodeEdge({Convention::kReversedInf, f}, infinite, DepthPick::kStoredZero))
+                               .hi()));
   }
 }
 
@@ -147,7 +149,7 @@ TEST(EncodeTest, LinearDepthUnderflowsInHalfFloatAtLargeRatios) {
   const Frame frame = TestFrame(1.0, 1e8);
   const StoredDepth s = EncodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, 1.0);
   EXPECT_EQ(s.fetched, 0.0f);
-  EXPECT_EQ(DecodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, s.code), 0.0L);
+  EXPECT_EQ(DecodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, s).hi(), 0.0);
 }
 
 }  // namespace
