@@ -87,8 +87,6 @@ void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint
       case kJudged:
         // Distance bands keep the total error only: what camera distance
         // does to a reconstruction shows there whole.
-        ++joint.finite;
-        ++distance.finite;
         joint.Record(Metric::kTotal, s.total_bin[i], s.total[i], index);
         joint.Record(Metric::kArith, s.arith_bin[i], s.arith[i], index);
         joint.Record(Metric::kAbsolute, s.absolute_bin[i], s.absolute[i], index);

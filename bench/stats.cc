@@ -141,7 +141,7 @@ CellAccumulator::Slot& CellAccumulator::NewJoint(int band) {
 void CellAccumulator::FlushInto(CellStats& out) {
   auto flush = [](Slot& slot, BandStats& band) {
     BandStats add;
-    add.finite = slot.finite;
+    for (std::uint32_t n : slot.bins[static_cast<int>(Metric::kTotal)]) add.finite += n;
     add.nan = slot.nan;
     add.inf = slot.inf;
     add.degenerate = slot.degenerate;
@@ -159,7 +159,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
   };
   for (int band = 0; band < kDistanceBands; ++band) {
     const Slot& d = slots_[band];
-    bool used = d.finite + d.nan + d.inf + d.degenerate + d.outside > 0;
+    bool used = d.nan + d.inf + d.degenerate + d.outside > 0;
     for (const auto& bins : d.bins)
       for (std::uint32_t n : bins) used = used || n != 0;
     if (used)

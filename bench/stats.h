@@ -133,7 +133,9 @@ class CellAccumulator {
     std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins{};
     std::array<double, kMetricCount> max_square{};
     std::array<std::uint64_t, kMetricCount> worst_index{};
-    std::uint64_t finite = 0, nan = 0, inf = 0, degenerate = 0, outside = 0;
+    // (Finite samples are not counted here: every one lands in a bin of the
+    // total error, and the flush counts them from there.)
+    std::uint64_t nan = 0, inf = 0, degenerate = 0, outside = 0;
     std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
     Slot() { worst_index.fill(std::numeric_limits<std::uint64_t>::max()); }
 

@@ -2,7 +2,12 @@
 // ray-based variants' interpolated inputs computed per pixel (screen.h).
 // The including shader defines RECONSTRUCT as its variant's
 // <variant>_world_position function from shared/variants/.
-layout(local_size_x = 64) in;
+//
+// Whole frames per workgroup: the host sets the workgroup size
+// (specialization constant 0) to a multiple of the samples per frame, so a
+// frame's constants are uniform across each of its invocations' SIMD
+// groups, as a real pass's are across a draw.
+layout(local_size_x_id = 0) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Frames { FrameParams frames[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_params[]; };
@@ -12,11 +17,13 @@ layout(std430, set = 0, binding = 4) writeonly buffer Positions { float position
 layout(push_constant) uniform Pass { PassConstants pass; };
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= pass.sample_count) {
+  // The batch may start inside its first frame.
+  int index = int(gl_GlobalInvocationID.x) - int(pass.first_sample_in_frame);
+  uint frame_index = gl_GlobalInvocationID.x / pass.samples_per_frame;
+  if (index < 0 || index >= int(pass.sample_count)) {
     return;
   }
-  uint frame_index = (i + pass.first_sample_in_frame) / pass.samples_per_frame;
+  uint i = uint(index);
   FrameParams frame = frames[frame_index];
   DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
   uint pixel = pixels[i];

@@ -55,7 +55,7 @@ struct DepthParams {
 // one cell reads and writes.
 struct PassConstants {
   uint sample_count;        // samples in the batch
-  uint samples_per_frame;   // sample i uses frame i / samples_per_frame
+  uint samples_per_frame;   // sample i uses frame (i + first_sample_in_frame) / samples_per_frame
   uint convention_slot;     // index of this cell's convention within a frame's DepthParams
   uint conventions_per_frame;
   uint depth_offset;        // first element of this cell's stored depths in the depth buffer

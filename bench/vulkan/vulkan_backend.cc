@@ -17,8 +17,17 @@
 namespace depthbench {
 namespace {
 
-// local_size_x of shaders/compute_pass.glsl.
-constexpr std::uint32_t kWorkgroupSize = 64;
+// shaders/compute_pass.glsl runs whole frames per workgroup: its size,
+// specialization constant 0, is a multiple of the samples per frame. A few
+// frames per group keep the per-group cost of a software implementation
+// (lavapipe starts every group on its own) small against the work.
+constexpr std::uint32_t kWorkgroupSizeConstant = 0;
+constexpr std::uint32_t kFramesPerWorkgroup = 8;
+constexpr std::uint32_t kWorkgroupSize = kFramesPerWorkgroup * kSamplesPerFrame;
+
+std::uint32_t WorkgroupsFor(const Batch& batch) {
+  return static_cast<std::uint32_t>((batch.frame_count() + kFramesPerWorkgroup - 1) / kFramesPerWorkgroup);
+}
 
 // The storage buffers of shaders/compute_pass.glsl, by binding number.
 enum Binding : std::uint32_t {
@@ -246,6 +255,10 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant)
   pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   pipeline_info.stage.module = module;
   pipeline_info.stage.pName = "main";
+  const std::uint32_t workgroup_size = kWorkgroupSize;
+  const VkSpecializationMapEntry entry{kWorkgroupSizeConstant, 0, sizeof(workgroup_size)};
+  VkSpecializationInfo specialization{1, &entry, sizeof(workgroup_size), &workgroup_size};
+  pipeline_info.stage.pSpecializationInfo = &specialization;
   pipeline_info.layout = pipeline_layout_.get();
   VkPipeline pipeline = VK_NULL_HANDLE;
   DB_RETURN_IF_ERROR(
@@ -299,7 +312,7 @@ Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t
     }
   }
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
-  const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  const std::uint32_t groups = WorkgroupsFor(batch);
   if (groups > limits.maxComputeWorkGroupCount[0]) {
     return InvalidArgument(fmt::format("a batch of {} samples needs {} workgroups; the device dispatches at most {}",
                                        batch.count, groups, limits.maxComputeWorkGroupCount[0]));
@@ -366,7 +379,7 @@ Status VulkanBackend::Record(const Batch& batch, std::span<const std::uint32_t> 
   DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
   vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
                           &descriptor_set_, 0, nullptr);
-  const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  const std::uint32_t groups = WorkgroupsFor(batch);
   VkPipeline bound = VK_NULL_HANDLE;
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
   for (std::size_t k = 0; k < which.size(); ++k) {
