@@ -130,6 +130,26 @@ Status Domain::Validate() const {
   return Status::Ok();
 }
 
+std::string Domain::ToFlags() const {
+  auto range = [](const Range& r) {
+    return r.fixed() ? fmt::format("{:.17g}", r.min) : fmt::format("{:.17g}:{:.17g}", r.min, r.max);
+  };
+  std::string flags = fmt::format("--fov {} --aspect {} --near {}", range(fov_degrees), range(aspect), range(near));
+  if (!finite_far) {
+    flags += " --ratio inf";
+  } else if (far) {
+    flags += " --far " + range(*far);
+  } else {
+    flags += " --ratio " + range(ratio) + (infinite_far ? ",inf" : "");
+  }
+  flags += " --camera-distance " + range(camera_distance);
+  if (eye_depth) flags += " --depth " + range(*eye_depth);
+  if (resolutions != Domain{}.resolutions) {
+    flags += fmt::format(" --resolution {}x{}", resolutions.front().width, resolutions.front().height);
+  }
+  return flags;
+}
+
 std::string Domain::Describe() const {
   std::string far_text;
   if (finite_far) {

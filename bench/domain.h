@@ -66,6 +66,9 @@ struct Domain {
 
   Status Validate() const;
   std::string Describe() const;
+  // The command-line flags that rebuild this domain exactly (numbers with
+  // 17 significant digits), e.g. "--fov 1:179 --near 0.0001:10 ...".
+  std::string ToFlags() const;
 };
 
 // The limits the flags enforce (also what --help prints).

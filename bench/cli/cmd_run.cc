@@ -7,7 +7,9 @@
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/progress.h"
+#include "bench/repro.h"
 #include "bench/results_table.h"
+#include "bench/files.h"
 #include "bench/sweep.h"
 
 namespace depthbench::cli {
@@ -18,6 +20,7 @@ struct RunFlags {
   std::uint64_t seed = 1;
   std::string shard;
   std::string json;
+  std::string index;
   std::vector<std::string> split;
   unsigned threads = 0;
   std::uint32_t batch = 16384;
@@ -66,6 +69,22 @@ int Run(const RunFlags& f) {
   std::vector<Backend*> backends;
   for (auto& b : *made) backends.push_back(b.get());
 
+  if (!f.index.empty()) {  // one sample, in full
+    char* end = nullptr;
+    const unsigned long long index = std::strtoull(f.index.c_str(), &end, 10);
+    if (f.index.empty() || *end != '\0' || f.index[0] == '-') {
+      return ReportError(InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ...)", f.index)));
+    }
+    auto repro = Reproduce(options.seed, index, options.domain, CellsForDomain(options.cells, options.domain), backends);
+    if (!repro.ok()) return ReportError(repro.status());
+    PrintRepro(*repro, std::cout);
+    if (!f.json.empty()) {
+      Status written = WriteFileAtomically(f.json, ReproToJson(*repro).dump(1) + "\n");
+      if (!written.ok()) return ReportError(written);
+    }
+    return kExitOk;
+  }
+
   Progress progress("run", StderrIsTerminal() && !f.quiet);
   options.progress = [&](const SweepProgress& p) {
     progress.Update(static_cast<double>(p.samples_done) / static_cast<double>(p.samples_total),
@@ -111,6 +130,9 @@ void AddRunCommand(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--seed", flags->seed, "random seed; the same seed gives the same samples anywhere (default 1)");
   cmd->add_option("--shard", flags->shard, "run shard K of N (1-based) of the sweep; shards merge exactly");
   cmd->add_option("--json", flags->json, "write the results (schema depthbench.results v1) to FILE");
+  cmd->add_option("--index", flags->index,
+                  "replay sample N alone and show everything about it (inputs, stored values, reference, each "
+                  "backend's output and errors): what the gate and the fuzzer print to reproduce a finding");
   cmd->add_option("--split", flags->split, "also print p99.9 per band: ratio, depth, distance")->delimiter(',');
   cmd->add_option("--threads", flags->threads, "worker threads (default: one per core)");
   cmd->add_option("--batch", flags->batch, "samples per batch (memory is proportional to it)")

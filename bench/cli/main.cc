@@ -20,6 +20,17 @@ int main(int argc, char** argv) {
   AddListCommand(app, action);
   AddRunCommand(app, action);
   AddMergeCommand(app, action);
+  // A first word that is neither a flag nor a subcommand gets a message
+  // that names it (CLI11 would only say a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-' && app.get_subcommands([&](const CLI::App* sub) {
+                                              return sub->get_name() == argv[1];
+                                            }).empty()) {
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+    std::cerr << "depthbench: error: unknown subcommand '" << argv[1] << "'; available: " << names
+              << " (see depthbench --help)\n";
+    return kExitCannotRun;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,103 @@
+// The depthbench program as a user meets it: bad input gets a message that
+// says what is wrong and what is allowed, and exit code 2; good input runs.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "bench/results.h"
+#include "tests/command_runner.h"
+
+namespace depthbench {
+namespace {
+
+using testing::RunDepthbench;
+
+struct BadInput {
+  std::vector<std::string> args;
+  std::string message;  // a part of the error message
+};
+
+class CliBadInputTest : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInputTest, NamesTheProblemAndExitsWithTwo) {
+  const BadInput& bad = GetParam();
+  const auto r = RunDepthbench(bad.args);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(bad.message), std::string::npos) << "stderr: " << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadInput, CliBadInputTest,
+    ::testing::Values(
+        BadInput{{"run", "--variant", "frustum"}, "unknown variant 'frustum'; allowed: frustum_ray, volume_ray"},
+        BadInput{{"run", "--convention", "backwards"}, "unknown convention 'backwards'; allowed: standard"},
+        BadInput{{"run", "--format", "d48"}, "unknown format 'd48'; allowed: d16_unorm (d16)"},
+        BadInput{{"run", "--variant", "divide", "--format", "r32f"}, "no cell matches these filters"},
+        BadInput{{"run", "--near", "0"}, "--near: 0 is out of range; allowed (0, 1e+06]"},
+        BadInput{{"run", "--near", "-1:2"}, "--near: -1:2 is out of range"},
+        BadInput{{"run", "--near", "5", "--far", "2"}, "far must be greater than near"},
+        BadInput{{"run", "--far", "10", "--ratio", "100"}, "--far and --ratio cannot be used together"},
+        BadInput{{"run", "--fov", "180"}, "--fov: 180 is out of range; allowed (0, 180) degrees"},
+        BadInput{{"run", "--fov", "10:5"}, "--fov: minimum 10 is above maximum 5"},
+        BadInput{{"run", "--aspect", "x"}, "--aspect: 'x' is not a finite number"},
+        BadInput{{"run", "--ratio", "1"}, "--ratio: 1 is out of range; allowed (1, 1e+15]"},
+        BadInput{{"run", "--ratio", "10:100,never"}, "--ratio: '10:100,never' is not understood"},
+        BadInput{{"run", "--camera-distance", "-5"}, "--camera-distance: -5 is out of range"},
+        BadInput{{"run", "--resolution", "1920*1080"}, "--resolution: '1920*1080' is not WIDTHxHEIGHT"},
+        BadInput{{"run", "--samples", "1.5"}, "--samples: '1.5' is not a whole number"},
+        BadInput{{"run", "--shard", "3/2"}, "--shard: '3/2' is not K/N with 1 <= K <= N"},
+        BadInput{{"run", "--split", "colour"}, "--split: 'colour' is not one of ratio, depth, distance"},
+        BadInput{{"run", "--backend", "metal"}, "unknown backend 'metal'; available: cpu, vulkan"},
+        BadInput{{"run", "--backend", "vulkan", "--device", "no-such-gpu"},
+                 "no Vulkan device matches 'no-such-gpu'; available: llvmpipe"},
+        BadInput{{"run", "--backend", "vulkan", "--shaders", "/no/such/dir", "--samples", "10"},
+                 "shader directory '/no/such/dir' does not exist"},
+        BadInput{{"run", "--samples", "10", "--json", "/no/such/dir/out.json"},
+                 "cannot write '/no/such/dir/out.json': directory '/no/such/dir' does not exist"},
+        BadInput{{"run", "--index", "-3"}, "--index: '-3' is not a sample index"},
+        BadInput{{"merge", "/no/such/file.json", "--json", "x.json"}, "File does not exist: /no/such/file.json"},
+        BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"}));
+
+TEST(CliTest, HelpTeachesAndExitsWithZero) {
+  const auto r = RunDepthbench({"run", "--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* text : {"--samples", "--ratio", "bits lost", "Examples:", "--shard"}) {
+    EXPECT_NE(r.out.find(text), std::string::npos) << text;
+  }
+}
+
+TEST(CliTest, ListNamesVariantsWithSeedsAndDevices) {
+  const auto r = RunDepthbench({"list"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  for (const char* text : {"frustum_ray", "000", "pq", "004", "reversed-inf-gl", "x8_d24_unorm", "106 cells", "llvmpipe"}) {
+    EXPECT_NE(r.out.find(text), std::string::npos) << text;
+  }
+}
+
+TEST(CliTest, RunWritesTheTableAndVersionedJson) {
+  const std::string dir = testing::MakeTempDir("cli_run");
+  const std::string json = dir + "/out.json";
+  const auto r = RunDepthbench({"run", "--samples", "2000", "--variant", "pq", "--convention", "reversed",
+                                "--json", json, "--split", "ratio"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("pq/reversed/d32_sfloat"), std::string::npos);
+  EXPECT_NE(r.out.find("p99.9 bits lost by far/near ratio band"), std::string::npos);
+  auto results = ReadResults(json);
+  ASSERT_TRUE(results.ok()) << results.status().message();
+  EXPECT_EQ(results->cells.size(), 6u);  // 3 formats x 2 backends
+  EXPECT_EQ(results->run.samples, 2000u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliTest, IndexReplaysOneSampleOnBothBackends) {
+  const auto r = RunDepthbench({"run", "--index", "77", "--variant", "divide", "--convention", "standard",
+                                "--format", "d24"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("sample 77 of seed 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("divide/standard/x8_d24_unorm"), std::string::npos);
+  EXPECT_NE(r.out.find("cpu:"), std::string::npos);
+  EXPECT_NE(r.out.find("vulkan:"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace depthbench
