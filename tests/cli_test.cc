@@ -1,5 +1,6 @@
 // The depthbench program as a user meets it: bad input gets a message that
 // says what is wrong and what is allowed, and exit code 2; good input runs.
+#include <cctype>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -56,7 +57,16 @@ INSTANTIATE_TEST_SUITE_P(
                  "cannot write '/no/such/dir/out.json': directory '/no/such/dir' does not exist"},
         BadInput{{"run", "--index", "-3"}, "--index: '-3' is not a sample index"},
         BadInput{{"merge", "/no/such/file.json", "--json", "x.json"}, "File does not exist: /no/such/file.json"},
-        BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"}));
+        BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"}),
+    [](const ::testing::TestParamInfo<BadInput>& info) {
+      // A readable test name from the arguments: run_near_0, ...
+      std::string name;
+      for (const std::string& arg : info.param.args) {
+        for (char c : arg) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+        name += '_';
+      }
+      return name + std::to_string(info.index);
+    });
 
 TEST(CliTest, HelpTeachesAndExitsWithZero) {
   const auto r = RunDepthbench({"run", "--help"});
