@@ -69,6 +69,7 @@ struct Domain {
   // The command-line flags that rebuild this domain exactly (numbers with
   // 17 significant digits), e.g. "--fov 1:179 --near 0.0001:10 ...".
   std::string ToFlags() const;
+  friend bool operator==(const Domain&, const Domain&) = default;
 };
 
 // The limits the flags enforce (also what --help prints).

@@ -91,11 +91,21 @@ json SummaryToJson(const BandStats& all) {
   return out;
 }
 
+}  // namespace
+
 json DeviceToJson(const DeviceInfo& d) {
   return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", d.kind}, {"compiler", d.compiler}};
 }
 
-}  // namespace
+Expected<DeviceInfo> DeviceFromJson(const JsonReader& r) {
+  DeviceInfo d;
+  DB_ASSIGN_OR_RETURN(d.name, r.String("name"));
+  DB_ASSIGN_OR_RETURN(d.driver, r.String("driver"));
+  DB_ASSIGN_OR_RETURN(d.api, r.String("api"));
+  DB_ASSIGN_OR_RETURN(d.kind, r.String("kind"));
+  DB_ASSIGN_OR_RETURN(d.compiler, r.String("compiler"));
+  return d;
+}
 
 json DomainToJson(const Domain& d) {
   json resolutions = json::array();
@@ -231,15 +241,6 @@ Expected<int> BandIndex(const JsonReader& r, const std::string& key, int count) 
   return static_cast<int>(v);
 }
 
-Expected<DeviceInfo> DeviceFrom(const JsonReader& r) {
-  DeviceInfo d;
-  DB_ASSIGN_OR_RETURN(d.name, r.String("name"));
-  DB_ASSIGN_OR_RETURN(d.driver, r.String("driver"));
-  DB_ASSIGN_OR_RETURN(d.api, r.String("api"));
-  DB_ASSIGN_OR_RETURN(d.kind, r.String("kind"));
-  DB_ASSIGN_OR_RETURN(d.compiler, r.String("compiler"));
-  return d;
-}
 
 }  // namespace
 
@@ -324,7 +325,7 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     BackendRecord record;
     DB_ASSIGN_OR_RETURN(record.name, b.String("name"));
     DB_ASSIGN_OR_RETURN(JsonReader device, b.Field("device"));
-    DB_ASSIGN_OR_RETURN(record.device, DeviceFrom(device));
+    DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
     run.backends.push_back(record);
   }
 

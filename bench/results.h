@@ -14,6 +14,7 @@
 #include "bench/backend.h"
 #include "bench/cells.h"
 #include "bench/domain.h"
+#include "bench/json_reader.h"
 #include "bench/stats.h"
 #include "bench/status.h"
 
@@ -80,5 +81,7 @@ Expected<Results> MergeResults(const std::vector<Results>& parts);
 
 nlohmann::json DomainToJson(const Domain& domain);
 Expected<Domain> DomainFromJson(const nlohmann::json& json, const std::string& source);
+nlohmann::json DeviceToJson(const DeviceInfo& device);
+Expected<DeviceInfo> DeviceFromJson(const JsonReader& json);
 
 }  // namespace depthbench

@@ -12,5 +12,6 @@ namespace depthbench::cli {
 void AddListCommand(CLI::App& app, std::function<int()>& action);
 void AddRunCommand(CLI::App& app, std::function<int()>& action);
 void AddMergeCommand(CLI::App& app, std::function<int()>& action);
+void AddGateCommand(CLI::App& app, std::function<int()>& action);
 
 }  // namespace depthbench::cli

@@ -1,0 +1,147 @@
+// The real gate, on edited copies of shaders/ and shared/ made in a
+// temporary directory, against the committed lavapipe baseline.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "tests/command_runner.h"
+
+namespace depthbench {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunDepthbench;
+
+const std::string kBaseline = std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/baselines/lavapipe.json";
+
+class GateTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = testing::MakeTempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shaders", root_ + "/shaders", fs::copy_options::recursive);
+    fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shared", root_ + "/shared", fs::copy_options::recursive);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  // Replaces `from` by `to` in a copied file; the text must be there.
+  void Edit(const std::string& relative, const std::string& from, const std::string& to) {
+    const std::string path = root_ + "/" + relative;
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    const auto at = s.find(from);
+    ASSERT_NE(at, std::string::npos) << "'" << from << "' not in " << relative;
+    s.replace(at, from.size(), to);
+    std::ofstream(path) << s;
+  }
+
+  testing::CommandResult Gate() {
+    return RunDepthbench({"gate", "--baseline", kBaseline, "--shaders", root_ + "/shaders"});
+  }
+
+  std::string root_;
+};
+
+TEST_F(GateTest, UnchangedCopyPasses) {
+  const auto r = Gate();
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_EQ(r.out.rfind("PASS", 0), 0u) << r.out;  // the verdict comes first
+}
+
+TEST_F(GateTest, RenamingAndReformattingWithoutNewArithmeticPasses) {
+  Edit("shared/variants/divide.h", R"(  real a = depth.coefficients.x;
+  real b = depth.coefficients.y;
+  vec3 view = vec3(ndc.x / frame.lens.z, ndc.y / frame.lens.w, -1.0f);
+  view = view / (ndc_z / b - a / b);
+  return world_from_view(frame, view);)",
+       R"(  // Same arithmetic, other names and layout.
+  real coefficient_a = depth.coefficients.x;
+  real coefficient_b = depth.coefficients.y;
+
+  vec3 position_in_view = vec3(ndc.x / frame.lens.z,
+                               ndc.y / frame.lens.w,
+                               -1.0f);
+  real one_over_eye_depth = ndc_z / coefficient_b - coefficient_a / coefficient_b;
+  position_in_view = position_in_view / one_over_eye_depth;
+  return world_from_view(frame, position_in_view);)");
+  const auto r = Gate();
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+}
+
+TEST_F(GateTest, ReciprocalRewrittenAsMultiplyAddFailsOnStandardZ) {
+  Edit("shared/variants/reciprocal.h", "real inverse_w = depth.coefficients.y / (ndc_z - depth.coefficients.x);",
+       "real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);");
+  const auto r = Gate();
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(r.out.rfind("FAIL", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("worse: reciprocal/standard/"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("worse: divide/"), std::string::npos) << "only the edited variant may change";
+}
+
+TEST_F(GateTest, SixteenBitIntermediateFails) {
+  // The NDC depth squeezed through a 16-bit float, as a careless half-
+  // precision optimisation would.
+  Edit("shared/variants/divide.h", "  real ndc_z = ndc_depth_from_window_depth(depth, stored);",
+       "  real ndc_z = unpackHalf2x16(packHalf2x16(vec2(ndc_depth_from_window_depth(depth, stored), 0.0f))).x;");
+  const auto r = Gate();
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("worse: divide/"), std::string::npos) << r.out;
+}
+
+TEST_F(GateTest, SyntaxErrorExitsWithTwoNamingFileAndLine) {
+  Edit("shared/variants/pq.h", "  real ndc_z = ndc_depth_from_window_depth(depth, stored);",
+       "  real ndc_z = ndc_depth_from_window_depth(depth, stored) +;");
+  const auto r = Gate();
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("shared/variants/pq.h:9: error:"), std::string::npos) << r.err;
+}
+
+TEST_F(GateTest, PlantedNanFailsAndItsReproducerReproducesIt) {
+  // NaN for stored depths in one range only.
+  Edit("shared/variants/pq.h",
+       "  real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);",
+       "  real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);\n"
+       "  if (stored > 0.25f && stored < 0.5f) inverse_w = inverse_w * (stored - stored) / (stored - stored);");
+  const auto r = Gate();
+  ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("NaN appeared"), std::string::npos) << r.out;
+  // The first reproducer printed: "  reproduce: depthbench run ...".
+  const std::string marker = "reproduce: depthbench ";
+  const auto at = r.out.find(marker);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::istringstream words(r.out.substr(at + marker.size(), r.out.find('\n', at) - at - marker.size()));
+  std::vector<std::string> args;
+  for (std::string w; words >> w;) args.push_back(w);
+  const auto replay = RunDepthbench(args);
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  EXPECT_NE(replay.out.find("vulkan:"), std::string::npos) << replay.out;
+  EXPECT_NE(replay.out.find("NaN"), std::string::npos) << replay.out;
+}
+
+TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
+  const std::string dir = testing::MakeTempDir("gate_inputs");
+  std::ofstream(dir + "/broken.json") << "{ \"schema\": \"depthbench.baseline\", ";
+  auto r = RunDepthbench({"gate", "--baseline", dir + "/broken.json"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the baseline does not parse: " + dir + "/broken.json:1:"), std::string::npos) << r.err;
+  r = RunDepthbench({"gate", "--baseline", dir + "/none.json"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("does not exist; make one with"), std::string::npos) << r.err;
+  // A baseline made with another sample plan.
+  std::ifstream in(kBaseline);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  s.replace(s.find("\"seed\": 1122"), 12, "\"seed\": 1123");
+  std::ofstream(dir + "/other_plan.json") << s;
+  r = RunDepthbench({"gate", "--baseline", dir + "/other_plan.json"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("another sample plan"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace depthbench
