@@ -1,0 +1,324 @@
+#include "bench/fit/precision_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <ostream>
+
+#include <fmt/format.h>
+
+#include "bench/bands.h"
+#include "bench/text_table.h"
+
+namespace depthbench {
+namespace {
+
+constexpr double kInfiniteSpan = Domain::kInfiniteDepthSpan;
+// Far/near range the budgets are searched over.
+constexpr double kLowestRatio = 10.0, kHighestRatio = 1e12;
+// The relative-error budgets of the depth-precision literature: 1e-3 where
+// z-fighting starts to show, 1e-6 "very good".
+const std::pair<const char*, double> kBudgets[] = {{"1e-3", 1e-3}, {"1e-6", 1e-6}};
+const std::pair<const char*, double> kPredictedRatios[] = {{"1e2", 1e2}, {"1e4", 1e4}, {"1e6", 1e6}, {"1e8", 1e8}};
+
+double QuantileOf(const MetricStats& m, Metric metric, Level level) {
+  const int low = kLowestOctave[static_cast<int>(metric)];
+  switch (level) {
+    case Level::kP50: return m.Quantile(0.5, low);
+    case Level::kP99: return m.Quantile(0.99, low);
+    case Level::kP999: return m.Quantile(0.999, low);
+    case Level::kMax: return m.max();
+  }
+  return 0.0;
+}
+
+bool InfiniteFar(const Cell& cell) {
+  const ConventionInfo& c = Info(cell.convention);
+  return c.hardware && (c.bits & 2u) != 0u;
+}
+
+// The far plane's b for a model: the point at eye depth = far.
+double FarPlane(const FittedModel& m, double x) { return m.Predict(x, x); }
+
+// Slope of the far-plane curve between f/n = 1e2 and 1e8, as a function of
+// the parameters (exact for the linear models).
+double SlopeOf(const FittedModel& m) {
+  const double x1 = std::log2(1e2), x2 = std::log2(1e8);
+  return (FarPlane(m, x2) - FarPlane(m, x1)) / (x2 - x1);
+}
+
+}  // namespace
+
+const char* LevelName(Level level) {
+  switch (level) {
+    case Level::kP50: return "p50";
+    case Level::kP99: return "p99";
+    case Level::kP999: return "p99.9";
+    case Level::kMax: return "max";
+  }
+  return "?";
+}
+
+Expected<Level> ParseLevel(const std::string& name) {
+  for (Level l : kAllLevels)
+    if (name == LevelName(l)) return l;
+  return InvalidArgument(fmt::format("unknown level '{}'; allowed: p50, p99, p99.9, max", name));
+}
+
+std::uint64_t MinimumSamples(Level level) {
+  // A quantile q needs a few samples beyond it: 4 / (1 - q).
+  switch (level) {
+    case Level::kP50: return 20;
+    case Level::kP99: return 400;
+    case Level::kP999: return 4000;
+    case Level::kMax: return 100;
+  }
+  return 0;
+}
+
+FitPlan::FitPlan() {
+  domain.camera_distance = {0.0, 0.0};
+  for (int k = 2; k <= 16; ++k) ratios.push_back(std::pow(10.0, k / 2.0));
+  held_out = {std::pow(10.0, 3.5), std::pow(10.0, 6.5)};
+}
+
+Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> backends,
+                                 const std::function<void(double)>& progress) {
+  FitSweeps sweeps;
+  std::vector<double> ratios = plan.ratios;
+  if (plan.infinite) ratios.push_back(INFINITY);
+  for (std::size_t k = 0; k < ratios.size(); ++k) {
+    SweepOptions options;
+    options.seed = plan.seed;
+    options.samples = plan.samples_per_ratio;
+    options.domain = plan.domain;
+    options.domain.far.reset();
+    if (std::isinf(ratios[k])) {
+      options.domain.finite_far = false;
+      options.domain.infinite_far = true;
+    } else {
+      options.domain.ratio = {ratios[k], ratios[k]};
+      options.domain.finite_far = true;
+      options.domain.infinite_far = false;
+    }
+    options.cells = CellsForDomain(plan.cells.empty() ? AllCells() : plan.cells, options.domain);
+    if (options.cells.empty()) continue;
+    auto results = RunSweep(options, backends);
+    if (!results.ok()) return results.status().WithContext(fmt::format("sweep at far/near {:g}", ratios[k]));
+    sweeps.ratios.push_back(ratios[k]);
+    sweeps.results.push_back(std::move(*results));
+    if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(ratios.size()));
+  }
+  return sweeps;
+}
+
+std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
+                                    Metric metric, Level level) {
+  std::vector<FitPoint> points;
+  for (std::size_t k = 0; k < sweeps.results.size(); ++k) {
+    const CellResult* result = sweeps.results[k].Find(cell, backend);
+    if (result == nullptr) continue;
+    const double ratio = sweeps.ratios[k];
+    const double span = std::isinf(ratio) ? kInfiniteSpan : ratio;
+    for (int d = 0; d < kDepthBands; ++d) {
+      const BandStats band = result->stats.ForDepth(d);
+      if (band.finite < MinimumSamples(level)) continue;
+      const double q = QuantileOf(band[metric], metric, level);
+      // A quantile in the underflow bin only says "tiny", an infinite one
+      // (a stored value that denotes infinity) nothing a model can follow.
+      if (!(q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)])) || !std::isfinite(q)) continue;
+      // The band's z/n, log-uniform between its edges (the top decade stops
+      // at the far plane).
+      const double lo = std::max(1.0, DepthBandLow(d)), hi = std::min(DepthBandLow(d) * 10.0, span);
+      if (!(hi > lo)) continue;
+      points.push_back({std::isinf(ratio) ? 0.0 : std::log2(ratio), 0.5 * (std::log2(lo) + std::log2(hi)),
+                        std::log2(q) + 24.0});
+    }
+  }
+  return points;
+}
+
+std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan, std::span<const Metric> metrics,
+                                       std::span<const Level> levels) {
+  // Every (cell, backend) that appears in the sweeps, in order.
+  std::vector<std::pair<Cell, std::string>> cells;
+  for (const Results& r : sweeps.results) {
+    for (const CellResult& c : r.cells) {
+      std::pair<Cell, std::string> key{c.cell, c.backend};
+      if (std::find(cells.begin(), cells.end(), key) == cells.end()) cells.push_back(key);
+    }
+  }
+  std::vector<PrecisionFit> fits;
+  for (const auto& [cell, backend] : cells) {
+    for (Metric metric : metrics) {
+      for (Level level : levels) {
+        PrecisionFit fit;
+        fit.cell = cell;
+        fit.backend = backend;
+        fit.metric = metric;
+        fit.level = level;
+        fit.infinite_far = InfiniteFar(cell);
+        const std::vector<FitPoint> points = CollectPoints(sweeps, cell, backend, metric, level);
+        fit.points = static_cast<int>(points.size());
+        std::vector<ModelKind> candidates;
+        for (ModelKind kind : kAllModels) {
+          if (fit.infinite_far && Info(kind).uses_ratio) continue;  // one ratio: no x to fit
+          candidates.push_back(kind);
+        }
+        fit.ranking = FitAndRank(points, candidates);
+        if (fit.ranking.empty()) continue;
+        fit.model = fit.ranking.front();
+        const FittedModel& m = fit.model;
+
+        if (!fit.infinite_far) {
+          // Slope of the far plane and its interval (delta method: the
+          // gradient of SlopeOf with respect to the parameters).
+          fit.slope = SlopeOf(m);
+          std::vector<double> gradient(m.parameters.size());
+          for (std::size_t i = 0; i < gradient.size(); ++i) {
+            FittedModel shifted = m;
+            const double h = 1e-6 * std::max(1.0, std::fabs(m.parameters[i]));
+            shifted.parameters[i] += h;
+            gradient[i] = (SlopeOf(shifted) - fit.slope) / h;
+          }
+          const double half = StudentT(0.95, std::max(1, m.points - static_cast<int>(m.parameters.size()))) *
+                              std::sqrt(m.Variance(gradient));
+          fit.slope_low = fit.slope - half;
+          fit.slope_high = fit.slope + half;
+          for (const auto& [name, ratio] : kPredictedRatios) {
+            fit.predicted[name] = std::max(0.0, FarPlane(m, std::log2(ratio)));
+          }
+          for (const auto& [name, budget] : kBudgets) {
+            const double limit = 24.0 + std::log2(budget);
+            std::optional<double> last_met;
+            bool ever_failed = false;
+            for (double x = std::log2(kLowestRatio); x <= std::log2(kHighestRatio) + 1e-9; x += 0.05) {
+              if (FarPlane(m, x) <= limit) {
+                if (!ever_failed) last_met = std::exp2(x);
+              } else {
+                ever_failed = true;
+              }
+            }
+            fit.budget_ratio[name] = !ever_failed ? std::nullopt : std::optional<double>(last_met.value_or(0.0));
+          }
+          // Hold-out: refit the chosen kind without the held-out ratios.
+          std::vector<FitPoint> train, test;
+          for (const FitPoint& p : points) {
+            const bool held = std::any_of(plan.held_out.begin(), plan.held_out.end(),
+                                          [&](double r) { return std::fabs(p.x - std::log2(r)) < 1e-9; });
+            (held ? test : train).push_back(p);
+          }
+          auto refit = FitModel(train, m.kind);
+          if (refit.ok() && !test.empty()) {
+            double sum = 0.0;
+            for (const FitPoint& p : test) {
+              const double miss = std::fabs(refit->Predict(p.x, p.y) - p.b);
+              fit.holdout_max_miss = std::max(fit.holdout_max_miss, miss);
+              sum += miss * miss;
+            }
+            fit.holdout_rms_miss = std::sqrt(sum / test.size());
+            fit.holdout_points = static_cast<int>(test.size());
+          }
+        } else {
+          fit.predicted["inf"] = std::max(0.0, m.Predict(0.0, std::log2(kInfiniteSpan)));
+        }
+        fits.push_back(std::move(fit));
+      }
+    }
+  }
+  return fits;
+}
+
+nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const FitPlan& plan) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const PrecisionFit& f : fits) {
+    nlohmann::json ranking = nlohmann::json::array();
+    for (const FittedModel& m : f.ranking) {
+      nlohmann::json parameters = nlohmann::json::array();
+      for (std::size_t i = 0; i < m.parameters.size(); ++i) {
+        parameters.push_back({{"name", Info(m.kind).parameter_names[i]},
+                              {"value", m.parameters[i]},
+                              {"standard_error", JsonNumber(m.StandardError(static_cast<int>(i)))}});
+      }
+      ranking.push_back({{"model", Info(m.kind).name},
+                         {"bic", m.bic},
+                         {"sigma_bits", m.sigma},
+                         {"converged", m.converged},
+                         {"parameters", parameters}});
+    }
+    nlohmann::json budgets = nlohmann::json::object();
+    for (const auto& [name, ratio] : f.budget_ratio) {
+      budgets[name] = ratio ? JsonNumber(*ratio) : nlohmann::json("met throughout");
+    }
+    out.push_back({{"cell", f.cell.Name()},
+                   {"backend", f.backend},
+                   {"metric", MetricName(f.metric)},
+                   {"level", LevelName(f.level)},
+                   {"infinite_far", f.infinite_far},
+                   {"points", f.points},
+                   {"model", Info(f.model.kind).name},
+                   {"slope_bits_per_doubling", f.slope},
+                   {"slope_interval_95", {f.slope_low, f.slope_high}},
+                   {"predicted_bits_lost", f.predicted},
+                   {"last_ratio_meeting_budget", budgets},
+                   {"holdout", {{"points", f.holdout_points},
+                                {"max_miss_bits", f.holdout_max_miss},
+                                {"rms_miss_bits", f.holdout_rms_miss}}},
+                   {"models", ranking}});
+  }
+  nlohmann::json ratios = nlohmann::json::array();
+  for (double r : plan.ratios) ratios.push_back(r);
+  return {{"schema", "depthbench.fit"},
+          {"schema_version", 1},
+          {"plan",
+           {{"seed", plan.seed},
+            {"samples_per_ratio", plan.samples_per_ratio},
+            {"ratios", ratios},
+            {"infinite", plan.infinite},
+            {"held_out", plan.held_out},
+            {"domain", DomainToJson(plan.domain)}}},
+          {"fits", out}};
+}
+
+void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std::ostream& out) {
+  using Align = TextTable::Align;
+  TextTable table({{"cell", Align::kLeft},
+                   {"backend", Align::kLeft},
+                   {"model", Align::kLeft},
+                   {"bits/doubling f/n [95%]"},
+                   {"1e2"},
+                   {"1e4"},
+                   {"1e6"},
+                   {"1e8"},
+                   {"inf"},
+                   {"f/n for 1e-3"},
+                   {"f/n for 1e-6"},
+                   {"held-out miss"}});
+  auto ratio_text = [](const std::map<std::string, std::optional<double>>& budgets, const char* name) {
+    auto it = budgets.find(name);
+    if (it == budgets.end()) return std::string("-");
+    if (!it->second) return std::string("always");
+    if (*it->second == 0.0) return std::string("never");
+    return fmt::format("{:.2g}", *it->second);
+  };
+  auto predicted = [](const PrecisionFit& f, const char* name) {
+    auto it = f.predicted.find(name);
+    return it == f.predicted.end() ? std::string("-") : fmt::format("{:.1f}", it->second);
+  };
+  for (const PrecisionFit& f : fits) {
+    if (f.metric != Metric::kTotal || f.level != level) continue;
+    table.AddRow({f.cell.Name(), f.backend, Info(f.model.kind).name,
+                  f.infinite_far ? "-" : fmt::format("{:.2f} [{:.2f}, {:.2f}]", f.slope, f.slope_low, f.slope_high),
+                  predicted(f, "1e2"), predicted(f, "1e4"), predicted(f, "1e6"), predicted(f, "1e8"),
+                  predicted(f, "inf"), ratio_text(f.budget_ratio, "1e-3"), ratio_text(f.budget_ratio, "1e-6"),
+                  f.holdout_points == 0 ? "-" : fmt::format("{:.2f} bit", f.holdout_max_miss)});
+  }
+  out << fmt::format(
+      "{} bits lost of the total error at the far plane, from the fitted model chosen by BIC; the far/near ratio "
+      "up to which the far plane meets a relative error of 1e-3 and 1e-6 ('always': up to 1e12, 'never': not even "
+      "at 10); the largest miss on held-out ratios\n",
+      LevelName(level));
+  table.Print(out);
+}
+
+}  // namespace depthbench

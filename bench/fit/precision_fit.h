@@ -1,0 +1,91 @@
+// Precision fits: the sweeps that feed the error models, and what the
+// fitted models say per cell: bits lost per doubling of far/near with its
+// confidence interval, predictions at chosen ratios, the ratio at which a
+// cell stops meeting common error budgets, and how far the model misses on
+// ratios it was not fitted to.
+//
+// The data come from sweeps at fixed far/near ratios (10^1, 10^1.5, ...,
+// 10^8) and one with an infinite far plane, so every point's ratio is exact;
+// eye depth is binned by decades of z/n. A point is one quantile of one
+// metric in one (ratio, depth decade) with enough samples behind it.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/backend.h"
+#include "bench/fit/error_model.h"
+#include "bench/results.h"
+#include "bench/sweep.h"
+
+namespace depthbench {
+
+// Levels the models are fitted for.
+enum class Level { kP50, kP99, kP999, kMax };
+inline constexpr Level kAllLevels[] = {Level::kP50, Level::kP99, Level::kP999, Level::kMax};
+const char* LevelName(Level level);
+Expected<Level> ParseLevel(const std::string& name);
+// Samples a band needs for a quantile at this level to mean something.
+std::uint64_t MinimumSamples(Level level);
+
+struct FitPlan {
+  std::uint64_t seed = 7;
+  std::uint64_t samples_per_ratio = 100000;
+  std::vector<double> ratios;  // finite far/near ratios swept; empty: 10^1 .. 10^8 in half decades
+  bool infinite = true;        // also sweep an infinite far plane
+  Domain domain;               // everything but the ratio (the camera defaults to the origin)
+  std::vector<Cell> cells;     // empty: all
+  std::vector<double> held_out;  // ratios kept out of the hold-out fit; empty: 10^3.5 and 10^6.5
+  FitPlan();
+};
+
+// The sweeps of a plan: one Results per finite ratio, then the infinite one.
+struct FitSweeps {
+  std::vector<double> ratios;  // +infinity for the infinite sweep
+  std::vector<Results> results;
+};
+Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> backends,
+                                 const std::function<void(double fraction)>& progress = {});
+
+// The points of one cell, backend, metric and level.
+std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
+                                    Metric metric, Level level);
+
+// What a fit says.
+struct PrecisionFit {
+  Cell cell;
+  std::string backend;
+  Metric metric = Metric::kTotal;
+  Level level = Level::kP999;
+  bool infinite_far = false;
+  int points = 0;
+  FittedModel model;                 // the chosen one
+  std::vector<FittedModel> ranking;  // every candidate, best BIC first
+  // Bits lost at the far plane per doubling of far/near, and its 95%
+  // interval (0 for models without a far/near or depth term).
+  double slope = 0.0, slope_low = 0.0, slope_high = 0.0;
+  // Predicted bits lost at the far plane (floored at 0), by ratio.
+  std::map<std::string, double> predicted;  // "1e2" ... "1e8", "inf"
+  // The largest far/near ratio at which the far plane still meets a
+  // relative-error budget; nullopt when the budget is met throughout
+  // [10, 1e12], 0 when it is not met even at 10.
+  std::map<std::string, std::optional<double>> budget_ratio;  // "1e-3", "1e-6"
+  // Hold-out check: fitted without the held-out ratios, how far the model
+  // misses their points, in bits.
+  double holdout_max_miss = 0.0, holdout_rms_miss = 0.0;
+  int holdout_points = 0;
+};
+
+std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan,
+                                       std::span<const Metric> metrics, std::span<const Level> levels);
+
+nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const FitPlan& plan);
+// The headline table: one row per cell and backend (total error, one level).
+void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std::ostream& out);
+
+}  // namespace depthbench
