@@ -12,6 +12,8 @@ namespace {
 // Relative slack on the frustum's planes: stored values at the planes
 // themselves decode to within a few float32 steps of them.
 constexpr double kPlaneSlack = 0x1p-20;
+// The largest float32, squared: distances beyond it overflow a world position.
+constexpr double kLargestFloatSquared = static_cast<double>(FLT_MAX) * static_cast<double>(FLT_MAX);
 
 }  // namespace
 
@@ -27,7 +29,10 @@ ReferenceSample ReferenceArrays::Get(std::size_t at) const {
 
 void SampleArrays::Resize(std::size_t n) {
   pick.resize(n);
-  for (auto* v : {&eye_depth, &near, &far, &depth_limit, &ray_length_sq, &inverse_distance_sq}) v->resize(n);
+  for (auto* v : {&eye_depth, &near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq,
+                  &inverse_distance_sq}) {
+    v->resize(n);
+  }
   depth_band.resize(n);
   ratio_band.resize(n);
 }
@@ -39,6 +44,8 @@ void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sam
   near[i] = frame.near;
   far[i] = frame.finite() ? frame.far : 0.0;
   depth_limit[i] = frame.depth_limit;
+  interest_min[i] = frame.depth_restricted ? frame.eye_depth_min : frame.near;
+  interest_max[i] = frame.depth_restricted ? frame.eye_depth_max : INFINITY;
   ray_length_sq[i] = glm::dot(ray, ray);
   inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
   depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
@@ -81,13 +88,17 @@ void References(Encoding encoding, const SampleArrays& samples, std::size_t firs
     out.denoted_depth[o] = std::isfinite(denoted.hi()) ? denoted.hi() : DBL_MAX;
     out.joint_band[o] = static_cast<std::uint8_t>(
         JointBand(infinite_far ? kInfiniteRatioBand : samples.ratio_band[i], depth_band));
-    const bool degenerate = !(t > 0.0) || !std::isfinite(t);
-    const double far = infinite_far ? INFINITY : samples.depth_limit[i];
-    const bool outside = t < near * (1.0 - kPlaneSlack) || t > far * (1.0 + kPlaneSlack);
+    const double length_sq = samples.ray_length_sq[i];
+    // A point float32 world coordinates cannot hold (an overflowing
+    // reconstruction is then the right answer) is no more judged than one
+    // at infinity.
+    const bool degenerate = !(t > 0.0) || !(t * t * length_sq < kLargestFloatSquared);
+    const double far = std::min(infinite_far ? INFINITY : samples.depth_limit[i], samples.interest_max[i]);
+    const double nearest = std::max(near, samples.interest_min[i]);
+    const bool outside = t < nearest * (1.0 - kPlaneSlack) || t > far * (1.0 + kPlaneSlack);
     const ReferenceStatus status =
         degenerate ? ReferenceStatus::kDegenerate : outside ? ReferenceStatus::kOutside : ReferenceStatus::kJudged;
     out.status[o] = status;
-    const double length_sq = samples.ray_length_sq[i];
     double inverse_distance_sq = samples.inverse_distance_sq[i];
     if (!eye) inverse_distance_sq = 1.0 / (t * t * length_sq);
     if (status != ReferenceStatus::kJudged) inverse_distance_sq = 0.0;

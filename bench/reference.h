@@ -26,9 +26,11 @@ namespace depthbench {
 
 enum class ReferenceStatus : std::uint8_t {
   kJudged,      // a finite point inside the frustum
-  kDegenerate,  // the point is the camera or at infinity: nothing to measure
-  kOutside,     // a finite point outside the frustum (nearer than near, or
-                // beyond a finite far plane): only NaN/Inf outputs count
+  kDegenerate,  // the point is the camera, at infinity, or beyond what float32
+                // world coordinates can hold: nothing to measure
+  kOutside,     // a finite point outside the frustum (nearer than near,
+                // beyond a finite far plane) or outside the domain's eye-depth
+                // range of interest: only NaN/Inf outputs count
 };
 
 // The reference of one (encoding, sample).
@@ -57,6 +59,7 @@ struct SampleArrays {
   std::vector<double> eye_depth;            // for eye-depth picks (near for the others)
   std::vector<double> near, far;            // the frame's planes (far 0 when infinite)
   std::vector<double> depth_limit;          // the frame's largest eye depth
+  std::vector<double> interest_min, interest_max;  // eye depths the domain is about (near..inf when unrestricted)
   std::vector<double> ray_length_sq;        // |PixelRay|^2
   std::vector<double> inverse_distance_sq;  // 1 / (eye depth * |ray|)^2, for eye-depth picks
   std::vector<std::uint8_t> depth_band;     // of the eye depth, for eye-depth picks

@@ -73,6 +73,7 @@ Frame Sampler::FrameAt(std::uint64_t frame_index) const {
   }
   f.eye_depth_min = f.near;
   f.eye_depth_max = f.depth_limit;
+  f.depth_restricted = d.eye_depth.has_value();
   if (d.eye_depth) {
     f.eye_depth_min = std::clamp(d.eye_depth->min, f.near, f.depth_limit);
     f.eye_depth_max = std::clamp(d.eye_depth->max, f.eye_depth_min, f.depth_limit);

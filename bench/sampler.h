@@ -35,6 +35,7 @@ struct Frame {
   double eye_depth_min = 0.0;  // eye-depth range samples are drawn from
   double eye_depth_max = 0.0;
   double log_eye_depth_span = 0.0;  // log(eye_depth_max / eye_depth_min)
+  bool depth_restricted = false;    // the domain names an eye-depth range of interest
   glm::dvec3 camera_position{0.0};  // float32-representable components
   glm::dmat3 rotation{1.0};         // columns: the camera's x, y, z axes in world space
   std::uint32_t width = 0;

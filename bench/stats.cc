@@ -68,6 +68,33 @@ double MetricStats::Quantile(double q, int lowest_octave) const {
   return max();
 }
 
+const char* LevelName(Level level) {
+  switch (level) {
+    case Level::kP50: return "p50";
+    case Level::kP99: return "p99";
+    case Level::kP999: return "p99.9";
+    case Level::kMax: return "max";
+  }
+  return "?";
+}
+
+Expected<Level> ParseLevel(const std::string& name) {
+  for (Level l : kAllLevels)
+    if (name == LevelName(l)) return l;
+  return InvalidArgument(fmt::format("unknown level '{}'; allowed: p50, p99, p99.9, max", name));
+}
+
+double MetricStats::AtLevel(Level level, Metric metric) const {
+  const int low = kLowestOctave[static_cast<int>(metric)];
+  switch (level) {
+    case Level::kP50: return Quantile(0.5, low);
+    case Level::kP99: return Quantile(0.99, low);
+    case Level::kP999: return Quantile(0.999, low);
+    case Level::kMax: return max();
+  }
+  return 0.0;
+}
+
 void BandStats::Merge(const BandStats& other) {
   finite += other.finite;
   nan += other.nan;

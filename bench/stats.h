@@ -23,9 +23,11 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "bench/bands.h"
+#include "bench/status.h"
 
 namespace depthbench {
 
@@ -66,6 +68,12 @@ inline int DenseBinOfSquare(double q, int lowest_octave) {
 }
 inline constexpr int kDenseBins = kBinsKept + 2;
 
+// The levels reported and modelled: three quantiles and the maximum.
+enum class Level { kP50, kP99, kP999, kMax };
+inline constexpr Level kAllLevels[] = {Level::kP50, Level::kP99, Level::kP999, Level::kMax};
+const char* LevelName(Level level);
+Expected<Level> ParseLevel(const std::string& name);
+
 // Statistics of one metric in one band: sparse bins keyed by dense slot.
 struct MetricStats {
   std::map<int, std::uint64_t> bins;  // dense slot -> count
@@ -80,6 +88,8 @@ struct MetricStats {
   // The q-quantile (q in [0, 1]) of the metric's value; 0 when empty.
   // Underflow reads as the lowest kept edge, overflow as the exact max.
   double Quantile(double q, int lowest_octave) const;
+  // The value at a level (a quantile, or the maximum) of metric `metric`.
+  double AtLevel(Level level, Metric metric) const;
   friend bool operator==(const MetricStats&, const MetricStats&) = default;
 };
 

@@ -21,17 +21,6 @@ constexpr double kLowestRatio = 10.0, kHighestRatio = 1e12;
 const std::pair<const char*, double> kBudgets[] = {{"1e-3", 1e-3}, {"1e-6", 1e-6}};
 const std::pair<const char*, double> kPredictedRatios[] = {{"1e2", 1e2}, {"1e4", 1e4}, {"1e6", 1e6}, {"1e8", 1e8}};
 
-double QuantileOf(const MetricStats& m, Metric metric, Level level) {
-  const int low = kLowestOctave[static_cast<int>(metric)];
-  switch (level) {
-    case Level::kP50: return m.Quantile(0.5, low);
-    case Level::kP99: return m.Quantile(0.99, low);
-    case Level::kP999: return m.Quantile(0.999, low);
-    case Level::kMax: return m.max();
-  }
-  return 0.0;
-}
-
 bool InfiniteFar(const Cell& cell) {
   const ConventionInfo& c = Info(cell.convention);
   return c.hardware && (c.bits & 2u) != 0u;
@@ -48,22 +37,6 @@ double SlopeOf(const FittedModel& m) {
 }
 
 }  // namespace
-
-const char* LevelName(Level level) {
-  switch (level) {
-    case Level::kP50: return "p50";
-    case Level::kP99: return "p99";
-    case Level::kP999: return "p99.9";
-    case Level::kMax: return "max";
-  }
-  return "?";
-}
-
-Expected<Level> ParseLevel(const std::string& name) {
-  for (Level l : kAllLevels)
-    if (name == LevelName(l)) return l;
-  return InvalidArgument(fmt::format("unknown level '{}'; allowed: p50, p99, p99.9, max", name));
-}
 
 std::uint64_t MinimumSamples(Level level) {
   // A quantile q needs a few samples beyond it: 4 / (1 - q).
@@ -123,7 +96,7 @@ std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, c
     for (int d = 0; d < kDepthBands; ++d) {
       const BandStats band = result->stats.ForDepth(d);
       if (band.finite < MinimumSamples(level)) continue;
-      const double q = QuantileOf(band[metric], metric, level);
+      const double q = band[metric].AtLevel(level, metric);
       // A quantile in the underflow bin only says "tiny", an infinite one
       // (a stored value that denotes infinity) nothing a model can follow.
       if (!(q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)])) || !std::isfinite(q)) continue;

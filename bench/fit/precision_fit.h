@@ -25,11 +25,6 @@
 
 namespace depthbench {
 
-// Levels the models are fitted for.
-enum class Level { kP50, kP99, kP999, kMax };
-inline constexpr Level kAllLevels[] = {Level::kP50, Level::kP99, Level::kP999, Level::kMax};
-const char* LevelName(Level level);
-Expected<Level> ParseLevel(const std::string& name);
 // Samples a band needs for a quantile at this level to mean something.
 std::uint64_t MinimumSamples(Level level);
 

@@ -1,0 +1,105 @@
+// Scene files: what they describe, and the errors bad ones get (file, line,
+// field, what is allowed).
+#include <gtest/gtest.h>
+
+#include "bench/scene.h"
+
+namespace depthbench {
+namespace {
+
+const std::string kScenes = std::string(DEPTHBENCH_SOURCE_DIR) + "/bench/scenes/";
+
+constexpr const char* kValid = R"(name = "test"
+[projection]
+near = 0.5
+far = 50000
+fov_degrees = [50, 90]
+aspect = 1.78
+resolution = [1920, 1080]
+[camera]
+distance_from_origin = [0, 20000]
+[engine]
+conventions = ["standard", "reversed"]
+formats = ["d24", "d32_sfloat"]
+[requirement]
+absolute_error = 0.01
+at_depth = 5000
+)";
+
+TEST(SceneTest, ParsesEveryFieldIntoTheDomain) {
+  auto scene = ParseScene(kValid, "valid.toml");
+  ASSERT_TRUE(scene.ok()) << scene.status().message();
+  EXPECT_EQ(scene->name, "test");
+  EXPECT_EQ(scene->domain.near, (Range{0.5, 0.5}));
+  EXPECT_EQ(scene->domain.far, (Range{50000, 50000}));
+  EXPECT_TRUE(scene->domain.finite_far);
+  EXPECT_FALSE(scene->domain.infinite_far);
+  EXPECT_EQ(scene->domain.fov_degrees, (Range{50, 90}));
+  EXPECT_EQ(scene->domain.aspect, (Range{1.78, 1.78}));
+  EXPECT_EQ(scene->domain.camera_distance, (Range{0, 20000}));
+  EXPECT_EQ(scene->domain.resolutions.size(), 1u);
+  EXPECT_EQ(scene->requirement.kind, Requirement::Kind::kAbsolute);
+  EXPECT_EQ(scene->requirement.at_depth, 5000.0);
+  EXPECT_DOUBLE_EQ(scene->requirement.RelativeLimit(), 0.01 / 5000);
+  // Standard and reversed, finite far, hardware formats only: 4 variants x 2 x 2.
+  EXPECT_EQ(scene->Candidates().size(), 16u);
+}
+
+TEST(SceneTest, ExampleScenesLoad) {
+  for (const char* name : {"indoor_shooter", "open_world", "space_game", "cad_viewer"}) {
+    auto scene = LoadScene(kScenes + name + ".toml");
+    EXPECT_TRUE(scene.ok()) << name << ": " << scene.status().message();
+  }
+  auto space = LoadScene(kScenes + "space_game.toml");
+  ASSERT_TRUE(space.ok());
+  EXPECT_FALSE(space->domain.finite_far);  // far = "inf"
+  for (const Cell& c : space->Candidates()) EXPECT_NE(Info(c.format).stores, DepthInput::kLinear) << c.Name();
+}
+
+struct BadScene {
+  std::string from, to;  // an edit of kValid
+  std::string message;   // part of the error
+};
+
+class BadSceneTest : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(BadSceneTest, NamesFileLineFieldAndWhatIsAllowed) {
+  std::string text = kValid;
+  const BadScene& bad = GetParam();
+  const auto at = text.find(bad.from);
+  ASSERT_NE(at, std::string::npos) << bad.from;
+  text.replace(at, bad.from.size(), bad.to);
+  auto scene = ParseScene(text, "bad.toml");
+  ASSERT_FALSE(scene.ok()) << text;
+  EXPECT_NE(scene.status().message().find(bad.message), std::string::npos) << scene.status().message();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Errors, BadSceneTest,
+    ::testing::Values(
+        BadScene{"near = 0.5\n", "", "bad.toml: projection.near: missing"},
+        BadScene{"near = 0.5", "near = -1", "bad.toml:3:8: projection.near: must be greater than 0 (got -1)"},
+        BadScene{"near = 0.5", "near = \"close\"", "bad.toml:3:8: projection.near: expected a number"},
+        BadScene{"far = 50000", "far = 0.2", "bad.toml:4:7: projection.far: must be greater than near (0.5); got 0.2"},
+        BadScene{"far = 50000", "far = \"forever\"", "bad.toml:4:7: projection.far: expected a number or \"inf\""},
+        BadScene{"fov_degrees = [50, 90]", "fov_degrees = [50, 190]",
+                 "bad.toml:5:15: projection.fov_degrees: 50:190 is out of range; allowed (0, 180) degrees"},
+        BadScene{"aspect = 1.78", "aspect = [1, 2, 3]", "bad.toml:6:10: projection.aspect: expected a number or [min, max]"},
+        BadScene{"formats = [\"d24\", \"d32_sfloat\"]", "formats = [\"d24\", \"d48\"]",
+                 "bad.toml:13:19: engine.formats: unknown format 'd48'; allowed: d16_unorm (d16)"},
+        BadScene{"conventions = [\"standard\", \"reversed\"]", "conventions = [\"sideways\"]",
+                 "engine.conventions: unknown convention 'sideways'; allowed: standard, reversed"},
+        BadScene{"at_depth = 5000\n", "",
+                 "requirement.at_depth: an absolute error needs the eye depth it applies at"},
+        BadScene{"absolute_error = 0.01", "absolute_error = 0.01\nrelative_error = 1e-4",
+                 "[requirement]: needs exactly one of absolute_error (world units), relative_error, bits_lost"},
+        BadScene{"at_depth = 5000", "at_depth = 90000",
+                 "requirement.at_depth: must lie in the scene's eye-depth range [0.5, 50000]; got 90000"},
+        BadScene{"[camera]", "[cameras]", "bad.toml:8:1: cameras: unknown field; allowed here: name, projection"},
+        BadScene{"resolution = [1920, 1080]", "resolution = [1920]",
+                 "projection.resolution: expected [width, height] in pixels"},
+        BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\""},
+        BadScene{"name = \"test\"", "name = \"test\"\nnear = [", "bad.toml:2:"}));
+
+}  // namespace
+}  // namespace depthbench
