@@ -57,6 +57,24 @@ Baseline BaselineFromResults(const Results& results, const std::string& backend)
   return b;
 }
 
+json SamplePlanToJson(const SamplePlan& plan) {
+  return {{"seed", plan.seed},
+          {"samples", plan.samples},
+          {"samples_per_frame", plan.samples_per_frame},
+          {"domain", DomainToJson(plan.domain)}};
+}
+
+Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan) {
+  SamplePlan p;
+  DB_ASSIGN_OR_RETURN(p.seed, plan.Unsigned("seed"));
+  DB_ASSIGN_OR_RETURN(p.samples, plan.Unsigned("samples"));
+  DB_ASSIGN_OR_RETURN(std::uint64_t per_frame, plan.Unsigned("samples_per_frame"));
+  p.samples_per_frame = static_cast<std::uint32_t>(per_frame);
+  DB_ASSIGN_OR_RETURN(JsonReader domain, plan.Field("domain"));
+  DB_ASSIGN_OR_RETURN(p.domain, DomainFromJson(domain.json(), plan.source()));
+  return p;
+}
+
 json BaselineToJson(const Baseline& b) {
   json cells = json::object();
   for (const auto& [name, figures] : b.cells) {
@@ -77,11 +95,7 @@ json BaselineToJson(const Baseline& b) {
           {"version", b.version},
           {"commit", b.commit},
           {"made_at", b.made_at},
-          {"plan",
-           {{"seed", b.plan.seed},
-            {"samples", b.plan.samples},
-            {"samples_per_frame", b.plan.samples_per_frame},
-            {"domain", DomainToJson(b.plan.domain)}}},
+          {"plan", SamplePlanToJson(b.plan)},
           {"cells", cells}};
 }
 
@@ -104,12 +118,7 @@ Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
   DB_ASSIGN_OR_RETURN(b.commit, top.String("commit"));
   DB_ASSIGN_OR_RETURN(b.made_at, top.String("made_at"));
   DB_ASSIGN_OR_RETURN(JsonReader plan, top.Field("plan"));
-  DB_ASSIGN_OR_RETURN(b.plan.seed, plan.Unsigned("seed"));
-  DB_ASSIGN_OR_RETURN(b.plan.samples, plan.Unsigned("samples"));
-  DB_ASSIGN_OR_RETURN(std::uint64_t per_frame, plan.Unsigned("samples_per_frame"));
-  b.plan.samples_per_frame = static_cast<std::uint32_t>(per_frame);
-  DB_ASSIGN_OR_RETURN(JsonReader domain, plan.Field("domain"));
-  DB_ASSIGN_OR_RETURN(b.plan.domain, DomainFromJson(domain.json(), source));
+  DB_ASSIGN_OR_RETURN(b.plan, SamplePlanFromJson(plan));
   DB_ASSIGN_OR_RETURN(JsonReader cells, top.Field("cells"));
   if (!cells.json().is_object()) return cells.Error("expected an object of cells");
   for (const auto& [name, bands_json] : cells.json().items()) {

@@ -14,6 +14,7 @@
 #include "bench/backend.h"
 #include "bench/cells.h"
 #include "bench/domain.h"
+#include "bench/json_reader.h"
 #include "bench/results.h"
 #include "bench/status.h"
 
@@ -57,6 +58,9 @@ struct Baseline {
 
 // The figures of one backend's cells in a run.
 Baseline BaselineFromResults(const Results& results, const std::string& backend);
+
+nlohmann::json SamplePlanToJson(const SamplePlan& plan);
+Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan);
 
 nlohmann::json BaselineToJson(const Baseline& baseline);
 Expected<Baseline> BaselineFromJson(const nlohmann::json& json, const std::string& source);

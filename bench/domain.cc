@@ -132,7 +132,7 @@ Status Domain::Validate() const {
 
 std::string Domain::ToFlags() const {
   auto range = [](const Range& r) {
-    return r.fixed() ? fmt::format("{:.17g}", r.min) : fmt::format("{:.17g}:{:.17g}", r.min, r.max);
+    return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max);
   };
   std::string flags = fmt::format("--fov {} --aspect {} --near {}", range(fov_degrees), range(aspect), range(near));
   if (!finite_far) {

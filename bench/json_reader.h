@@ -42,6 +42,7 @@ class JsonReader {
   Status Error(const std::string& message) const;
   const nlohmann::json& json() const { return json_; }
   const std::string& path() const { return path_; }
+  const std::string& source() const { return source_; }
 
  private:
   const nlohmann::json& json_;

@@ -84,15 +84,18 @@ Expected<Level> ParseLevel(const std::string& name) {
   return InvalidArgument(fmt::format("unknown level '{}'; allowed: p50, p99, p99.9, max", name));
 }
 
-double MetricStats::AtLevel(Level level, Metric metric) const {
-  const int low = kLowestOctave[static_cast<int>(metric)];
+double LevelQuantile(Level level) {
   switch (level) {
-    case Level::kP50: return Quantile(0.5, low);
-    case Level::kP99: return Quantile(0.99, low);
-    case Level::kP999: return Quantile(0.999, low);
-    case Level::kMax: return max();
+    case Level::kP50: return 0.5;
+    case Level::kP99: return 0.99;
+    case Level::kP999: return 0.999;
+    case Level::kMax: return 1.0;
   }
-  return 0.0;
+  return 1.0;
+}
+
+double MetricStats::AtLevel(Level level, Metric metric) const {
+  return level == Level::kMax ? max() : Quantile(LevelQuantile(level), kLowestOctave[static_cast<int>(metric)]);
 }
 
 void BandStats::Merge(const BandStats& other) {

@@ -73,6 +73,8 @@ enum class Level { kP50, kP99, kP999, kMax };
 inline constexpr Level kAllLevels[] = {Level::kP50, Level::kP99, Level::kP999, Level::kMax};
 const char* LevelName(Level level);
 Expected<Level> ParseLevel(const std::string& name);
+// The quantile a level stands for (1 for the maximum).
+double LevelQuantile(Level level);
 
 // Statistics of one metric in one band: sparse bins keyed by dense slot.
 struct MetricStats {

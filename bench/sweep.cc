@@ -1,5 +1,6 @@
 #include "bench/sweep.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -11,9 +12,20 @@
 #include "bench/environment.h"
 #include "bench/judge.h"
 #include "bench/sampler.h"
+#include "bench/text_table.h"
 #include "bench/thread_pool.h"
 
 namespace depthbench {
+
+double SweepProgress::fraction() const {
+  return samples_total == 0 ? 1.0 : static_cast<double>(samples_done) / static_cast<double>(samples_total);
+}
+
+std::string SweepProgress::Describe() const {
+  return fmt::format("{}/{} samples, {} reconstructions/s", ShortCount(static_cast<double>(samples_done)),
+                     ShortCount(static_cast<double>(samples_total)),
+                     ShortCount(static_cast<double>(reconstructions_done) / std::max(seconds, 1e-9)));
+}
 namespace {
 
 // A 32-bit bin can count 4.29e9 samples; flush well before.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
 namespace depthbench {
 
 void TextTable::AddRow(std::vector<std::string> cells) {
@@ -43,6 +45,13 @@ void TextTable::Print(std::ostream& out) const {
       print_row(row);
     }
   }
+}
+
+std::string ShortCount(double x) {
+  if (x >= 1e9) return fmt::format("{:.2f}G", x / 1e9);
+  if (x >= 1e6) return fmt::format("{:.2f}M", x / 1e6);
+  if (x >= 1e4) return fmt::format("{:.0f}k", x / 1e3);
+  return fmt::format("{:.0f}", x);
 }
 
 }  // namespace depthbench

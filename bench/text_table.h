@@ -27,4 +27,7 @@ class TextTable {
   std::vector<std::vector<std::string>> rows_;  // an empty row is a separator
 };
 
+// A count in few characters: 950, 12k, 4.20M, 1.50G.
+std::string ShortCount(double x);
+
 }  // namespace depthbench

@@ -41,7 +41,9 @@ TEST(ChooseTest, OpenWorldIsNotGivenStandardZ) {
       EXPECT_FALSE(v.meets) << v.cell.Name();
     }
   }
-  if (!r.ranked.front().meets) EXPECT_FALSE(r.suggestions.empty());  // says what would have to change
+  if (!r.ranked.front().meets) {
+    EXPECT_FALSE(r.suggestions.empty());  // says what would have to change
+  }
 }
 
 TEST(ChooseTest, SceneThatEveryCandidateMeetsGetsTheCheapest) {

@@ -50,4 +50,26 @@ std::string MakeTempDir(const std::string& name) {
   return dir.string();
 }
 
+void CopyShaderSources(const std::string& dir) {
+  namespace fs = std::filesystem;
+  fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shaders", dir + "/shaders", fs::copy_options::recursive);
+  fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shared", dir + "/shared", fs::copy_options::recursive);
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool ReplaceInFile(const std::string& path, const std::string& from, const std::string& to) {
+  std::string s = ReadText(path);
+  const auto at = s.find(from);
+  if (at == std::string::npos) return false;
+  s.replace(at, from.size(), to);
+  std::ofstream(path) << s;
+  return true;
+}
+
 }  // namespace depthbench::testing

@@ -19,4 +19,14 @@ CommandResult RunDepthbench(const std::vector<std::string>& args);
 // A fresh empty directory under the system's temporary directory.
 std::string MakeTempDir(const std::string& name);
 
+// Copies the source tree's shaders/ and shared/ into `dir`, so that a test
+// can edit them and run the edited shaders with --shaders DIR/shaders.
+void CopyShaderSources(const std::string& dir);
+
+// Replaces the first `from` by `to` in a file; false when `from` is not in it.
+bool ReplaceInFile(const std::string& path, const std::string& from, const std::string& to);
+
+// The whole text of a file ("" when it cannot be read).
+std::string ReadText(const std::string& path);
+
 }  // namespace depthbench::testing

@@ -20,22 +20,13 @@ class GateTest : public ::testing::Test {
  protected:
   void SetUp() override {
     root_ = testing::MakeTempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shaders", root_ + "/shaders", fs::copy_options::recursive);
-    fs::copy(std::string(DEPTHBENCH_SOURCE_DIR) + "/shared", root_ + "/shared", fs::copy_options::recursive);
+    testing::CopyShaderSources(root_);
   }
   void TearDown() override { fs::remove_all(root_); }
 
   // Replaces `from` by `to` in a copied file; the text must be there.
   void Edit(const std::string& relative, const std::string& from, const std::string& to) {
-    const std::string path = root_ + "/" + relative;
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string s = text.str();
-    const auto at = s.find(from);
-    ASSERT_NE(at, std::string::npos) << "'" << from << "' not in " << relative;
-    s.replace(at, from.size(), to);
-    std::ofstream(path) << s;
+    ASSERT_TRUE(testing::ReplaceInFile(root_ + "/" + relative, from, to)) << "'" << from << "' not in " << relative;
   }
 
   testing::CommandResult Gate() {

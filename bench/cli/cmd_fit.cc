@@ -51,9 +51,7 @@ int Fit(const FitFlags& f) {
   for (auto& b : *made) backends.push_back(b.get());
 
   Progress progress("fit", StderrIsTerminal());
-  auto sweeps = RunFitSweeps(plan, backends, [&](double fraction) {
-    progress.Update(fraction, fmt::format("{} far/near ratios", plan.ratios.size() + 1));
-  });
+  auto sweeps = RunFitSweeps(plan, backends, [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); });
   if (!sweeps.ok()) return ReportError(sweeps.status());
   const Metric metrics[] = {Metric::kTotal, Metric::kStorage, Metric::kArith};
   const std::vector<PrecisionFit> fits = FitPrecision(*sweeps, plan, metrics, kAllLevels);

@@ -88,8 +88,7 @@ int Gate(const GateFlags& f) {
   options.threads = f.threads;
   Progress progress("gate", StderrIsTerminal());
   options.progress = [&](const SweepProgress& p) {
-    progress.Update(static_cast<double>(p.samples_done) / static_cast<double>(p.samples_total),
-                    fmt::format("{} of {} samples", p.samples_done, p.samples_total));
+    progress.Update(p.fraction(), p.Describe());
   };
   auto results = RunSweep(options, backends);
   if (!results.ok()) return ReportError(results.status());

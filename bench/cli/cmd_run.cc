@@ -11,6 +11,7 @@
 #include "bench/results_table.h"
 #include "bench/files.h"
 #include "bench/sweep.h"
+#include "bench/text_table.h"
 
 namespace depthbench::cli {
 namespace {
@@ -29,10 +30,6 @@ struct RunFlags {
   CellFlags cells;
   BackendFlags backends;
 };
-
-std::string Si(double x) {
-  return x >= 1e9 ? fmt::format("{:.2f}G", x / 1e9) : x >= 1e6 ? fmt::format("{:.2f}M", x / 1e6) : fmt::format("{:.0f}k", x / 1e3);
-}
 
 int Run(const RunFlags& f) {
   SweepOptions options;
@@ -87,14 +84,12 @@ int Run(const RunFlags& f) {
 
   Progress progress("run", StderrIsTerminal() && !f.quiet);
   options.progress = [&](const SweepProgress& p) {
-    progress.Update(static_cast<double>(p.samples_done) / static_cast<double>(p.samples_total),
-                    fmt::format("{}/{} samples, {} reconstructions/s", Si(p.samples_done), Si(p.samples_total),
-                                Si(p.reconstructions_done / std::max(p.seconds, 1e-9))));
+    progress.Update(p.fraction(), p.Describe());
   };
   auto results = RunSweep(options, backends);
   if (!results.ok()) return ReportError(results.status());
   if (!f.quiet) {
-    progress.Finish(fmt::format("{} reconstructions in {} cells", Si(results->run.reconstructions),
+    progress.Finish(fmt::format("{} reconstructions in {} cells", ShortCount(static_cast<double>(results->run.reconstructions)),
                                 results->cells.size()));
   }
 

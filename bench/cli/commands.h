@@ -12,6 +12,10 @@ namespace depthbench::cli {
 void AddListCommand(CLI::App& app, std::function<int()>& action);
 void AddRunCommand(CLI::App& app, std::function<int()>& action);
 void AddMergeCommand(CLI::App& app, std::function<int()>& action);
+void AddSpeedCommand(CLI::App& app, std::function<int()>& action);
 void AddGateCommand(CLI::App& app, std::function<int()>& action);
+void AddFitCommand(CLI::App& app, std::function<int()>& action);
+void AddChooseCommand(CLI::App& app, std::function<int()>& action);
+void AddReportCommand(CLI::App& app, std::function<int()>& action);
 
 }  // namespace depthbench::cli

@@ -20,7 +20,11 @@ int main(int argc, char** argv) {
   AddListCommand(app, action);
   AddRunCommand(app, action);
   AddMergeCommand(app, action);
+  AddSpeedCommand(app, action);
   AddGateCommand(app, action);
+  AddFitCommand(app, action);
+  AddChooseCommand(app, action);
+  AddReportCommand(app, action);
   // A first word that is neither a flag nor a subcommand gets a message
   // that names it (CLI11 would only say a subcommand is required).
   if (argc > 1 && argv[1][0] != '-' && app.get_subcommands([&](const CLI::App* sub) {

@@ -151,6 +151,25 @@ double FittedModel::Variance(std::span<const double> weights) const {
   return v;
 }
 
+Estimate EstimateOf(const FittedModel& model, const std::function<double(const FittedModel&)>& quantity,
+                    double confidence) {
+  Estimate e;
+  e.value = quantity(model);
+  std::vector<double> gradient(model.parameters.size());
+  FittedModel shifted = model;
+  for (std::size_t i = 0; i < gradient.size(); ++i) {
+    const double h = 1e-6 * std::max(1.0, std::fabs(model.parameters[i]));
+    shifted.parameters[i] = model.parameters[i] + h;
+    gradient[i] = (quantity(shifted) - e.value) / h;
+    shifted.parameters[i] = model.parameters[i];
+  }
+  const int dof = std::max(1, model.points - static_cast<int>(model.parameters.size()));
+  const double half = StudentT(confidence, dof) * std::sqrt(model.Variance(gradient));
+  e.low = e.value - half;
+  e.high = e.value + half;
+  return e;
+}
+
 Expected<FittedModel> FitModel(std::span<const FitPoint> points, ModelKind kind) {
   const ModelInfo& info = Info(kind);
   const int n = static_cast<int>(points.size());

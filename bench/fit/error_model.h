@@ -20,6 +20,7 @@
 // need is dropped.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -67,6 +68,18 @@ struct FittedModel {
   // Variance of a linear combination sum w_i p_i of the parameters.
   double Variance(std::span<const double> weights) const;
 };
+
+// A quantity derived from a fitted model, with its confidence interval.
+struct Estimate {
+  double value = 0.0, low = 0.0, high = 0.0;
+};
+// Any function of a model's parameters (a prediction, a slope) with its
+// two-sided interval at `confidence`: the delta method (the function's
+// gradient by forward differences, the parameter covariance, Student's t
+// on the fit's residual degrees of freedom). Without a covariance the
+// interval is NaN.
+Estimate EstimateOf(const FittedModel& model, const std::function<double(const FittedModel&)>& quantity,
+                    double confidence = 0.95);
 
 // Fits one model. Fails when there are fewer points than parameters + 1.
 Expected<FittedModel> FitModel(std::span<const FitPoint> points, ModelKind kind);

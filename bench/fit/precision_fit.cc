@@ -1,6 +1,7 @@
 #include "bench/fit/precision_fit.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <ostream>
@@ -56,10 +57,13 @@ FitPlan::FitPlan() {
 }
 
 Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> backends,
-                                 const std::function<void(double)>& progress) {
+                                 const std::function<void(const SweepProgress&)>& progress) {
   FitSweeps sweeps;
   std::vector<double> ratios = plan.ratios;
   if (plan.infinite) ratios.push_back(INFINITY);
+  SweepProgress total;
+  total.samples_total = plan.samples_per_ratio * ratios.size();
+  const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < ratios.size(); ++k) {
     SweepOptions options;
     options.seed = plan.seed;
@@ -75,19 +79,32 @@ Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> 
       options.domain.infinite_far = false;
     }
     options.cells = CellsForDomain(plan.cells.empty() ? AllCells() : plan.cells, options.domain);
-    if (options.cells.empty()) continue;
+    if (options.cells.empty()) {
+      total.samples_total -= plan.samples_per_ratio;
+      continue;
+    }
+    const SweepProgress before = total;
+    if (progress) {
+      options.progress = [&](const SweepProgress& p) {
+        total.samples_done = before.samples_done + p.samples_done;
+        total.reconstructions_done = before.reconstructions_done + p.reconstructions_done;
+        total.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        progress(total);
+      };
+    }
     auto results = RunSweep(options, backends);
     if (!results.ok()) return results.status().WithContext(fmt::format("sweep at far/near {:g}", ratios[k]));
     sweeps.ratios.push_back(ratios[k]);
+    total.samples_done = before.samples_done + plan.samples_per_ratio;
+    total.reconstructions_done = before.reconstructions_done + results->run.reconstructions;
     sweeps.results.push_back(std::move(*results));
-    if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(ratios.size()));
   }
   return sweeps;
 }
 
-std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
-                                    Metric metric, Level level) {
-  std::vector<FitPoint> points;
+std::vector<BandPoint> CollectBandPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
+                                         Metric metric, Level level) {
+  std::vector<BandPoint> points;
   for (std::size_t k = 0; k < sweeps.results.size(); ++k) {
     const CellResult* result = sweeps.results[k].Find(cell, backend);
     if (result == nullptr) continue;
@@ -95,24 +112,41 @@ std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, c
     const double span = std::isinf(ratio) ? kInfiniteSpan : ratio;
     for (int d = 0; d < kDepthBands; ++d) {
       const BandStats band = result->stats.ForDepth(d);
-      if (band.finite < MinimumSamples(level)) continue;
-      const double q = band[metric].AtLevel(level, metric);
-      // A quantile in the underflow bin only says "tiny", an infinite one
-      // (a stored value that denotes infinity) nothing a model can follow.
-      if (!(q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)])) || !std::isfinite(q)) continue;
+      // NaN and Inf outputs count: they are the top of the distribution.
+      if (band.judged() < MinimumSamples(level)) continue;
       // The band's z/n, log-uniform between its edges (the top decade stops
       // at the far plane).
       const double lo = std::max(1.0, DepthBandLow(d)), hi = std::min(DepthBandLow(d) * 10.0, span);
       if (!(hi > lo)) continue;
-      points.push_back({std::isinf(ratio) ? 0.0 : std::log2(ratio), 0.5 * (std::log2(lo) + std::log2(hi)),
-                        std::log2(q) + 24.0});
+      // A share of NaN/Inf above 1 - q puts the quantile at infinity.
+      const double q = static_cast<double>(band.nan + band.inf) >
+                               (1.0 - LevelQuantile(level)) * static_cast<double>(band.judged())
+                           ? INFINITY
+                           : band[metric].AtLevel(level, metric);
+      BandPoint p;
+      p.ratio = ratio;
+      p.depth_band = d;
+      p.point = {std::isinf(ratio) ? 0.0 : std::log2(ratio), 0.5 * (std::log2(lo) + std::log2(hi)),
+                 std::isfinite(q) ? std::log2(q) + 24.0 : INFINITY};
+      p.modelled = q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)]) && std::isfinite(q);
+      points.push_back(p);
     }
   }
   return points;
 }
 
+std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
+                                    Metric metric, Level level) {
+  std::vector<FitPoint> points;
+  for (const BandPoint& p : CollectBandPoints(sweeps, cell, backend, metric, level)) {
+    if (p.modelled) points.push_back(p.point);
+  }
+  return points;
+}
+
 std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan, std::span<const Metric> metrics,
-                                       std::span<const Level> levels) {
+                                       std::span<const Level> levels,
+                                       const std::function<void(std::size_t, std::size_t)>& progress) {
   // Every (cell, backend) that appears in the sweeps, in order.
   std::vector<std::pair<Cell, std::string>> cells;
   for (const Results& r : sweeps.results) {
@@ -122,7 +156,9 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
     }
   }
   std::vector<PrecisionFit> fits;
+  std::size_t done = 0;
   for (const auto& [cell, backend] : cells) {
+    if (progress) progress(done++, cells.size());
     for (Metric metric : metrics) {
       for (Level level : levels) {
         PrecisionFit fit;
@@ -144,20 +180,11 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
         const FittedModel& m = fit.model;
 
         if (!fit.infinite_far) {
-          // Slope of the far plane and its interval (delta method: the
-          // gradient of SlopeOf with respect to the parameters).
-          fit.slope = SlopeOf(m);
-          std::vector<double> gradient(m.parameters.size());
-          for (std::size_t i = 0; i < gradient.size(); ++i) {
-            FittedModel shifted = m;
-            const double h = 1e-6 * std::max(1.0, std::fabs(m.parameters[i]));
-            shifted.parameters[i] += h;
-            gradient[i] = (SlopeOf(shifted) - fit.slope) / h;
-          }
-          const double half = StudentT(0.95, std::max(1, m.points - static_cast<int>(m.parameters.size()))) *
-                              std::sqrt(m.Variance(gradient));
-          fit.slope_low = fit.slope - half;
-          fit.slope_high = fit.slope + half;
+          // Slope of the far plane and its interval.
+          const Estimate slope = EstimateOf(m, SlopeOf);
+          fit.slope = slope.value;
+          fit.slope_low = slope.low;
+          fit.slope_high = slope.high;
           for (const auto& [name, ratio] : kPredictedRatios) {
             fit.predicted[name] = std::max(0.0, FarPlane(m, std::log2(ratio)));
           }
@@ -199,6 +226,7 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
       }
     }
   }
+  if (progress) progress(cells.size(), cells.size());
   return fits;
 }
 

@@ -44,10 +44,25 @@ struct FitSweeps {
   std::vector<double> ratios;  // +infinity for the infinite sweep
   std::vector<Results> results;
 };
+// `progress` sees the sweeps as one: samples of every ratio together.
 Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> backends,
-                                 const std::function<void(double fraction)>& progress = {});
+                                 const std::function<void(const SweepProgress&)>& progress = {});
 
-// The points of one cell, backend, metric and level.
+// Every (ratio, eye-depth decade) of one cell, backend, metric and level
+// with enough samples for the level's quantile, whether a model can follow
+// it or not.
+struct BandPoint {
+  double ratio = 0.0;  // +infinity for the infinite sweep
+  int depth_band = 0;
+  FitPoint point;      // b = +infinity when the quantile is not finite
+  // A point the models are fitted to: finite, and above the lowest kept
+  // bin (a quantile in the underflow bin only says "tiny").
+  bool modelled = false;
+};
+std::vector<BandPoint> CollectBandPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
+                                         Metric metric, Level level);
+
+// The points of one cell, backend, metric and level that models are fitted to.
 std::vector<FitPoint> CollectPoints(const FitSweeps& sweeps, const Cell& cell, const std::string& backend,
                                     Metric metric, Level level);
 
@@ -76,8 +91,10 @@ struct PrecisionFit {
   int holdout_points = 0;
 };
 
+// `progress` is told (cells fitted, cells to fit) after each (cell, backend).
 std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan,
-                                       std::span<const Metric> metrics, std::span<const Level> levels);
+                                       std::span<const Metric> metrics, std::span<const Level> levels,
+                                       const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const FitPlan& plan);
 // The headline table: one row per cell and backend (total error, one level).

@@ -1,0 +1,209 @@
+// depthbench speed: the speed side of the trade on one Vulkan device. GPU
+// time per pixel of full-screen passes reading a real depth image, in a
+// memory-bound and an ALU-bound regime; the static instruction mix of each
+// variant; the CPU backend's cost; and the speed/accuracy front.
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "bench/cli/cli_common.h"
+#include "bench/cli/commands.h"
+#include "bench/progress.h"
+#include "bench/results.h"
+#include "bench/speed/speed_run.h"
+#include "bench/speed/speed_table.h"
+#include "bench/sweep.h"
+#include "bench/vulkan/vulkan_backend.h"
+
+namespace depthbench::cli {
+namespace {
+
+struct SpeedFlags {
+  std::string device;
+  std::string shaders;
+  bool validate = false;
+  CellFlags cells;
+  std::vector<std::string> resolutions{"1920x1080", "3840x2160"};
+  std::uint32_t taps = 16;
+  std::uint32_t repetitions = 10;
+  std::uint32_t warmup = 2;
+  std::string results;
+  std::string accuracy_samples = "1e5";
+  std::string json;
+  std::string compare;
+  bool quick = false;
+  bool quiet = false;
+  // Which flags were given (quick must not override them).
+  bool repetitions_given = false, warmup_given = false, accuracy_samples_given = false;
+};
+
+// Accuracy results for the trade: the file given, or a run of the selected
+// cells on the same device's Vulkan backend.
+Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cells,
+                              std::shared_ptr<VulkanContext> context, std::uint64_t samples, std::string& source) {
+  if (!f.results.empty()) {
+    source = f.results;
+    return ReadResults(f.results);
+  }
+  BackendOptions backend_options{f.device, f.shaders, f.validate};
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<Backend> backend, MakeVulkanBackend(std::move(context), backend_options));
+  SweepOptions sweep;
+  sweep.samples = samples;
+  sweep.cells = CellsForDomain(cells, sweep.domain);
+  Backend* backends[] = {backend.get()};
+  source = fmt::format("internal run of {} samples, seed {}, default domain", samples, sweep.seed);
+  return RunSweep(sweep, backends);
+}
+
+int Speed(const SpeedFlags& f) {
+  SpeedOptions options;
+  auto cells = f.cells.Select();
+  if (!cells.ok()) return ReportError(cells.status());
+  options.cells = *cells;
+  options.resolutions.clear();
+  for (const std::string& text : f.resolutions) {
+    auto resolution = ParseResolution(text, "--resolution");
+    if (!resolution.ok()) return ReportError(resolution.status());
+    options.resolutions.push_back(*resolution);
+  }
+  options.alu_taps = f.taps;
+  options.warmup = f.quick && !f.warmup_given ? 1 : f.warmup;
+  options.repetitions = f.quick && !f.repetitions_given ? 5 : f.repetitions;
+  if (f.quick) options.cpu.repetitions = 5;
+  // Formats named on purpose must be measured; by default the device's
+  // unsupported formats are left out and listed.
+  options.refuse_unsupported = !f.cells.formats.empty();
+  Status valid = ValidateSpeedOptions(options);
+  if (!valid.ok()) {
+    // Name the flags, not the struct.
+    if (options.alu_taps < 2 || options.alu_taps > GpuPassTimer::kMaxTaps) {
+      return ReportError(InvalidArgument(fmt::format("--taps: {} is out of range; allowed 2 to {} (the ALU-bound "
+                                                     "regime; 1 tap is the memory-bound one, always measured)",
+                                                     options.alu_taps, GpuPassTimer::kMaxTaps)));
+    }
+    if (options.repetitions < 3) {
+      return ReportError(InvalidArgument(
+          fmt::format("--repetitions: {} is too few; at least 3 (a spread needs three values)", options.repetitions)));
+    }
+    if (options.warmup < 1) return ReportError(InvalidArgument("--warmup: at least 1 warm-up pass is needed"));
+    return ReportError(valid);
+  }
+  const std::string accuracy_samples_text = f.quick && !f.accuracy_samples_given ? "1e4" : f.accuracy_samples;
+  auto accuracy_samples = ParseCount(accuracy_samples_text, "--accuracy-samples");
+  if (!accuracy_samples.ok()) return ReportError(accuracy_samples.status());
+  if (!f.json.empty()) {
+    Status writable = CheckWritable(f.json, "--json");
+    if (!writable.ok()) return ReportError(writable);
+  }
+  // Files given are read before the long work starts.
+  std::optional<SpeedResults> previous;
+  if (!f.compare.empty()) {
+    auto read = ReadSpeedResults(f.compare);
+    if (!read.ok()) return ReportError(read.status().WithContext("--compare"));
+    previous = std::move(read).value();
+  }
+  std::optional<Results> given_accuracy;
+  if (!f.results.empty()) {
+    auto read = ReadResults(f.results);
+    if (!read.ok()) return ReportError(read.status().WithContext("--results"));
+    given_accuracy = std::move(read).value();
+  }
+
+  VulkanContextOptions context_options;
+  context_options.device = f.device;
+  context_options.validation = f.validate;
+  auto context = VulkanContext::Create(context_options);
+  if (!context.ok()) return ReportError(context.status());
+  std::shared_ptr<VulkanContext> shared_context = std::move(context).value();
+  const std::filesystem::path shader_dir =
+      f.shaders.empty() ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders" : std::filesystem::path(f.shaders);
+  auto timer = GpuPassTimer::Create(shared_context, shader_dir);
+  if (!timer.ok()) return ReportError(timer.status());
+
+  Progress progress("speed", StderrIsTerminal() && !f.quiet);
+  options.progress = [&](std::size_t done, std::size_t total, const std::string& what) {
+    progress.Update(static_cast<double>(done) / static_cast<double>(total), what);
+  };
+  auto results = RunSpeed(**timer, shader_dir, options);
+  if (!results.ok()) return ReportError(results.status());
+  if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results->gpu.size(), results->run.seconds));
+
+  std::string source;
+  Expected<Results> accuracy =
+      given_accuracy ? Expected<Results>(*given_accuracy)
+                     : AccuracyFor(f, options.cells, shared_context, *accuracy_samples, source);
+  if (given_accuracy) source = f.results;
+  if (!accuracy.ok()) return ReportError(accuracy.status().WithContext("accuracy results for the trade"));
+  Status traded = AddTrade(*results, *accuracy, source);
+  if (!traded.ok()) return ReportError(traded.WithContext("accuracy results for the trade"));
+
+  PrintSpeedHeader(*results, std::cout);
+  PrintGpuTable(*results, std::cout);
+  PrintStaticTable(*results, std::cout);
+  PrintCpuTable(*results, std::cout);
+  PrintTradeTable(*results, std::cout);
+  PrintSkipped(*results, std::cout);
+  if (!f.json.empty()) {
+    Status written = WriteSpeedResults(f.json, *results);
+    if (!written.ok()) return ReportError(written);
+  }
+  if (previous) {
+    auto comparison = CompareRankings(*previous, *results);
+    if (!comparison.ok()) return ReportError(comparison.status().WithContext("--compare"));
+    PrintRankingComparison(*comparison, std::cout);
+    if (!comparison->contradictions.empty()) return kExitFinding;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddSpeedCommand(CLI::App& app, std::function<int()>& action) {
+  auto flags = std::make_shared<SpeedFlags>();
+  CLI::App* cmd = app.add_subcommand(
+      "speed",
+      "Measure the speed side of the trade on a Vulkan device: GPU time per pixel of full-screen passes reading a "
+      "real depth image (memory-bound and ALU-bound), the SPIR-V instruction mix, the CPU backend's cost, and each "
+      "variant's cost against its p99.9 bits lost (the Pareto front)");
+  cmd->footer(
+      "Timing on lavapipe (the default device) is timing of JIT-compiled CPU code, not of a GPU; results are kept "
+      "per device (reports/speed/<device>.json).\n\n"
+      "Examples:\n"
+      "  depthbench speed --json reports/speed/llvmpipe.json\n"
+      "  depthbench speed --device nvidia --results results.json --json reports/speed/nvidia-h200.json\n"
+      "  depthbench speed --variant divide,pq --convention reversed --format d32f --resolution 1920x1080 --quick\n"
+      "  depthbench speed --compare reports/speed/llvmpipe.json   (exit 1 if a ranking flips)");
+  cmd->add_option("--device", flags->device,
+                  "Vulkan device: a case-insensitive part of its name (default: Mesa lavapipe, 'llvmpipe')");
+  cmd->add_option("--shaders", flags->shaders,
+                  "directory of the shaders (holding speed/), compiled at run time (default: the source tree's "
+                  "shaders/)");
+  cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer and fail on its messages");
+  flags->cells.Add(*cmd);
+  cmd->add_option("--resolution", flags->resolutions,
+                  "full-screen pass sizes WIDTHxHEIGHT (several, or comma-separated; default 1920x1080,3840x2160)")
+      ->delimiter(',');
+  cmd->add_option("--taps", flags->taps, "reconstructions per pixel in the ALU-bound regime, 2 to 64 (default 16)");
+  cmd->add_option("--repetitions", flags->repetitions, "timed repetitions per measurement, at least 3 (default 10)")
+      ->each([flags](const std::string&) { flags->repetitions_given = true; });
+  cmd->add_option("--warmup", flags->warmup,
+                  "warm-up rounds (one pass of each variant timed together), at least 1; more follow up to 20 ms "
+                  "of device time (default 2)")
+      ->each([flags](const std::string&) { flags->warmup_given = true; });
+  cmd->add_option("--results", flags->results,
+                  "accuracy results (depthbench run --json) for the trade; default: an internal run on the same "
+                  "device");
+  cmd->add_option("--accuracy-samples", flags->accuracy_samples,
+                  "samples of the internal accuracy run when no --results is given (default 1e5)")
+      ->each([flags](const std::string&) { flags->accuracy_samples_given = true; });
+  cmd->add_option("--json", flags->json, "write the results (schema depthbench.speed v1) to FILE");
+  cmd->add_option("--compare", flags->compare,
+                  "an earlier speed JSON of the same device: report whether the variants rank the same way "
+                  "wherever their medians differ by more than the spread (exit 1 where they do not)");
+  cmd->add_flag("--quick", flags->quick,
+                "fewer repetitions (1 warm-up, 5 repetitions) and a 1e4-sample accuracy run, for tests");
+  cmd->add_flag("--quiet", flags->quiet, "no progress line");
+  cmd->callback([flags, &action] { action = [flags] { return Speed(*flags); }; });
+}
+
+}  // namespace depthbench::cli

@@ -1,0 +1,90 @@
+// The nightly precision report: what it measures, and everything it shows
+// as one JSON document (schema "depthbench.report", version 1; documented
+// in reports/report.schema.json). The page (report_html.h) and the summary
+// (report_markdown.h) are drawn from that document alone: they format, they
+// never compute.
+//
+// Measurements:
+//   - the fit sweeps (precision_fit.h): every cell at far/near 10^1, 10^1.5,
+//     ..., 10^8 and with an infinite far plane, camera at the origin, on
+//     every backend; the error models fitted to them;
+//   - the default-domain sweep (every projection, pose and depth the
+//     sampler draws, cameras up to 1e6 from the origin): NaN/Inf findings,
+//     the worst samples, and the per-band figures kept in the history;
+//   - speed files (`depthbench speed --json`) where they exist, joined with
+//     this run's accuracy into the speed/accuracy front; the static
+//     instruction mix of every variant otherwise.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/backend.h"
+#include "bench/baseline.h"
+#include "bench/fit/precision_fit.h"
+#include "bench/report/history.h"
+#include "bench/results.h"
+#include "bench/speed/speed_results.h"
+#include "bench/status.h"
+#include "bench/sweep.h"
+
+namespace depthbench {
+
+inline constexpr const char* kReportSchema = "depthbench.report";
+inline constexpr int kReportSchemaVersion = 1;
+
+struct ReportPlan {
+  bool quick = false;
+  FitPlan fit;                  // the fixed-ratio sweeps and their models
+  std::uint64_t main_seed = 1;  // the default-domain sweep
+  std::uint64_t main_samples = 0;
+  Domain main_domain;
+  std::vector<Cell> cells;  // empty: all
+  std::vector<std::filesystem::path> speed_files;
+  std::filesystem::path shader_dir;  // for the instruction mix
+  int trend_runs = 60;               // runs of the history the trend shows
+
+  // The nightly plan, and the quick one (same sweeps, fewer samples).
+  static ReportPlan Nightly();
+  static ReportPlan Quick();
+};
+
+// Progress of the measuring stages, for the command line to show.
+struct ReportProgress {
+  std::function<void(const std::string& stage)> begin;
+  std::function<void(const SweepProgress&)> sweep;
+  std::function<void(std::size_t done, std::size_t total)> fits;
+  std::function<void(const std::string& summary)> end;
+};
+
+struct ReportMeasurements {
+  FitSweeps sweeps;
+  std::vector<PrecisionFit> fits;
+  Results main;
+  std::vector<std::pair<std::filesystem::path, SpeedResults>> speed;
+  std::vector<StaticCost> static_costs;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,
+                                           const ReportProgress& progress = {});
+
+// The report document, without its "history" part.
+nlohmann::json ReportJson(const ReportPlan& plan, const ReportMeasurements& measured);
+
+// The headline figures of each backend, as the history keeps them.
+std::vector<Baseline> HistoryFigures(const ReportMeasurements& measured);
+
+// Records the run in the history and adds the "history" part to the
+// document: the trend of every cell, the previous comparable run, and what
+// got worse (or better) since it, by the gate's tolerances.
+Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run,
+                  std::span<const Baseline> figures, int trend_runs);
+
+}  // namespace depthbench

@@ -1,0 +1,40 @@
+// The report's two renderings, both drawn from the report document alone
+// (report.h): a self-contained HTML page with interactive Vega-Lite plots,
+// and a short Markdown summary for a CI job page.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/status.h"
+
+namespace depthbench {
+
+// The plotting library the page embeds: Vega, Vega-Lite and vega-embed,
+// as npm installs them (reports/package.json) into `node_modules`.
+struct PlotLibrary {
+  std::filesystem::path node_modules;
+  // The three bundles, in load order.
+  std::vector<std::filesystem::path> Bundles() const;
+  // NotFound with what to run when a bundle is missing.
+  Status Check() const;
+};
+
+// The page: `template_file` (reports/report_template.html) with the
+// library bundles and the document inlined, so that it opens offline.
+Expected<std::string> RenderHtml(const nlohmann::json& report, const std::filesystem::path& template_file,
+                                 const PlotLibrary& library);
+
+// The Markdown summary: what changed since the last comparable run, the
+// headline per convention and format, the worst cells, NaN/Inf findings.
+std::string RenderMarkdown(const nlohmann::json& report);
+
+// The cells the summary calls worst: the highest p99.9 bits lost over the
+// default domain (then the highest maximum), `count` of them, as
+// "variant/convention/format on backend".
+std::vector<std::string> WorstCells(const nlohmann::json& report, std::size_t count);
+
+}  // namespace depthbench

@@ -1,0 +1,597 @@
+#include "bench/speed/gpu_pass_timer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "bench/speed/timing_stats.h"
+#include "bench/vulkan/shader_compiler.h"
+
+namespace depthbench {
+namespace {
+
+// shaders/speed/speed_pass.glsl: its bindings, specialization constants and
+// workgroup size.
+enum Binding : std::uint32_t { kConstantsBinding = 0, kImageBinding = 1, kResultsBinding = 2 };
+constexpr std::uint32_t kTapsConstant = 0;
+constexpr std::uint32_t kConventionConstant = 1;
+constexpr std::uint32_t kWorkgroupSide = 8;
+struct PassSize {
+  std::uint32_t width;
+  std::uint32_t height;
+};
+// The uniform block: FrameParams then DepthParams, std140 = std430 here.
+struct PassConstants {
+  f32::FrameParams frame;
+  f32::DepthParams depth;
+};
+// More warm-up passes than this are not needed on any device.
+constexpr std::uint64_t kMaxExtraWarmupPasses = 65536;
+
+std::uint32_t GroupsFor(std::uint32_t pixels) { return (pixels + kWorkgroupSide - 1) / kWorkgroupSide; }
+
+void ComputeToComputeBarrier(VkCommandBuffer commands) {
+  VkMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                       &barrier, 0, nullptr, 0, nullptr);
+}
+
+}  // namespace
+
+VkFormat VulkanFormatOf(Format format) {
+  switch (format) {
+    case Format::kD16Unorm: return VK_FORMAT_D16_UNORM;
+    case Format::kX8D24Unorm: return VK_FORMAT_X8_D24_UNORM_PACK32;
+    case Format::kD32Sfloat: return VK_FORMAT_D32_SFLOAT;
+    case Format::kR32Sfloat: return VK_FORMAT_R32_SFLOAT;
+    case Format::kR16Sfloat: return VK_FORMAT_R16_SFLOAT;
+    case Format::kR16Unorm: return VK_FORMAT_R16_UNORM;
+    case Format::kR32SfloatViewZ: return VK_FORMAT_R32_SFLOAT;
+  }
+  return VK_FORMAT_UNDEFINED;
+}
+
+bool IsDepthFormat(Format format) { return Info(format).stores == DepthInput::kHardware; }
+
+Status CheckFormatFeatures(Format format, VkFormatFeatureFlags features, const std::string& device_name) {
+  std::string missing;
+  if ((features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT) == 0) missing = "sampled images";
+  if ((features & VK_FORMAT_FEATURE_TRANSFER_DST_BIT) == 0) {
+    missing += std::string(missing.empty() ? "" : " and ") + "transfers into images";
+  }
+  if (missing.empty()) return Status::Ok();
+  return Unavailable(fmt::format("{} ({}) is not supported by Vulkan device '{}': its optimal-tiling features "
+                                 "lack {}, so no pass can read a real image of it",
+                                 Info(format).name, Info(format).vulkan_name, device_name, missing));
+}
+
+GpuPassTimer::GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir)
+    : context_(std::move(context)), shader_dir_(std::move(shader_dir)) {}
+
+Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<VulkanContext> context,
+                                                             std::filesystem::path shader_dir) {
+  if (context == nullptr) return InvalidArgument("the GPU pass timer needs a Vulkan context");
+  const VulkanDeviceProperties& properties = context->properties();
+  if (properties.queue_timestamp_valid_bits == 0) {
+    return Unavailable(fmt::format("Vulkan device '{}': its compute queue cannot write timestamps "
+                                   "(timestampValidBits 0), so passes cannot be timed on it",
+                                   properties.name));
+  }
+  if (!(properties.limits.timestampPeriod > 0.0f)) {
+    return Unavailable(fmt::format("Vulkan device '{}' reports timestampPeriod {}", properties.name,
+                                   properties.limits.timestampPeriod));
+  }
+  std::error_code error;
+  if (!std::filesystem::is_directory(shader_dir / "speed", error)) {
+    return NotFound(fmt::format("speed shader directory '{}' does not exist", (shader_dir / "speed").string()));
+  }
+  std::unique_ptr<GpuPassTimer> timer(new GpuPassTimer(std::move(context), std::move(shader_dir)));
+  const std::uint64_t errors_before = timer->context_->validation_log()->error_count();
+  DB_RETURN_IF_ERROR(timer->CreateLayouts());
+  DB_RETURN_IF_ERROR(timer->CreateCommandObjects());
+  DB_RETURN_IF_ERROR(timer->CheckValidation(errors_before, "creating the GPU pass timer"));
+  return timer;
+}
+
+GpuPassTimer::~GpuPassTimer() {
+  if (context_->queue() != VK_NULL_HANDLE) vkQueueWaitIdle(context_->queue());
+  if (command_buffer_ != VK_NULL_HANDLE) {
+    vkFreeCommandBuffers(vk_device(), context_->command_pool(), 1, &command_buffer_);
+  }
+}
+
+Status GpuPassTimer::CreateLayouts() {
+  const std::array<VkDescriptorSetLayoutBinding, 3> bindings = {{
+      {kConstantsBinding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {kImageBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {kResultsBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+  }};
+  VkDescriptorSetLayoutCreateInfo set_layout_info{};
+  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  set_layout_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
+  set_layout_info.pBindings = bindings.data();
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(vk_device(), &set_layout_info, nullptr, &set_layout),
+                             "vkCreateDescriptorSetLayout"));
+  set_layout_ = DeviceObject<VkDescriptorSetLayout>(vk_device(), set_layout, vkDestroyDescriptorSetLayout);
+
+  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PassSize)};
+  VkPipelineLayoutCreateInfo pipeline_layout_info{};
+  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pipeline_layout_info.setLayoutCount = 1;
+  pipeline_layout_info.pSetLayouts = &set_layout;
+  pipeline_layout_info.pushConstantRangeCount = 1;
+  pipeline_layout_info.pPushConstantRanges = &push_constants;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(vk_device(), &pipeline_layout_info, nullptr, &pipeline_layout),
+                             "vkCreatePipelineLayout"));
+  pipeline_layout_ = DeviceObject<VkPipelineLayout>(vk_device(), pipeline_layout, vkDestroyPipelineLayout);
+
+  const std::array<VkDescriptorPoolSize, 3> pool_sizes = {{{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+                                                           {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+                                                           {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}};
+  VkDescriptorPoolCreateInfo pool_info{};
+  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = static_cast<std::uint32_t>(pool_sizes.size());
+  pool_info.pPoolSizes = pool_sizes.data();
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateDescriptorPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
+  descriptor_pool_ = DeviceObject<VkDescriptorPool>(vk_device(), pool, vkDestroyDescriptorPool);
+
+  VkDescriptorSetAllocateInfo set_info{};
+  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  set_info.descriptorPool = pool;
+  set_info.descriptorSetCount = 1;
+  set_info.pSetLayouts = &set_layout;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkAllocateDescriptorSets(vk_device(), &set_info, &descriptor_set_), "vkAllocateDescriptorSets"));
+
+  // texelFetch ignores filtering and addressing; the sampler only has to exist.
+  VkSamplerCreateInfo sampler_info{};
+  sampler_info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+  sampler_info.magFilter = VK_FILTER_NEAREST;
+  sampler_info.minFilter = VK_FILTER_NEAREST;
+  sampler_info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  sampler_info.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  sampler_info.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  sampler_info.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  VkSampler sampler = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateSampler(vk_device(), &sampler_info, nullptr, &sampler), "vkCreateSampler"));
+  sampler_ = DeviceObject<VkSampler>(vk_device(), sampler, vkDestroySampler);
+  return Status::Ok();
+}
+
+Status GpuPassTimer::CreateCommandObjects() {
+  VkCommandBufferAllocateInfo command_info{};
+  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  command_info.commandPool = context_->command_pool();
+  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  command_info.commandBufferCount = 1;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkAllocateCommandBuffers(vk_device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
+  VkFenceCreateInfo fence_info{};
+  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VkFence fence = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(vk_device(), &fence_info, nullptr, &fence), "vkCreateFence"));
+  fence_ = DeviceObject<VkFence>(vk_device(), fence, vkDestroyFence);
+  return Status::Ok();
+}
+
+Status GpuPassTimer::CheckFormat(Format format) const {
+  VkFormatProperties properties{};
+  vkGetPhysicalDeviceFormatProperties(context_->physical_device(), VulkanFormatOf(format), &properties);
+  return CheckFormatFeatures(format, properties.optimalTilingFeatures, device().name);
+}
+
+Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention convention, std::uint32_t taps) {
+  const auto key = std::make_tuple(variant, convention, taps);
+  if (auto found = pipelines_.find(key); found != pipelines_.end()) return found->second.get();
+  auto compiled = spirv_.find(variant);
+  if (compiled == spirv_.end()) {
+    const std::filesystem::path path = shader_dir_ / "speed" / (std::string(Info(variant).name) + ".comp");
+    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> words, CompileComputeShader(path));
+    compiled = spirv_.emplace(variant, std::move(words)).first;
+  }
+  const std::vector<std::uint32_t>& spirv = compiled->second;
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+  module_info.pCode = spirv.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(vk_device(), &module_info, nullptr, &module),
+                             fmt::format("vkCreateShaderModule for the {} speed pass", Info(variant).name)));
+  const DeviceObject<VkShaderModule> module_owner(vk_device(), module, vkDestroyShaderModule);
+
+  const std::array<std::uint32_t, 2> values = {taps, Info(convention).bits};
+  const std::array<VkSpecializationMapEntry, 2> entries = {{
+      {kTapsConstant, 0, sizeof(std::uint32_t)},
+      {kConventionConstant, sizeof(std::uint32_t), sizeof(std::uint32_t)},
+  }};
+  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                                            sizeof(values), values.data()};
+  VkComputePipelineCreateInfo pipeline_info{};
+  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeline_info.stage.module = module;
+  pipeline_info.stage.pName = "main";
+  pipeline_info.stage.pSpecializationInfo = &specialization;
+  pipeline_info.layout = pipeline_layout_.get();
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateComputePipelines(vk_device(), VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
+              fmt::format("vkCreateComputePipelines for the {} speed pass", Info(variant).name)));
+  auto& stored = pipelines_[key];
+  stored = DeviceObject<VkPipeline>(vk_device(), pipeline, vkDestroyPipeline);
+  return stored.get();
+}
+
+Expected<DeviceObject<VkDeviceMemory>> GpuPassTimer::AllocateDeviceLocal(
+    const VkMemoryRequirements& requirements) const {
+  // Device-local first, as an engine places its render targets; a device
+  // without it (none known) still runs.
+  DB_ASSIGN_OR_RETURN(const std::uint32_t type,
+                      context_->FindMemoryType(requirements.memoryTypeBits,
+                                               {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VkMemoryPropertyFlags{0}}));
+  VkMemoryAllocateInfo allocate_info{};
+  allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  allocate_info.allocationSize = requirements.size;
+  allocate_info.memoryTypeIndex = type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(vk_device(), &allocate_info, nullptr, &memory),
+                             fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
+  return DeviceObject<VkDeviceMemory>(vk_device(), memory, vkFreeMemory);
+}
+
+template <class Record>
+Status GpuPassTimer::Submit(Record record) {
+  VkCommandBufferBeginInfo begin_info{};
+  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
+  record(command_buffer_);
+  DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer"));
+  const VkFence fence = fence_.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(vk_device(), 1, &fence), "vkResetFences"));
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer_;
+  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
+  return CheckVk(vkWaitForFences(vk_device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()),
+                 "vkWaitForFences");
+}
+
+Status GpuPassTimer::CreateImage(const DepthImage& image) {
+  const Format format = image.encoding.format;
+  DB_RETURN_IF_ERROR(CheckFormat(format));
+  const VkFormat vk_format = VulkanFormatOf(format);
+  VkImageCreateInfo image_info{};
+  image_info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+  image_info.imageType = VK_IMAGE_TYPE_2D;
+  image_info.format = vk_format;
+  image_info.extent = {image.resolution.width, image.resolution.height, 1};
+  image_info.mipLevels = 1;
+  image_info.arrayLayers = 1;
+  image_info.samples = VK_SAMPLE_COUNT_1_BIT;
+  image_info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  image_info.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  image_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  image_info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImage handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateImage(vk_device(), &image_info, nullptr, &handle),
+                             fmt::format("vkCreateImage of {} {}x{}", Info(format).vulkan_name,
+                                         image.resolution.width, image.resolution.height)));
+  DeviceObject<VkImage> new_image(vk_device(), handle, vkDestroyImage);
+  VkMemoryRequirements requirements{};
+  vkGetImageMemoryRequirements(vk_device(), handle, &requirements);
+  DB_ASSIGN_OR_RETURN(DeviceObject<VkDeviceMemory> memory, AllocateDeviceLocal(requirements));
+  DB_RETURN_IF_ERROR(CheckVk(vkBindImageMemory(vk_device(), handle, memory.get(), 0), "vkBindImageMemory"));
+
+  const VkImageAspectFlags aspect = IsDepthFormat(format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  VkImageViewCreateInfo view_info{};
+  view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+  view_info.image = handle;
+  view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view_info.format = vk_format;
+  view_info.subresourceRange = {aspect, 0, 1, 0, 1};
+  VkImageView view = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateImageView(vk_device(), &view_info, nullptr, &view), "vkCreateImageView"));
+  DeviceObject<VkImageView> new_view(vk_device(), view, vkDestroyImageView);
+
+  // The texels travel through a staging buffer, as an engine uploads.
+  DB_ASSIGN_OR_RETURN(VulkanBuffer staging, context_->CreateHostBuffer(image.texels.size(),
+                                                                        VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                                                        HostAccess::kUpload));
+  std::memcpy(staging.mapped(), image.texels.data(), image.texels.size());
+  DB_RETURN_IF_ERROR(staging.FlushHostWrites());
+  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+    VkImageMemoryBarrier to_transfer{};
+    to_transfer.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    to_transfer.srcAccessMask = 0;
+    to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_transfer.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    to_transfer.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    to_transfer.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_transfer.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_transfer.image = handle;
+    to_transfer.subresourceRange = {aspect, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                         0, nullptr, 1, &to_transfer);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {aspect, 0, 0, 1};
+    region.imageExtent = {image.resolution.width, image.resolution.height, 1};
+    vkCmdCopyBufferToImage(commands, staging.handle(), handle, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    VkImageMemoryBarrier to_shader = to_transfer;
+    to_shader.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_shader.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    to_shader.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    to_shader.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                         nullptr, 0, nullptr, 1, &to_shader);
+  }));
+  image_view_.Reset();
+  image_.Reset();
+  image_memory_ = std::move(memory);
+  image_ = std::move(new_image);
+  image_view_ = std::move(new_view);
+  return Status::Ok();
+}
+
+Status GpuPassTimer::CreateResultBuffer(VkDeviceSize bytes) {
+  if (bytes == result_bytes_) return Status::Ok();
+  const VkPhysicalDeviceLimits& limits = device().limits;
+  if (bytes > limits.maxStorageBufferRange) {
+    return InvalidArgument(fmt::format("a pass over {}x{} pixels writes {} bytes; Vulkan device '{}' binds at "
+                                       "most {} bytes of storage buffer",
+                                       resolution_.width, resolution_.height, bytes, device().name,
+                                       limits.maxStorageBufferRange));
+  }
+  result_buffer_.Reset();
+  result_memory_.Reset();
+  result_bytes_ = 0;
+  VkBufferCreateInfo buffer_info{};
+  buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  buffer_info.size = bytes;
+  buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkBuffer handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateBuffer(vk_device(), &buffer_info, nullptr, &handle), "vkCreateBuffer"));
+  DeviceObject<VkBuffer> buffer(vk_device(), handle, vkDestroyBuffer);
+  VkMemoryRequirements requirements{};
+  vkGetBufferMemoryRequirements(vk_device(), handle, &requirements);
+  DB_ASSIGN_OR_RETURN(result_memory_, AllocateDeviceLocal(requirements));
+  DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, result_memory_.get(), 0), "vkBindBufferMemory"));
+  result_buffer_ = std::move(buffer);
+  result_bytes_ = bytes;
+  return Status::Ok();
+}
+
+void GpuPassTimer::WriteDescriptors() {
+  const VkDescriptorBufferInfo constants_info{constants_.handle(), 0, sizeof(PassConstants)};
+  const VkDescriptorImageInfo image_info{sampler_.get(), image_view_.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorBufferInfo results_info{result_buffer_.get(), 0, result_bytes_};
+  std::array<VkWriteDescriptorSet, 3> writes{};
+  for (VkWriteDescriptorSet& write : writes) {
+    write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    write.dstSet = descriptor_set_;
+    write.descriptorCount = 1;
+  }
+  writes[0].dstBinding = kConstantsBinding;
+  writes[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  writes[0].pBufferInfo = &constants_info;
+  writes[1].dstBinding = kImageBinding;
+  writes[1].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  writes[1].pImageInfo = &image_info;
+  writes[2].dstBinding = kResultsBinding;
+  writes[2].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  writes[2].pBufferInfo = &results_info;
+  vkUpdateDescriptorSets(vk_device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
+
+Status GpuPassTimer::LoadImage(const DepthImage& image) {
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  loaded_ = false;
+  resolution_ = image.resolution;
+  const std::size_t expected =
+      static_cast<std::size_t>(image.resolution.width) * image.resolution.height * TexelBytes(image.encoding.format);
+  if (image.texels.size() != expected || image.texel_bytes != TexelBytes(image.encoding.format)) {
+    return InvalidArgument(fmt::format("depth image of {}x{} {} holds {} bytes; it needs {}", image.resolution.width,
+                                       image.resolution.height, Info(image.encoding.format).name,
+                                       image.texels.size(), expected));
+  }
+  DB_RETURN_IF_ERROR(CreateImage(image));
+  DB_RETURN_IF_ERROR(CreateResultBuffer(static_cast<VkDeviceSize>(image.resolution.width) * image.resolution.height *
+                                        sizeof(float)));
+  if (constants_.handle() == VK_NULL_HANDLE) {
+    DB_ASSIGN_OR_RETURN(constants_, context_->CreateHostBuffer(sizeof(PassConstants),
+                                                               VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                                               HostAccess::kUpload));
+  }
+  const PassConstants constants{image.frame_params, image.depth_params};
+  std::memcpy(constants_.mapped(), &constants, sizeof(constants));
+  DB_RETURN_IF_ERROR(constants_.FlushHostWrites());
+  WriteDescriptors();
+  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "loading the depth image"));
+  encoding_ = image.encoding;
+  loaded_ = true;
+  return Status::Ok();
+}
+
+void GpuPassTimer::RecordPasses(VkPipeline pipeline, std::uint32_t passes) {
+  vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
+                          &descriptor_set_, 0, nullptr);
+  const PassSize size{resolution_.width, resolution_.height};
+  vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(size), &size);
+  for (std::uint32_t pass = 0; pass < passes; ++pass) {
+    vkCmdDispatch(command_buffer_, GroupsFor(resolution_.width), GroupsFor(resolution_.height), 1);
+    // Each pass waits for the one before, and the next submission's passes
+    // for the last: they all write the same results.
+    ComputeToComputeBarrier(command_buffer_);
+  }
+}
+
+Expected<std::vector<double>> GpuPassTimer::TimeGroups(std::span<const Group> groups) {
+  const auto queries = static_cast<std::uint32_t>(2 * groups.size());
+  if (queries > query_capacity_) {
+    query_pool_.Reset();
+    query_capacity_ = 0;
+    VkQueryPoolCreateInfo pool_info{};
+    pool_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    pool_info.queryCount = queries;
+    VkQueryPool pool = VK_NULL_HANDLE;
+    DB_RETURN_IF_ERROR(CheckVk(vkCreateQueryPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateQueryPool"));
+    query_pool_ = DeviceObject<VkQueryPool>(vk_device(), pool, vkDestroyQueryPool);
+    query_capacity_ = queries;
+  }
+  const VkQueryPool pool = query_pool_.get();
+  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+    vkCmdResetQueryPool(commands, pool, 0, queries);
+    for (std::uint32_t g = 0; g < groups.size(); ++g) {
+      // Bottom of pipe: written once everything recorded before has finished.
+      vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g);
+      RecordPasses(groups[g].pipeline, groups[g].passes);
+      vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g + 1);
+    }
+  }));
+  std::vector<std::uint64_t> stamps(queries);
+  DB_RETURN_IF_ERROR(CheckVk(vkGetQueryPoolResults(vk_device(), pool, 0, queries, stamps.size() * sizeof(std::uint64_t),
+                                                   stamps.data(), sizeof(std::uint64_t),
+                                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                             "vkGetQueryPoolResults"));
+  std::vector<double> ns_per_pass(groups.size());
+  for (std::uint32_t g = 0; g < groups.size(); ++g) {
+    DB_ASSIGN_OR_RETURN(const double ns,
+                        CheckedTimestampIntervalNs(stamps[2 * g], stamps[2 * g + 1],
+                                                   device().queue_timestamp_valid_bits, timestamp_period_ns()));
+    ns_per_pass[g] = ns / groups[g].passes;
+  }
+  return ns_per_pass;
+}
+
+Expected<PassTiming> GpuPassTimer::TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup,
+                                            std::uint32_t repetitions) {
+  const Variant variants[] = {variant};
+  DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimePasses(variants, taps, warmup, repetitions));
+  return std::move(timings.front());
+}
+
+Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Variant> variants, std::uint32_t taps,
+                                                           std::uint32_t warmup, std::uint32_t repetitions) {
+  if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
+  if (variants.empty()) return InvalidArgument("no variant to time");
+  for (const Variant variant : variants) {
+    if (!Reads(variant, encoding_.convention, encoding_.format)) {
+      return InvalidArgument(fmt::format("{} does not read {} under the {} convention (see 'depthbench list'); "
+                                         "such a pass is not timed",
+                                         Info(variant).name, Info(encoding_.format).name,
+                                         Info(encoding_.convention).name));
+    }
+  }
+  if (taps == 0 || taps > kMaxTaps) {
+    return InvalidArgument(fmt::format("taps {} is outside 1 to {}", taps, kMaxTaps));
+  }
+  if (warmup == 0 || repetitions == 0) {
+    return InvalidArgument("a timed pass needs at least one warm-up pass and one repetition");
+  }
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const std::size_t count = variants.size();
+  std::vector<VkPipeline> pipelines;
+  for (const Variant variant : variants) {
+    DB_ASSIGN_OR_RETURN(const VkPipeline pipeline, Pipeline(variant, encoding_.convention, taps));
+    pipelines.push_back(pipeline);
+  }
+
+  // Warm-up rounds, one pass of each variant: also each one's pass time.
+  std::vector<Group> schedule;
+  for (std::uint32_t round = 0; round < warmup; ++round) {
+    for (const VkPipeline pipeline : pipelines) schedule.push_back({pipeline, 1});
+  }
+  DB_ASSIGN_OR_RETURN(const std::vector<double> first, TimeGroups(schedule));
+  std::vector<PassTiming> timings(count);
+  std::vector<double> pass_ns(count);
+  double warmed_ns = 0.0;
+  double round_ns = 0.0;
+  for (std::size_t v = 0; v < count; ++v) {
+    std::vector<double> own;
+    for (std::uint32_t round = 0; round < warmup; ++round) own.push_back(first[round * count + v]);
+    DB_ASSIGN_OR_RETURN(const TimingSummary estimate, SummarizeTimings(own));
+    pass_ns[v] = std::max(estimate.median, 1.0);
+    for (double ns : own) warmed_ns += ns;
+    round_ns += pass_ns[v];
+    timings[v].warmup_passes = warmup;
+  }
+  // More rounds until the device has run kMinWarmupNs.
+  if (warmed_ns < kMinWarmupNs) {
+    const auto rounds = static_cast<std::uint32_t>(std::min<double>(
+        std::ceil((kMinWarmupNs - warmed_ns) / round_ns), static_cast<double>(kMaxExtraWarmupPasses / count)));
+    DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer) {
+      for (std::uint32_t round = 0; round < rounds; ++round) {
+        for (const VkPipeline pipeline : pipelines) RecordPasses(pipeline, 1);
+      }
+    }));
+    for (PassTiming& timing : timings) timing.warmup_passes += rounds;
+  }
+  // The timed rounds: one group of each variant per round.
+  for (std::size_t v = 0; v < count; ++v) {
+    timings[v].passes_per_repetition =
+        static_cast<std::uint32_t>(std::clamp<double>(std::ceil(kMinGroupNs / pass_ns[v]), 1.0, kMaxPassesPerGroup));
+  }
+  schedule.clear();
+  for (std::uint32_t round = 0; round < repetitions; ++round) {
+    for (std::size_t v = 0; v < count; ++v) schedule.push_back({pipelines[v], timings[v].passes_per_repetition});
+  }
+  DB_ASSIGN_OR_RETURN(const std::vector<double> timed, TimeGroups(schedule));
+  for (std::uint32_t round = 0; round < repetitions; ++round) {
+    for (std::size_t v = 0; v < count; ++v) timings[v].ns_per_pass.push_back(timed[round * count + v]);
+  }
+  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "timing passes"));
+  return timings;
+}
+
+Expected<std::vector<float>> GpuPassTimer::ReadResults() {
+  if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
+  DB_ASSIGN_OR_RETURN(VulkanBuffer readback,
+                      context_->CreateHostBuffer(result_bytes_, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                 HostAccess::kReadback));
+  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+    VkMemoryBarrier to_transfer{};
+    to_transfer.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    to_transfer.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
+                         &to_transfer, 0, nullptr, 0, nullptr);
+    const VkBufferCopy region{0, 0, result_bytes_};
+    vkCmdCopyBuffer(commands, result_buffer_.get(), readback.handle(), 1, &region);
+    VkMemoryBarrier to_host{};
+    to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                         nullptr, 0, nullptr);
+  }));
+  DB_RETURN_IF_ERROR(readback.InvalidateForHostReads());
+  std::vector<float> values(result_bytes_ / sizeof(float));
+  std::memcpy(values.data(), readback.mapped(), result_bytes_);
+  return values;
+}
+
+Status GpuPassTimer::CheckValidation(std::uint64_t errors_before, const std::string& during) const {
+  const std::shared_ptr<ValidationLog> log = context_->validation_log();
+  const std::uint64_t errors = log->error_count() - errors_before;
+  if (errors == 0) return Status::Ok();
+  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) while {}; the last: {}", errors,
+                              during, log->last_error()));
+}
+
+}  // namespace depthbench

@@ -1,0 +1,150 @@
+// GpuPassTimer: times full-screen compute passes (shaders/speed/) on one
+// Vulkan device with timestamp queries.
+//
+// Lifecycle:
+//   1. Create(context, shader_dir) on an existing VulkanContext;
+//   2. LoadImage(image): uploads a depth image of one encoding into a
+//      device-local VkImage of its real format (a depth format as a sampled
+//      depth image) and the frame's constants into a uniform buffer;
+//   3. TimePasses(variants, taps, ...) any number of times: the variants'
+//      passes over the loaded image, taps reconstructions per pixel, timed.
+// Pipelines are built on first use, one per (variant, convention, taps).
+//
+// How passes are timed: the variants that compete (those reading the
+// loaded image) are timed together, interleaved, so that a slow drift of
+// the device (clocks, temperature, other work on a CPU device) reaches
+// all of them alike and shows in each one's spread rather than between
+// their medians. First `warmup` rounds of one pass of each variant (also
+// the estimate of each one's pass time), then more rounds until at least
+// kMinWarmupNs of device time has run, so that a real GPU has left its
+// idle clocks; then `repetitions` rounds, each timing one group per
+// variant of enough back-to-back passes to last about kMinGroupNs (one on
+// a slow device). Passes are separated by barriers, as an engine's passes
+// are. Each group is bracketed by two bottom-of-pipe timestamps: the first
+// is written when everything before it has finished, the second when the
+// group has; their difference, in the device's timestampPeriod, divided by
+// the group's passes, is one repetition's time per pass.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "bench/cells.h"
+#include "bench/speed/depth_image.h"
+#include "bench/status.h"
+#include "bench/vulkan/vulkan_context.h"
+
+namespace depthbench {
+
+// The Vulkan format a bench format is stored in, and whether it is a depth
+// format (sampled through the depth aspect).
+VkFormat VulkanFormatOf(Format format);
+bool IsDepthFormat(Format format);
+// Ok when `features` (the device's optimal-tiling features of the format)
+// allow sampling the image and copying into it; otherwise Unavailable,
+// naming the format, the device and what is missing.
+Status CheckFormatFeatures(Format format, VkFormatFeatureFlags features, const std::string& device_name);
+
+struct PassTiming {
+  std::vector<double> ns_per_pass;  // one value per repetition
+  std::uint32_t passes_per_repetition = 1;
+  std::uint32_t warmup_passes = 0;
+};
+
+class GpuPassTimer {
+ public:
+  static constexpr double kMinWarmupNs = 20e6;
+  static constexpr double kMinGroupNs = 1e6;
+  static constexpr std::uint32_t kMaxPassesPerGroup = 4096;
+  static constexpr std::uint32_t kMaxTaps = 64;
+
+  static Expected<std::unique_ptr<GpuPassTimer>> Create(std::shared_ptr<VulkanContext> context,
+                                                        std::filesystem::path shader_dir);
+  ~GpuPassTimer();
+  GpuPassTimer(const GpuPassTimer&) = delete;
+  GpuPassTimer& operator=(const GpuPassTimer&) = delete;
+
+  const VulkanDeviceProperties& device() const { return context_->properties(); }
+  double timestamp_period_ns() const { return context_->properties().limits.timestampPeriod; }
+
+  // Ok when the device can sample `format` (CheckFormatFeatures).
+  Status CheckFormat(Format format) const;
+  // Replaces the loaded image.
+  Status LoadImage(const DepthImage& image);
+  // One PassTiming per variant, in order. InvalidArgument when a variant
+  // does not read the loaded image's encoding (the pairing rule), when
+  // there is none, when taps is 0 or above kMaxTaps, or when warmup or
+  // repetitions is 0.
+  Expected<std::vector<PassTiming>> TimePasses(std::span<const Variant> variants, std::uint32_t taps,
+                                               std::uint32_t warmup, std::uint32_t repetitions);
+  // The same for one variant.
+  Expected<PassTiming> TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup,
+                                std::uint32_t repetitions);
+  // The values the last pass wrote, one per pixel (for tests).
+  Expected<std::vector<float>> ReadResults();
+
+ private:
+  explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
+  VkDevice vk_device() const { return context_->device(); }
+
+  Status CreateLayouts();
+  Status CreateCommandObjects();
+  Expected<VkPipeline> Pipeline(Variant variant, Convention convention, std::uint32_t taps);
+  Expected<DeviceObject<VkDeviceMemory>> AllocateDeviceLocal(const VkMemoryRequirements& requirements) const;
+  Status CreateImage(const DepthImage& image);
+  Status CreateResultBuffer(VkDeviceSize bytes);
+  void WriteDescriptors();
+  // Records `record` into the command buffer, submits it and waits.
+  template <class Record>
+  Status Submit(Record record);
+  // `passes` passes of `pipeline` with barriers between them.
+  void RecordPasses(VkPipeline pipeline, std::uint32_t passes);
+  // A group: `passes` back-to-back passes of one pipeline.
+  struct Group {
+    VkPipeline pipeline;
+    std::uint32_t passes;
+  };
+  // Times the groups in order, in one submission; ns per pass per group.
+  Expected<std::vector<double>> TimeGroups(std::span<const Group> groups);
+  Status CheckValidation(std::uint64_t errors_before, const std::string& during) const;
+
+  std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
+  std::filesystem::path shader_dir_;
+
+  DeviceObject<VkDescriptorSetLayout> set_layout_;
+  DeviceObject<VkPipelineLayout> pipeline_layout_;
+  DeviceObject<VkDescriptorPool> descriptor_pool_;
+  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;  // freed with the pool
+  DeviceObject<VkSampler> sampler_;
+  DeviceObject<VkFence> fence_;
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // from the context's pool; the destructor frees it
+  DeviceObject<VkQueryPool> query_pool_;
+  std::uint32_t query_capacity_ = 0;
+
+  std::map<Variant, std::vector<std::uint32_t>> spirv_;  // compiled once per variant
+  std::map<std::tuple<Variant, Convention, std::uint32_t>, DeviceObject<VkPipeline>> pipelines_;
+
+  // The loaded image and what its passes use. Views before images before
+  // memory, so that destruction runs the other way.
+  bool loaded_ = false;
+  Encoding encoding_{};
+  Resolution resolution_{0, 0};
+  DeviceObject<VkDeviceMemory> image_memory_;
+  DeviceObject<VkImage> image_;
+  DeviceObject<VkImageView> image_view_;
+  VulkanBuffer constants_;
+  DeviceObject<VkDeviceMemory> result_memory_;
+  DeviceObject<VkBuffer> result_buffer_;
+  VkDeviceSize result_bytes_ = 0;
+};
+
+}  // namespace depthbench

@@ -1,0 +1,149 @@
+// SpeedResults: what `depthbench speed` measured on one device, and the
+// speed/accuracy trade made from it. Saved as versioned JSON (schema
+// "depthbench.speed", version 1) for the report and for `choose`. Results
+// are kept per device: every file names the device it was measured on,
+// and rankings of different devices are never mixed.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/backend.h"
+#include "bench/cells.h"
+#include "bench/domain.h"
+#include "bench/speed/cpu_cost.h"
+#include "bench/speed/instruction_mix.h"
+#include "bench/speed/timing_stats.h"
+#include "bench/status.h"
+
+namespace depthbench {
+
+inline constexpr const char* kSpeedSchema = "depthbench.speed";
+inline constexpr int kSpeedSchemaVersion = 1;
+
+// The two regimes of a timed pass.
+enum class Regime : std::uint8_t {
+  kMemory,  // one reconstruction per pixel: the fetch and the write dominate
+  kAlu,     // many reconstructions per pixel (taps), as an SSAO kernel makes
+};
+const char* RegimeName(Regime regime);
+Expected<Regime> ParseRegime(std::string_view name);
+
+// One timed (cell, resolution, regime).
+struct GpuTiming {
+  Cell cell;
+  Resolution resolution{0, 0};
+  Regime regime = Regime::kMemory;
+  std::uint32_t taps = 1;
+  TimingSummary ns_per_pass;            // over the repetitions
+  std::vector<double> repetitions_ns;   // each repetition's time per pass
+  std::uint32_t passes_per_repetition = 1;
+  std::uint32_t warmup_passes = 0;
+  std::uint32_t rank = 0;  // among the variants of its group (RankGpuTimings); 0 before ranking
+  // The variants of its group whose medians differ from its own by no more
+  // than the spread: no ranking between them is claimed.
+  std::vector<Variant> indistinguishable_from;
+
+  double pixels() const { return static_cast<double>(resolution.width) * resolution.height; }
+  double ns_per_pixel() const { return ns_per_pass.median / pixels(); }
+  double spread_ns_per_pixel() const { return ns_per_pass.spread() / pixels(); }
+  double ns_per_reconstruction() const { return ns_per_pixel() / taps; }
+};
+
+// Timings compete with each other within a group: the same convention,
+// format, resolution and regime.
+bool SameGroup(const GpuTiming& a, const GpuTiming& b);
+// Sets every timing's rank within its group (timing_stats.h RankByTiming)
+// and the variants it is indistinguishable from.
+void RankGpuTimings(std::vector<GpuTiming>& timings);
+
+struct StaticCost {
+  Variant variant;
+  std::string function;  // the SPIR-V function counted, "<variant>_world_position"
+  InstructionMix mix;
+};
+
+// One variant at one (convention, format) in the trade.
+struct TradePoint {
+  Variant variant;
+  double gpu_ns_per_reconstruction = 0.0;  // ALU-bound regime at the trade's resolution
+  double gpu_spread_ns = 0.0;              // its spread, in the same unit
+  double gpu_memory_ns_per_pixel = 0.0;    // memory-bound regime, for reference
+  double cpu_ns_per_reconstruction = 0.0;
+  double cpu_spread_ns = 0.0;
+  double p999_bits_lost = 0.0;  // total error, from the accuracy results
+  std::uint64_t nonfinite = 0;  // NaN or Inf outputs in the accuracy results
+  bool on_gpu_front = false;
+  bool on_cpu_front = false;
+};
+
+struct TradeFront {
+  Convention convention;
+  Format format;
+  std::vector<TradePoint> points;
+};
+
+struct SpeedRunInfo {
+  std::string version;
+  std::string commit;
+  std::string started_at;
+  std::string host;
+  DeviceInfo device;                 // the Vulkan device the passes ran on
+  std::string device_type;           // "cpu", "discrete gpu", ...
+  double timestamp_period_ns = 0.0;  // VkPhysicalDeviceLimits::timestampPeriod
+  std::uint32_t timestamp_valid_bits = 0;
+  std::string note;                  // what the figures mean on this device
+  std::uint32_t warmup = 0;
+  std::uint32_t repetitions = 0;
+  std::uint32_t alu_taps = 0;
+  std::vector<Resolution> resolutions;
+  Resolution trade_resolution{0, 0};
+  std::string accuracy_source;   // the results file, or "internal run of N samples"
+  std::string accuracy_backend;  // which backend's errors the trade uses
+  std::string accuracy_device;
+  std::string cpu_compiler;      // the CPU backend's compiler
+  double seconds = 0.0;
+};
+
+struct SpeedResults {
+  SpeedRunInfo run;
+  std::vector<GpuTiming> gpu;
+  std::vector<StaticCost> static_costs;
+  std::vector<CpuCost> cpu;
+  std::vector<TradeFront> trade;
+  std::vector<std::string> skipped;  // cells not timed on this device, with the reason
+
+  const GpuTiming* FindGpu(const Cell& cell, Resolution resolution, Regime regime) const;
+  const CpuCost* FindCpu(const Cell& cell) const;
+};
+
+nlohmann::json ToJson(const SpeedResults& results);
+// `source` names the input in error messages (a file path). Records of
+// cells that do not exist (a variant paired with a format or convention it
+// does not read) are refused with the field that holds them.
+Expected<SpeedResults> SpeedResultsFromJson(const nlohmann::json& json, const std::string& source);
+Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results);
+Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path);
+
+// "1920x1080" and back.
+std::string ResolutionName(Resolution resolution);
+Expected<Resolution> ParseResolution(std::string_view text, std::string_view what);
+
+// How two runs on one device rank the variants, pair by pair within each
+// group present in both.
+struct RankingComparison {
+  std::uint32_t pairs = 0;          // pairs of variants compared
+  std::uint32_t agree = 0;          // the same order in both runs, both distinguishable
+  std::uint32_t both_ties = 0;      // indistinguishable in both runs
+  std::uint32_t one_sided = 0;      // distinguishable in one run, a tie in the other
+  std::vector<std::string> contradictions;  // opposite distinguishable orders, described
+};
+// InvalidArgument when the runs are of different devices: rankings are
+// kept per device.
+Expected<RankingComparison> CompareRankings(const SpeedResults& first, const SpeedResults& second);
+
+}  // namespace depthbench

@@ -1,0 +1,192 @@
+#include "bench/speed/speed_run.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "bench/backend_cpu.h"
+#include "bench/environment.h"
+#include "bench/speed/depth_image.h"
+#include "bench/speed/trade.h"
+#include "bench/thread_pool.h"
+#include "bench/vulkan/shader_compiler.h"
+
+namespace depthbench {
+
+Status ValidateSpeedOptions(const SpeedOptions& o) {
+  if (o.cells.empty()) return InvalidArgument("Violated constraint: SpeedOptions::cells is not empty");
+  if (o.resolutions.empty()) return InvalidArgument("Violated constraint: SpeedOptions::resolutions is not empty");
+  if (o.alu_taps < 2 || o.alu_taps > GpuPassTimer::kMaxTaps) {
+    return InvalidArgument(fmt::format("Violated constraint: 2 <= SpeedOptions::alu_taps <= {} (it is {}; one tap "
+                                       "is the memory-bound regime)",
+                                       GpuPassTimer::kMaxTaps, o.alu_taps));
+  }
+  if (o.warmup < 1) return InvalidArgument("Violated constraint: SpeedOptions::warmup >= 1");
+  // Quartiles of fewer than three values are the values themselves.
+  if (o.repetitions < 3) {
+    return InvalidArgument(fmt::format("Violated constraint: SpeedOptions::repetitions >= 3 (it is {}); a spread "
+                                       "needs at least three",
+                                       o.repetitions));
+  }
+  if (o.cpu.repetitions < 3) return InvalidArgument("Violated constraint: CpuCostOptions::repetitions >= 3");
+  for (const Cell& cell : o.cells) {
+    if (!Reads(cell.variant, cell.convention, cell.format)) {
+      return InvalidArgument(fmt::format("{} does not read {} under the {} convention: no such pass to time",
+                                         Info(cell.variant).name, Info(cell.format).name,
+                                         Info(cell.convention).name));
+    }
+  }
+  return Status::Ok();
+}
+
+std::string DeviceTypeName(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual gpu";
+    default: return "other";
+  }
+}
+
+std::string DeviceNote(const VulkanDeviceProperties& device) {
+  if (device.type == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+    return fmt::format(
+        "'{}' is a CPU implementation of Vulkan: its timings are of JIT-compiled CPU code on this machine's cores, "
+        "not of a GPU, and its ranking need not hold on a real GPU (reports/speed/ holds a real GPU's figures)",
+        device.name);
+  }
+  return fmt::format("GPU time from Vulkan timestamp queries on '{}' (timestampPeriod {} ns)", device.name,
+                     device.limits.timestampPeriod);
+}
+
+Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedOptions& options,
+                                               std::vector<std::string>& skipped) {
+  DB_RETURN_IF_ERROR(ValidateSpeedOptions(options));
+  // Formats the device cannot sample are refused or left out first.
+  std::vector<Cell> cells;
+  for (const Cell& cell : options.cells) {
+    Status supported = timer.CheckFormat(cell.format);
+    if (supported.ok()) {
+      cells.push_back(cell);
+    } else if (options.refuse_unsupported) {
+      return supported;
+    } else {
+      skipped.push_back(fmt::format("{}: {}", cell.Name(), supported.message()));
+    }
+  }
+  const RunLayout layout = MakeRunLayout(cells);
+  const std::size_t total = cells.size() * options.resolutions.size() * 2;
+  std::size_t done = 0;
+  ThreadPool pool;
+  std::vector<GpuTiming> timings;
+  for (const Resolution& resolution : options.resolutions) {
+    for (const Encoding& encoding : layout.encodings) {
+      DB_ASSIGN_OR_RETURN(const DepthImage image, MakeDepthImage(encoding, resolution, pool));
+      DB_RETURN_IF_ERROR(timer.LoadImage(image));
+      // The variants reading this image compete: they are timed together.
+      std::vector<Cell> group;
+      std::vector<Variant> variants;
+      for (const CellPlan& plan : layout.cells) {
+        if (plan.cell.encoding() != encoding) continue;
+        group.push_back(plan.cell);
+        variants.push_back(plan.cell.variant);
+      }
+      for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
+        const std::uint32_t taps = regime == Regime::kMemory ? 1 : options.alu_taps;
+        if (options.progress) {
+          options.progress(done, total,
+                           fmt::format("{} {} {} {}", Info(encoding.convention).name, Info(encoding.format).name,
+                                       ResolutionName(resolution), RegimeName(regime)));
+        }
+        DB_ASSIGN_OR_RETURN(const std::vector<PassTiming> passes,
+                            timer.TimePasses(variants, taps, options.warmup, options.repetitions));
+        for (std::size_t k = 0; k < group.size(); ++k) {
+          GpuTiming timing;
+          timing.cell = group[k];
+          timing.resolution = resolution;
+          timing.regime = regime;
+          timing.taps = taps;
+          DB_ASSIGN_OR_RETURN(timing.ns_per_pass, SummarizeTimings(passes[k].ns_per_pass));
+          timing.repetitions_ns = passes[k].ns_per_pass;
+          timing.passes_per_repetition = passes[k].passes_per_repetition;
+          timing.warmup_passes = passes[k].warmup_passes;
+          timings.push_back(std::move(timing));
+          ++done;
+        }
+      }
+    }
+  }
+  RankGpuTimings(timings);
+  return timings;
+}
+
+Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path& shader_dir,
+                                                     std::span<const Cell> cells) {
+  std::vector<StaticCost> costs;
+  for (const VariantInfo& variant : AllVariants()) {
+    const bool selected =
+        std::any_of(cells.begin(), cells.end(), [&](const Cell& c) { return c.variant == variant.id; });
+    if (!selected) continue;
+    const std::filesystem::path path = shader_dir / "speed" / (std::string(variant.name) + ".comp");
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
+    const std::string function = std::string(variant.name) + "_world_position";
+    Expected<InstructionMix> mix = CountInstructionMix(spirv, function);
+    if (!mix.ok()) return mix.status().WithContext(path.string());
+    costs.push_back({variant.id, function, *mix});
+  }
+  return costs;
+}
+
+Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path& shader_dir,
+                                const SpeedOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SpeedResults results;
+  SpeedRunInfo& run = results.run;
+  run.version = DEPTHBENCH_VERSION;
+  run.commit = CurrentCommit();
+  run.started_at = CurrentTimeUtc();
+  run.host = HostName();
+  const VulkanDeviceProperties& device = timer.device();
+  run.device.name = device.name;
+  run.device.driver = device.DriverString();
+  run.device.api = "Vulkan " + VulkanVersionString(device.api_version);
+  run.device.kind = device.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu";
+  run.device.compiler = GlslangVersion();
+  run.device_type = DeviceTypeName(device.type);
+  run.timestamp_period_ns = device.limits.timestampPeriod;
+  run.timestamp_valid_bits = device.queue_timestamp_valid_bits;
+  run.note = DeviceNote(device);
+  run.warmup = options.warmup;
+  run.repetitions = options.repetitions;
+  run.alu_taps = options.alu_taps;
+  run.resolutions = options.resolutions;
+  run.trade_resolution = *std::max_element(
+      options.resolutions.begin(), options.resolutions.end(), [](const Resolution& a, const Resolution& b) {
+        return std::uint64_t{a.width} * a.height < std::uint64_t{b.width} * b.height;
+      });
+  run.cpu_compiler = MakeCpuBackend()->device().compiler;
+
+  DB_ASSIGN_OR_RETURN(results.static_costs, MeasureStaticCosts(shader_dir, options.cells));
+  DB_ASSIGN_OR_RETURN(results.gpu, TimeGpuPasses(timer, options, results.skipped));
+  if (options.progress) options.progress(1, 1, "CPU backend");
+  DB_ASSIGN_OR_RETURN(results.cpu, MeasureCpuCosts(options.cells, options.cpu));
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return results;
+}
+
+Status AddTrade(SpeedResults& speed, const Results& accuracy, const std::string& source) {
+  DB_ASSIGN_OR_RETURN(const std::string backend, TradeBackend(accuracy));
+  speed.run.accuracy_source = source;
+  speed.run.accuracy_backend = backend;
+  for (const BackendRecord& record : accuracy.run.backends) {
+    if (record.name == backend) speed.run.accuracy_device = record.device.name;
+  }
+  std::vector<std::string> left_out;
+  speed.trade = BuildTrade(speed, accuracy, backend, speed.run.trade_resolution, left_out);
+  for (std::string& line : left_out) speed.skipped.push_back(std::move(line));
+  return Status::Ok();
+}
+
+}  // namespace depthbench

@@ -1,0 +1,173 @@
+#include "bench/speed/speed_table.h"
+
+#include <algorithm>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "bench/text_table.h"
+
+namespace depthbench {
+namespace {
+
+using Align = TextTable::Align;
+
+// "2.41 ±0.031": the median and its spread, three significant digits.
+std::string WithSpread(double value, double spread) { return fmt::format("{:.3g} ±{:.2g}", value, spread); }
+
+// A rank, with '=' where another member of the group shares it.
+std::string RankText(const SpeedResults& results, const GpuTiming& timing) {
+  int sharing = 0;
+  for (const GpuTiming& other : results.gpu) {
+    if (SameGroup(other, timing) && other.rank == timing.rank) ++sharing;
+  }
+  return fmt::format("{}{}", sharing > 1 ? "=" : "", timing.rank);
+}
+
+std::string Count(const OpCount& c) {
+  if (c.instructions == 0) return "0";
+  return c.instructions == c.lanes ? fmt::format("{}", c.instructions)
+                                   : fmt::format("{} ({})", c.instructions, c.lanes);
+}
+
+}  // namespace
+
+void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
+  const SpeedRunInfo& run = results.run;
+  out << fmt::format("depthbench {} speed (commit {}) on {} [{}; {}; {}]\n", run.version, run.commit,
+                     run.device.name, run.device_type, run.device.driver, run.device.api);
+  out << fmt::format("timestamps: period {} ns, {} valid bits; {} warm-up passes (and more up to 20 ms), {} "
+                     "repetitions; ALU-bound regime: {} taps per pixel\n",
+                     run.timestamp_period_ns, run.timestamp_valid_bits, run.warmup, run.repetitions, run.alu_taps);
+  out << "note: " << run.note << "\n";
+  out << "figures are medians ±spread (interquartile range); a rank is 1 + the variants of the same convention, "
+         "format, resolution and regime that are faster by more than the spread; '=' marks a rank shared with "
+         "an indistinguishable variant\n\n";
+}
+
+void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
+  std::vector<TextTable::Column> columns = {{"variant", Align::kLeft}, {"convention", Align::kLeft},
+                                            {"format", Align::kLeft}};
+  for (const Resolution& r : results.run.resolutions) {
+    columns.push_back({fmt::format("{} mem ns/px", ResolutionName(r))});
+    columns.push_back({"rank"});
+    columns.push_back({fmt::format("{} alu ns/recon", ResolutionName(r))});
+    columns.push_back({"rank"});
+  }
+  TextTable table(columns);
+  std::vector<Cell> cells;
+  for (const GpuTiming& t : results.gpu) {
+    if (std::find(cells.begin(), cells.end(), t.cell) == cells.end()) cells.push_back(t.cell);
+  }
+  Encoding previous{};
+  bool first = true;
+  for (const Cell& cell : cells) {
+    if (!first && cell.encoding() != previous) table.AddSeparator();
+    first = false;
+    previous = cell.encoding();
+    std::vector<std::string> row = {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
+                                    std::string(Info(cell.format).short_name)};
+    for (const Resolution& r : results.run.resolutions) {
+      for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
+        const GpuTiming* t = results.FindGpu(cell, r, regime);
+        if (t == nullptr) {
+          row.insert(row.end(), {"-", "-"});
+          continue;
+        }
+        row.push_back(regime == Regime::kMemory
+                          ? WithSpread(t->ns_per_pixel(), t->spread_ns_per_pixel())
+                          : WithSpread(t->ns_per_reconstruction(), t->spread_ns_per_pixel() / t->taps));
+        row.push_back(RankText(results, *t));
+      }
+    }
+    table.AddRow(row);
+  }
+  out << "GPU time per pixel (memory-bound, 1 reconstruction per pixel) and per reconstruction (ALU-bound, "
+      << results.run.alu_taps << " per pixel), ns\n";
+  table.Print(out);
+  out << "\n";
+}
+
+void PrintStaticTable(const SpeedResults& results, std::ostream& out) {
+  TextTable table({{"variant", Align::kLeft},
+                   {"fdiv"},
+                   {"fmul"},
+                   {"fadd/fsub"},
+                   {"fma"},
+                   {"dot"},
+                   {"mat*vec"},
+                   {"extended", Align::kLeft},
+                   {"calls"},
+                   {"instructions"}});
+  for (const StaticCost& s : results.static_costs) {
+    std::string extended;
+    for (const auto& [name, count] : s.mix.extended_by_name) {
+      extended += fmt::format("{}{} {}", extended.empty() ? "" : ", ", name, Count(count));
+    }
+    table.AddRow({std::string(Info(s.variant).name), Count(s.mix.fdiv), Count(s.mix.fmul), Count(s.mix.fadd),
+                  Count(s.mix.fma), Count(s.mix.dot), Count(s.mix.matrix_vector), extended.empty() ? "-" : extended,
+                  fmt::format("{}", s.mix.function_calls), fmt::format("{}", s.mix.total_instructions)});
+  }
+  out << "Static cost: SPIR-V instructions of one reconstruction (lanes in parentheses where vector), counted "
+         "in the compiled module\n";
+  table.Print(out);
+  out << "\n";
+}
+
+void PrintCpuTable(const SpeedResults& results, std::ostream& out) {
+  TextTable table({{"cell", Align::kLeft}, {"ns/recon"}, {"runs x samples"}});
+  for (const CpuCost& c : results.cpu) {
+    table.AddRow({c.cell.Name(), WithSpread(c.ns_per_reconstruction.median, c.ns_per_reconstruction.spread()),
+                  fmt::format("{} x {}", c.runs_per_repetition, c.samples_per_run)});
+  }
+  out << "CPU backend (" << results.run.cpu_compiler << ", 8 float32 lanes, one thread), ns per reconstruction\n";
+  table.Print(out);
+  out << "\n";
+}
+
+void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
+  if (results.trade.empty()) return;
+  TextTable table({{"convention", Align::kLeft},
+                   {"format", Align::kLeft},
+                   {"variant", Align::kLeft},
+                   {"p99.9 bits"},
+                   {"gpu ns/recon"},
+                   {"gpu front", Align::kLeft},
+                   {"cpu ns/recon"},
+                   {"cpu front", Align::kLeft},
+                   {"NaN/Inf"}});
+  bool first = true;
+  for (const TradeFront& front : results.trade) {
+    if (!first) table.AddSeparator();
+    first = false;
+    for (const TradePoint& p : front.points) {
+      table.AddRow({std::string(Info(front.convention).name), std::string(Info(front.format).short_name),
+                    std::string(Info(p.variant).name), fmt::format("{:.1f}", p.p999_bits_lost),
+                    WithSpread(p.gpu_ns_per_reconstruction, p.gpu_spread_ns), p.on_gpu_front ? "*" : "",
+                    WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns), p.on_cpu_front ? "*" : "",
+                    fmt::format("{}", p.nonfinite)});
+    }
+  }
+  out << fmt::format("The trade at {} (ALU-bound GPU cost) and on the CPU: cost against p99.9 bits lost ({} "
+                     "backend, {}); * = on the Pareto front (no variant is as cheap, to the spread, and as "
+                     "accurate, to 1/4 bit, and better in one)\n",
+                     ResolutionName(results.run.trade_resolution), results.run.accuracy_backend,
+                     results.run.accuracy_source);
+  table.Print(out);
+  out << "\n";
+}
+
+void PrintSkipped(const SpeedResults& results, std::ostream& out) {
+  for (const std::string& line : results.skipped) out << "not measured: " << line << "\n";
+  if (!results.skipped.empty()) out << "\n";
+}
+
+void PrintRankingComparison(const RankingComparison& c, std::ostream& out) {
+  out << fmt::format(
+      "Repeatability: {} pairs of variants compared; {} in the same order in both runs, {} indistinguishable in "
+      "both, {} distinguishable in one run only, {} in opposite orders\n",
+      c.pairs, c.agree, c.both_ties, c.one_sided, c.contradictions.size());
+  for (const std::string& line : c.contradictions) out << "  opposite: " << line << "\n";
+}
+
+}  // namespace depthbench

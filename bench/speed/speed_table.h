@@ -1,0 +1,24 @@
+// The human-readable view of speed results. Formats only: every figure and
+// every mark (rank, tie, front) is computed before (speed_run.h, trade.h).
+#pragma once
+
+#include <ostream>
+
+#include "bench/speed/speed_results.h"
+
+namespace depthbench {
+
+// Device, driver, timestamp period, settings, and what the figures mean.
+void PrintSpeedHeader(const SpeedResults& results, std::ostream& out);
+// One row per cell: per resolution, the memory-bound ns per pixel and the
+// ALU-bound ns per reconstruction, each with its spread and rank.
+void PrintGpuTable(const SpeedResults& results, std::ostream& out);
+// One row per variant: the instruction mix of its reconstruction.
+void PrintStaticTable(const SpeedResults& results, std::ostream& out);
+void PrintCpuTable(const SpeedResults& results, std::ostream& out);
+// Per convention and format: cost against p99.9 bits lost, front marked.
+void PrintTradeTable(const SpeedResults& results, std::ostream& out);
+void PrintSkipped(const SpeedResults& results, std::ostream& out);
+void PrintRankingComparison(const RankingComparison& comparison, std::ostream& out);
+
+}  // namespace depthbench

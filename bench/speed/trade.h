@@ -1,0 +1,55 @@
+// The trade: for each convention and format, every variant's cost against
+// its p99.9 bits lost, and which variants are on the Pareto front (no other
+// variant is at least as cheap and at least as accurate, and better in one).
+#pragma once
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bench/results.h"
+#include "bench/speed/speed_results.h"
+#include "bench/status.h"
+
+namespace depthbench {
+
+// Bits-lost figures closer than this are the same accuracy: the statistics
+// keep errors in quarter-octave bins (stats.h), so a p99.9 is known to a
+// quarter of a bit and finer differences are interpolation.
+inline constexpr double kBitsResolution = 1.0 / 4.0;
+// A cell whose NaN and Inf outputs exceed this share of its judged samples
+// has a non-finite p99.9: it counts as losing every bit.
+inline constexpr double kNonfiniteShareAtP999 = 0.001;
+inline constexpr double kAllBitsLost = 24.0;
+
+struct FrontCandidate {
+  double cost = 0.0;
+  double spread = 0.0;  // the cost's spread: smaller differences are ties
+  double bits_lost = 0.0;
+};
+// a dominates b: a is no costlier (cheaper by more than the larger spread,
+// or a tie) and loses no more bits (fewer, or the same to kBitsResolution),
+// and is strictly better in one of the two.
+bool Dominates(const FrontCandidate& a, const FrontCandidate& b);
+// For each candidate, whether no other dominates it.
+std::vector<bool> ParetoFront(std::span<const FrontCandidate> candidates);
+
+// p99.9 bits lost of a cell's total error, and its NaN/Inf count.
+struct CellAccuracy {
+  double p999_bits_lost = 0.0;
+  std::uint64_t nonfinite = 0;
+};
+CellAccuracy AccuracyOf(const CellStats& stats);
+
+// The backend whose errors the trade uses: "vulkan" when the results hold
+// it (the errors of the shaders the GPU runs), else "cpu". NotFound when
+// they hold neither.
+Expected<std::string> TradeBackend(const Results& accuracy);
+
+// One TradeFront per (convention, format) with a GPU timing at
+// `resolution` in the ALU-bound regime; a variant without accuracy results
+// or without a CPU cost is left out of its front and named in `left_out`.
+std::vector<TradeFront> BuildTrade(const SpeedResults& speed, const Results& accuracy, const std::string& backend,
+                                   Resolution resolution, std::vector<std::string>& left_out);
+
+}  // namespace depthbench

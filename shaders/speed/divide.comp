@@ -1,0 +1,7 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// divide (seed 004), timed: the formula is in shared/variants/divide.h.
+#include "../common.glsl"
+#include "../../shared/variants/divide.h"
+#define RECONSTRUCT divide_world_position
+#include "speed_pass.glsl"

@@ -1,0 +1,7 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// inverse_vp (seed 002), timed: the formula is in shared/variants/inverse_vp.h.
+#include "../common.glsl"
+#include "../../shared/variants/inverse_vp.h"
+#define RECONSTRUCT inverse_vp_world_position
+#include "speed_pass.glsl"

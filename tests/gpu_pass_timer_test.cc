@@ -1,0 +1,203 @@
+// The GPU pass timer on lavapipe, with the validation layer on: a heavier
+// pass measures slower in the same run, timestamps are converted with the
+// device's period, the passes compute the formulas over the real image, and
+// pairs that do not exist are refused with a clear message.
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bench/encode.h"
+#include "bench/formulas.h"
+#include "bench/speed/depth_image.h"
+#include "bench/speed/gpu_pass_timer.h"
+#include "bench/speed/timing_stats.h"
+#include "bench/thread_pool.h"
+#include "bench/vulkan/vulkan_context.h"
+
+namespace depthbench {
+namespace {
+
+class GpuPassTimerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    VulkanContextOptions options;
+    options.validation = true;
+    auto context = VulkanContext::Create(options);
+    ASSERT_TRUE(context.ok()) << context.status().message();
+    context_ = std::move(context).value();
+    auto timer = GpuPassTimer::Create(context_, std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders");
+    ASSERT_TRUE(timer.ok()) << timer.status().message();
+    timer_ = std::move(timer).value();
+  }
+
+  void TearDown() override {
+    if (context_ == nullptr) return;
+    // Destroying the device reports every object the timer leaked.
+    const std::shared_ptr<ValidationLog> log = context_->validation_log();
+    timer_.reset();
+    context_.reset();
+    for (const std::string& message : log->TakeMessages()) ADD_FAILURE() << message;
+  }
+
+  DepthImage Load(Encoding encoding, Resolution resolution) {
+    auto image = MakeDepthImage(encoding, resolution, pool_);
+    EXPECT_TRUE(image.ok()) << image.status().message();
+    if (!image.ok()) return {};
+    Status loaded = timer_->LoadImage(*image);
+    EXPECT_TRUE(loaded.ok()) << loaded.message();
+    return *image;
+  }
+
+  TimingSummary Time(Variant variant, std::uint32_t taps, std::uint32_t repetitions) {
+    auto timing = timer_->TimePass(variant, taps, 1, repetitions);
+    EXPECT_TRUE(timing.ok()) << timing.status().message();
+    if (!timing.ok()) return {};
+    EXPECT_EQ(timing->ns_per_pass.size(), repetitions);
+    auto summary = SummarizeTimings(timing->ns_per_pass);
+    EXPECT_TRUE(summary.ok());
+    return *summary;
+  }
+
+  ThreadPool pool_;
+  std::shared_ptr<VulkanContext> context_;
+  std::unique_ptr<GpuPassTimer> timer_;
+};
+
+TEST_F(GpuPassTimerTest, HeavierPassMeasuresSlowerInTheSameRun) {
+  Load({Convention::kReversed, Format::kD32Sfloat}, {256, 256});
+  const TimingSummary light = Time(Variant::kDivide, 1, 9);
+  const TimingSummary heavy = Time(Variant::kDivide, 64, 9);
+  // 64 reconstructions per pixel against one: slower by more than the
+  // spread, the rule that decides any ranking. (So many taps that a busy
+  // machine, which widens the spread, cannot hide the difference.)
+  EXPECT_EQ(Compare(heavy, light), Ordering::kSlower)
+      << "1 tap " << light.median << " ns (spread " << light.spread() << "), 16 taps " << heavy.median
+      << " ns (spread " << heavy.spread() << ")";
+}
+
+TEST_F(GpuPassTimerTest, TimestampsAreInTheDevicesPeriod) {
+  Load({Convention::kReversed, Format::kD32Sfloat}, {256, 256});
+  const double period = timer_->timestamp_period_ns();
+  ASSERT_GT(period, 0.0);
+  // Compile the pipeline first, so that the timed call below does device
+  // work almost only.
+  ASSERT_TRUE(timer_->TimePass(Variant::kInverseVp, 64, 1, 3).ok());
+  const auto start = std::chrono::steady_clock::now();
+  auto timing = timer_->TimePass(Variant::kInverseVp, 64, 1, 10);
+  const double host_ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(timing.ok()) << timing.status().message();
+  double device_ns = 0.0;
+  for (double ns : timing->ns_per_pass) device_ns += ns * timing->passes_per_repetition;
+  // The timed groups ran inside the host's interval, so they cannot have
+  // taken longer. Of that interval they fill a good part: besides them
+  // only the warm-up runs (at most as long as 20 ms or one pass, whichever
+  // is longer) and submission overhead. A tenth leaves room for a loaded
+  // machine; a timestamp read in the wrong unit would be off by a factor
+  // of a thousand or more.
+  EXPECT_LE(device_ns, host_ns);
+  EXPECT_GE(device_ns, 0.1 * host_ns) << "device " << device_ns << " ns, host " << host_ns << " ns";
+}
+
+// Each pixel's value against the CPU float32 formula on the texel the
+// pass fetched. Lavapipe and GLM may order the four terms of a
+// matrix-vector product differently (tests/vulkan_backend_test.cc), which
+// moves each component by a few units of 2^-24 of the largest term; terms
+// are bounded by |p| + 2 |camera| per component here. 16 units of the sum
+// of those bounds covers that and the two additions that sum the
+// components.
+void ExpectPassComputesFormula(const DepthImage& image, const std::vector<float>& values, Variant variant) {
+  ASSERT_EQ(values.size(), std::size_t{image.resolution.width} * image.resolution.height);
+  f32::DepthParams depth = image.depth_params;
+  depth.convention = Info(image.encoding.convention).bits;
+  const auto& camera = image.frame_params.camera_position;
+  const double camera_sum = std::fabs(camera.x) + std::fabs(camera.y) + std::fabs(camera.z);
+  for (std::uint32_t y = 0; y < image.resolution.height; ++y) {
+    for (std::uint32_t x = 0; x < image.resolution.width; ++x) {
+      const float stored = FetchTexel(image.encoding.format, image.Code(x, y));
+      const glm::vec2 uv = f32::uv_from_pixel(static_cast<float>(x), static_cast<float>(y),
+                                              image.frame_params.resolution);
+      glm::vec3 p;
+      switch (variant) {
+        case Variant::kPq: p = f32::pq_world_position(image.frame_params, depth, uv, stored); break;
+        case Variant::kFrustumRay: p = f32::frustum_ray_world_position(image.frame_params, depth, uv, stored); break;
+        default: FAIL() << "no CPU formula wired for " << Info(variant).name;
+      }
+      const double expected = static_cast<double>(p.x) + p.y + p.z;
+      const double scale = std::fabs(p.x) + std::fabs(p.y) + std::fabs(p.z) + 2.0 * camera_sum;
+      ASSERT_NEAR(values[std::size_t{y} * image.resolution.width + x], expected, 16.0 * std::ldexp(scale, -24))
+          << Info(variant).name << " at pixel (" << x << ", " << y << ")";
+    }
+  }
+}
+
+TEST_F(GpuPassTimerTest, PassesComputeTheFormulaOverTheRealImage) {
+  // A hardware depth format (a sampled depth image) and a half-float colour one.
+  const DepthImage d24 = Load({Convention::kReversed, Format::kX8D24Unorm}, {67, 45});
+  ASSERT_TRUE(timer_->TimePass(Variant::kPq, 1, 1, 3).ok());
+  auto values = timer_->ReadResults();
+  ASSERT_TRUE(values.ok()) << values.status().message();
+  ExpectPassComputesFormula(d24, *values, Variant::kPq);
+
+  const DepthImage r16f = Load({Convention::kLinear, Format::kR16Sfloat}, {40, 31});
+  ASSERT_TRUE(timer_->TimePass(Variant::kFrustumRay, 1, 1, 3).ok());
+  values = timer_->ReadResults();
+  ASSERT_TRUE(values.ok()) << values.status().message();
+  ExpectPassComputesFormula(r16f, *values, Variant::kFrustumRay);
+}
+
+TEST_F(GpuPassTimerTest, RefusesPairsThatDoNotExist) {
+  Load({Convention::kLinear, Format::kR32Sfloat}, {16, 16});
+  auto divide = timer_->TimePass(Variant::kDivide, 1, 1, 3);
+  ASSERT_FALSE(divide.ok());
+  EXPECT_EQ(divide.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(divide.status().message().find("divide does not read r32_sfloat under the linear convention"),
+            std::string::npos)
+      << divide.status().message();
+
+  auto taps = timer_->TimePass(Variant::kFrustumRay, 0, 1, 3);
+  ASSERT_FALSE(taps.ok());
+  EXPECT_NE(taps.status().message().find("taps 0 is outside 1 to 64"), std::string::npos);
+
+  auto image = MakeDepthImage({Convention::kStandard, Format::kR32Sfloat}, {16, 16}, pool_);
+  ASSERT_FALSE(image.ok());
+  EXPECT_NE(image.status().message().find("no variant reads r32_sfloat under the standard convention"),
+            std::string::npos);
+}
+
+TEST(FormatSupportTest, UnsupportedFormatsAreRefusedByName) {
+  const Status missing = CheckFormatFeatures(Format::kX8D24Unorm, VK_FORMAT_FEATURE_TRANSFER_DST_BIT, "Test GPU");
+  EXPECT_EQ(missing.code(), StatusCode::kUnavailable);
+  EXPECT_NE(missing.message().find("x8_d24_unorm (VK_FORMAT_X8_D24_UNORM_PACK32) is not supported by Vulkan device "
+                                   "'Test GPU'"),
+            std::string::npos)
+      << missing.message();
+  EXPECT_NE(missing.message().find("lack sampled images"), std::string::npos);
+  EXPECT_TRUE(CheckFormatFeatures(Format::kD16Unorm,
+                                  VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT, "Test GPU")
+                  .ok());
+}
+
+TEST(DepthImageTest, TexelsAreTheEncodersCodes) {
+  ThreadPool pool;
+  auto image = MakeDepthImage({Convention::kStandard, Format::kD16Unorm}, {33, 17}, pool);
+  ASSERT_TRUE(image.ok());
+  EXPECT_EQ(image->texel_bytes, 2u);
+  EXPECT_EQ(image->texels.size(), 33u * 17u * 2u);
+  // Depth grows up the screen: the bottom row is nearer the camera, so
+  // it stores smaller standard-Z depth than the top row.
+  EXPECT_LT(image->Code(16, 16), image->Code(16, 0));
+  // Every code is what the encoder makes of some float in [0, 1].
+  const Frame& frame = image->frame;
+  EXPECT_EQ(frame.width, 33u);
+  EXPECT_EQ(frame.height, 17u);
+  const float fetched = FetchTexel(Format::kD16Unorm, image->Code(0, 0));
+  EXPECT_EQ(StoreFloat(Format::kD16Unorm, fetched).code, image->Code(0, 0));
+}
+
+}  // namespace
+}  // namespace depthbench

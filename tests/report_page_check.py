@@ -1,0 +1,109 @@
+#!/usr/bin/python3
+"""Checks a report that `depthbench report` wrote, the way a reader sees it.
+
+  report_page_check.py schema REPORT_DIR SCHEMA
+      results.json validates against the report's JSON Schema (jsonschema,
+      Debian's python3-jsonschema), and the schema rejects a document with a
+      field broken on purpose (so that the check itself can fail).
+
+  report_page_check.py browser REPORT_DIR ARTIFACT_DIR
+      opens report.html in headless Chromium (no network, fresh profile),
+      waits for the page's own render check, and asserts: no console or
+      page errors, every plot drawn with data in it, the headline table
+      present; saves a screenshot and the rendered DOM as test artifacts.
+"""
+import copy
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                  "--disable-component-update", "--no-first-run", "--disable-sync"]
+# Virtual time lets the page finish its asynchronous drawing before the DOM
+# is dumped; 60 s of it is far beyond what the page needs (about 2 s).
+VIRTUAL_TIME_MS = "60000"
+PLOTS = ["precision", "depth", "split", "diff", "speed", "trend"]
+
+
+def fail(message):
+    print("FAIL: " + message)
+    sys.exit(1)
+
+
+def check_schema(report_dir, schema_path):
+    import jsonschema
+    with open(schema_path) as f:
+        schema = json.load(f)
+    with open(os.path.join(report_dir, "results.json")) as f:
+        document = json.load(f)
+    validator = jsonschema.Draft202012Validator(schema)
+    errors = sorted(validator.iter_errors(document), key=lambda e: list(e.path))
+    for e in errors[:10]:
+        print("schema error at /%s: %s" % ("/".join(map(str, e.path)), e.message))
+    if errors:
+        fail("%d schema errors in results.json" % len(errors))
+    # The schema must be able to say no: a bits figure as text, a missing
+    # section, an unknown level.
+    for name, broken in [("bits as text", lambda d: d["split"][0].__setitem__("total", "12")),
+                         ("no headline", lambda d: d.pop("headline")),
+                         ("unknown level", lambda d: d["precision_points"][0].__setitem__("level", "p42"))]:
+        d = copy.deepcopy(document)
+        broken(d)
+        if validator.is_valid(d):
+            fail("the schema accepts a document with " + name)
+    print("results.json: valid (%d headline rows, %d precision points)" %
+          (len(document["headline"]), len(document["precision_points"])))
+
+
+def check_browser(report_dir, artifact_dir):
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if chromium is None:
+        fail("chromium is not installed (./setup.sh --tests installs it)")
+    os.makedirs(artifact_dir, exist_ok=True)
+    page = "file://" + os.path.abspath(os.path.join(report_dir, "report.html"))
+    with tempfile.TemporaryDirectory() as profile:
+        common = [chromium] + CHROMIUM_FLAGS + ["--user-data-dir=" + profile, "--virtual-time-budget=" + VIRTUAL_TIME_MS]
+        dom = subprocess.run(common + ["--enable-logging=stderr", "--v=0", "--dump-dom", page],
+                             capture_output=True, text=True, timeout=300)
+        if dom.returncode != 0:
+            fail("chromium exited with %d: %s" % (dom.returncode, dom.stderr[-2000:]))
+        with open(os.path.join(artifact_dir, "report.dom.html"), "w") as f:
+            f.write(dom.stdout)
+        shot = os.path.join(artifact_dir, "report.png")
+        subprocess.run(common + ["--hide-scrollbars", "--window-size=1300,6000", "--screenshot=" + shot, page],
+                       capture_output=True, text=True, timeout=300)
+    # Console messages that are errors (Chromium logs the page's console on stderr).
+    console_errors = [line for line in dom.stderr.splitlines()
+                      if "CONSOLE" in line and re.search(r"error|uncaught|exception", line, re.I)]
+    if console_errors:
+        fail("console errors:\n" + "\n".join(console_errors[:10]))
+    match = re.search(r'<pre id="render-check"[^>]*data-done="true"[^>]*>(.*?)</pre>', dom.stdout, re.S)
+    if not match:
+        fail("the page did not finish drawing (no render check in the DOM)")
+    check = json.loads(match.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    if check["errors"]:
+        fail("page errors: %s" % check["errors"])
+    if check["headline_rows"] < 1:
+        fail("the headline table is empty")
+    for plot in PLOTS:
+        drawn = check["plots"].get(plot)
+        if drawn is None or drawn < 1:
+            fail("plot '%s' drew %s data marks" % (plot, drawn))
+    if not os.path.isfile(shot) or os.path.getsize(shot) < 10000:
+        fail("no screenshot")
+    print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
+          (check["headline_rows"], check["plots"], shot))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 4 or sys.argv[1] not in ("schema", "browser"):
+        print(__doc__)
+        sys.exit(2)
+    if sys.argv[1] == "schema":
+        check_schema(sys.argv[2], sys.argv[3])
+    else:
+        check_browser(sys.argv[2], sys.argv[3])

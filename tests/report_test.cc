@@ -1,0 +1,160 @@
+// depthbench report as a user runs it: two nights into one history
+// database, the second with a planted precision loss in a shader; what the
+// Markdown summary and the JSON document say about them.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/command_runner.h"
+
+namespace depthbench {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using testing::ReadText;
+using testing::RunDepthbench;
+
+// A small report: two variants, two conventions, two formats, both
+// backends, quick sample counts. Enough for every part of the document.
+std::vector<std::string> SmallReport(const std::string& root, const std::string& out) {
+  return {"report",     "--quick",    "--out",         out,       "--history", root + "/history.sqlite",
+          "--shaders",  root + "/shaders", "--variant", "divide,pq", "--convention", "standard,reversed",
+          "--format",   "d24,d32f",   "--no-speed"};
+}
+
+class ReportTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new std::string(testing::MakeTempDir("report_test"));
+    testing::CopyShaderSources(*root_);
+    // Night 1: the shaders as they are.
+    first_ = new testing::CommandResult(RunDepthbench(SmallReport(*root_, *root_ + "/night1")));
+    // Night 2: divide squeezes its NDC depth through a 16-bit float, as a
+    // careless half-precision optimisation would.
+    ASSERT_TRUE(testing::ReplaceInFile(
+        *root_ + "/shared/variants/divide.h", "  real ndc_z = ndc_depth_from_window_depth(depth, stored);",
+        "  real ndc_z = unpackHalf2x16(packHalf2x16(vec2(ndc_depth_from_window_depth(depth, stored), 0.0f))).x;"));
+    std::vector<std::string> args = SmallReport(*root_, *root_ + "/night2");
+    args.push_back("--fail-on-regression");
+    second_ = new testing::CommandResult(RunDepthbench(args));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete first_;
+    delete second_;
+    delete root_;
+  }
+
+  static json Document(const std::string& night) { return json::parse(ReadText(*root_ + "/" + night + "/results.json")); }
+
+  static std::string* root_;
+  static testing::CommandResult* first_;
+  static testing::CommandResult* second_;
+};
+std::string* ReportTest::root_ = nullptr;
+testing::CommandResult* ReportTest::first_ = nullptr;
+testing::CommandResult* ReportTest::second_ = nullptr;
+
+TEST_F(ReportTest, WritesThePageTheSummaryAndTheDocument) {
+  ASSERT_EQ(first_->exit_code, 0) << first_->err;
+  for (const char* name : {"report.html", "report.md", "results.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(*root_ + "/night1/" + name)) << name;
+  }
+  const json doc = Document("night1");
+  EXPECT_EQ(doc["schema"], "depthbench.report");
+  // 2 variants x 2 conventions x 2 formats, on 2 backends.
+  EXPECT_EQ(doc["headline"].size(), 16u);
+  // The first night has nothing to compare with, and says so.
+  EXPECT_TRUE(doc["history"]["previous"].empty());
+  EXPECT_NE(ReadText(*root_ + "/night1/report.md").find("nothing to compare with"), std::string::npos);
+  // The page is self-contained: the library and the document are inlined.
+  const std::string page = ReadText(*root_ + "/night1/report.html");
+  EXPECT_NE(page.find("vegaEmbed"), std::string::npos);
+  EXPECT_EQ(page.find("<script src="), std::string::npos) << "the page must not load scripts from anywhere";
+  EXPECT_EQ(page.find("DEPTHBENCH:DATA"), std::string::npos);
+}
+
+TEST_F(ReportTest, TwoRunsGiveTwoTrendPointsPerCell) {
+  ASSERT_NE(second_->exit_code, 2) << second_->err;
+  const json doc = Document("night2");
+  std::map<std::pair<std::string, std::string>, std::set<std::int64_t>> runs;
+  for (const json& p : doc["history"]["trend"]) runs[{p["backend"], p["cell"]}].insert(p["run"].get<std::int64_t>());
+  ASSERT_EQ(runs.size(), 16u);
+  for (const auto& [key, ids] : runs) EXPECT_EQ(ids.size(), 2u) << key.second << " on " << key.first;
+  EXPECT_EQ(doc["history"]["runs_recorded"], 2);
+}
+
+TEST_F(ReportTest, PlantedRegressionIsFlaggedAndOnlyThere) {
+  // --fail-on-regression: the planted loss is a finding.
+  EXPECT_EQ(second_->exit_code, 1) << second_->out << second_->err;
+  const json doc = Document("night2");
+  std::set<std::string> worse_cells;
+  for (const json& c : doc["history"]["changes"]) {
+    if (c["direction"] == "worse") worse_cells.insert(c["cell"].get<std::string>() + " on " + c["backend"].get<std::string>());
+  }
+  // The GPU ran the edited shader; the CPU backend's formulas are compiled
+  // in, and pq was not touched: with a fixed seed nothing else may move.
+  EXPECT_FALSE(worse_cells.empty());
+  for (const std::string& cell : worse_cells) {
+    EXPECT_EQ(cell.rfind("divide/", 0), 0u) << cell;
+    EXPECT_NE(cell.find(" on vulkan"), std::string::npos) << cell;
+  }
+  EXPECT_TRUE(worse_cells.count("divide/reversed/d32_sfloat on vulkan")) << "reversed D32F loses most to a half";
+  const std::string summary = ReadText(*root_ + "/night2/report.md");
+  EXPECT_NE(summary.find("got worse"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("`divide/reversed/d32_sfloat` on vulkan"), std::string::npos) << summary;
+}
+
+TEST_F(ReportTest, SummaryNamesTheWorstCells) {
+  const json doc = Document("night1");
+  // Worst: the highest p99.9 bits lost over the default domain, then the
+  // highest maximum; null is not finite, the worst of all.
+  struct Row {
+    double p999, max;
+    std::string name;
+  };
+  auto bits = [](const json& v) { return v.is_null() ? INFINITY : v.get<double>(); };
+  std::vector<Row> rows;
+  for (const json& r : doc["headline"]) {
+    rows.push_back({bits(r["p999_bits"]), bits(r["max_bits"]),
+                    "`" + r["variant"].get<std::string>() + "/" + r["convention"].get<std::string>() + "/" +
+                        r["format"].get<std::string>() + "` | " + r["backend"].get<std::string>()});
+  }
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const Row& a, const Row& b) { return a.p999 != b.p999 ? a.p999 > b.p999 : a.max > b.max; });
+  const std::string summary = ReadText(*root_ + "/night1/report.md");
+  const auto section = summary.find("## Worst cells");
+  ASSERT_NE(section, std::string::npos) << summary;
+  const std::string worst = summary.substr(section, summary.find("##", section + 2) - section);
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_NE(worst.find(rows[i].name), std::string::npos) << rows[i].name;
+  // The best cell of all is not among the worst.
+  EXPECT_EQ(worst.find(rows.back().name), std::string::npos) << rows.back().name;
+}
+
+TEST_F(ReportTest, RefusesAFileThatIsNotAHistory) {
+  const std::string bogus = *root_ + "/not_a_db.sqlite";
+  std::ofstream(bogus) << "this is not a database\n";
+  const auto r = RunDepthbench({"report", "--quick", "--out", *root_ + "/bogus", "--history", bogus, "--backend", "cpu",
+                                "--variant", "divide", "--convention", "standard", "--format", "d24"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("not_a_db.sqlite"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not a SQLite database"), std::string::npos) << r.err;
+}
+
+TEST_F(ReportTest, MissingPlotLibraryIsACleanError) {
+  const auto r = RunDepthbench({"report", "--quick", "--out", *root_ + "/nolib", "--no-history", "--plot-library",
+                                *root_ + "/nowhere", "--backend", "cpu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("npm ci --prefix reports"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(*root_ + "/nolib/report.html"));
+}
+
+}  // namespace
+}  // namespace depthbench

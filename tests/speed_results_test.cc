@@ -1,0 +1,185 @@
+// The speed results file: it reads back what was written, refuses records of
+// cells that do not exist and files of another schema, ranks within groups,
+// and compares the rankings of two runs of one device only.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "bench/speed/speed_results.h"
+
+namespace depthbench {
+namespace {
+
+TimingSummary Summary(double q1, double median, double q3) {
+  TimingSummary s;
+  s.count = 5;
+  s.min = q1 - 1;
+  s.q1 = q1;
+  s.median = median;
+  s.q3 = q3;
+  s.max = q3 + 1;
+  return s;
+}
+
+GpuTiming Timing(Variant variant, double median, Regime regime = Regime::kAlu) {
+  GpuTiming t;
+  t.cell = {variant, Convention::kReversed, Format::kD32Sfloat};
+  t.resolution = {1920, 1080};
+  t.regime = regime;
+  t.taps = regime == Regime::kAlu ? 16 : 1;
+  t.ns_per_pass = Summary(median - 1, median, median + 1);
+  t.repetitions_ns = {median - 2, median - 1, median, median + 1, median + 2};
+  t.passes_per_repetition = 3;
+  t.warmup_passes = 7;
+  return t;
+}
+
+SpeedResults Example() {
+  SpeedResults r;
+  r.run.version = "0.1.0";
+  r.run.commit = "abc";
+  r.run.started_at = "2026-01-01T00:00:00Z";
+  r.run.host = "test";
+  r.run.device = {"llvmpipe (LLVM 15.0.6, 256 bits)", "llvmpipe Mesa 22.3.6", "Vulkan 1.3.230", "cpu", "glslang 12"};
+  r.run.device_type = "cpu";
+  r.run.timestamp_period_ns = 1.0;
+  r.run.timestamp_valid_bits = 64;
+  r.run.note = "a CPU implementation";
+  r.run.warmup = 2;
+  r.run.repetitions = 5;
+  r.run.alu_taps = 16;
+  r.run.resolutions = {{1920, 1080}};
+  r.run.trade_resolution = {1920, 1080};
+  r.run.accuracy_source = "results.json";
+  r.run.accuracy_backend = "vulkan";
+  r.run.accuracy_device = "llvmpipe";
+  r.run.cpu_compiler = "g++ 12.2.0";
+  r.run.seconds = 3.5;
+  r.gpu = {Timing(Variant::kDivide, 100), Timing(Variant::kPq, 50), Timing(Variant::kDivide, 10, Regime::kMemory)};
+  RankGpuTimings(r.gpu);
+  InstructionMix mix;
+  mix.fdiv = {5, 7};
+  mix.matrix_vector = {1, 16};
+  mix.extended_by_name["InverseSqrt"] = {1, 1};
+  mix.extended = {1, 1};
+  mix.total_instructions = 40;
+  r.static_costs = {{Variant::kDivide, "divide_world_position", mix}};
+  CpuCost cpu;
+  cpu.cell = {Variant::kDivide, Convention::kReversed, Format::kD32Sfloat};
+  cpu.ns_per_reconstruction = Summary(0.9, 1.0, 1.1);
+  cpu.runs_per_repetition = 100;
+  cpu.samples_per_run = 4096;
+  r.cpu = {cpu};
+  TradePoint point;
+  point.variant = Variant::kDivide;
+  point.gpu_ns_per_reconstruction = 100.0 / (1920.0 * 1080.0 * 16.0);
+  point.p999_bits_lost = 3.5;
+  point.on_gpu_front = true;
+  r.trade = {{Convention::kReversed, Format::kD32Sfloat, {point}}};
+  r.skipped = {"nothing"};
+  return r;
+}
+
+TEST(SpeedResultsTest, ReadsBackWhatItWrote) {
+  const SpeedResults written = Example();
+  const nlohmann::json json = ToJson(written);
+  auto read = SpeedResultsFromJson(json, "example.json");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(ToJson(*read), json);
+  EXPECT_EQ(read->gpu.size(), 3u);
+  EXPECT_EQ(read->static_costs[0].mix, written.static_costs[0].mix);
+  EXPECT_EQ(json["schema"], "depthbench.speed");
+  EXPECT_EQ(json["schema_version"], 1);
+}
+
+TEST(SpeedResultsTest, RefusesCellsThatDoNotExist) {
+  nlohmann::json json = ToJson(Example());
+  json["gpu"][1]["cell"] = "divide/linear/r32_sfloat";
+  auto read = SpeedResultsFromJson(json, "bad.json");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().message().find("bad.json: gpu[1].cell: cell 'divide/linear/r32_sfloat' does not exist: "
+                                         "divide does not read r32_sfloat under the linear convention"),
+            std::string::npos)
+      << read.status().message();
+
+  json = ToJson(Example());
+  json["trade"][0]["points"][0]["variant"] = "frustum_ray";
+  read = SpeedResultsFromJson(json, "bad.json");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().message().find(
+                "trade[0].points[0]: frustum_ray does not read d32_sfloat under the reversed convention"),
+            std::string::npos)
+      << read.status().message();
+}
+
+TEST(SpeedResultsTest, RefusesOtherSchemas) {
+  nlohmann::json json = ToJson(Example());
+  json["schema"] = "depthbench.results";
+  auto read = SpeedResultsFromJson(json, "x.json");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().message().find("schema is 'depthbench.results', expected 'depthbench.speed'"),
+            std::string::npos);
+  json = ToJson(Example());
+  json["schema_version"] = 2;
+  EXPECT_FALSE(SpeedResultsFromJson(json, "x.json").ok());
+}
+
+TEST(SpeedResultsTest, RanksWithinGroupsOnly) {
+  const SpeedResults r = Example();
+  // pq (50) is faster than divide (100) in the ALU-bound group; the
+  // memory-bound divide is alone in its group.
+  EXPECT_EQ(r.gpu[0].rank, 2u);
+  EXPECT_EQ(r.gpu[1].rank, 1u);
+  EXPECT_EQ(r.gpu[2].rank, 1u);
+  EXPECT_TRUE(r.gpu[0].indistinguishable_from.empty());
+  // Within the spread of each other: both rank 1, and each names the other.
+  std::vector<GpuTiming> tied = {Timing(Variant::kDivide, 100), Timing(Variant::kPq, 101)};
+  RankGpuTimings(tied);
+  EXPECT_EQ(tied[0].rank, 1u);
+  EXPECT_EQ(tied[1].rank, 1u);
+  EXPECT_EQ(tied[0].indistinguishable_from, std::vector<Variant>{Variant::kPq});
+  EXPECT_EQ(tied[1].indistinguishable_from, std::vector<Variant>{Variant::kDivide});
+}
+
+TEST(SpeedResultsTest, ComparesRankingsOfOneDevice) {
+  const SpeedResults first = Example();
+  SpeedResults second = Example();
+  auto same = CompareRankings(first, second);
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(same->pairs, 1u);
+  EXPECT_EQ(same->agree, 1u);
+  EXPECT_TRUE(same->contradictions.empty());
+
+  // pq slower than divide now, by more than the spread: a contradiction.
+  second.gpu[1].ns_per_pass = Summary(149, 150, 151);
+  auto flipped = CompareRankings(first, second);
+  ASSERT_TRUE(flipped.ok());
+  ASSERT_EQ(flipped->contradictions.size(), 1u);
+  EXPECT_NE(flipped->contradictions[0].find("divide is slower than pq in the first run"), std::string::npos)
+      << flipped->contradictions[0];
+
+  // Within the spread in the second run: one-sided, not a contradiction.
+  second.gpu[1].ns_per_pass = Summary(90, 99, 110);
+  auto tie = CompareRankings(first, second);
+  ASSERT_TRUE(tie.ok());
+  EXPECT_EQ(tie->one_sided, 1u);
+  EXPECT_TRUE(tie->contradictions.empty());
+
+  second.run.device.name = "NVIDIA H100";
+  auto other = CompareRankings(first, second);
+  ASSERT_FALSE(other.ok());
+  EXPECT_NE(other.status().message().find("rankings are kept per device"), std::string::npos);
+}
+
+TEST(SpeedResultsTest, ParsesResolutions) {
+  auto r = ParseResolution("3840x2160", "--resolution");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->width, 3840u);
+  EXPECT_EQ(r->height, 2160u);
+  for (const char* bad : {"1920", "0x10", "10x", "x10", "10x10x10", "-5x10"}) {
+    EXPECT_FALSE(ParseResolution(bad, "--resolution").ok()) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace depthbench
