@@ -1,5 +1,7 @@
 // Scene files: what they describe, and the errors bad ones get (file, line,
 // field, what is allowed).
+#include <cctype>
+
 #include <gtest/gtest.h>
 
 #include "bench/scene.h"
@@ -61,6 +63,19 @@ struct BadScene {
   std::string message;   // part of the error
 };
 
+// A readable test name: the field the message is about, as in
+// "projection_near_3".
+std::string TestNameOf(const std::string& message, size_t index) {
+  std::string field = message.substr(message.find(": ") == std::string::npos ? 0 : message.find(": ") + 2);
+  field = field.substr(0, field.find(':'));
+  std::string name;
+  for (char c : field) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return name + "_" + std::to_string(index);
+}
+
+// What ctest shows for a case (gtest_discover_tests prints the parameter).
+void PrintTo(const BadScene& bad, std::ostream* os) { *os << TestNameOf(bad.message, 0); }
+
 class BadSceneTest : public ::testing::TestWithParam<BadScene> {};
 
 TEST_P(BadSceneTest, NamesFileLineFieldAndWhatIsAllowed) {
@@ -86,7 +101,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "bad.toml:5:15: projection.fov_degrees: 50:190 is out of range; allowed (0, 180) degrees"},
         BadScene{"aspect = 1.78", "aspect = [1, 2, 3]", "bad.toml:6:10: projection.aspect: expected a number or [min, max]"},
         BadScene{"formats = [\"d24\", \"d32_sfloat\"]", "formats = [\"d24\", \"d48\"]",
-                 "bad.toml:13:19: engine.formats: unknown format 'd48'; allowed: d16_unorm (d16)"},
+                 "bad.toml:12:19: engine.formats: unknown format 'd48'; allowed: d16_unorm (d16)"},
         BadScene{"conventions = [\"standard\", \"reversed\"]", "conventions = [\"sideways\"]",
                  "engine.conventions: unknown convention 'sideways'; allowed: standard, reversed"},
         BadScene{"at_depth = 5000\n", "",
@@ -99,7 +114,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"resolution = [1920, 1080]", "resolution = [1920]",
                  "projection.resolution: expected [width, height] in pixels"},
         BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\""},
-        BadScene{"name = \"test\"", "name = \"test\"\nnear = [", "bad.toml:2:"}));
+        BadScene{"name = \"test\"", "name = \"test\"\nbroken = = 1", "bad.toml:2:"}),
+    [](const ::testing::TestParamInfo<BadScene>& info) { return TestNameOf(info.param.message, info.index); });
 
 }  // namespace
 }  // namespace depthbench
