@@ -67,6 +67,13 @@ if [ ! -e "$out/lib/libvulkan.so.1" ]; then
   exit 1
 fi
 
+# The commit the package was built from travels in run.sh: the GPU machine
+# has no checkout to ask.
+commit=$(git -C "$source_dir" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git -C "$source_dir" status --porcelain --untracked-files=no 2>/dev/null)" ]; then
+  commit="$commit-modified"
+fi
+
 cat > "$out/run.sh" <<'SCRIPT'
 #!/bin/sh
 # Runs the packed depthbench with its own libraries. Where no Vulkan driver
@@ -92,7 +99,9 @@ if [ -z "${__EGL_VENDOR_LIBRARY_FILENAMES:-}" ]; then
     fi
   done
 fi
+export DEPTHBENCH_COMMIT="${DEPTHBENCH_COMMIT:-@COMMIT@}"
 exec "$here/depthbench" "$@"
 SCRIPT
+sed -i "s/@COMMIT@/$commit/" "$out/run.sh"
 chmod +x "$out/run.sh"
 du -sh "$out"
