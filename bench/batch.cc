@@ -22,7 +22,7 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
   return layout;
 }
 
-BatchBuilder::BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings)
+BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings)
     : sampler_(sampler), encodings_(std::move(encodings)) {
   for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
     auto shares = [&](std::uint32_t k) {

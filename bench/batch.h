@@ -62,13 +62,13 @@ RunLayout MakeRunLayout(std::span<const Cell> cells);
 
 class BatchBuilder {
  public:
-  BatchBuilder(const Sampler& sampler, std::vector<Encoding> encodings);
+  BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings);
 
   // Fills `batch` with samples [first, first + count).
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const;
 
  private:
-  const Sampler& sampler_;
+  const SampleSource& sampler_;
   std::vector<Encoding> encodings_;
   // The formats of one convention share the pipeline's float (encode.h):
   // encodings_[s] reads pipeline value pipeline_of_slot_[s], which is

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 
 #include "bench/mpfr_real.h"
 #include "shared/compat.h"
@@ -12,8 +13,12 @@
 namespace depthbench::mp {
 using real = MpfrReal;
 using uint = std::uint32_t;
-// Plain holders: the mapping only builds and reads vectors.
+// Plain holders: the mapping only builds and reads vectors. The constructor
+// is spelled out because clang 14 (the fuzz and sanitizer compiler) lacks
+// C++20's parenthesised initialisation of aggregates, which vec2(a, b) needs.
 struct vec2 {
+  vec2() = default;
+  vec2(real x_in, real y_in) : x(std::move(x_in)), y(std::move(y_in)) {}
   real x, y;
 };
 struct vec4 {

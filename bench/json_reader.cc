@@ -28,13 +28,20 @@ Expected<nlohmann::json> JsonReader::Parse(const std::string& text, const std::s
   nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (!json.is_discarded()) return json;
   // Locate the syntax error: parse again with exceptions for the byte
-  // offset, then turn it into a line and column.
+  // offset, then turn it into a line and column. Not every refusal is a
+  // syntax error: a number beyond the range of a double ("1e999") is an
+  // out_of_range error without a position (found by fuzz_results_json).
   std::size_t byte = 0;
   try {
     nlohmann::json ignored = nlohmann::json::parse(text);
     (void)ignored;
   } catch (const nlohmann::json::parse_error& e) {
     byte = e.byte;
+  } catch (const nlohmann::json::out_of_range& e) {
+    return InvalidArgument(fmt::format("{}: not valid JSON: a number beyond the range of a double ({})", source,
+                                       e.what()));
+  } catch (const nlohmann::json::exception& e) {
+    return InvalidArgument(fmt::format("{}: not valid JSON ({})", source, e.what()));
   }
   std::size_t line = 1, column = 1;
   for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {

@@ -37,9 +37,18 @@ const char* PickName(DepthPick p) {
 Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain,
                           std::span<const Cell> cells, std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(domain.Validate());
+  const Sampler sampler(seed, domain);
+  DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(sampler, index, cells, backends));
+  repro.seed = seed;
+  repro.domain = domain;
+  repro.origin = fmt::format("sample {} of seed {}", index, seed);
+  return repro;
+}
+
+Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, std::span<const Cell> cells,
+                              std::span<Backend* const> backends) {
   if (cells.empty()) return InvalidArgument("no cell to reproduce");
   const RunLayout layout = MakeRunLayout(cells);
-  const Sampler sampler(seed, domain);
   const BatchBuilder builder(sampler, layout.encodings);
   ThreadPool pool(1);
   Batch batch;
@@ -48,9 +57,7 @@ Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain&
   const PixelSample sample = sampler.SampleAt(index, frame);
 
   Repro repro;
-  repro.seed = seed;
   repro.index = index;
-  repro.domain = domain;
   repro.frame = fmt::format(
       "frame {}: fov {:.9g} deg, aspect {:.9g}, near {:.9g}, far {:.9g} (far/near {:.4g}), camera ({:.9g}, {:.9g}, "
       "{:.9g}) at {:.4g} from the origin, render target {}x{}",
@@ -98,7 +105,7 @@ Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain&
 }
 
 void PrintRepro(const Repro& repro, std::ostream& out) {
-  out << fmt::format("sample {} of seed {}\n{}\n{}\n", repro.index, repro.seed, repro.frame, repro.sample);
+  out << fmt::format("{}\n{}\n{}\n", repro.origin, repro.frame, repro.sample);
   for (const ReproCell& c : repro.cells) {
     out << fmt::format("\n{}: stored 0x{:08x} (fetched as {:.9g}); true eye depth {:.17g}, stored value denotes "
                        "{:.17g} (storage error {:.3g}); {}\n",

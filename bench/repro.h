@@ -16,6 +16,7 @@
 #include "bench/backend.h"
 #include "bench/cells.h"
 #include "bench/domain.h"
+#include "bench/sampler.h"
 #include "bench/status.h"
 
 namespace depthbench {
@@ -37,6 +38,7 @@ struct ReproCell {
 };
 
 struct Repro {
+  std::string origin;  // "sample 12 of seed 1", "the case of findings/x.json"
   std::uint64_t seed = 0;
   std::uint64_t index = 0;
   Domain domain;
@@ -47,6 +49,9 @@ struct Repro {
 
 Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain,
                           std::span<const Cell> cells, std::span<Backend* const> backends);
+// The same for sample `index` of any source (a reproducer file's case).
+Expected<Repro> ReproduceFrom(const SampleSource& source, std::uint64_t index, std::span<const Cell> cells,
+                              std::span<Backend* const> backends);
 void PrintRepro(const Repro& repro, std::ostream& out);
 nlohmann::json ReproToJson(const Repro& repro);
 

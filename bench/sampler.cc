@@ -54,38 +54,69 @@ double Sampler::Unit(std::uint64_t index, std::uint32_t stream) const {
   return static_cast<double>((hi << 26) | lo) * 0x1.0p-53;
 }
 
+FrameUnits Sampler::FrameUnitsAt(std::uint64_t i) const {
+  FrameUnits u;
+  u.fov = Unit(i, kFrameFov);
+  u.aspect = Unit(i, kFrameAspect);
+  u.near = Unit(i, kFrameNear);
+  u.far = Unit(i, kFrameFar);
+  for (int k = 0; k < 3; ++k) u.rotation[k] = Unit(i, kFrameRotation + 2 * k);
+  for (int k = 0; k < 2; ++k) u.direction[k] = Unit(i, kFrameDirection + 2 * k);
+  u.distance = Unit(i, kFrameDistance);
+  u.at_origin = Unit(i, kFrameDistance + 2);
+  u.resolution = Bits(i, kFrameResolution) * 0x1.0p-32;  // exact: the pick below is floor(bits * n / 2^32)
+  u.volume = Unit(i, kFrameVolume);
+  return u;
+}
+
+SampleUnits Sampler::SampleUnitsAt(std::uint64_t index) const {
+  SampleUnits u;
+  u.pick = Unit(index, kPickStream);
+  u.depth = Unit(index, kDepthStream);
+  u.pixel_kind = Unit(index, kPixelKindStream);
+  u.x = Bits(index, kPixelXStream) * 0x1.0p-32;
+  u.y = Bits(index, kPixelYStream) * 0x1.0p-32;
+  return u;
+}
+
 Frame Sampler::FrameAt(std::uint64_t frame_index) const {
-  const Domain& d = domain_;
-  const std::uint64_t i = frame_index;
-  Frame f;
-  f.index = frame_index;
-  f.fov_y_degrees = d.fov_degrees.min + Unit(i, kFrameFov) * (d.fov_degrees.max - d.fov_degrees.min);
+  return FrameFromUnits(domain_, FrameUnitsAt(frame_index), frame_index);
+}
+
+PixelSample Sampler::SampleAt(std::uint64_t index, const Frame& frame) const {
+  return SampleFromUnits(SampleUnitsAt(index), frame, index);
+}
+
+void CompleteFrame(Frame& f, const std::optional<Range>& eye_depth) {
   f.tan_half_fov_y = std::tan(f.fov_y_degrees * std::numbers::pi / 360.0);
-  f.aspect = LogUniform(Unit(i, kFrameAspect), d.aspect);
-  f.near = LogUniform(Unit(i, kFrameNear), d.near);
-  if (!d.finite_far) {
-    f.far = INFINITY;
-    f.depth_limit = f.near * Domain::kInfiniteDepthSpan;
-  } else {
-    f.far = d.far ? LogUniform(Unit(i, kFrameFar), *d.far)
-                  : f.near * LogUniform(Unit(i, kFrameFar), d.ratio);
-    f.depth_limit = f.far;
-  }
+  f.depth_limit = f.finite() ? f.far : f.near * Domain::kInfiniteDepthSpan;
   f.eye_depth_min = f.near;
   f.eye_depth_max = f.depth_limit;
-  f.depth_restricted = d.eye_depth.has_value();
-  if (d.eye_depth) {
-    f.eye_depth_min = std::clamp(d.eye_depth->min, f.near, f.depth_limit);
-    f.eye_depth_max = std::clamp(d.eye_depth->max, f.eye_depth_min, f.depth_limit);
+  f.depth_restricted = eye_depth.has_value();
+  if (eye_depth) {
+    f.eye_depth_min = std::clamp(eye_depth->min, f.near, f.depth_limit);
+    f.eye_depth_max = std::clamp(eye_depth->max, f.eye_depth_min, f.depth_limit);
   }
   f.log_eye_depth_span = std::log(f.eye_depth_max / f.eye_depth_min);
+}
+
+Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_index) {
+  Frame f;
+  f.index = frame_index;
+  f.fov_y_degrees = d.fov_degrees.min + u.fov * (d.fov_degrees.max - d.fov_degrees.min);
+  f.aspect = LogUniform(u.aspect, d.aspect);
+  f.near = LogUniform(u.near, d.near);
+  if (!d.finite_far) {
+    f.far = INFINITY;
+  } else {
+    f.far = d.far ? LogUniform(u.far, *d.far) : f.near * LogUniform(u.far, d.ratio);
+  }
+  CompleteFrame(f, d.eye_depth);
 
   // A uniformly random orientation (Shoemake's construction from three
   // uniforms).
-  double u1 = Unit(i, kFrameRotation), u2 = Unit(i, kFrameRotation + 2),
-         u3 = Unit(i, kFrameRotation + 4);
-  double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
-  double t2 = 2.0 * std::numbers::pi * u2, t3 = 2.0 * std::numbers::pi * u3;
+  double a = std::sqrt(1.0 - u.rotation[0]), b = std::sqrt(u.rotation[0]);
+  double t2 = 2.0 * std::numbers::pi * u.rotation[1], t3 = 2.0 * std::numbers::pi * u.rotation[2];
   glm::dquat q(b * std::cos(t3), a * std::sin(t2), a * std::cos(t2), b * std::sin(t3));
   f.rotation = glm::mat3_cast(glm::normalize(q));
 
@@ -96,54 +127,51 @@ Frame Sampler::FrameAt(std::uint64_t frame_index) const {
   if (dist.fixed()) {
     distance = dist.min;
   } else if (dist.min == 0.0) {
-    distance = Unit(i, kFrameDistance + 2) < 0.25 ? 0.0
-                                                   : LogUniform(Unit(i, kFrameDistance),
-                                                                dist.max * 1e-6, dist.max);
+    distance = u.at_origin < 0.25 ? 0.0 : LogUniform(u.distance, dist.max * 1e-6, dist.max);
   } else {
-    distance = LogUniform(Unit(i, kFrameDistance), dist);
+    distance = LogUniform(u.distance, dist);
   }
-  double cz = 2.0 * Unit(i, kFrameDirection) - 1.0;
-  double phi = 2.0 * std::numbers::pi * Unit(i, kFrameDirection + 2);
+  double cz = 2.0 * u.direction[0] - 1.0;
+  double phi = 2.0 * std::numbers::pi * u.direction[1];
   double rxy = std::sqrt(std::max(0.0, 1.0 - cz * cz));
   glm::dvec3 direction(rxy * std::cos(phi), rxy * std::sin(phi), cz);
   for (int k = 0; k < 3; ++k) {
     f.camera_position[k] = static_cast<double>(static_cast<float>(direction[k] * distance));
   }
 
-  const Resolution& res =
-      d.resolutions[(static_cast<std::uint64_t>(Bits(i, kFrameResolution)) * d.resolutions.size()) >> 32];
-  f.width = res.width;
-  f.height = res.height;
-  f.volume_depth = LogUniform(Unit(i, kFrameVolume), f.near, f.depth_limit);
+  const std::size_t pick = std::min(d.resolutions.size() - 1,
+                                    static_cast<std::size_t>(std::floor(u.resolution * d.resolutions.size())));
+  f.width = d.resolutions[pick].width;
+  f.height = d.resolutions[pick].height;
+  f.volume_depth = LogUniform(u.volume, f.near, f.depth_limit);
   return f;
 }
 
-PixelSample Sampler::SampleAt(std::uint64_t index, const Frame& frame) const {
+PixelSample SampleFromUnits(const SampleUnits& u, const Frame& frame, std::uint64_t index) {
   PixelSample s;
   s.index = index;
 
   // Depth: mostly log-uniform eye depth, with the bands and stored values
   // where reconstructions break drawn on purpose.
-  double pick = Unit(index, kPickStream);
-  double u = Unit(index, kDepthStream);
+  const double pick = u.pick;
   const double lo = frame.eye_depth_min, hi = frame.eye_depth_max;
   if (pick < 0.05) {
     static constexpr DepthPick kEdges[4] = {DepthPick::kStoredZero, DepthPick::kStoredOne,
                                             DepthPick::kStoredAfterZero, DepthPick::kStoredBeforeOne};
     s.pick = kEdges[std::min(3, static_cast<int>(pick / 0.05 * 4.0))];
   } else if (pick < 0.15) {  // near band: the first doubling of depth
-    s.eye_depth = std::min(hi, lo * std::exp2(u));
+    s.eye_depth = std::min(hi, lo * std::exp2(u.depth));
   } else if (pick < 0.25) {  // far band: the last doubling
-    s.eye_depth = std::max(lo, hi * std::exp2(-u));
+    s.eye_depth = std::max(lo, hi * std::exp2(-u.depth));
   } else {
-    s.eye_depth = std::min(hi, lo * std::exp(u * frame.log_eye_depth_span));
+    s.eye_depth = std::min(hi, lo * std::exp(u.depth * frame.log_eye_depth_span));
   }
 
   // Pixel: mostly uniform over the render target, with its exact corners
   // and edges drawn on purpose.
-  double kind = Unit(index, kPixelKindStream);
-  auto scaled = [&](std::uint32_t stream, std::uint32_t n) {
-    return static_cast<std::uint32_t>((static_cast<std::uint64_t>(Bits(index, stream)) * n) >> 32);
+  const double kind = u.pixel_kind;
+  auto scaled = [](double unit, std::uint32_t n) {
+    return std::min(n - 1, static_cast<std::uint32_t>(std::floor(unit * n)));
   };
   const std::uint32_t w = frame.width, h = frame.height;
   if (kind < 0.04) {
@@ -152,11 +180,11 @@ PixelSample Sampler::SampleAt(std::uint64_t index, const Frame& frame) const {
     s.y = (corner & 2) ? h - 1 : 0;
   } else if (kind < 0.08) {
     int edge = std::min(3, static_cast<int>((kind - 0.04) / 0.04 * 4.0));
-    s.x = edge < 2 ? (edge == 0 ? 0 : w - 1) : scaled(kPixelXStream, w);
-    s.y = edge < 2 ? scaled(kPixelYStream, h) : (edge == 2 ? 0 : h - 1);
+    s.x = edge < 2 ? (edge == 0 ? 0 : w - 1) : scaled(u.x, w);
+    s.y = edge < 2 ? scaled(u.y, h) : (edge == 2 ? 0 : h - 1);
   } else {
-    s.x = scaled(kPixelXStream, w);
-    s.y = scaled(kPixelYStream, h);
+    s.x = scaled(u.x, w);
+    s.y = scaled(u.y, h);
   }
   return s;
 }

@@ -64,12 +64,45 @@ struct PixelSample {
   double eye_depth = 0.0;  // for kEyeDepth
 };
 
-class Sampler {
+// Where a batch's frames and samples come from: the random sampler, or an
+// explicit list (fuzz cases, reproducer files, a search's candidates).
+// Sample `index` belongs to frame index / kSamplesPerFrame.
+class SampleSource {
+ public:
+  virtual ~SampleSource() = default;
+  virtual Frame FrameAt(std::uint64_t frame_index) const = 0;
+  virtual PixelSample SampleAt(std::uint64_t index, const Frame& frame) const = 0;
+};
+
+// A point of the domain in unit coordinates: every random choice the
+// sampler makes, each in [0, 1). The sampler draws them from (seed, index);
+// a search moves them directly and so never leaves the domain.
+struct FrameUnits {
+  double fov = 0, aspect = 0, near = 0, far = 0;
+  double rotation[3] = {0, 0, 0};
+  double direction[2] = {0, 0};
+  double distance = 0, at_origin = 0;  // at_origin < 0.25 puts the camera at the origin (when the range allows)
+  double resolution = 0, volume = 0;
+};
+struct SampleUnits {
+  double pick = 0, depth = 0;
+  double pixel_kind = 0, x = 0, y = 0;
+};
+Frame FrameFromUnits(const Domain& domain, const FrameUnits& units, std::uint64_t frame_index);
+PixelSample SampleFromUnits(const SampleUnits& units, const Frame& frame, std::uint64_t index);
+// Fills the fields that follow from the others (tan_half_fov_y, depth
+// limits and the eye-depth range), as the sampler does; `eye_depth` is the
+// domain's range of interest, if any.
+void CompleteFrame(Frame& frame, const std::optional<Range>& eye_depth);
+
+class Sampler : public SampleSource {
  public:
   Sampler(std::uint64_t seed, Domain domain);
 
-  Frame FrameAt(std::uint64_t frame_index) const;
-  PixelSample SampleAt(std::uint64_t index, const Frame& frame) const;
+  Frame FrameAt(std::uint64_t frame_index) const override;
+  PixelSample SampleAt(std::uint64_t index, const Frame& frame) const override;
+  FrameUnits FrameUnitsAt(std::uint64_t frame_index) const;
+  SampleUnits SampleUnitsAt(std::uint64_t index) const;
 
   std::uint64_t seed() const { return seed_; }
   const Domain& domain() const { return domain_; }

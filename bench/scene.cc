@@ -178,8 +178,11 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   DB_RETURN_IF_ERROR(r.Check(d.aspect, projection->get("aspect"), "projection.aspect", kAspectLimits));
   if (const toml::node* res = projection->get("resolution")) {
     const toml::array* a = res->as_array();
-    auto w = a && a->size() == 2 ? a->get(0)->value<std::int64_t>() : std::nullopt;
-    auto h = a && a->size() == 2 ? a->get(1)->value<std::int64_t>() : std::nullopt;
+    // value_exact: whole numbers only. toml++'s value<int64_t>() converts a
+    // float such as 1e300 to an integer before it checks the range, which is
+    // undefined behaviour (found by fuzz_scene).
+    auto w = a && a->size() == 2 ? a->get(0)->value_exact<std::int64_t>() : std::nullopt;
+    auto h = a && a->size() == 2 ? a->get(1)->value_exact<std::int64_t>() : std::nullopt;
     if (!w || !h || *w < 1 || *h < 1 || *w > 65535 || *h > 65535) {
       return r.Error(res, "projection.resolution", "expected [width, height] in pixels, 1 to 65535 each");
     }

@@ -1,8 +1,11 @@
 #include "bench/cli/cli_common.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -147,9 +150,18 @@ Status CheckWritable(const std::string& path, const std::string& what) {
   if (!fs::is_directory(dir, ec)) {
     return IoError(fmt::format("{}: cannot write '{}': directory '{}' does not exist", what, path, dir.string()));
   }
-  if (::access(dir.c_str(), W_OK) != 0) {
-    return IoError(fmt::format("{}: cannot write '{}': directory '{}' is not writable", what, path, dir.string()));
+  // Create (and remove) a file beside the target: the only test that holds
+  // for every case, including root (for whom access() says yes to any
+  // directory) and pseudo or read-only file systems. The name is the one
+  // WriteFileAtomically uses for its temporary file, with another suffix.
+  const fs::path probe = dir / ("." + target.filename().string() + ".probe." + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    return IoError(fmt::format("{}: cannot write '{}': cannot create a file in directory '{}': {}", what, path,
+                               dir.string(), std::strerror(errno)));
   }
+  ::close(fd);
+  fs::remove(probe, ec);
   return Status::Ok();
 }
 

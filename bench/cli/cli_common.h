@@ -44,7 +44,9 @@ struct BackendFlags {
 
 // "1e6", "1000000" -> a positive count.
 Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what);
-// Checks that an output file can be created, before a long run starts.
+// Checks that an output file can be created, before a long run starts: the
+// path names a file (not a folder) in an existing folder where a file can be
+// created right now. The message names `what` (the flag) and the path.
 Status CheckWritable(const std::string& path, const std::string& what);
 
 // True when stderr is a terminal (progress lines are shown only then).

@@ -41,6 +41,10 @@ int Gate(const GateFlags& f) {
   for (const std::string& path : f.baselines) {
     BaselineSlot slot;
     slot.path = path;
+    if (f.update) {  // refused now, not after the sweep
+      Status writable = CheckWritable(path, "--baseline");
+      if (!writable.ok()) return ReportError(writable.WithContext("--update"));
+    }
     slot.exists = std::filesystem::exists(path);
     if (slot.exists) {
       auto baseline = ReadBaseline(path);

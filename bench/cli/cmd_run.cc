@@ -7,7 +7,10 @@
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/progress.h"
+#include "bench/fuzz/case_check.h"
+#include "bench/fuzz/fuzz_case.h"
 #include "bench/repro.h"
+#include "bench/stats.h"
 #include "bench/results_table.h"
 #include "bench/files.h"
 #include "bench/sweep.h"
@@ -22,6 +25,7 @@ struct RunFlags {
   std::string shard;
   std::string json;
   std::string index;
+  std::string repro;
   std::vector<std::string> split;
   unsigned threads = 0;
   std::uint32_t batch = 16384;
@@ -30,6 +34,44 @@ struct RunFlags {
   CellFlags cells;
   BackendFlags backends;
 };
+
+// Replays a reproducer file of depthbench fuzz: the same output, and
+// whether the finding still holds (exit 1) or is gone (exit 0).
+int ReplayReproFile(const RunFlags& f, std::vector<Backend*>& backends) {
+  auto file = ReadReproFile(f.repro);
+  if (!file.ok()) return ReportError(file.status());
+  const CaseSource source(file->fuzz_case);
+  auto repro = ReproduceFrom(source, 0, file->cells, backends);
+  if (!repro.ok()) return ReportError(repro.status());
+  repro->origin = fmt::format("the case of {}", f.repro);
+  PrintRepro(*repro, std::cout);
+  auto checker = CaseChecker::Make(file->cells, backends, 1);
+  if (!checker.ok()) return ReportError(checker.status());
+  Status evaluated = checker->Evaluate(source, 0, 1);
+  if (!evaluated.ok()) return ReportError(evaluated);
+  int failures = 0;
+  std::cout << "\n";
+  for (std::size_t c = 0; c < file->cells.size(); ++c) {
+    for (std::size_t b = 0; b < backends.size(); ++b) {
+      const Judgement& j = checker->At(c, b, 0);
+      std::string verdict = !j.checked ? "not checked (the reference is degenerate)"
+                            : j.nan    ? "FINDING: NaN where the reference is finite"
+                            : j.inf    ? "FINDING: Inf where the reference is finite"
+                            : j.arith > j.bound
+                                ? fmt::format("FINDING: arithmetic error {:.3g} ({:.1f} bits lost) beyond the bound "
+                                              "{:.3g} ({:.1f} bits)",
+                                              j.arith, BitsLost(j.arith), j.bound, BitsLost(j.bound))
+                                : fmt::format("holds: arithmetic error {:.3g} within the bound {:.3g}", j.arith, j.bound);
+      failures += j.violates();
+      std::cout << fmt::format("{} on {}: {}\n", file->cells[c].Name(), backends[b]->name(), verdict);
+    }
+  }
+  if (!f.json.empty()) {
+    Status written = WriteFileAtomically(f.json, ReproToJson(*repro).dump(1) + "\n");
+    if (!written.ok()) return ReportError(written);
+  }
+  return failures > 0 ? kExitFinding : kExitOk;
+}
 
 int Run(const RunFlags& f) {
   SweepOptions options;
@@ -66,6 +108,7 @@ int Run(const RunFlags& f) {
   std::vector<Backend*> backends;
   for (auto& b : *made) backends.push_back(b.get());
 
+  if (!f.repro.empty()) return ReplayReproFile(f, backends);
   if (!f.index.empty()) {  // one sample, in full
     char* end = nullptr;
     const unsigned long long index = std::strtoull(f.index.c_str(), &end, 10);
@@ -128,6 +171,9 @@ void AddRunCommand(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--index", flags->index,
                   "replay sample N alone and show everything about it (inputs, stored values, reference, each "
                   "backend's output and errors): what the gate and the fuzzer print to reproduce a finding");
+  cmd->add_option("--repro", flags->repro,
+                  "replay a reproducer file written by depthbench fuzz (its cells, on the selected backends) and say "
+                  "whether the finding still holds (exit 1) or not (exit 0)");
   cmd->add_option("--split", flags->split, "also print p99.9 per band: ratio, depth, distance")->delimiter(',');
   cmd->add_option("--threads", flags->threads, "worker threads (default: one per core)");
   cmd->add_option("--batch", flags->batch, "samples per batch (memory is proportional to it)")

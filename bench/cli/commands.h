@@ -16,6 +16,7 @@ void AddSpeedCommand(CLI::App& app, std::function<int()>& action);
 void AddGateCommand(CLI::App& app, std::function<int()>& action);
 void AddFitCommand(CLI::App& app, std::function<int()>& action);
 void AddChooseCommand(CLI::App& app, std::function<int()>& action);
+void AddFuzzCommand(CLI::App& app, std::function<int()>& action);
 void AddReportCommand(CLI::App& app, std::function<int()>& action);
 
 }  // namespace depthbench::cli

@@ -1,0 +1,213 @@
+// depthbench fuzz: the GPU fuzz campaign, and the worst-case search.
+#include <filesystem>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "bench/cli/cli_common.h"
+#include "bench/cli/commands.h"
+#include "bench/fuzz/campaign.h"
+#include "bench/fuzz/worst_case.h"
+#include "bench/progress.h"
+#include "bench/stats.h"
+#include "bench/sweep.h"
+#include "bench/text_table.h"
+
+namespace depthbench::cli {
+namespace {
+
+struct FuzzFlags {
+  double seconds = 30;
+  std::string cases;
+  std::uint64_t seed = 1;
+  std::vector<std::string> corpus{std::string(DEPTHBENCH_SOURCE_DIR) + "/fuzz/corpus/formulas"};
+  std::string out = "fuzz-findings";
+  bool search = false;
+  std::string against_random;
+  bool quiet = false;
+  DomainFlags domain;
+  CellFlags cells;
+  BackendFlags backends;
+};
+
+std::string DescribeCase(const FuzzCase& c) {
+  const Frame& f = c.frame;
+  std::string depth = c.sample.pick == DepthPick::kEyeDepth ? fmt::format("eye depth {:.6g}", c.sample.eye_depth)
+                      : c.sample.pick == DepthPick::kStoredZero    ? "stored 0"
+                      : c.sample.pick == DepthPick::kStoredOne     ? "stored 1"
+                      : c.sample.pick == DepthPick::kStoredAfterZero ? "first stored value above 0"
+                                                                     : "last stored value below 1";
+  return fmt::format("fov {:.4g}, aspect {:.4g}, near {:.4g}, far/near {:.3g}, camera at {:.3g}, pixel ({}, {}) of "
+                     "{}x{}, {}",
+                     f.fov_y_degrees, f.aspect, f.near, f.ratio(), f.camera_distance(), c.sample.x, c.sample.y,
+                     f.width, f.height, depth);
+}
+
+int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backend*>& backends) {
+  CampaignOptions options;
+  options.seconds = f.seconds;
+  if (!f.cases.empty()) {
+    auto cases = ParseCount(f.cases, "--cases");
+    if (!cases.ok()) return ReportError(cases.status());
+    options.cases = *cases;
+    options.seconds = 0;
+  }
+  options.seed = f.seed;
+  options.cells = cells;
+  for (const std::string& c : f.corpus) options.corpus.emplace_back(c);
+  options.out = f.out;
+  auto domain = f.domain.Apply(FuzzDomain());
+  if (!domain.ok()) return ReportError(domain.status());
+  options.domain = *domain;
+  options.cells = CellsForDomain(cells, options.domain);
+  Progress progress("fuzz", StderrIsTerminal() && !f.quiet);
+  options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
+  auto result = RunCampaign(options, backends);
+  if (!result.ok()) return ReportError(result.status());
+  if (!f.quiet) progress.Finish(fmt::format("{} inputs", result->cases));
+
+  std::cout << fmt::format(
+      "fuzz: {} inputs ({} from the corpus, {} at the domain's extremes, {} random, {} mutated) through {} cells on "
+      "{}: {} checks in {:.1f} s ({:.0f} inputs/s)\n",
+      result->cases, result->from_corpus * kSamplesPerFrame, result->from_extremes * kSamplesPerFrame,
+      result->from_random * kSamplesPerFrame, result->from_mutation * kSamplesPerFrame, options.cells.size(),
+      backends.size() == 1 ? backends[0]->name() : "cpu and vulkan", result->checks, result->seconds,
+      result->cases / std::max(result->seconds, 1e-9));
+  std::cout << fmt::format("invariants: finite output where the reference is finite; arithmetic error within "
+                           "{}x2^-24 x (depth + ray + world condition numbers)\n",
+                           kRoundings);
+  if (result->findings.empty()) {
+    std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result->closest_cell,
+                             result->closest);
+    return kExitOk;
+  }
+  std::cout << fmt::format("{} findings (deduplicated by cell, backend and kind; each shrunk):\n",
+                           result->findings.size());
+  using Align = TextTable::Align;
+  TextTable table({{"finding", Align::kLeft}, {"hits"}, {"arith bits lost"}, {"bound"}, {"shrunk case", Align::kLeft},
+                   {"reproducer", Align::kLeft}});
+  for (const CampaignFinding& finding : result->findings) {
+    const Judgement& j = finding.judgement;
+    table.AddRow({finding.signature, std::to_string(finding.hits),
+                  std::isfinite(j.arith) ? fmt::format("{:.1f}", BitsLost(j.arith)) : (j.nan ? "NaN" : "Inf"),
+                  fmt::format("{:.1f}", BitsLost(j.bound)), DescribeCase(finding.shrunk),
+                  finding.file.empty() ? "-" : "depthbench run --repro " + finding.file.string()});
+  }
+  table.Print(std::cout);
+  return kExitFinding;
+}
+
+int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backend*>& backends) {
+  auto domain = f.domain.Apply(Domain{});
+  if (!domain.ok()) return ReportError(domain.status());
+  std::uint64_t random_samples = 0;
+  if (!f.against_random.empty()) {
+    auto n = ParseCount(f.against_random, "--against-random");
+    if (!n.ok()) return ReportError(n.status());
+    random_samples = *n;
+  }
+  Backend& backend = *backends.front();
+  TextTable table({{"cell", TextTable::Align::kLeft}, {"search: worst bits lost"}, {"evaluations"}, {"seconds"},
+                   {"random: worst bits lost"}, {"samples"}, {"seconds"}, {"search >= random"}});
+  bool all_found = true;
+  for (const Cell& cell : CellsForDomain(cells, *domain)) {
+    SearchOptions options;
+    options.cell = cell;
+    options.domain = *domain;
+    options.seed = f.seed;
+    options.seconds = f.seconds;
+    Progress progress(cell.Name(), StderrIsTerminal() && !f.quiet);
+    options.progress = [&](double fraction, double worst) {
+      progress.Update(fraction, fmt::format("worst {:.2f} bits lost", BitsLost(worst)));
+    };
+    auto found = SearchWorstCase(options, backend);
+    if (!found.ok()) return ReportError(found.status());
+    if (!f.quiet) progress.Finish(fmt::format("{:.2f} bits lost", BitsLost(found->worst)));
+    std::vector<std::string> row = {cell.Name(), fmt::format("{:.3f}", BitsLost(found->worst)),
+                                    ShortCount(static_cast<double>(found->evaluations)),
+                                    fmt::format("{:.1f}", found->seconds)};
+    if (random_samples > 0) {
+      SweepOptions sweep;
+      sweep.samples = random_samples;
+      sweep.seed = f.seed;
+      sweep.domain = *domain;
+      sweep.cells = {cell};
+      Backend* only[] = {&backend};
+      auto results = RunSweep(sweep, only);
+      if (!results.ok()) return ReportError(results.status());
+      const double random_worst = results->cells.front().stats.All()[Metric::kTotal].max();
+      const bool ok = found->worst >= random_worst;
+      all_found = all_found && ok;
+      row.insert(row.end(), {fmt::format("{:.3f}", BitsLost(random_worst)), ShortCount(static_cast<double>(random_samples)),
+                             fmt::format("{:.1f}", results->run.seconds), ok ? "yes" : "NO"});
+    } else {
+      row.insert(row.end(), {"-", "-", "-", "-"});
+    }
+    table.AddRow(row);
+    if (!f.quiet) std::cerr << "  worst input of " << cell.Name() << ": " << DescribeCase(found->worst_case) << "\n";
+  }
+  std::cout << fmt::format("worst-case search on {} ({}), {:.1f} s per cell, domain {}\n", backend.name(),
+                           backend.device().name, f.seconds, domain->Describe());
+  table.Print(std::cout);
+  return all_found ? kExitOk : kExitFinding;
+}
+
+int Fuzz(const FuzzFlags& f) {
+  if (!(f.seconds > 0)) return ReportError(InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds)));
+  auto cells = f.cells.Select();
+  if (!cells.ok()) return ReportError(cells.status());
+  if (!f.search && !f.out.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(f.out, ec);
+    Status writable = CheckWritable(f.out + "/.probe", "--out");
+    if (!writable.ok()) return ReportError(writable);
+  }
+  BackendFlags backend_flags = f.backends;
+  if (f.search && backend_flags.backends.size() > 1) backend_flags.backends = {"cpu"};
+  auto made = backend_flags.Make();
+  if (!made.ok()) return ReportError(made.status());
+  std::vector<Backend*> backends;
+  for (auto& b : *made) backends.push_back(b.get());
+  return f.search ? Search(f, *cells, backends) : Campaign(f, *cells, backends);
+}
+
+}  // namespace
+
+void AddFuzzCommand(CLI::App& app, std::function<int()>& action) {
+  auto flags = std::make_shared<FuzzFlags>();
+  CLI::App* cmd = app.add_subcommand(
+      "fuzz",
+      "Fuzz every cell on the GPU and the CPU together with adversarial inputs (the corpus, the extremes of every "
+      "range, random and mutated points), or search each cell's worst case (--search)");
+  cmd->footer(
+      "Invariants: where the reference is finite the output must be finite, and the arithmetic error (from the "
+      "value the texel holds) must stay within a first-order rounding bound (bench/fuzz/case_check.h). Findings "
+      "are deduplicated by cell, backend and kind, shrunk, and written to --out as reproducer files; exit 1 when "
+      "there are any.\n\n"
+      "The fuzz domain spans the extremes catalogue: near 1e-7 to 10, far/near 10 to 1e9 (and infinite far "
+      "planes), fov 0.01 to 179.9 degrees, aspect 1e-3 to 1e3, cameras up to 1e7 from the origin; the domain "
+      "flags narrow it.\n\n"
+      "Examples:\n"
+      "  depthbench fuzz --seconds 60 --out findings/\n"
+      "  depthbench run --repro findings/divide_standard_d32_sfloat_cpu_beyond_bound.json\n"
+      "  depthbench fuzz --search --seconds 2 --against-random 1e8 --variant divide --convention standard");
+  cmd->add_option("--seconds", flags->seconds,
+                  "how long to fuzz (default 30); with --search, the time per cell");
+  cmd->add_option("--cases", flags->cases, "stop after this many inputs instead of a time");
+  cmd->add_option("--seed", flags->seed, "random seed of the mutations and of the search (default 1)");
+  cmd->add_option("--corpus", flags->corpus, "files or folders of inputs to run first (default fuzz/corpus/formulas)");
+  cmd->add_option("--out", flags->out, "folder for the reproducer files (default fuzz-findings)");
+  cmd->add_flag("--search", flags->search,
+                "search each cell's worst case (largest total error) in the default domain, narrowed by the domain "
+                "flags, on the CPU backend unless --backend says otherwise");
+  cmd->add_option("--against-random", flags->against_random,
+                  "with --search: also draw this many random samples per cell (e.g. 1e8) and compare the worst error "
+                  "and the time");
+  cmd->add_flag("--quiet", flags->quiet, "no progress line");
+  flags->domain.Add(*cmd);
+  flags->cells.Add(*cmd);
+  flags->backends.Add(*cmd);
+  cmd->callback([flags, &action] { action = [flags] { return Fuzz(*flags); }; });
+}
+
+}  // namespace depthbench::cli

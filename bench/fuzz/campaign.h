@@ -1,0 +1,62 @@
+// The GPU fuzz campaign (depthbench fuzz): batches of adversarial inputs run
+// through every backend together, checked against the invariants of
+// case_check.h. Inputs come from the committed corpus (fuzz/corpus/formulas),
+// from the ends of every range of the fuzz domain (the extremes catalogue),
+// from random points, and from mutations of the inputs that came closest to
+// their bound. Findings are deduplicated by signature (cell, backend, kind),
+// shrunk to the simplest case that still fails the same way, and written as
+// reproducer files that `depthbench run --repro FILE` replays.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bench/backend.h"
+#include "bench/fuzz/case_check.h"
+#include "bench/fuzz/fuzz_case.h"
+
+namespace depthbench {
+
+struct CampaignOptions {
+  double seconds = 10.0;        // stop after this long (0: no limit)
+  std::uint64_t cases = 0;      // or after this many cases (0: no limit)
+  std::uint64_t seed = 1;
+  std::vector<Cell> cells;
+  std::vector<std::filesystem::path> corpus;  // files of FuzzPoint bytes, or folders of them
+  std::filesystem::path out;    // where reproducer files go ("" = none written)
+  Domain domain = FuzzDomain();
+  std::uint32_t frames_per_batch = 64;  // x 64 samples
+  std::function<void(double fraction, const std::string& line)> progress;
+};
+
+struct CampaignFinding {
+  std::string signature;  // "divide/standard/d32_sfloat cpu beyond_bound"
+  Cell cell;
+  std::string backend;
+  FindingKind kind = FindingKind::kBeyondBound;
+  std::uint64_t hits = 0;  // cases that failed with this signature
+  FuzzCase first;          // as found
+  FuzzCase shrunk;         // the simplest that still fails the same way
+  Judgement judgement;     // of the shrunk case
+  std::filesystem::path file;
+};
+
+struct CampaignResult {
+  std::uint64_t cases = 0;          // inputs run (each through every cell and backend)
+  std::uint64_t checks = 0;         // (cell, backend, input) triples checked
+  std::uint64_t from_corpus = 0, from_extremes = 0, from_random = 0, from_mutation = 0;
+  double seconds = 0.0;
+  double closest = 0.0;             // the largest arithmetic error / bound seen that was no finding
+  std::string closest_cell;
+  std::vector<CampaignFinding> findings;
+};
+
+Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<Backend* const> backends);
+
+// Reads FuzzPoints from files and folders of files.
+Expected<std::vector<FuzzPoint>> ReadCorpus(const std::vector<std::filesystem::path>& paths);
+
+}  // namespace depthbench

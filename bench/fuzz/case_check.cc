@@ -1,0 +1,112 @@
+#include "bench/fuzz/case_check.h"
+
+#include <cfloat>
+#include <cmath>
+
+#include "bench/fuzz/fuzz_case.h"
+#include "bench/judge.h"
+
+namespace depthbench {
+
+const char* FindingKindName(FindingKind kind) {
+  switch (kind) {
+    case FindingKind::kNaN: return "nan";
+    case FindingKind::kInf: return "inf";
+    case FindingKind::kBeyondBound: return "beyond_bound";
+  }
+  return "?";
+}
+
+double ArithmeticBound(const Cell& cell, const Frame& frame, const f32::DepthParams& depth, float fetched,
+                       double distance_from_camera) {
+  const ConventionInfo& convention = Info(cell.convention);
+  double depth_condition = 1.0;
+  if (Info(cell.format).stores == DepthInput::kHardware) {
+    const bool minus_one = (convention.bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u;
+    const double d = fetched;
+    const double ndc = minus_one ? 2.0 * d - 1.0 : d;
+    const double a = depth.coefficients.x;
+    const double gap = std::abs(ndc - a);
+    depth_condition = (std::abs(ndc) + std::abs(a) + (minus_one ? 2.0 : 0.0)) / gap + 1.0;
+  }
+  const double ray_condition = 1.0 + 2.0 * frame.tan_half_fov_y * (frame.aspect + 1.0);
+  const double world_condition = 1.0 + frame.camera_distance() / distance_from_camera;
+  // inverse_vp carries the camera's translation through the homogeneous
+  // divide: the rounding of w scales the whole translated point, so the
+  // depth and world conditions multiply instead of adding.
+  const double conditions = cell.variant == Variant::kInverseVp
+                                ? depth_condition * world_condition + ray_condition
+                                : depth_condition + ray_condition + world_condition;
+  return kRoundings * 0x1.0p-24 * conditions;
+}
+
+CaseChecker::CaseChecker(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads)
+    : cells_(std::move(cells)), backends_(std::move(backends)), layout_(MakeRunLayout(cells_)),
+      pool_(std::make_unique<ThreadPool>(threads)) {}
+
+Expected<CaseChecker> CaseChecker::Make(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads) {
+  if (cells.empty()) return InvalidArgument("no cell to check");
+  if (backends.empty()) return InvalidArgument("no backend to check on");
+  CaseChecker checker(std::move(cells), std::move(backends), threads);
+  for (Backend* b : checker.backends_) DB_RETURN_IF_ERROR(b->Prepare(checker.layout_.cells));
+  return checker;
+}
+
+Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, std::uint32_t count) {
+  const BatchBuilder builder(source, layout_.encodings);
+  builder.Build(first, count, batch_, *pool_);
+  judgements_.assign(cells_.size() * backends_.size() * count, Judgement{});
+  std::vector<std::uint32_t> every(cells_.size());
+  for (std::uint32_t c = 0; c < every.size(); ++c) every[c] = c;
+  for (std::size_t b = 0; b < backends_.size(); ++b) {
+    DB_ASSIGN_OR_RETURN(std::span<const float> out, backends_[b]->Run(batch_, every, scratch_));
+    pool_->ParallelFor(
+        cells_.size() * count,
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t job = begin; job < end; ++job) {
+            const std::size_t c = job / count;
+            const auto i = static_cast<std::uint32_t>(job % count);
+            const CellPlan& plan = layout_.cells[c];
+            const std::uint32_t f = batch_.FrameOf(i);
+            const Frame& frame = batch_.frames[f];
+            Judgement& j = judgements_[(c * backends_.size() + b) * count + i];
+            const std::size_t at = static_cast<std::size_t>(plan.depth_slot) * count + i;
+            const ReferenceSample r = batch_.reference.Get(at);
+            if (!CellRunsOn(plan.cell, frame) || r.status == ReferenceStatus::kDegenerate) continue;
+            j.checked = true;
+            j.judged = r.status == ReferenceStatus::kJudged;
+            float p[3];
+            for (int k = 0; k < 3; ++k) p[k] = out[(c * 3 + k) * count + i];
+            j.nan = std::isnan(p[0]) || std::isnan(p[1]) || std::isnan(p[2]);
+            j.inf = !j.nan && !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+            const glm::dvec3 ray = batch_.Ray(i);
+            const double distance = r.denoted_depth * glm::length(ray);
+            // The judge measures errors relative to the true point's
+            // distance; the bound is about the point the texel denotes.
+            j.bound = ArithmeticBound(plan.cell, frame, batch_.depth_params[f * kHardwareConventionCount + plan.convention_slot],
+                                      batch_.depths[at], distance) *
+                      (r.denoted_depth / r.true_depth);
+            if (r.denoted_depth == DBL_MAX && !j.nan) {
+              // The texel denotes a point at infinity (the storage rounded
+              // it there): an infinite output is the faithful answer, and
+              // only NaN is a finding.
+              j.inf = false;
+              j.total = j.arith = INFINITY;
+              j.bound = INFINITY;
+              continue;
+            }
+            if (j.nan || j.inf) {
+              j.total = j.arith = NAN;
+              continue;
+            }
+            const SampleErrors e = ErrorsOf(r, ray, frame.camera_position, p);
+            j.total = std::sqrt(e.total_sq);
+            j.arith = std::sqrt(e.arith_sq);
+          }
+        },
+        256);
+  }
+  return Status::Ok();
+}
+
+}  // namespace depthbench

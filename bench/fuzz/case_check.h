@@ -1,0 +1,88 @@
+// The fuzzer's invariants, checked on explicit inputs through real backends.
+//
+// For every (cell, backend, sample): where the reference is finite (the
+// sample is judged or lies outside the frustum), the output must be finite,
+// and its arithmetic error (the error of the reconstruction from the value
+// the texel really holds; storage rounding is the format's, not the
+// shader's) must stay within ArithmeticBound. Anything else is a finding:
+// NaN, Inf, or beyond the bound.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bench/backend.h"
+#include "bench/batch.h"
+#include "bench/cells.h"
+#include "bench/sampler.h"
+#include "bench/status.h"
+#include "bench/thread_pool.h"
+
+namespace depthbench {
+
+enum class FindingKind : std::uint8_t { kNaN, kInf, kBeyondBound };
+const char* FindingKindName(FindingKind kind);  // "nan", "inf", "beyond_bound"
+
+// The documented theoretical bound on the relative arithmetic error of one
+// reconstruction, until fitted models replace it. First-order rounding
+// analysis: a float32 evaluation of a few dozen operations errs by at most
+// kRoundings * 2^-24 times the sum of the condition numbers of its three
+// steps:
+//   depth: ndc_z = A + B / z inverted as B / (ndc_z - A): (|ndc_z| + |A|) /
+//          |ndc_z - A| + 1, plus 2 / |ndc_z - A| where ndc_z = 2d - 1 is
+//          computed first ([-1, 1] conventions); 1 for linear depth;
+//   ray:   the pixel's NDC offset 2(x + 0.5)/w - 1 carries an absolute
+//          rounding of ~2^-24, scaled by the lens: 1 + 2 tan(fov/2) (aspect + 1);
+//   world: adding the camera position: 1 + |camera| / |point - camera|
+//          (inverse_vp: times the depth condition, see the .cc).
+// The bound is relative to the distance of the point the texel denotes;
+// CaseChecker rescales it to the true point's, as the judge measures.
+// kRoundings = 32: the longest path (inverse_vp: a 4x4 matrix-vector
+// product, a divide, the camera) rounds about 16 times, doubled for margin.
+inline constexpr double kRoundings = 32.0;
+double ArithmeticBound(const Cell& cell, const Frame& frame, const f32::DepthParams& depth, float fetched,
+                       double distance_from_camera);
+
+struct Judgement {
+  double total = 0.0;   // relative errors (NaN when the output is not finite)
+  double arith = 0.0;
+  double bound = 0.0;   // ArithmeticBound
+  bool checked = false;  // the reference is finite and the cell runs on the frame
+  bool judged = false;   // and the point lies inside the frustum (errors count, as in a sweep)
+  bool nan = false, inf = false;
+  bool violates() const { return checked && (nan || inf || (std::isfinite(bound) && arith > bound)); }
+  FindingKind kind() const { return nan ? FindingKind::kNaN : inf ? FindingKind::kInf : FindingKind::kBeyondBound; }
+};
+
+class CaseChecker {
+ public:
+  // Prepares every backend for the cells (shaders compiled once).
+  static Expected<CaseChecker> Make(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads = 0);
+
+  // Runs samples [first, first + count) of `source` through every backend
+  // and judges each output.
+  Status Evaluate(const SampleSource& source, std::uint64_t first, std::uint32_t count);
+
+  const std::vector<Cell>& cells() const { return cells_; }
+  std::span<Backend* const> backends() const { return backends_; }
+  const Batch& batch() const { return batch_; }
+  const Judgement& At(std::size_t cell, std::size_t backend, std::uint32_t sample) const {
+    return judgements_[(cell * backends_.size() + backend) * batch_.count + sample];
+  }
+
+ private:
+  CaseChecker(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads);
+
+  std::vector<Cell> cells_;
+  std::vector<Backend*> backends_;
+  RunLayout layout_;
+  std::unique_ptr<ThreadPool> pool_;
+  Batch batch_;
+  std::vector<float> scratch_;
+  std::vector<Judgement> judgements_;
+};
+
+}  // namespace depthbench

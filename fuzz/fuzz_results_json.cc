@@ -1,0 +1,52 @@
+// Fuzz target: the JSON readers of results (run --json), baselines (gate) and
+// speed results (speed --json), on the same bytes, through the same parse
+// their Read* functions use. Invariants: no crash, hang, sanitizer report or
+// escaping exception; a refused document says why; an accepted one is written
+// back and read again with as many records (what the bench reads, it can write).
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+#include "bench/baseline.h"
+#include "bench/json_reader.h"
+#include "bench/results.h"
+#include "bench/speed/speed_results.h"
+
+namespace {
+
+// Aborts (a finding for libFuzzer) when a refusal has no message.
+template <class T>
+bool Accepted(const depthbench::Expected<T>& read) {
+  if (read.ok()) return true;
+  if (read.status().message().empty()) std::abort();
+  return false;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace depthbench;
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  const Expected<nlohmann::json> json = JsonReader::Parse(text, "fuzz.json");
+  if (!Accepted(json)) return 0;
+
+  const Expected<Results> results = ResultsFromJson(*json, "fuzz.json");
+  if (Accepted(results)) {
+    const Expected<Results> again = ResultsFromJson(ToJson(*results), "written");
+    if (!again.ok() || again->cells.size() != results->cells.size()) std::abort();
+  }
+  const Expected<Baseline> baseline = BaselineFromJson(*json, "fuzz.json");
+  if (Accepted(baseline)) {
+    const Expected<Baseline> again = BaselineFromJson(BaselineToJson(*baseline), "written");
+    if (!again.ok() || again->cells.size() != baseline->cells.size()) std::abort();
+  }
+  const Expected<SpeedResults> speed = SpeedResultsFromJson(*json, "fuzz.json");
+  if (Accepted(speed)) {
+    const Expected<SpeedResults> again = SpeedResultsFromJson(ToJson(*speed), "written");
+    if (!again.ok() || again->gpu.size() != speed->gpu.size() || again->cpu.size() != speed->cpu.size()) {
+      std::abort();
+    }
+  }
+  return 0;
+}

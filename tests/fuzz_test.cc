@@ -1,0 +1,178 @@
+// The fuzzer's engine: fuzz points and their bytes, reproducer files, the
+// invariants on the real CPU backend, the campaign and the worst-case
+// search.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "bench/backend_cpu.h"
+#include "bench/fuzz/campaign.h"
+#include "bench/fuzz/case_check.h"
+#include "bench/fuzz/fuzz_case.h"
+#include "bench/fuzz/worst_case.h"
+#include "bench/stats.h"
+#include "bench/sweep.h"
+#include "tests/command_runner.h"
+
+namespace depthbench {
+namespace {
+
+TEST(FuzzPointTest, ZeroAndOneBytesReachBothEndsOfEveryRange) {
+  const Domain d = FuzzDomain();
+  const std::vector<std::uint8_t> zeros(kFuzzPointBytes, 0), ones(kFuzzPointBytes, 0xff);
+  const FuzzCase low = CaseAt(d, DecodePoint(zeros));
+  const FuzzCase high = CaseAt(d, DecodePoint(ones));
+  EXPECT_DOUBLE_EQ(low.frame.fov_y_degrees, 0.01);
+  EXPECT_NEAR(high.frame.fov_y_degrees, 179.9, 1e-9);
+  EXPECT_NEAR(low.frame.aspect, 1e-3, 1e-15);
+  EXPECT_NEAR(high.frame.aspect, 1e3, 1e-9);
+  EXPECT_NEAR(low.frame.near, 1e-7, 1e-19);
+  EXPECT_NEAR(high.frame.ratio(), 1e9, 1e-3);
+  EXPECT_EQ(low.frame.camera_distance(), 0.0);  // at_origin unit 0: the camera sits at the origin
+  EXPECT_NEAR(high.frame.camera_distance(), 1e7, 1.0);
+  EXPECT_EQ(low.sample.pick, DepthPick::kStoredZero);
+  EXPECT_EQ(low.sample.x, 0u);  // pixel kind 0: the top-left corner
+  EXPECT_EQ(low.sample.y, 0u);
+}
+
+TEST(FuzzPointTest, BytesRoundTripAndShortInputsReadAsZero) {
+  FuzzPoint p;
+  for (int k = 0; k < kFuzzUnits; ++k) UnitOf(p, k) = (k + 1) / 19.0;
+  const FuzzPoint back = DecodePoint(EncodePoint(p));
+  for (int k = 0; k < kFuzzUnits; ++k) {
+    EXPECT_NEAR(UnitOf(const_cast<FuzzPoint&>(back), k), UnitOf(p, k), 1e-9) << k;  // 32-bit words
+  }
+  const std::uint8_t three[] = {1, 2, 3};
+  FuzzPoint short_point = DecodePoint(three);
+  EXPECT_GT(UnitOf(short_point, 0), 0.0);
+  for (int k = 1; k < kFuzzUnits; ++k) EXPECT_EQ(UnitOf(short_point, k), 0.0) << k;
+}
+
+TEST(ReproFileTest, RoundTripsTheCaseExactly) {
+  FuzzPoint p;
+  for (int k = 0; k < kFuzzUnits; ++k) UnitOf(p, k) = std::fmod(0.37 * (k + 1), 1.0);
+  UnitOf(p, 13) = 0.9;  // an eye-depth pick
+  ReproFile file;
+  file.fuzz_case = CaseAt(FuzzDomain(), p);
+  file.cells = {*ParseCell("divide/standard/d24")};
+  file.backends = {"cpu"};
+  const nlohmann::json json = nlohmann::json::parse(ReproFileToJson(file).dump());
+  auto back = ReproFileFromJson(json, "x.json");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  const Frame &a = file.fuzz_case.frame, &b = back->fuzz_case.frame;
+  EXPECT_EQ(a.fov_y_degrees, b.fov_y_degrees);
+  EXPECT_EQ(a.tan_half_fov_y, b.tan_half_fov_y);
+  EXPECT_EQ(a.aspect, b.aspect);
+  EXPECT_EQ(a.near, b.near);
+  EXPECT_EQ(a.far, b.far);
+  EXPECT_EQ(a.rotation, b.rotation);
+  EXPECT_EQ(a.camera_position, b.camera_position);
+  EXPECT_EQ(a.volume_depth, b.volume_depth);
+  EXPECT_EQ(back->fuzz_case.sample.eye_depth, file.fuzz_case.sample.eye_depth);
+  EXPECT_EQ(back->fuzz_case.sample.x, file.fuzz_case.sample.x);
+  EXPECT_EQ(back->cells.front(), file.cells.front());
+}
+
+TEST(ReproFileTest, BadFilesNameTheField) {
+  ReproFile file;
+  file.fuzz_case = CaseAt(FuzzDomain(), FuzzPoint{});
+  file.cells = {*ParseCell("pq/reversed/d32f")};
+  const nlohmann::json good = ReproFileToJson(file);
+  struct Case {
+    std::string pointer;
+    nlohmann::json value;
+    std::string message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"/schema", "depthbench.results", "not 'depthbench.repro'"},
+           {"/case/frame/near", -1.0, "case.frame.near: -1 is out of range"},
+           {"/case/frame/far", 1e-9, "must be greater than near"},
+           {"/case/frame/rotation/0", 2.0, "not an orthonormal matrix"},
+           {"/case/frame/camera_position/0", 0.1, "must be a float32 value"},
+           {"/case/sample/x", 99999, "is outside the"},
+           {"/case/sample/pick", "somewhere", "unknown depth pick 'somewhere'"},
+           {"/cells/0", "divide/sideways/d24", "sideways"},
+       }) {
+    nlohmann::json bad = good;
+    bad[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    auto read = ReproFileFromJson(bad, "bad.json");
+    ASSERT_FALSE(read.ok()) << c.pointer;
+    EXPECT_NE(read.status().message().find(c.message), std::string::npos) << read.status().message();
+    EXPECT_NE(read.status().message().find("bad.json"), std::string::npos) << read.status().message();
+  }
+}
+
+TEST(CaseCheckTest, BoundFollowsTheConditionNumbers) {
+  Frame frame;
+  frame.fov_y_degrees = 60;
+  frame.aspect = 1;
+  frame.near = 1;
+  frame.far = 1e6;
+  CompleteFrame(frame, std::nullopt);
+  f32::DepthParams standard{};
+  standard.coefficients.x = 1.0f;  // A of standard Z with a far plane far away
+  f32::DepthParams reversed{};
+  reversed.coefficients.x = 0.0f;
+  const Cell s = *ParseCell("divide/standard/d32f"), r = *ParseCell("divide/reversed/d32f");
+  // Standard Z near the far plane: ndc - A is tiny, the bound grows as 1/gap.
+  const double near_far_plane = ArithmeticBound(s, frame, standard, 1.0f - 0x1.0p-20f, 1e5);
+  const double mid = ArithmeticBound(s, frame, standard, 0.5f, 1e5);
+  EXPECT_GT(near_far_plane / mid, 1e4);
+  // Reversed Z: the same depth is well conditioned.
+  EXPECT_LT(ArithmeticBound(r, frame, reversed, 0x1.0p-20f, 1e5), 4 * mid);
+  // A camera 1e6 from the origin costs 1e6 / distance in the world step.
+  frame.camera_position = glm::dvec3(1e6, 0, 0);
+  EXPECT_GT(ArithmeticBound(r, frame, reversed, 0.5f, 1.0), 1e5 * kRoundings * 0x1.0p-24);
+}
+
+// The campaign's invariants hold on random inputs of the default domain for
+// the CPU backend (the bound is a bound), and the campaign runs its corpus.
+TEST(CampaignTest, RandomInputsOfTheDefaultDomainStayWithinTheBound) {
+  auto cpu = MakeCpuBackend();
+  CampaignOptions options;
+  options.seconds = 0;
+  options.cases = 64 * 64 * 4;
+  options.cells = CellsForDomain(AllCells(), Domain{});
+  options.domain = Domain{};
+  options.corpus = {std::string(DEPTHBENCH_SOURCE_DIR) + "/fuzz/corpus/formulas"};
+  Backend* backends[] = {cpu.get()};
+  auto result = RunCampaign(options, backends);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_GE(result->cases, options.cases);
+  EXPECT_EQ(result->from_corpus, 22u);  // every file of the committed corpus ran
+  for (const CampaignFinding& f : result->findings) ADD_FAILURE() << f.signature;
+  EXPECT_GT(result->closest, 0.0);
+  EXPECT_LT(result->closest, 1.0);
+}
+
+// A search of one second finds an error at least as large as the largest of
+// 10^6 random samples, which take longer than that on the CPU backend.
+TEST(WorstCaseTest, SearchFindsAtLeastTheRandomMaximum) {
+  auto cpu = MakeCpuBackend();
+  for (const char* name : {"reciprocal/reversed/d32f", "frustum_ray/linear/r32f"}) {
+    const Cell cell = *ParseCell(name);
+    SweepOptions sweep;
+    sweep.samples = 1'000'000;
+    sweep.seed = 7;
+    sweep.cells = {cell};
+    Backend* only[] = {cpu.get()};
+    auto random = RunSweep(sweep, only);
+    ASSERT_TRUE(random.ok()) << random.status().message();
+    const double random_worst = random->cells.front().stats.All()[Metric::kTotal].max();
+
+    SearchOptions options;
+    options.cell = cell;
+    options.domain = Domain{};
+    options.seconds = std::max(0.5, random->run.seconds / 4);
+    auto found = SearchWorstCase(options, *cpu);
+    ASSERT_TRUE(found.ok()) << found.status().message();
+    EXPECT_GE(found->worst, random_worst) << name << ": search " << BitsLost(found->worst) << " bits in "
+                                          << found->seconds << " s, random " << BitsLost(random_worst)
+                                          << " bits in " << random->run.seconds << " s";
+  }
+}
+
+}  // namespace
+}  // namespace depthbench
