@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -127,25 +129,96 @@ TEST(CaseCheckTest, BoundFollowsTheConditionNumbers) {
   EXPECT_GT(ArithmeticBound(r, frame, reversed, 0.5f, 1.0), 1e5 * kRoundings * 0x1.0p-24);
 }
 
-// The campaign's invariants hold on random inputs of the default domain for
-// the CPU backend (the bound is a bound), and the campaign runs its corpus.
-TEST(CampaignTest, RandomInputsOfTheDefaultDomainStayWithinTheBound) {
+// A named extreme of the catalogue (issue 7): the fuzz campaign on the CPU
+// backend, 64 x 64 x 8 inputs with the extreme held and everything else
+// random, against the invariants.
+struct Extreme {
+  std::string name;
+  std::function<void(Domain&)> domain;  // applied to the well-conditioned base below
+  std::vector<std::pair<int, double>> pinned;
+  // The cells expected to fail, as "variant kind" pairs; empty: none.
+  std::set<std::string> expected;
+};
+
+void PrintTo(const Extreme& e, std::ostream* os) { *os << e.name; }
+
+// The base: everything but the extreme inside what float32 constants carry
+// (far/near up to 1e6: f/(f - n) still differs from 1 in float32).
+Domain Base() {
+  Domain d;
+  d.ratio = {10.0, 1e6};
+  return d;
+}
+
+// Units of a FuzzPoint (fuzz_case.h): 13 pick, 15 pixel kind.
+constexpr int kPick = 13, kPixelKind = 15;
+
+class ExtremeTest : public ::testing::TestWithParam<Extreme> {};
+
+TEST_P(ExtremeTest, FiniteWithinTheBoundOrACountedFinding) {
+  const Extreme& e = GetParam();
   auto cpu = MakeCpuBackend();
   CampaignOptions options;
   options.seconds = 0;
-  options.cases = 64 * 64 * 4;
-  options.cells = CellsForDomain(AllCells(), Domain{});
-  options.domain = Domain{};
-  options.corpus = {std::string(DEPTHBENCH_SOURCE_DIR) + "/fuzz/corpus/formulas"};
+  options.cases = 64 * 64 * 8;
+  options.domain = Base();
+  e.domain(options.domain);
+  ASSERT_TRUE(options.domain.Validate().ok()) << options.domain.Validate().message();
+  options.cells = CellsForDomain(AllCells(), options.domain);
+  // Eye depths and uniform pixels unless the extreme pins a stored value or
+  // a corner: each test isolates its extreme.
+  options.pinned = {{kPick, 0.6}, {kPixelKind, 0.5}};
+  options.pinned.insert(options.pinned.end(), e.pinned.begin(), e.pinned.end());
+  const std::string out = testing::MakeTempDir("extreme_" + e.name);
+  options.out = out;
   Backend* backends[] = {cpu.get()};
   auto result = RunCampaign(options, backends);
   ASSERT_TRUE(result.ok()) << result.status().message();
-  EXPECT_GE(result->cases, options.cases);
-  EXPECT_EQ(result->from_corpus, 22u);  // every file of the committed corpus ran
-  for (const CampaignFinding& f : result->findings) ADD_FAILURE() << f.signature;
-  EXPECT_GT(result->closest, 0.0);
-  EXPECT_LT(result->closest, 1.0);
+  EXPECT_GT(result->checks, options.cases);  // every input went through many cells
+  std::set<std::string> found;
+  for (const CampaignFinding& f : result->findings) {
+    found.insert(std::string(Info(f.cell.variant).name) + " " + FindingKindName(f.kind));
+    // Every finding is counted and written as a reproducer that replays it.
+    EXPECT_GE(f.hits, 1u);
+    auto file = ReadReproFile(f.file);
+    ASSERT_TRUE(file.ok()) << file.status().message();
+    auto one = CaseChecker::Make(file->cells, {cpu.get()}, 1);
+    ASSERT_TRUE(one.ok());
+    const CaseSource source(file->fuzz_case);
+    ASSERT_TRUE(one->Evaluate(source, 0, 1).ok());
+    EXPECT_TRUE(one->At(0, 0, 0).violates()) << f.signature << " does not replay";
+  }
+  EXPECT_EQ(found, e.expected);
 }
+
+const std::set<std::string> kProjectiveNaN = {"divide nan", "reciprocal nan", "pq nan", "inverse_vp nan",
+                                              "inverse_vp inf"};
+
+INSTANTIATE_TEST_SUITE_P(
+    Catalogue, ExtremeTest,
+    ::testing::Values(
+        Extreme{"near_1e_6", [](Domain& d) { d.near = {1e-6, 1e-6}; }, {}, {}},
+        Extreme{"near_1e_7", [](Domain& d) { d.near = {1e-7, 1e-7}; }, {}, {}},
+        // Far/near beyond 2^24: f/(f - n) rounds to 1 in float32 and the
+        // projective variants divide by zero at the far plane.
+        Extreme{"ratio_1e9", [](Domain& d) { d.ratio = {1e9, 1e9}; }, {}, kProjectiveNaN},
+        // divide forms ndc_z/B - A/B: on [-1, 1] infinite conventions the
+        // two quotients are equal in float32 for depths far enough, the
+        // difference is exactly 0 and the position NaN (seed 004's trap).
+        Extreme{"infinite_far", [](Domain& d) { d.finite_far = false; }, {}, {"divide nan"}},
+        Extreme{"fov_0_01", [](Domain& d) { d.fov_degrees = {0.01, 0.01}; }, {}, {}},
+        Extreme{"fov_179_9", [](Domain& d) { d.fov_degrees = {179.9, 179.9}; }, {}, {}},
+        Extreme{"aspect_1e_3", [](Domain& d) { d.aspect = {1e-3, 1e-3}; }, {}, {}},
+        Extreme{"aspect_1e3", [](Domain& d) { d.aspect = {1e3, 1e3}; }, {}, {}},
+        Extreme{"camera_1e7", [](Domain& d) { d.camera_distance = {1e7, 1e7}; }, {}, {}},
+        Extreme{"stored_zero", [](Domain&) {}, {{kPick, 0.005}}, {}},
+        Extreme{"stored_one", [](Domain&) {}, {{kPick, 0.018}}, {}},
+        Extreme{"smallest_subnormal", [](Domain&) {}, {{kPick, 0.03}}, {}},
+        // The same trap on standard infinite Z: ndc_z = 1 - 2^-24 and A = 1.
+        Extreme{"one_step_below_one", [](Domain&) {}, {{kPick, 0.045}}, {"divide nan"}},
+        Extreme{"corner_top_left", [](Domain&) {}, {{kPixelKind, 0.001}}, {}},
+        Extreme{"corner_bottom_right", [](Domain&) {}, {{kPixelKind, 0.031}}, {}}),
+    [](const ::testing::TestParamInfo<Extreme>& info) { return info.param.name; });
 
 // A search of one second finds an error at least as large as the largest of
 // 10^6 random samples, which take longer than that on the CPU backend.

@@ -205,11 +205,13 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
           ++result.from_random;
         }
       }
+      for (const auto& [unit, value] : options.pinned) UnitOf(base, unit) = value;
       const Frame frame = FrameFromUnits(options.domain, base.frame, f);
       frame_list.push_back(frame);
       for (std::uint32_t s = 0; s < kSamplesPerFrame; ++s) {
         FuzzPoint p = base;
         if (s > 0) p.sample = (s % 2 ? Mutate(base, rng) : RandomPoint(rng, 0.3)).sample;
+        for (const auto& [unit, value] : options.pinned) UnitOf(p, unit) = value;
         points.push_back(p);
         samples.push_back(SampleFromUnits(p.sample, frame, f * kSamplesPerFrame + s));
       }

@@ -29,6 +29,9 @@ struct CampaignOptions {
   std::filesystem::path out;    // where reproducer files go ("" = none written)
   Domain domain = FuzzDomain();
   std::uint32_t frames_per_batch = 64;  // x 64 samples
+  // Units held at a value in every input (index into the 18 units of a
+  // FuzzPoint, value): how a named extreme pins a depth pick or a pixel.
+  std::vector<std::pair<int, double>> pinned;
   std::function<void(double fraction, const std::string& line)> progress;
 };
 

@@ -86,13 +86,13 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
             j.bound = ArithmeticBound(plan.cell, frame, batch_.depth_params[f * kHardwareConventionCount + plan.convention_slot],
                                       batch_.depths[at], distance) *
                       (r.denoted_depth / r.true_depth);
-            if (r.denoted_depth == DBL_MAX && !j.nan) {
+            if (r.denoted_depth == DBL_MAX) {
               // The texel denotes a point at infinity (the storage rounded
-              // it there): an infinite output is the faithful answer, and
-              // only NaN is a finding.
-              j.inf = false;
-              j.total = j.arith = INFINITY;
-              j.bound = INFINITY;
+              // it there): the point has no finite world position, and
+              // rotating a direction scaled to infinity gives Inf or, where
+              // a matrix entry is 0, NaN (0 * Inf). Neither is the shader's
+              // fault; the sweep counts these as storage losses.
+              j.checked = j.judged = false;
               continue;
             }
             if (j.nan || j.inf) {

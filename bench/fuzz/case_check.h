@@ -1,7 +1,8 @@
 // The fuzzer's invariants, checked on explicit inputs through real backends.
 //
 // For every (cell, backend, sample): where the reference is finite (the
-// sample is judged or lies outside the frustum), the output must be finite,
+// sample is judged or lies outside the frustum) and the texel does not
+// denote a point at infinity, the output must be finite,
 // and its arithmetic error (the error of the reconstruction from the value
 // the texel really holds; storage rounding is the format's, not the
 // shader's) must stay within ArithmeticBound. Anything else is a finding:
