@@ -249,3 +249,38 @@ TEST(WorstCaseTest, SearchFindsAtLeastTheRandomMaximum) {
 
 }  // namespace
 }  // namespace depthbench
+
+namespace depthbench {
+namespace {
+
+// depthbench fuzz as a user runs it, on lavapipe and the CPU together:
+// far/near 1e9 (beyond what float32 constants carry) makes the divide
+// variant divide by zero at the far plane on both backends; the campaign
+// says so, exits 1, writes one shrunk reproducer per backend, and
+// `run --repro` replays it with the same verdict.
+TEST(FuzzCommandTest, FindsShrinksWritesAndReplaysOnBothBackends) {
+  const std::string out = testing::MakeTempDir("fuzz_command");
+  const testing::CommandResult fuzz =
+      testing::RunDepthbench({"fuzz", "--cases", "8192", "--ratio", "1e9", "--variant", "divide", "--convention",
+                              "standard", "--format", "d32f", "--out", out, "--quiet", "--validate"});
+  ASSERT_EQ(fuzz.exit_code, 1) << fuzz.out << fuzz.err;
+  EXPECT_NE(fuzz.out.find("divide/standard/d32_sfloat cpu nan"), std::string::npos) << fuzz.out;
+  EXPECT_NE(fuzz.out.find("divide/standard/d32_sfloat vulkan nan"), std::string::npos) << fuzz.out;
+  for (const char* backend : {"cpu", "vulkan"}) {
+    const std::string file = out + "/divide_standard_d32_sfloat_" + backend + "_nan.json";
+    const testing::CommandResult replay = testing::RunDepthbench({"run", "--repro", file, "--validate"});
+    EXPECT_EQ(replay.exit_code, 1) << replay.out << replay.err;
+    EXPECT_NE(replay.out.find(std::string("divide/standard/d32_sfloat on ") + backend +
+                              ": FINDING: NaN where the reference is finite"),
+              std::string::npos)
+        << replay.out;
+  }
+  // A file that is not a reproducer is refused with its field named.
+  const testing::CommandResult bad =
+      testing::RunDepthbench({"run", "--repro", std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/baselines/cpu.json"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("schema is 'depthbench.baseline', not 'depthbench.repro'"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace depthbench
