@@ -184,9 +184,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     if (options.cases > 0 && result.cases >= options.cases) break;
     // One batch: each frame's point comes from one source; its 64 samples
     // vary the point's sample units (the first keeps them).
-    std::vector<FuzzPoint> points;
-    std::vector<Frame> frame_list;
-    std::vector<PixelSample> samples;
+    PointBatch batch(options.domain);
     for (std::uint32_t f = 0; f < frames; ++f) {
       FuzzPoint base;
       if (corpus_next < corpus.size()) {
@@ -206,18 +204,15 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
         }
       }
       for (const auto& [unit, value] : options.pinned) UnitOf(base, unit) = value;
-      const Frame frame = FrameFromUnits(options.domain, base.frame, f);
-      frame_list.push_back(frame);
-      for (std::uint32_t s = 0; s < kSamplesPerFrame; ++s) {
+      batch.AddFrame(base, [&](std::uint32_t s) {
         FuzzPoint p = base;
         if (s > 0) p.sample = (s % 2 ? Mutate(base, rng) : RandomPoint(rng, 0.3)).sample;
         for (const auto& [unit, value] : options.pinned) UnitOf(p, unit) = value;
-        points.push_back(p);
-        samples.push_back(SampleFromUnits(p.sample, frame, f * kSamplesPerFrame + s));
-      }
+        return p;
+      });
     }
-    const CaseSource source(frame_list, samples);
-    const auto count = static_cast<std::uint32_t>(samples.size());
+    const CaseSource source = batch.Source();
+    const std::uint32_t count = batch.count();
     DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, count));
     result.cases += count;
 
@@ -234,7 +229,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
               result.closest_cell = checker.cells()[c].Name();
             }
             if (ratio > 0.05) {
-              elite.emplace_back(ratio, points[i]);
+              elite.emplace_back(ratio, batch.point(i));
             }
             continue;
           }
@@ -251,7 +246,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
           finding.backend = backend_list[b]->name();
           finding.kind = j.kind();
           finding.hits = 1;
-          finding.first = {frame_list[i / kSamplesPerFrame], samples[i]};
+          finding.first = batch.CaseOf(i);
           result.findings.push_back(std::move(finding));
         }
       }

@@ -218,6 +218,17 @@ PixelSample CaseSource::SampleAt(std::uint64_t index, const Frame&) const {
   return s;
 }
 
+void PointBatch::AddFrame(const FuzzPoint& base, const std::function<FuzzPoint(std::uint32_t)>& sample_point) {
+  const auto f = static_cast<std::uint32_t>(frames_.size());
+  const Frame frame = FrameFromUnits(domain_, base.frame, f);
+  frames_.push_back(frame);
+  for (std::uint32_t s = 0; s < kSamplesPerFrame; ++s) {
+    const FuzzPoint p = sample_point(s);
+    points_.push_back(p);
+    samples_.push_back(SampleFromUnits(p.sample, frame, std::uint64_t{f} * kSamplesPerFrame + s));
+  }
+}
+
 bool CellRunsOn(const Cell& cell, const Frame& frame) {
   const ConventionInfo& c = Info(cell.convention);
   const bool needs_finite = (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) ||

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -62,6 +63,25 @@ class CaseSource : public SampleSource {
   std::uint64_t sample_count() const { return samples_.size(); }
 
  private:
+  std::vector<Frame> frames_;
+  std::vector<PixelSample> samples_;
+};
+
+// A batch being assembled from points: frame f is made from one point's
+// frame units, its kSamplesPerFrame samples from the sample units of the
+// points `sample_point(s)` gives.
+class PointBatch {
+ public:
+  explicit PointBatch(const Domain& domain) : domain_(domain) {}
+  void AddFrame(const FuzzPoint& base, const std::function<FuzzPoint(std::uint32_t sample)>& sample_point);
+  CaseSource Source() const { return CaseSource(frames_, samples_); }
+  std::uint32_t count() const { return static_cast<std::uint32_t>(samples_.size()); }
+  const FuzzPoint& point(std::uint32_t i) const { return points_[i]; }
+  FuzzCase CaseOf(std::uint32_t i) const { return {frames_[i / kSamplesPerFrame], samples_[i]}; }
+
+ private:
+  const Domain& domain_;
+  std::vector<FuzzPoint> points_;
   std::vector<Frame> frames_;
   std::vector<PixelSample> samples_;
 };

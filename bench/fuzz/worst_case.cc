@@ -51,9 +51,7 @@ Expected<SearchResult> SearchWorstCase(const SearchOptions& options, Backend& ba
   constexpr int kFrameUnits = 13;
 
   while (elapsed() < options.seconds) {
-    std::vector<FuzzPoint> points;
-    std::vector<Frame> frame_list;
-    std::vector<PixelSample> samples;
+    PointBatch batch(options.domain);
     for (std::uint32_t f = 0; f < frames; ++f) {
       // A frame: a fresh random one (a quarter of them, and all until the
       // elite fills), or a step from an elite frame.
@@ -67,21 +65,18 @@ Expected<SearchResult> SearchWorstCase(const SearchOptions& options, Backend& ba
         base = elite[pick].second;
         if (unit(rng) < 0.7) base = Step(base, 0, kFrameUnits, rng);
       }
-      const Frame frame = FrameFromUnits(options.domain, base.frame, f);
-      frame_list.push_back(frame);
-      for (std::uint32_t s = 0; s < kSamplesPerFrame; ++s) {
+      batch.AddFrame(base, [&](std::uint32_t s) {
         FuzzPoint p = base;
         if (explore || s >= kSamplesPerFrame / 2) {
           if (s > 0) p.sample = UniformPoint(rng).sample;
         } else if (s > 0) {
           p = Step(p, kFrameUnits, kFuzzUnits, rng);
         }
-        points.push_back(p);
-        samples.push_back(SampleFromUnits(p.sample, frame, f * kSamplesPerFrame + s));
-      }
+        return p;
+      });
     }
-    const CaseSource source(frame_list, samples);
-    const auto count = static_cast<std::uint32_t>(samples.size());
+    const CaseSource source = batch.Source();
+    const std::uint32_t count = batch.count();
     DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, count));
     result.evaluations += count;
     for (std::uint32_t i = 0; i < count; ++i) {
@@ -91,10 +86,10 @@ Expected<SearchResult> SearchWorstCase(const SearchOptions& options, Backend& ba
       if (elite.size() >= options.elite && j.total <= elite.back().first) continue;
       if (j.total > result.worst) {
         result.worst = j.total;
-        result.point = points[i];
-        result.worst_case = {frame_list[i / kSamplesPerFrame], samples[i]};
+        result.point = batch.point(i);
+        result.worst_case = batch.CaseOf(i);
       }
-      elite.emplace_back(j.total, points[i]);
+      elite.emplace_back(j.total, batch.point(i));
       std::sort(elite.begin(), elite.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
       if (elite.size() > options.elite) elite.pop_back();
     }

@@ -112,47 +112,11 @@ Status GpuPassTimer::CreateLayouts() {
       {kImageBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
       {kResultsBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
   }};
-  VkDescriptorSetLayoutCreateInfo set_layout_info{};
-  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_layout_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
-  set_layout_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(vk_device(), &set_layout_info, nullptr, &set_layout),
-                             "vkCreateDescriptorSetLayout"));
-  set_layout_ = DeviceObject<VkDescriptorSetLayout>(vk_device(), set_layout, vkDestroyDescriptorSetLayout);
-
-  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PassSize)};
-  VkPipelineLayoutCreateInfo pipeline_layout_info{};
-  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pipeline_layout_info.setLayoutCount = 1;
-  pipeline_layout_info.pSetLayouts = &set_layout;
-  pipeline_layout_info.pushConstantRangeCount = 1;
-  pipeline_layout_info.pPushConstantRanges = &push_constants;
-  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(vk_device(), &pipeline_layout_info, nullptr, &pipeline_layout),
-                             "vkCreatePipelineLayout"));
-  pipeline_layout_ = DeviceObject<VkPipelineLayout>(vk_device(), pipeline_layout, vkDestroyPipelineLayout);
-
-  const std::array<VkDescriptorPoolSize, 3> pool_sizes = {{{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                                           {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
-                                                           {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}};
-  VkDescriptorPoolCreateInfo pool_info{};
-  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = static_cast<std::uint32_t>(pool_sizes.size());
-  pool_info.pPoolSizes = pool_sizes.data();
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateDescriptorPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
-  descriptor_pool_ = DeviceObject<VkDescriptorPool>(vk_device(), pool, vkDestroyDescriptorPool);
-
-  VkDescriptorSetAllocateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  set_info.descriptorPool = pool;
-  set_info.descriptorSetCount = 1;
-  set_info.pSetLayouts = &set_layout;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkAllocateDescriptorSets(vk_device(), &set_info, &descriptor_set_), "vkAllocateDescriptorSets"));
+  DB_ASSIGN_OR_RETURN(ComputeLayout layout, context_->CreateComputeLayout(bindings, sizeof(PassSize)));
+  set_layout_ = std::move(layout.set_layout);
+  pipeline_layout_ = std::move(layout.pipeline_layout);
+  descriptor_pool_ = std::move(layout.pool);
+  descriptor_set_ = layout.set;
 
   // texelFetch ignores filtering and addressing; the sampler only has to exist.
   VkSamplerCreateInfo sampler_info{};
@@ -169,21 +133,7 @@ Status GpuPassTimer::CreateLayouts() {
   return Status::Ok();
 }
 
-Status GpuPassTimer::CreateCommandObjects() {
-  VkCommandBufferAllocateInfo command_info{};
-  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  command_info.commandPool = context_->command_pool();
-  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  command_info.commandBufferCount = 1;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkAllocateCommandBuffers(vk_device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
-  VkFenceCreateInfo fence_info{};
-  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VkFence fence = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(vk_device(), &fence_info, nullptr, &fence), "vkCreateFence"));
-  fence_ = DeviceObject<VkFence>(vk_device(), fence, vkDestroyFence);
-  return Status::Ok();
-}
+Status GpuPassTimer::CreateCommandObjects() { return context_->CreateCommandObjects(command_buffer_, fence_); }
 
 Status GpuPassTimer::CheckFormat(Format format) const {
   VkFormatProperties properties{};
@@ -201,15 +151,6 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
     compiled = spirv_.emplace(variant, std::move(words)).first;
   }
   const std::vector<std::uint32_t>& spirv = compiled->second;
-  VkShaderModuleCreateInfo module_info{};
-  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
-  module_info.pCode = spirv.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(vk_device(), &module_info, nullptr, &module),
-                             fmt::format("vkCreateShaderModule for the {} speed pass", Info(variant).name)));
-  const DeviceObject<VkShaderModule> module_owner(vk_device(), module, vkDestroyShaderModule);
-
   const std::array<std::uint32_t, 2> values = {taps, Info(convention).bits};
   const std::array<VkSpecializationMapEntry, 2> entries = {{
       {kTapsConstant, 0, sizeof(std::uint32_t)},
@@ -217,20 +158,11 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
   }};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
                                             sizeof(values), values.data()};
-  VkComputePipelineCreateInfo pipeline_info{};
-  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pipeline_info.stage.module = module;
-  pipeline_info.stage.pName = "main";
-  pipeline_info.stage.pSpecializationInfo = &specialization;
-  pipeline_info.layout = pipeline_layout_.get();
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateComputePipelines(vk_device(), VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
-              fmt::format("vkCreateComputePipelines for the {} speed pass", Info(variant).name)));
+  DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
+                      context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
+                                                      fmt::format("the {} speed pass", Info(variant).name)));
   auto& stored = pipelines_[key];
-  stored = DeviceObject<VkPipeline>(vk_device(), pipeline, vkDestroyPipeline);
+  stored = std::move(pipeline);
   return stored.get();
 }
 

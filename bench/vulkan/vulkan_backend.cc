@@ -154,62 +154,15 @@ Status VulkanBackend::CreateDescriptorObjects() {
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   }
-  VkDescriptorSetLayoutCreateInfo set_layout_info{};
-  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_layout_info.bindingCount = kBindingCount;
-  set_layout_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(vk_device(), &set_layout_info, nullptr, &set_layout),
-                             "vkCreateDescriptorSetLayout"));
-  set_layout_ = DeviceObject<VkDescriptorSetLayout>(vk_device(), set_layout, vkDestroyDescriptorSetLayout);
-
-  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(f32::PassConstants)};
-  VkPipelineLayoutCreateInfo pipeline_layout_info{};
-  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pipeline_layout_info.setLayoutCount = 1;
-  pipeline_layout_info.pSetLayouts = &set_layout;
-  pipeline_layout_info.pushConstantRangeCount = 1;
-  pipeline_layout_info.pPushConstantRanges = &push_constants;
-  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(vk_device(), &pipeline_layout_info, nullptr, &pipeline_layout),
-                             "vkCreatePipelineLayout"));
-  pipeline_layout_ = DeviceObject<VkPipelineLayout>(vk_device(), pipeline_layout, vkDestroyPipelineLayout);
-
-  const VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
-  VkDescriptorPoolCreateInfo pool_info{};
-  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &pool_size;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateDescriptorPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
-  descriptor_pool_ = DeviceObject<VkDescriptorPool>(vk_device(), pool, vkDestroyDescriptorPool);
-
-  VkDescriptorSetAllocateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  set_info.descriptorPool = pool;
-  set_info.descriptorSetCount = 1;
-  set_info.pSetLayouts = &set_layout;
-  return CheckVk(vkAllocateDescriptorSets(vk_device(), &set_info, &descriptor_set_), "vkAllocateDescriptorSets");
-}
-
-Status VulkanBackend::CreateCommandObjects() {
-  VkCommandBufferAllocateInfo command_info{};
-  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  command_info.commandPool = context_->command_pool();
-  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  command_info.commandBufferCount = 1;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkAllocateCommandBuffers(vk_device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
-
-  VkFenceCreateInfo fence_info{};
-  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VkFence fence = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(vk_device(), &fence_info, nullptr, &fence), "vkCreateFence"));
-  fence_ = DeviceObject<VkFence>(vk_device(), fence, vkDestroyFence);
+  DB_ASSIGN_OR_RETURN(ComputeLayout layout, context_->CreateComputeLayout(bindings, sizeof(f32::PassConstants)));
+  set_layout_ = std::move(layout.set_layout);
+  pipeline_layout_ = std::move(layout.pipeline_layout);
+  descriptor_pool_ = std::move(layout.pool);
+  descriptor_set_ = layout.set;
   return Status::Ok();
 }
+
+Status VulkanBackend::CreateCommandObjects() { return context_->CreateCommandObjects(command_buffer_, fence_); }
 
 Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
   const std::uint64_t errors_before = context_->validation_log()->error_count();
@@ -239,32 +192,11 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant)
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
 
-  VkShaderModuleCreateInfo module_info{};
-  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
-  module_info.pCode = spirv.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(vk_device(), &module_info, nullptr, &module),
-                             fmt::format("vkCreateShaderModule for '{}'", path.string())));
-  // The pipeline keeps what it needs; the module goes when this returns.
-  const DeviceObject<VkShaderModule> module_owner(vk_device(), module, vkDestroyShaderModule);
-
-  VkComputePipelineCreateInfo pipeline_info{};
-  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pipeline_info.stage.module = module;
-  pipeline_info.stage.pName = "main";
   const std::uint32_t workgroup_size = kWorkgroupSize;
   const VkSpecializationMapEntry entry{kWorkgroupSizeConstant, 0, sizeof(workgroup_size)};
-  VkSpecializationInfo specialization{1, &entry, sizeof(workgroup_size), &workgroup_size};
-  pipeline_info.stage.pSpecializationInfo = &specialization;
-  pipeline_info.layout = pipeline_layout_.get();
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateComputePipelines(vk_device(), VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
-              fmt::format("vkCreateComputePipelines for '{}'", path.string())));
-  return DeviceObject<VkPipeline>(vk_device(), pipeline, vkDestroyPipeline);
+  const VkSpecializationInfo specialization{1, &entry, sizeof(workgroup_size), &workgroup_size};
+  return context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
+                                         fmt::format("'{}'", path.string()));
 }
 
 // The positions stay in the mapped readback buffer; `scratch` is not needed.

@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -153,6 +154,15 @@ enum class HostAccess {
   kReadback,  // written by shaders, read by the host: cached memory is much faster to read
 };
 
+// One descriptor set's layout, the pipeline layout around it, a pool
+// holding that one set, and the set (freed with the pool).
+struct ComputeLayout {
+  DeviceObject<VkDescriptorSetLayout> set_layout;
+  DeviceObject<VkPipelineLayout> pipeline_layout;
+  DeviceObject<VkDescriptorPool> pool;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+};
+
 class VulkanContext {
  public:
   static Expected<std::unique_ptr<VulkanContext>> Create(const VulkanContextOptions& options);
@@ -178,6 +188,19 @@ class VulkanContext {
                                          std::initializer_list<VkMemoryPropertyFlags> candidates) const;
   // A mapped buffer of `size` bytes (> 0) in memory suited to `access`.
   Expected<VulkanBuffer> CreateHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage, HostAccess access) const;
+
+  // What every compute pass of this project builds the same way (the
+  // backend's and the speed timer's): the descriptor objects of one set of
+  // `bindings` with `push_constant_bytes` of push constants; a primary
+  // command buffer of the context's pool with an unsignalled fence; a
+  // compute pipeline running `main` of `spirv` (`what` names it in errors).
+  Expected<ComputeLayout> CreateComputeLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
+                                              std::uint32_t push_constant_bytes) const;
+  Status CreateCommandObjects(VkCommandBuffer& command_buffer, DeviceObject<VkFence>& fence) const;
+  Expected<DeviceObject<VkPipeline>> CreateComputePipeline(std::span<const std::uint32_t> spirv,
+                                                           VkPipelineLayout layout,
+                                                           const VkSpecializationInfo& specialization,
+                                                           const std::string& what) const;
 
  private:
   VulkanContext() = default;
