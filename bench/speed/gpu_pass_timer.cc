@@ -191,15 +191,7 @@ Status GpuPassTimer::Submit(Record record) {
   DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
   record(command_buffer_);
   DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer"));
-  const VkFence fence = fence_.get();
-  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(vk_device(), 1, &fence), "vkResetFences"));
-  VkSubmitInfo submit{};
-  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &command_buffer_;
-  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
-  return CheckVk(vkWaitForFences(vk_device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()),
-                 "vkWaitForFences");
+  return context_->SubmitAndWait(command_buffer_, fence_);
 }
 
 Status GpuPassTimer::CreateImage(const DepthImage& image) {

@@ -40,15 +40,6 @@ Status ValidateSpeedOptions(const SpeedOptions& o) {
   return Status::Ok();
 }
 
-std::string DeviceTypeName(VkPhysicalDeviceType type) {
-  switch (type) {
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual gpu";
-    default: return "other";
-  }
-}
 
 std::string DeviceNote(const VulkanDeviceProperties& device) {
   if (device.type == VK_PHYSICAL_DEVICE_TYPE_CPU) {

@@ -337,15 +337,7 @@ Status VulkanBackend::Record(const Batch& batch, std::span<const std::uint32_t> 
 }
 
 Status VulkanBackend::SubmitAndWait() {
-  const VkFence fence = fence_.get();
-  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(vk_device(), 1, &fence), "vkResetFences"));
-  VkSubmitInfo submit{};
-  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &command_buffer_;
-  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
-  DB_RETURN_IF_ERROR(CheckVk(
-      vkWaitForFences(vk_device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()), "vkWaitForFences"));
+  DB_RETURN_IF_ERROR(context_->SubmitAndWait(command_buffer_, fence_));
   return buffers_[kPositions].InvalidateForHostReads();
 }
 

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string_view>
 
@@ -34,15 +35,6 @@ bool ValidationRequestedByEnvironment() {
   return value != nullptr && std::string_view(value) == "1";
 }
 
-std::string DeviceTypeName(VkPhysicalDeviceType type) {
-  switch (type) {
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete gpu";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual gpu";
-    default: return "other";
-  }
-}
 
 VKAPI_ATTR VkBool32 VKAPI_CALL RecordValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                        VkDebugUtilsMessageTypeFlagsEXT,
@@ -210,6 +202,16 @@ Expected<const DeviceCandidate*> SelectDevice(const std::vector<DeviceCandidate>
 }
 
 }  // namespace
+
+std::string DeviceTypeName(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual gpu";
+    default: return "other";
+  }
+}
 
 std::string VkResultName(VkResult result) {
   switch (result) {
@@ -525,6 +527,18 @@ Status VulkanContext::CreateCommandObjects(VkCommandBuffer& command_buffer, Devi
   DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device_, &fence_info, nullptr, &handle), "vkCreateFence"));
   fence = DeviceObject<VkFence>(device_, handle, vkDestroyFence);
   return Status::Ok();
+}
+
+Status VulkanContext::SubmitAndWait(VkCommandBuffer command_buffer, const DeviceObject<VkFence>& fence_object) const {
+  const VkFence fence = fence_object.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(device_, 1, &fence), "vkResetFences"));
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer;
+  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit"));
+  return CheckVk(vkWaitForFences(device_, 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()),
+                 "vkWaitForFences");
 }
 
 Expected<DeviceObject<VkPipeline>> VulkanContext::CreateComputePipeline(std::span<const std::uint32_t> spirv,

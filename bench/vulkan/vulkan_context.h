@@ -23,6 +23,8 @@ namespace depthbench {
 std::string VkResultName(VkResult result);
 // Unavailable("<what> failed: <VkResult name>") unless `result` is VK_SUCCESS.
 Status CheckVk(VkResult result, const std::string& what);
+// "cpu", "integrated gpu", "discrete gpu", "virtual gpu" or "other".
+std::string DeviceTypeName(VkPhysicalDeviceType type);
 // "1.3.230".
 std::string VulkanVersionString(std::uint32_t version);
 
@@ -197,6 +199,8 @@ class VulkanContext {
   Expected<ComputeLayout> CreateComputeLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
                                               std::uint32_t push_constant_bytes) const;
   Status CreateCommandObjects(VkCommandBuffer& command_buffer, DeviceObject<VkFence>& fence) const;
+  // Submits a recorded command buffer to the queue and waits on `fence`.
+  Status SubmitAndWait(VkCommandBuffer command_buffer, const DeviceObject<VkFence>& fence) const;
   Expected<DeviceObject<VkPipeline>> CreateComputePipeline(std::span<const std::uint32_t> spirv,
                                                            VkPipelineLayout layout,
                                                            const VkSpecializationInfo& specialization,
