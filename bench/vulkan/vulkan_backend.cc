@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -17,17 +18,24 @@
 namespace depthbench {
 namespace {
 
-// shaders/compute_pass.glsl runs whole frames per workgroup: its size,
-// specialization constant 0, is a multiple of the samples per frame. A few
-// frames per group keep the per-group cost of a software implementation
-// (lavapipe starts every group on its own) small against the work.
+// shaders/compute_pass.glsl runs one frame per workgroup: workgroup size
+// (specialization constant 0) times samples per invocation (constant 1) is
+// the samples per frame. On a CPU device (lavapipe) an invocation loops over
+// eight samples and reads its frame's constants once for them; a GPU runs
+// one sample per invocation.
 constexpr std::uint32_t kWorkgroupSizeConstant = 0;
-constexpr std::uint32_t kFramesPerWorkgroup = 8;
-constexpr std::uint32_t kWorkgroupSize = kFramesPerWorkgroup * kSamplesPerFrame;
-
-std::uint32_t WorkgroupsFor(const Batch& batch) {
-  return static_cast<std::uint32_t>((batch.frame_count() + kFramesPerWorkgroup - 1) / kFramesPerWorkgroup);
+constexpr std::uint32_t kSamplesPerInvocationConstant = 1;
+struct PassShape {
+  std::uint32_t workgroup_size;
+  std::uint32_t samples_per_invocation;
+};
+PassShape PassShapeFor(VkPhysicalDeviceType type) {
+  const std::uint32_t per_invocation = type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 8 : 1;
+  static_assert(kSamplesPerFrame % 8 == 0);
+  return {kSamplesPerFrame / per_invocation, per_invocation};
 }
+
+std::uint32_t WorkgroupsFor(const Batch& batch) { return static_cast<std::uint32_t>(batch.frame_count()); }
 
 // The storage buffers of shaders/compute_pass.glsl, by binding number.
 enum Binding : std::uint32_t {
@@ -192,9 +200,13 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant)
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
 
-  const std::uint32_t workgroup_size = kWorkgroupSize;
-  const VkSpecializationMapEntry entry{kWorkgroupSizeConstant, 0, sizeof(workgroup_size)};
-  const VkSpecializationInfo specialization{1, &entry, sizeof(workgroup_size), &workgroup_size};
+  const PassShape shape = PassShapeFor(context_->properties().type);
+  const std::array<VkSpecializationMapEntry, 2> entries = {
+      VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
+      VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
+                               sizeof(std::uint32_t)}};
+  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                                            sizeof(shape), &shape};
   return context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
                                          fmt::format("'{}'", path.string()));
 }
