@@ -23,13 +23,13 @@
 #include <cmath>
 #include <cstdint>
 
+#include "bench/simd.h"
+
 #if defined(__FMA__)
 #include <immintrin.h>
 #endif
 
 namespace depthbench {
-
-using Double4 = double __attribute__((vector_size(32)));
 
 namespace dd_detail {
 

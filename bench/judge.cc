@@ -2,25 +2,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace depthbench {
 namespace {
 
-// The arithmetic of the judge, written once for the vectorized loop and for
-// single samples. The output minus the camera position is exact in double
-// (both are float32 values), so world-space magnitudes never enter the
-// error; both reference points lie on the pixel's ray.
-inline SampleErrors Errors(double px, double py, double pz, const glm::dvec3& camera, const glm::dvec3& ray,
-                           double true_depth, double denoted_depth, double inverse_distance_sq) {
-  const double qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
-  const double tx = qx - true_depth * ray.x, ty = qy - true_depth * ray.y, tz = qz - true_depth * ray.z;
-  const double ax = qx - denoted_depth * ray.x, ay = qy - denoted_depth * ray.y,
-               az = qz - denoted_depth * ray.z;
-  SampleErrors e;
-  e.absolute_sq = tx * tx + ty * ty + tz * tz;
-  e.total_sq = e.absolute_sq * inverse_distance_sq;
-  e.arith_sq = (ax * ax + ay * ay + az * az) * inverse_distance_sq;
-  return e;
+// The arithmetic of the judge, written once for one sample (Real = double)
+// and for four SIMD lanes (Double4), each lane computing exactly what the
+// scalar form does. The output minus the camera position is exact in
+// double (both are float32 values), so world-space magnitudes never enter
+// the error; both reference points lie on the pixel's ray.
+template <class Real>
+struct ErrorLanes {
+  Real total_sq, arith_sq, absolute_sq;
+};
+template <class Real>
+ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera, Real ray_x, Real ray_y, Real ray_z,
+                        Real true_depth, Real denoted_depth, Real inverse_distance_sq) {
+  const Real qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
+  const Real tx = qx - true_depth * ray_x, ty = qy - true_depth * ray_y, tz = qz - true_depth * ray_z;
+  const Real ax = qx - denoted_depth * ray_x, ay = qy - denoted_depth * ray_y, az = qz - denoted_depth * ray_z;
+  const Real absolute_sq = tx * tx + ty * ty + tz * tz;
+  return {absolute_sq * inverse_distance_sq, (ax * ax + ay * ay + az * az) * inverse_distance_sq, absolute_sq};
 }
 
 // What a sample is to one cell.
@@ -31,7 +34,7 @@ constexpr std::uint32_t kMaxRun = kSamplesPerFrame;  // a frame's samples at mos
 // Per-cell working set of one frame run, small enough to stay in L1.
 struct RunScratch {
   std::array<double, kMaxRun> total, arith, absolute;
-  std::array<std::int16_t, kMaxRun> total_bin, arith_bin, absolute_bin;
+  std::array<std::int32_t, kMaxRun> total_bin, arith_bin, absolute_bin;
   std::array<std::uint8_t, kMaxRun> kind;
 };
 
@@ -48,18 +51,46 @@ struct RunInputs {
   const ReferenceStatus* status;
 };
 
-// Pass 1: errors, bins and kinds of a run of samples (no branches: the
-// compiler vectorizes it).
+// Pass 1: errors, bins and kinds of a run of samples, four at a time.
 void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n, RunScratch& s) {
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const SampleErrors e = Errors(in.x[i], in.y[i], in.z[i], camera, {in.ray_x[i], in.ray_y[i], in.ray_z[i]},
-                                  in.true_depth[i], in.denoted_depth[i], in.inverse_distance_sq[i]);
+  using Float4 = float __attribute__((vector_size(16)));
+  using Int32x4 = std::int32_t __attribute__((vector_size(16)));
+  const auto store = [](auto* to, auto lanes) { std::memcpy(to, &lanes, sizeof(lanes)); };
+  const auto bins = [](Double4 square, int metric) {
+    return __builtin_convertvector(DenseBinsOfSquares<Int4>(square, kLowestOctave[metric]), Int32x4);
+  };
+  std::uint32_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const auto wide = [&](const float* p) {
+      Float4 f;
+      std::memcpy(&f, p + i, sizeof(f));
+      return __builtin_convertvector(f, Double4);
+    };
+    const auto load = [&](const double* p) {
+      Double4 d;
+      std::memcpy(&d, p + i, sizeof(d));
+      return d;
+    };
+    const ErrorLanes<Double4> e =
+        Errors(wide(in.x), wide(in.y), wide(in.z), camera, load(in.ray_x), load(in.ray_y), load(in.ray_z),
+               load(in.true_depth), load(in.denoted_depth), load(in.inverse_distance_sq));
+    store(&s.total[i], e.total_sq);
+    store(&s.arith[i], e.arith_sq);
+    store(&s.absolute[i], e.absolute_sq);
+    store(&s.total_bin[i], bins(e.total_sq, kTotal));
+    store(&s.arith_bin[i], bins(e.arith_sq, kArith));
+    store(&s.absolute_bin[i], bins(e.absolute_sq, kAbsolute));
+  }
+  for (; i < n; ++i) {  // the tail of a batch that ends inside a frame
+    const ErrorLanes<double> e = Errors<double>(in.x[i], in.y[i], in.z[i], camera, in.ray_x[i], in.ray_y[i],
+                                                in.ray_z[i], in.true_depth[i], in.denoted_depth[i],
+                                                in.inverse_distance_sq[i]);
     s.total[i] = e.total_sq;
     s.arith[i] = e.arith_sq;
     s.absolute[i] = e.absolute_sq;
-    s.total_bin[i] = static_cast<std::int16_t>(DenseBinOfSquare(e.total_sq, kLowestOctave[kTotal]));
-    s.arith_bin[i] = static_cast<std::int16_t>(DenseBinOfSquare(e.arith_sq, kLowestOctave[kArith]));
-    s.absolute_bin[i] = static_cast<std::int16_t>(DenseBinOfSquare(e.absolute_sq, kLowestOctave[kAbsolute]));
+    s.total_bin[i] = DenseBinOfSquare(e.total_sq, kLowestOctave[kTotal]);
+    s.arith_bin[i] = DenseBinOfSquare(e.arith_sq, kLowestOctave[kArith]);
+    s.absolute_bin[i] = DenseBinOfSquare(e.absolute_sq, kLowestOctave[kAbsolute]);
   }
   // Kinds in a loop of their own, so that the one above stays vectorized.
   static_assert(static_cast<int>(ReferenceStatus::kJudged) == kJudged &&
@@ -112,8 +143,9 @@ void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint
 
 SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm::dvec3& camera,
                       const float* position) {
-  return Errors(position[0], position[1], position[2], camera, ray, r.true_depth, r.denoted_depth,
-                r.inverse_distance_sq);
+  const ErrorLanes<double> e = Errors<double>(position[0], position[1], position[2], camera, ray.x, ray.y, ray.z,
+                                              r.true_depth, r.denoted_depth, r.inverse_distance_sq);
+  return {e.total_sq, e.arith_sq, e.absolute_sq};
 }
 
 void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells) {

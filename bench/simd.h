@@ -8,9 +8,15 @@
 // shader code over a frame's constants does.
 #pragma once
 
+#include <cstdint>
 #include <type_traits>
 
 namespace depthbench {
+
+// Four double or int64 lanes, for the double-precision side (reference,
+// judge): GCC vector extensions, one IEEE operation per lane.
+using Double4 = double __attribute__((vector_size(32)));
+using Int4 = std::int64_t __attribute__((vector_size(32)));
 
 class Float8 {
  public:

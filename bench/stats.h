@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "bench/bands.h"
+#include "bench/simd.h"
 #include "bench/status.h"
 
 namespace depthbench {
@@ -44,27 +45,38 @@ inline constexpr int kBinsKept = kBinsPerOctave * kOctavesKept;
 // an underflow or overflow bin; exact zeros into the underflow bin.
 inline constexpr std::array<int, kMetricCount> kLowestOctave = {-56, -56, -56, -48};
 
+// The bin arithmetic below is written once for one value (Int = int64_t,
+// Real = double) and for four SIMD lanes (Int4, Double4): GCC's vector
+// extensions give comparisons and ?: lane by lane, so each lane computes
+// exactly what the scalar form does.
+
 // floor(4 * log2(sqrt(q))) for q > 0 finite, from q's bits: the exponent
 // gives whole octaves of q (half octaves of sqrt(q)); the significand is
 // compared with sqrt(2)'s, which splits an octave of q in two.
-inline int QuarterOctaveOfSqrt(double q) {
-  constexpr std::uint64_t kSqrt2Fraction = 0x6A09E667F3BCDull;  // ceil(frac(sqrt 2) * 2^52)
-  std::uint64_t bits = std::bit_cast<std::uint64_t>(q);
-  int exponent = static_cast<int>(bits >> 52) - 1023;
-  int upper = (bits & 0xFFFFFFFFFFFFFull) >= kSqrt2Fraction ? 1 : 0;
+template <class Int, class Real>
+Int QuarterOctavesOfSqrt(Real q) {
+  constexpr std::int64_t kSqrt2Fraction = 0x6A09E667F3BCDll;  // ceil(frac(sqrt 2) * 2^52)
+  const Int bits = std::bit_cast<Int>(q);
+  const Int exponent = (bits >> 52) - 1023;
+  const Int upper = (bits & 0xFFFFFFFFFFFFFll) >= kSqrt2Fraction ? Int{} + 1 : Int{};
   return 2 * exponent + upper;
 }
+inline int QuarterOctaveOfSqrt(double q) { return static_cast<int>(QuarterOctavesOfSqrt<std::int64_t>(q)); }
 
 // Bin slot of a squared error value in a dense histogram: 0 underflow
 // (including 0 and subnormal squares), 1..kBinsKept kept bins, kBinsKept + 1
 // overflow.
 // Branch-free, so that loops over samples vectorize; NaN lands in the
-// overflow bin (callers keep NaN outputs out).
+// underflow bin (callers keep NaN outputs out).
+template <class Int, class Real>
+Int DenseBinsOfSquares(Real q, int lowest_octave) {
+  Int slot = QuarterOctavesOfSqrt<Int>(q) - lowest_octave * kBinsPerOctave + 1;
+  slot = slot < 0 ? Int{} : slot;
+  slot = slot > kBinsKept + 1 ? Int{} + (kBinsKept + 1) : slot;
+  return q >= 0x1p-1022 ? slot : Int{};
+}
 inline int DenseBinOfSquare(double q, int lowest_octave) {
-  int slot = QuarterOctaveOfSqrt(q) - lowest_octave * kBinsPerOctave + 1;
-  slot = slot < 0 ? 0 : slot;
-  slot = slot > kBinsKept + 1 ? kBinsKept + 1 : slot;
-  return q >= 0x1p-1022 ? slot : 0;
+  return static_cast<int>(DenseBinsOfSquares<std::int64_t>(q, lowest_octave));
 }
 inline constexpr int kDenseBins = kBinsKept + 2;
 
