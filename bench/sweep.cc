@@ -118,6 +118,13 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   std::vector<std::vector<float>> scratch(pool.size());
   std::vector<std::vector<std::uint32_t>> cells_of_slot(slot_count);
   for (std::uint32_t c = 0; c < cell_count; ++c) cells_of_slot[layout.cells[c].depth_slot].push_back(c);
+  // Depth slots, those with the most cells first: the threads take them in
+  // this order, and the small ones at the end even out the finish.
+  std::vector<std::uint32_t> slot_order(slot_count);
+  std::iota(slot_order.begin(), slot_order.end(), 0u);
+  std::stable_sort(slot_order.begin(), slot_order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return cells_of_slot[a].size() > cells_of_slot[b].size();
+  });
   std::vector<std::uint32_t> every_cell(cell_count);
   std::iota(every_cell.begin(), every_cell.end(), 0u);
 
@@ -143,7 +150,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       if (backend.concurrent()) {
         FirstError error;
         pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
-          for (std::size_t slot = lo; slot < hi; ++slot) {
+          for (std::size_t next = lo; next < hi; ++next) {
+            const std::uint32_t slot = slot_order[next];
             auto out = backend.Run(batch, cells_of_slot[slot], scratch[worker]);
             if (!out.ok()) {
               error.Set(out.status());
@@ -160,7 +168,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         if (!out.ok()) return out.status().WithContext("running the " + backend.name() + " backend");
         const std::span<const float> positions = *out;
         pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
-          for (std::size_t slot = lo; slot < hi; ++slot) {
+          for (std::size_t next = lo; next < hi; ++next) {
+            const std::uint32_t slot = slot_order[next];
             judge(slot, [&](std::uint32_t c) { return positions.subspan(c * per_cell, per_cell); });
           }
         });

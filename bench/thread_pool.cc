@@ -22,8 +22,11 @@ void ThreadPool::ParallelFor(std::size_t n, const std::function<void(std::size_t
                              std::size_t grain) {
   if (n == 0) return;
   const std::size_t threads = size();
-  // A few chunks per thread balance uneven work without much overhead.
-  std::size_t chunk = std::max<std::size_t>(grain, (n + threads * 4 - 1) / (threads * 4));
+  // Many chunks per thread balance uneven work (a lock per chunk costs
+  // little against a grain of work); callers with few, uneven items list
+  // the largest first.
+  constexpr std::size_t kChunksPerThread = 16;
+  std::size_t chunk = std::max<std::size_t>(grain, (n + threads * kChunksPerThread - 1) / (threads * kChunksPerThread));
   std::size_t chunks = (n + chunk - 1) / chunk;
   if (threads == 1 || chunks == 1) {
     fn(0, n, 0);
