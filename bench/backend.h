@@ -62,6 +62,9 @@ struct BackendOptions {
   std::string device;           // Vulkan: device name (substring, case-insensitive); "" picks lavapipe
   std::string shader_dir;       // Vulkan: where the shaders/ sources are ("" = built-in default)
   bool validation = false;      // Vulkan: enable VK_LAYER_KHRONOS_validation, fail on its messages
+  // Vulkan: samples each compute invocation reconstructs (a divisor of the
+  // samples per frame); 0 picks by device type: 8 on a CPU device, 1 on a GPU.
+  std::uint32_t samples_per_invocation = 0;
 };
 
 // "cpu" or "vulkan".

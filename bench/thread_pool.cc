@@ -26,7 +26,8 @@ void ThreadPool::ParallelFor(std::size_t n, const std::function<void(std::size_t
   // little against a grain of work); callers with few, uneven items list
   // the largest first.
   constexpr std::size_t kChunksPerThread = 16;
-  std::size_t chunk = std::max<std::size_t>(grain, (n + threads * kChunksPerThread - 1) / (threads * kChunksPerThread));
+  const std::size_t most_chunks = threads * kChunksPerThread;
+  std::size_t chunk = std::max<std::size_t>(grain, (n + most_chunks - 1) / most_chunks);
   std::size_t chunks = (n + chunk - 1) / chunk;
   if (threads == 1 || chunks == 1) {
     fn(0, n, 0);

@@ -44,6 +44,28 @@ TEST(StatsTest, DenseBinsClampAndKeepZeroAndNanApart) {
   EXPECT_EQ(DenseBinOfSquare(std::ldexp(1.0, -48), low), (-24 - low) * kBinsPerOctave + 1);
 }
 
+// The judge bins four lanes at a time (DenseBinsOfSquares on Double4):
+// every lane must land where the scalar form puts it, at bin edges too.
+TEST(StatsTest, FourLaneBinsMatchTheScalarBins) {
+  const double sqrt2 = std::sqrt(2.0);
+  std::vector<double> values = {0.0, 1e-310, 0x1p-1022, 1e-300, 1e300, INFINITY, NAN, 0x1p-48, 0x1p-112, 0x1p-111};
+  for (int k = -120; k <= 40; ++k) {
+    const double edge = std::ldexp(k % 2 == 0 ? 1.0 : sqrt2, k / 2);
+    values.insert(values.end(), {edge, std::nextafter(edge, 0.0), std::nextafter(edge, INFINITY)});
+  }
+  while (values.size() % 4 != 0) values.push_back(1.0);
+  for (int metric = 0; metric < kMetricCount; ++metric) {
+    const int low = kLowestOctave[metric];
+    for (std::size_t i = 0; i < values.size(); i += 4) {
+      const Double4 lanes = {values[i], values[i + 1], values[i + 2], values[i + 3]};
+      const Int4 bins = DenseBinsOfSquares<Int4>(lanes, low);
+      for (int lane = 0; lane < 4; ++lane) {
+        ASSERT_EQ(bins[lane], DenseBinOfSquare(values[i + lane], low)) << values[i + lane] << " metric " << metric;
+      }
+    }
+  }
+}
+
 MetricStats Fill(const std::vector<double>& values, int low) {
   CellAccumulator acc;
   std::uint64_t index = 0;

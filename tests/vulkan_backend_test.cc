@@ -4,6 +4,7 @@
 // matrix-vector product in another order than GLM). Runs with the validation
 // layer on and fails on anything it reports.
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -189,6 +190,44 @@ TEST_F(VulkanBackendTest, AllCellsMatchCpuBackend) {
   // of workgroups.
   const Batch batch = BuildBatch(layout, 4101, 1000);
   ExpectBackendsAgree(layout, batch, AllIndices(layout));
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
+}
+
+// The GPU's pass shape (one sample per invocation, 64 per workgroup) is
+// never run by CI otherwise: on lavapipe it must give exactly the positions
+// of the CPU-device shape (eight samples per invocation), and a shape that
+// does not divide a frame is refused. Same arithmetic per sample, so any
+// difference is an indexing error.
+TEST_F(VulkanBackendTest, EveryPassShapeGivesTheSamePositions) {
+  const RunLayout layout = MakeRunLayout(AllCells());
+  const Batch batch = BuildBatch(layout, 4101, 1000);  // starts and ends inside a frame
+  const std::vector<std::uint32_t> which = AllIndices(layout);
+  std::vector<std::vector<float>> outputs;
+  for (std::uint32_t per_invocation : {1u, 8u, 64u}) {
+    BackendOptions options;
+    options.samples_per_invocation = per_invocation;
+    auto backend = MakeVulkanBackend(context_, options);
+    ASSERT_TRUE(backend.ok()) << backend.status().message();
+    Status status = (*backend)->Prepare(layout.cells);
+    ASSERT_TRUE(status.ok()) << status.message();
+    std::vector<float> scratch;
+    auto out = (*backend)->Run(batch, which, scratch);
+    ASSERT_TRUE(out.ok()) << out.status().message();
+    outputs.emplace_back(out->begin(), out->end());
+  }
+  for (std::size_t k = 1; k < outputs.size(); ++k) {
+    ASSERT_EQ(outputs[k].size(), outputs[0].size());
+    // Bitwise, so that NaN outputs compare too.
+    EXPECT_EQ(std::memcmp(outputs[k].data(), outputs[0].data(), outputs[0].size() * sizeof(float)), 0)
+        << "shape " << k;
+  }
+  BackendOptions bad;
+  bad.samples_per_invocation = 3;
+  auto backend = MakeVulkanBackend(context_, bad);
+  ASSERT_TRUE(backend.ok());
+  const Status status = (*backend)->Prepare(layout.cells);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("do not divide"), std::string::npos) << status.message();
   EXPECT_TRUE(context_->TakeValidationMessages().empty());
 }
 

@@ -29,10 +29,17 @@ struct PassShape {
   std::uint32_t workgroup_size;
   std::uint32_t samples_per_invocation;
 };
-PassShape PassShapeFor(VkPhysicalDeviceType type) {
-  const std::uint32_t per_invocation = type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 8 : 1;
-  static_assert(kSamplesPerFrame % 8 == 0);
-  return {kSamplesPerFrame / per_invocation, per_invocation};
+constexpr std::uint32_t kCpuSamplesPerInvocation = 8;  // one SIMD group of lavapipe's 256-bit lanes per frame
+static_assert(kSamplesPerFrame % kCpuSamplesPerInvocation == 0);
+// `requested` is BackendOptions::samples_per_invocation (0: by device type).
+Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, std::uint32_t requested) {
+  const std::uint32_t per_invocation =
+      requested != 0 ? requested : type == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuSamplesPerInvocation : 1;
+  if (kSamplesPerFrame % per_invocation != 0) {
+    return InvalidArgument(fmt::format("{} samples per invocation do not divide the {} samples of a frame",
+                                       per_invocation, kSamplesPerFrame));
+  }
+  return PassShape{kSamplesPerFrame / per_invocation, per_invocation};
 }
 
 std::uint32_t WorkgroupsFor(const Batch& batch) { return static_cast<std::uint32_t>(batch.frame_count()); }
@@ -85,7 +92,8 @@ class VulkanBackend final : public Backend {
                                        std::vector<float>& scratch) override;
 
  private:
-  VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
+  VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
+                std::uint32_t samples_per_invocation);
 
   VkDevice vk_device() const { return context_->device(); }
   std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
@@ -109,6 +117,7 @@ class VulkanBackend final : public Backend {
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
+  std::uint32_t samples_per_invocation_;  // 0: by device type (PassShapeFor)
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
 
@@ -124,8 +133,11 @@ class VulkanBackend final : public Backend {
   std::array<VulkanBuffer, kBindingCount> buffers_;
 };
 
-VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir)
-    : context_(std::move(context)), shader_dir_(std::move(shader_dir)) {
+VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
+                             std::uint32_t samples_per_invocation)
+    : context_(std::move(context)),
+      shader_dir_(std::move(shader_dir)),
+      samples_per_invocation_(samples_per_invocation) {
   const VulkanDeviceProperties& properties = context_->properties();
   device_.name = properties.name;
   device_.driver = properties.DriverString();
@@ -140,7 +152,8 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
   std::filesystem::path shader_dir = options.shader_dir.empty()
                                          ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
                                          : std::filesystem::path(options.shader_dir);
-  std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir)));
+  std::unique_ptr<VulkanBackend> backend(
+      new VulkanBackend(std::move(context), std::move(shader_dir), options.samples_per_invocation));
   const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
   Status status = backend->CreateDescriptorObjects();
   if (status.ok()) status = backend->CreateCommandObjects();
@@ -200,7 +213,7 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant)
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
 
-  const PassShape shape = PassShapeFor(context_->properties().type);
+  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, samples_per_invocation_));
   const std::array<VkSpecializationMapEntry, 2> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
