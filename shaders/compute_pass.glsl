@@ -7,40 +7,85 @@
 // invocation, as a real pass's are across a draw. Each invocation handles
 // SAMPLES_PER_INVOCATION samples of its frame, and the host sets the
 // workgroup size (specialization constant 0) so that the two multiply to
-// the samples per frame. A GPU gets one sample per invocation. A software
-// implementation runs a workgroup's invocations in SIMD groups and reads
-// storage-buffer constants lane by lane (lavapipe does), so there each
-// invocation loops over several samples and reads its frame's constants
-// once for all of them.
+// the samples per frame. A GPU gets one sample per invocation.
+//
+// A software implementation runs the invocations in SIMD groups, and its
+// cost is in memory access, not arithmetic: Mesa 22.3's lavapipe loads and
+// stores storage buffers lane by lane, in a loop with a branch per lane
+// (unless the index is built from constants alone), but moves a vector's
+// components within one lane's turn. So there:
+//   - each invocation loops over several samples and reads its frame's
+//     constants once for them;
+//   - where the samples per invocation are a multiple of four, an
+//     invocation takes consecutive samples, and the per-sample inputs come
+//     in and the positions go out as four-component vectors: one lane loop
+//     per four samples instead of four. The host aligns the batch's slices
+//     to quads (PassConstants.first_in_frame and slice_length).
+// (Uniform texel buffers, which lavapipe fetches for all lanes at once,
+// measured slower than this: its texel fetch runs the whole sampler.)
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SAMPLES_PER_INVOCATION = 1u;
 
 layout(std430, set = 0, binding = 0) readonly buffer Frames { FrameParams frames[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_params[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };
+// The per-sample buffers, each also seen as quads of four samples.
+layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };  // x | y << 16
+layout(std430, set = 0, binding = 2) readonly buffer PixelQuads { uvec4 pixel_quads[]; };
 layout(std430, set = 0, binding = 3) readonly buffer StoredDepths { float stored_depths[]; };
+layout(std430, set = 0, binding = 3) readonly buffer StoredDepthQuads { vec4 stored_depth_quads[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer Positions { float positions[]; };
+layout(std430, set = 0, binding = 4) writeonly buffer PositionQuads { vec4 position_quads[]; };
 layout(push_constant) uniform Pass { PassConstants pass; };
+
+// One sample, from its pixel and its stored depth.
+vec3 reconstruct_sample(FrameParams frame, DepthParams depth, uint pixel, float stored) {
+  vec2 uv = uv_from_pixel(float(pixel & 0xffffu), float(pixel >> 16u), frame.resolution);
+  return RECONSTRUCT(frame, depth, uv, stored);
+}
+
+// The slice element of the sample at `in_frame` within frame `frame_index`;
+// negative or >= slice_length when the batch starts or ends inside the frame.
+int slice_element(uint frame_index, uint in_frame) {
+  return int(frame_index * pass.samples_per_frame + in_frame) - int(pass.first_in_frame);
+}
 
 void main() {
   uint frame_index = gl_WorkGroupID.x;
   FrameParams frame = frames[frame_index];
   DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
-  for (uint k = 0u; k < SAMPLES_PER_INVOCATION; ++k) {
-    // The batch may start and end inside a frame.
-    uint in_frame = k * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-    int index = int(frame_index * pass.samples_per_frame + in_frame) - int(pass.first_sample_in_frame);
-    if (index < 0 || index >= int(pass.sample_count)) {
-      continue;
+  uint n = pass.slice_length;
+  // Chosen at pipeline creation: the other branch compiles away.
+  if (SAMPLES_PER_INVOCATION % 4u == 0u) {
+    // Quads: consecutive samples per invocation, four at a time. The host
+    // starts and pads the slices so that quads never straddle their ends.
+    for (uint q = 0u; q < SAMPLES_PER_INVOCATION; q += 4u) {
+      int e = slice_element(frame_index, gl_LocalInvocationID.x * SAMPLES_PER_INVOCATION + q);
+      if (e < 0 || e >= int(n)) {
+        continue;
+      }
+      uint i = uint(e);
+      uvec4 px = pixel_quads[i / 4u];
+      vec4 sd = stored_depth_quads[(pass.depth_offset + i) / 4u];
+      mat4x3 p = mat4x3(reconstruct_sample(frame, depth, px.x, sd.x), reconstruct_sample(frame, depth, px.y, sd.y),
+                        reconstruct_sample(frame, depth, px.z, sd.z), reconstruct_sample(frame, depth, px.w, sd.w));
+      mat3x4 t = transpose(p);  // rows: x, y, z of the four samples
+      uint o = (pass.output_offset + i) / 4u;
+      position_quads[o] = t[0];
+      position_quads[o + n / 4u] = t[1];
+      position_quads[o + n / 2u] = t[2];
     }
-    uint i = uint(index);
-    uint pixel = pixels[i];
-    vec2 uv = uv_from_pixel(float(pixel & 0xffffu), float(pixel >> 16u), frame.resolution);
-    vec3 p = RECONSTRUCT(frame, depth, uv, stored_depths[pass.depth_offset + i]);
-    // Component by component: x of every sample, then y, then z.
-    uint o = pass.output_offset + i;
-    positions[o] = p.x;
-    positions[o + pass.sample_count] = p.y;
-    positions[o + 2u * pass.sample_count] = p.z;
+  } else {
+    for (uint k = 0u; k < SAMPLES_PER_INVOCATION; ++k) {
+      int e = slice_element(frame_index, k * gl_WorkGroupSize.x + gl_LocalInvocationID.x);
+      if (e < 0 || e >= int(n)) {
+        continue;
+      }
+      uint i = uint(e);
+      vec3 p = reconstruct_sample(frame, depth, pixels[i], stored_depths[pass.depth_offset + i]);
+      uint o = pass.output_offset + i;
+      positions[o] = p.x;
+      positions[o + n] = p.y;
+      positions[o + 2u * n] = p.z;
+    }
   }
 }

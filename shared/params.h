@@ -51,15 +51,17 @@ struct DepthParams {
   uint reserved2;
 };
 
-// Push constants of one compute dispatch: which slice of the batch's buffers
-// one cell reads and writes.
+// Push constants of one compute dispatch: which slices of the batch's
+// buffers one cell reads and writes. A slice holds one value per sample:
+// the batch's samples, after `lead` unused elements where the host aligns
+// them (compute_pass.glsl), and padding to slice_length.
 struct PassConstants {
-  uint sample_count;        // samples in the batch
-  uint samples_per_frame;   // sample i uses frame (i + first_sample_in_frame) / samples_per_frame
+  uint slice_length;        // elements per slice
+  uint samples_per_frame;   // element e belongs to frame (e + first_in_frame) / samples_per_frame
   uint convention_slot;     // index of this cell's convention within a frame's DepthParams
   uint conventions_per_frame;
-  uint depth_offset;        // first element of this cell's stored depths in the depth buffer
-  uint output_offset;       // first float of this cell's positions: x of every sample, then y, then z
-  uint first_sample_in_frame;  // index of the batch's first sample within its frame
+  uint depth_offset;        // first element of this cell's stored-depth slice in the depth buffer
+  uint output_offset;       // first float of this cell's positions: slices of x, then y, then z
+  uint first_in_frame;      // position within its frame of a slice's first element
   uint reserved0;
 };

@@ -93,13 +93,13 @@ TEST_F(LayoutTest, DepthParamsMatchesStd430) {
 }
 
 TEST_F(LayoutTest, PassConstantsMatchesStd430) {
-  EXPECT_MEMBER_AT(pass, PassConstants, sample_count);
+  EXPECT_MEMBER_AT(pass, PassConstants, slice_length);
   EXPECT_MEMBER_AT(pass, PassConstants, samples_per_frame);
   EXPECT_MEMBER_AT(pass, PassConstants, convention_slot);
   EXPECT_MEMBER_AT(pass, PassConstants, conventions_per_frame);
   EXPECT_MEMBER_AT(pass, PassConstants, depth_offset);
   EXPECT_MEMBER_AT(pass, PassConstants, output_offset);
-  EXPECT_MEMBER_AT(pass, PassConstants, first_sample_in_frame);
+  EXPECT_MEMBER_AT(pass, PassConstants, first_in_frame);
   EXPECT_MEMBER_AT(pass, PassConstants, reserved0);
   EXPECT_EQ(MembersOf("pass"), 8) << "a PassConstants member is not listed above";
   EXPECT_EQ(Offset("pass_end"), static_cast<int>(sizeof(f32::PassConstants)));

@@ -200,26 +200,32 @@ TEST_F(VulkanBackendTest, AllCellsMatchCpuBackend) {
 // difference is an indexing error.
 TEST_F(VulkanBackendTest, EveryPassShapeGivesTheSamePositions) {
   const RunLayout layout = MakeRunLayout(AllCells());
-  const Batch batch = BuildBatch(layout, 4101, 1000);  // starts and ends inside a frame
   const std::vector<std::uint32_t> which = AllIndices(layout);
-  std::vector<std::vector<float>> outputs;
-  for (std::uint32_t per_invocation : {1u, 8u, 64u}) {
-    BackendOptions options;
-    options.samples_per_invocation = per_invocation;
-    auto backend = MakeVulkanBackend(context_, options);
-    ASSERT_TRUE(backend.ok()) << backend.status().message();
-    Status status = (*backend)->Prepare(layout.cells);
-    ASSERT_TRUE(status.ok()) << status.message();
-    std::vector<float> scratch;
-    auto out = (*backend)->Run(batch, which, scratch);
-    ASSERT_TRUE(out.ok()) << out.status().message();
-    outputs.emplace_back(out->begin(), out->end());
-  }
-  for (std::size_t k = 1; k < outputs.size(); ++k) {
-    ASSERT_EQ(outputs[k].size(), outputs[0].size());
-    // Bitwise, so that NaN outputs compare too.
-    EXPECT_EQ(std::memcmp(outputs[k].data(), outputs[0].data(), outputs[0].size() * sizeof(float)), 0)
-        << "shape " << k;
+  // Both start and end inside a frame. The first starts one sample past a
+  // quad, so the quad shapes (4, 8, 64 per invocation) run it with a lead
+  // and padding and gather the positions; the second is quad-aligned and
+  // comes back as the device wrote it.
+  for (const auto [first, count] : {std::pair<std::uint64_t, std::uint32_t>{4101, 1000}, {4104, 1000}}) {
+    const Batch batch = BuildBatch(layout, first, count);
+    std::vector<std::vector<float>> outputs;
+    for (std::uint32_t per_invocation : {1u, 4u, 8u, 64u}) {
+      BackendOptions options;
+      options.samples_per_invocation = per_invocation;
+      auto backend = MakeVulkanBackend(context_, options);
+      ASSERT_TRUE(backend.ok()) << backend.status().message();
+      Status status = (*backend)->Prepare(layout.cells);
+      ASSERT_TRUE(status.ok()) << status.message();
+      std::vector<float> scratch;
+      auto out = (*backend)->Run(batch, which, scratch);
+      ASSERT_TRUE(out.ok()) << out.status().message();
+      outputs.emplace_back(out->begin(), out->end());
+    }
+    for (std::size_t k = 1; k < outputs.size(); ++k) {
+      ASSERT_EQ(outputs[k].size(), outputs[0].size());
+      // Bitwise, so that NaN outputs compare too.
+      EXPECT_EQ(std::memcmp(outputs[k].data(), outputs[0].data(), outputs[0].size() * sizeof(float)), 0)
+          << "batch at " << first << ", shape " << k;
+    }
   }
   BackendOptions bad;
   bad.samples_per_invocation = 3;

@@ -44,6 +44,24 @@ Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, std::uint32_t reques
 
 std::uint32_t WorkgroupsFor(const Batch& batch) { return static_cast<std::uint32_t>(batch.frame_count()); }
 
+// Where a batch's samples lie in the per-sample slices (one per depth
+// slot for the stored depths, one per cell and component for the
+// positions). The quad form of the pass moves four consecutive samples
+// of a frame at once, from an element that is a multiple of four: there
+// the samples start `lead` elements into their slices, so that frame
+// positions and elements agree modulo four, and the slices are padded to
+// whole quads.
+struct SliceLayout {
+  std::uint32_t lead = 0;
+  std::uint32_t length = 0;
+  bool compact(const Batch& batch) const { return lead == 0 && length == batch.count; }
+};
+SliceLayout SliceLayoutFor(const Batch& batch, const PassShape& shape) {
+  if (shape.samples_per_invocation % 4 != 0) return {0, batch.count};
+  const std::uint32_t lead = batch.first_offset % 4;
+  return {lead, (lead + batch.count + 3) / 4 * 4};
+}
+
 // The storage buffers of shaders/compute_pass.glsl, by binding number.
 enum Binding : std::uint32_t {
   kFrames,
@@ -55,22 +73,25 @@ enum Binding : std::uint32_t {
 };
 using BindingBytes = std::array<VkDeviceSize, kBindingCount>;
 
-// Bytes each binding holds for a batch; positions are `output_floats`.
-BindingBytes BytesFor(const Batch& batch, std::size_t output_floats) {
+std::size_t DepthSlotsOf(const Batch& batch) { return batch.depths.size() / batch.count; }
+
+// Bytes each binding holds for a batch of `cells` cells.
+BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t cells) {
   return {batch.frame_params.size() * sizeof(f32::FrameParams), batch.depth_params.size() * sizeof(f32::DepthParams),
-          std::size_t{batch.count} * sizeof(std::uint32_t), batch.depths.size() * sizeof(float),
-          output_floats * sizeof(float)};
+          std::size_t{slices.length} * sizeof(std::uint32_t),
+          DepthSlotsOf(batch) * slices.length * sizeof(float), cells * 3 * slices.length * sizeof(float)};
 }
 
-// The k-th listed cell's slice of the batch, as compute_pass.glsl reads it.
-f32::PassConstants PassConstantsFor(const Batch& batch, const CellPlan& plan, std::size_t k) {
-  return {.sample_count = batch.count,
+// The k-th listed cell's slices of the batch, as compute_pass.glsl reads them.
+f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slices, const CellPlan& plan,
+                                    std::size_t k) {
+  return {.slice_length = slices.length,
           .samples_per_frame = kSamplesPerFrame,
           .convention_slot = plan.convention_slot,
           .conventions_per_frame = kHardwareConventionCount,
-          .depth_offset = plan.depth_slot * batch.count,
-          .output_offset = static_cast<std::uint32_t>(k * batch.count * 3),
-          .first_sample_in_frame = batch.first_offset,
+          .depth_offset = plan.depth_slot * slices.length,
+          .output_offset = static_cast<std::uint32_t>(k * slices.length * 3),
+          .first_in_frame = batch.first_offset - slices.lead,
           .reserved0 = 0};
 }
 
@@ -103,14 +124,15 @@ class VulkanBackend final : public Backend {
   Status CreateCommandObjects();
 
   Status PrepareOnDevice(std::span<const CellPlan> cells);
-  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant) const;
+  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape) const;
 
-  Expected<std::span<const float>> RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which);
+  Expected<std::span<const float>> RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+                                               std::vector<float>& scratch);
   Status CheckRun(const Batch& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
-  Status Upload(const Batch& batch, const BindingBytes& bytes);
+  Status Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes);
   void BindBuffers(const BindingBytes& bytes);
-  Status Record(const Batch& batch, std::span<const std::uint32_t> which);
+  Status Record(const Batch& batch, const SliceLayout& slices, std::span<const std::uint32_t> which);
   Status SubmitAndWait();
   // Internal when the validation layer reported errors since `errors_before`.
   Status CheckValidation(std::uint64_t errors_before, std::string_view during) const;
@@ -118,6 +140,7 @@ class VulkanBackend final : public Backend {
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
   std::uint32_t samples_per_invocation_;  // 0: by device type (PassShapeFor)
+  PassShape shape_{};                     // of the prepared pipelines
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
 
@@ -198,22 +221,22 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
     return NotFound(fmt::format("shader directory '{}' does not exist", shader_dir_.string()));
   }
   // Built aside so that a failure leaves the previous preparation intact.
+  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, samples_per_invocation_));
   std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
   for (const CellPlan& plan : cells) {
     DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
     if (pipeline.get() != VK_NULL_HANDLE) continue;
-    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant));
+    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape));
   }
   pipelines_ = std::move(pipelines);
+  shape_ = shape;
   cells_.assign(cells.begin(), cells.end());
   return Status::Ok();
 }
 
-Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant) const {
+Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape) const {
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
-
-  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, samples_per_invocation_));
   const std::array<VkSpecializationMapEntry, 2> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
@@ -224,25 +247,36 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant)
                                          fmt::format("'{}'", path.string()));
 }
 
-// The positions stay in the mapped readback buffer; `scratch` is not needed.
+// The positions stay in the mapped readback buffer when their slices are
+// compact; otherwise they are gathered into `scratch`.
 Expected<std::span<const float>> VulkanBackend::Run(const Batch& batch, std::span<const std::uint32_t> which,
-                                                    std::vector<float>& /*scratch*/) {
-  Expected<std::span<const float>> positions = RunOnDevice(batch, which);
+                                                    std::vector<float>& scratch) {
+  Expected<std::span<const float>> positions = RunOnDevice(batch, which, scratch);
   if (!positions.ok()) return positions.status().WithContext(DeviceContext());
   return positions;
 }
 
-Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which) {
+Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+                                                            std::vector<float>& scratch) {
   const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
   if (output_floats == 0) return std::span<const float>();
-  const BindingBytes bytes = BytesFor(batch, output_floats);
+  const SliceLayout slices = SliceLayoutFor(batch, shape_);
+  const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const std::uint64_t errors_before = context_->validation_log()->error_count();
-  DB_RETURN_IF_ERROR(Upload(batch, bytes));
-  DB_RETURN_IF_ERROR(Record(batch, which));
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes));
+  DB_RETURN_IF_ERROR(Record(batch, slices, which));
   DB_RETURN_IF_ERROR(SubmitAndWait());
   DB_RETURN_IF_ERROR(CheckValidation(errors_before, "Run"));
-  return std::span<const float>(static_cast<const float*>(buffers_[kPositions].mapped()), output_floats);
+  const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
+  if (slices.compact(batch)) return std::span<const float>(device_positions, output_floats);
+  // Every slice's samples, without the lead and the padding.
+  scratch.resize(output_floats);
+  for (std::size_t slice = 0; slice < 3 * which.size(); ++slice) {
+    std::memcpy(scratch.data() + slice * batch.count, device_positions + slice * slices.length + slices.lead,
+                batch.count * sizeof(float));
+  }
+  return std::span<const float>(scratch);
 }
 
 // What the shaders would otherwise read or write out of bounds, and what
@@ -251,12 +285,12 @@ Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t
                                const BindingBytes& bytes) const {
   const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
   if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
-      batch.pixels.size() < batch.count) {
+      batch.pixels.size() < batch.count || batch.depths.size() % batch.count != 0) {
     return InvalidArgument(
-        fmt::format("batch of {} samples has {} frame parameters, {} depth parameters and {} "
-                    "pixels; it needs {}, {} and {}",
-                    batch.count, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(), frames,
-                    frames * kHardwareConventionCount, batch.count));
+        fmt::format("batch of {} samples has {} frame parameters, {} depth parameters, {} "
+                    "pixels and {} stored depths; it needs {}, {}, {} and a multiple of {}",
+                    batch.count, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(),
+                    batch.depths.size(), frames, frames * kHardwareConventionCount, batch.count, batch.count));
   }
   for (std::uint32_t index : which) {
     if (index >= cells_.size()) {
@@ -298,14 +332,27 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
   return Status::Ok();
 }
 
-Status VulkanBackend::Upload(const Batch& batch, const BindingBytes& bytes) {
-  const std::array<const void*, kPositions> inputs = {batch.frame_params.data(), batch.depth_params.data(),
-                                                      batch.pixels.data(), batch.depths.data()};
+Status VulkanBackend::Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes) {
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
   }
+  std::memcpy(buffers_[kFrames].mapped(), batch.frame_params.data(), bytes[kFrames]);
+  std::memcpy(buffers_[kDepthParams].mapped(), batch.depth_params.data(), bytes[kDepthParams]);
+  // The per-sample inputs, slice by slice; the lead and the padding are
+  // zeros (the shader reconstructs them too, into positions nobody reads).
+  static_assert(sizeof(batch.pixels[0]) == 4 && sizeof(batch.depths[0]) == 4);
+  const auto put_slice = [&](Binding binding, std::size_t slice, const void* samples) {
+    auto* to = static_cast<std::byte*>(buffers_[binding].mapped()) + slice * slices.length * 4;
+    const std::size_t end = std::size_t{slices.lead} + batch.count;
+    std::memset(to, 0, std::size_t{slices.lead} * 4);
+    std::memcpy(to + std::size_t{slices.lead} * 4, samples, std::size_t{batch.count} * 4);
+    std::memset(to + end * 4, 0, (slices.length - end) * 4);
+  };
+  put_slice(kPixels, 0, batch.pixels.data());
+  for (std::size_t slot = 0; slot < DepthSlotsOf(batch); ++slot) {
+    put_slice(kStoredDepths, slot, batch.depths.data() + slot * batch.count);
+  }
   for (std::uint32_t binding = 0; binding < kPositions; ++binding) {
-    std::memcpy(buffers_[binding].mapped(), inputs[binding], bytes[binding]);
     DB_RETURN_IF_ERROR(buffers_[binding].FlushHostWrites());
   }
   BindBuffers(bytes);
@@ -329,7 +376,7 @@ void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
   vkUpdateDescriptorSets(vk_device(), kBindingCount, writes.data(), 0, nullptr);
 }
 
-Status VulkanBackend::Record(const Batch& batch, std::span<const std::uint32_t> which) {
+Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, std::span<const std::uint32_t> which) {
   VkCommandBufferBeginInfo begin_info{};
   begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -346,7 +393,7 @@ Status VulkanBackend::Record(const Batch& batch, std::span<const std::uint32_t> 
       vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
       bound = pipeline;
     }
-    const f32::PassConstants constants = PassConstantsFor(batch, plan, k);
+    const f32::PassConstants constants = PassConstantsFor(batch, slices, plan, k);
     vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(constants),
                        &constants);
     vkCmdDispatch(command_buffer_, groups, 1, 1);
