@@ -34,7 +34,8 @@ constexpr std::uint32_t kMaxRun = kSamplesPerFrame;  // a frame's samples at mos
 // Per-cell working set of one frame run, small enough to stay in L1.
 struct RunScratch {
   std::array<double, kMaxRun> total, arith, absolute;
-  std::array<std::int32_t, kMaxRun> total_bin, arith_bin, absolute_bin;
+  // (64-bit, as the four-lane arithmetic makes them: narrowing costs shuffles.)
+  std::array<std::int64_t, kMaxRun> total_bin, arith_bin, absolute_bin;
   std::array<std::uint8_t, kMaxRun> kind;
 };
 
@@ -54,11 +55,8 @@ struct RunInputs {
 // Pass 1: errors, bins and kinds of a run of samples, four at a time.
 void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n, RunScratch& s) {
   using Float4 = float __attribute__((vector_size(16)));
-  using Int32x4 = std::int32_t __attribute__((vector_size(16)));
   const auto store = [](auto* to, auto lanes) { std::memcpy(to, &lanes, sizeof(lanes)); };
-  const auto bins = [](Double4 square, int metric) {
-    return __builtin_convertvector(DenseBinsOfSquares<Int4>(square, kLowestOctave[metric]), Int32x4);
-  };
+  const auto bins = [](Double4 square, int metric) { return DenseBinsOfSquares<Int4>(square, kLowestOctave[metric]); };
   std::uint32_t i = 0;
   for (; i + 4 <= n; i += 4) {
     const auto wide = [&](const float* p) {
@@ -118,10 +116,10 @@ void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint
       case kJudged:
         // Distance bands keep the total error only: what camera distance
         // does to a reconstruction shows there whole.
-        joint.Record(Metric::kTotal, s.total_bin[i], s.total[i], index);
-        joint.Record(Metric::kArith, s.arith_bin[i], s.arith[i], index);
-        joint.Record(Metric::kAbsolute, s.absolute_bin[i], s.absolute[i], index);
-        distance.Record(Metric::kTotal, s.total_bin[i], s.total[i], index);
+        joint.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+        joint.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
+        joint.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), s.absolute[i], index);
+        distance.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
         break;
       case kDegenerate:
         ++joint.degenerate;
@@ -139,6 +137,19 @@ void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint
   }
 }
 
+// Calls run(frame, begin, end) for each frame's samples [begin, end) of
+// the batch, in order: the camera and the distance band are the frame's.
+template <class Run>
+void ForEachFrameRun(const Batch& batch, Run run) {
+  for (std::uint32_t begin = 0; begin < batch.count;) {
+    const std::uint32_t frame = batch.FrameOf(begin);
+    const std::uint32_t end =
+        std::min<std::uint32_t>(batch.count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
+    run(frame, begin, end);
+    begin = end;
+  }
+}
+
 }  // namespace
 
 SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm::dvec3& camera,
@@ -153,11 +164,9 @@ void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const Jud
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * count;
   const ReferenceArrays& ref = batch.reference;
   RunScratch scratch;
-  // Frame by frame: the camera and the distance band are the frame's, and a
-  // frame's reference stays in cache while every cell reads it.
-  for (std::uint32_t begin = 0; begin < count;) {
-    const std::uint32_t frame = batch.FrameOf(begin);
-    const std::uint32_t end = std::min<std::uint32_t>(count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
+  // Frame by frame: a frame's reference stays in cache while every cell
+  // reads it.
+  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) {
     const std::uint32_t n = end - begin;
     const glm::dvec3 camera = batch.frames[frame].camera_position;
     const std::size_t at = offset + begin;
@@ -171,8 +180,7 @@ void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const Jud
       Record(in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
              cell.accumulator->Distance(batch.distance_bands[frame]));
     }
-    begin = end;
-  }
+  });
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 
@@ -181,12 +189,27 @@ void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator
   const ReferenceStatus* status = batch.reference.status.data() + offset;
   const std::uint8_t* joint_band = batch.reference.joint_band.data() + offset;
   const double* storage = batch.reference.storage_square.data() + offset;
-  for (std::uint32_t i = 0; i < batch.count; ++i) {
-    if (status[i] != ReferenceStatus::kJudged) continue;
-    const std::uint64_t index = batch.first_index + i;
-    accumulator.Joint(joint_band[i]).Record(Metric::kStorage, storage[i], index);
-    accumulator.Distance(batch.distance_bands[batch.FrameOf(i)]).Record(Metric::kStorage, storage[i], index);
-  }
+  constexpr int kStorage = static_cast<int>(Metric::kStorage);
+  std::array<std::int64_t, kMaxRun> bins;
+  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) {
+    // The bins four at a time (as the judge's Measure does), then the counts.
+    std::uint32_t i = begin;
+    for (; i + 4 <= end; i += 4) {
+      Double4 squares;
+      std::memcpy(&squares, storage + i, sizeof(squares));
+      const Int4 lanes = DenseBinsOfSquares<Int4>(squares, kLowestOctave[kStorage]);
+      std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
+    }
+    for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
+    CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
+    for (i = begin; i < end; ++i) {
+      if (status[i] != ReferenceStatus::kJudged) continue;
+      const std::uint64_t index = batch.first_index + i;
+      const int bin = static_cast<int>(bins[i - begin]);
+      accumulator.Joint(joint_band[i]).Record(Metric::kStorage, bin, storage[i], index);
+      distance.Record(Metric::kStorage, bin, storage[i], index);
+    }
+  });
   accumulator.Count(batch.count);
 }
 

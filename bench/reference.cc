@@ -2,6 +2,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 
 #include "bench/bands.h"
 #include "bench/formulas.h"
@@ -67,48 +68,110 @@ glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
   return ray;
 }
 
+namespace {
+
+// The per-lane arithmetic of References, written once for one sample
+// (D = double, I = int64_t) and for four SIMD lanes (Double4, Int4); each
+// lane computes exactly what the scalar form does. Bands are left to the
+// caller: they are integer work, and stored-value picks need a decade of
+// their own.
+template <class D, class I>
+struct ReferenceLanes {
+  D true_depth, denoted_depth, inverse_distance_sq, storage_square;
+  I status;  // ReferenceStatus
+};
+template <class D, class I>
+ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo, D near, D depth_limit,
+                                 D interest_min, D interest_max, D ray_length_sq, D eye_inverse_distance_sq,
+                                 bool infinite_far) {
+  using DD = BasicDoubleDouble<D>;
+  const auto eye = eye_pick != 0.0;
+  // Stored-value picks have no scene point of their own: the truth is what
+  // the stored value denotes, and their storage error is zero.
+  const DD denoted = DD::FromParts(denoted_hi, denoted_lo);
+  const D zero = D{} * 0.0;
+  const DD truth = DD::FromParts(eye ? eye_depth : denoted_hi, eye ? zero : denoted_lo);
+  const D t = truth.hi();
+  ReferenceLanes<D, I> out;
+  out.true_depth = t;
+  out.denoted_depth = (denoted_hi - denoted_hi) == 0.0 ? denoted_hi : zero + DBL_MAX;  // finite, or DBL_MAX
+  // A point float32 world coordinates cannot hold (an overflowing
+  // reconstruction is then the right answer) is no more judged than one at
+  // infinity.
+  const auto holdable = (t > 0.0) & (t * t * ray_length_sq < kLargestFloatSquared);
+  const D limit = infinite_far ? zero + INFINITY : depth_limit;
+  const D far = interest_max < limit ? interest_max : limit;     // std::min(limit, interest_max)
+  const D nearest = near < interest_min ? interest_min : near;  // std::max(near, interest_min)
+  const auto outside = (t < nearest * (1.0 - kPlaneSlack)) | (t > far * (1.0 + kPlaneSlack));
+  const I judged = I{} + static_cast<std::int64_t>(ReferenceStatus::kJudged);
+  const I degenerate = I{} + static_cast<std::int64_t>(ReferenceStatus::kDegenerate);
+  const I outside_status = I{} + static_cast<std::int64_t>(ReferenceStatus::kOutside);
+  out.status = holdable ? (outside ? outside_status : judged) : degenerate;
+  const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (t * t * ray_length_sq);
+  out.inverse_distance_sq = out.status == judged ? inverse : zero;
+  // The difference of the two depths is taken in double-double (they may
+  // be close); its ratio to the distance needs no more than double. Both
+  // points lie on the same ray, so the relative error of the position is
+  // the relative error of the depth.
+  const D difference = (denoted - truth).hi();
+  out.storage_square = difference * difference * out.inverse_distance_sq * ray_length_sq;
+  return out;
+}
+
+}  // namespace
+
 void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
                 const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first) {
   const ConventionInfo& convention = Info(encoding.convention);
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = first + k, o = out_first + k;
-    // Stored-value picks have no scene point of their own: the truth is
-    // what the stored value denotes, and their storage error is zero.
-    const bool eye = samples.pick[i] == DepthPick::kEyeDepth;
-    const DoubleDouble denoted = DoubleDouble::FromParts(denoted_hi[k], denoted_lo[k]);
-    const DoubleDouble truth = eye ? DoubleDouble(samples.eye_depth[i]) : denoted;
-    const double t = truth.hi();
-    const double near = samples.near[i];
-    // (Stored-value picks are rare: their band and distance are worked out
-    // here, behind a branch that predicts well.)
-    int depth_band = samples.depth_band[i];
-    if (!eye) depth_band = DepthBand(t / near);
-    out.true_depth[o] = t;
-    out.denoted_depth[o] = std::isfinite(denoted.hi()) ? denoted.hi() : DBL_MAX;
-    out.joint_band[o] = static_cast<std::uint8_t>(
-        JointBand(infinite_far ? kInfiniteRatioBand : samples.ratio_band[i], depth_band));
-    const double length_sq = samples.ray_length_sq[i];
-    // A point float32 world coordinates cannot hold (an overflowing
-    // reconstruction is then the right answer) is no more judged than one
-    // at infinity.
-    const bool degenerate = !(t > 0.0) || !(t * t * length_sq < kLargestFloatSquared);
-    const double far = std::min(infinite_far ? INFINITY : samples.depth_limit[i], samples.interest_max[i]);
-    const double nearest = std::max(near, samples.interest_min[i]);
-    const bool outside = t < nearest * (1.0 - kPlaneSlack) || t > far * (1.0 + kPlaneSlack);
-    const ReferenceStatus status =
-        degenerate ? ReferenceStatus::kDegenerate : outside ? ReferenceStatus::kOutside : ReferenceStatus::kJudged;
-    out.status[o] = status;
-    double inverse_distance_sq = samples.inverse_distance_sq[i];
-    if (!eye) inverse_distance_sq = 1.0 / (t * t * length_sq);
-    if (status != ReferenceStatus::kJudged) inverse_distance_sq = 0.0;
-    out.inverse_distance_sq[o] = inverse_distance_sq;
-    // The difference of the two depths is taken in double-double (they may
-    // be close); its ratio to the distance needs no more than double. Both
-    // points lie on the same ray, so the relative error of the position is
-    // the relative error of the depth.
-    const double difference = (denoted - truth).hi();
-    out.storage_square[o] = difference * difference * inverse_distance_sq * length_sq;
+  // Plain pointers, read once: the stores below cannot then be taken for
+  // changes to the vectors' own pointers.
+  const DepthPick* pick = samples.pick.data() + first;
+  const double *eye_depth = samples.eye_depth.data() + first, *near = samples.near.data() + first,
+               *depth_limit = samples.depth_limit.data() + first,
+               *interest_min = samples.interest_min.data() + first,
+               *interest_max = samples.interest_max.data() + first,
+               *ray_length_sq = samples.ray_length_sq.data() + first,
+               *eye_inverse_distance_sq = samples.inverse_distance_sq.data() + first;
+  double *true_depth = out.true_depth.data() + out_first, *denoted_depth = out.denoted_depth.data() + out_first,
+         *inverse_distance_sq = out.inverse_distance_sq.data() + out_first,
+         *storage_square = out.storage_square.data() + out_first;
+  ReferenceStatus* status = out.status.data() + out_first;
+  const auto store = [&](std::size_t k, const auto& lanes, auto put) {
+    put(true_depth + k, lanes.true_depth);
+    put(denoted_depth + k, lanes.denoted_depth);
+    put(inverse_distance_sq + k, lanes.inverse_distance_sq);
+    put(storage_square + k, lanes.storage_square);
+  };
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const auto load = [&](const double* p) {
+      Double4 d;
+      std::memcpy(&d, p + k, sizeof(d));
+      return d;
+    };
+    Double4 eye_pick;
+    for (int lane = 0; lane < 4; ++lane) eye_pick[lane] = pick[k + lane] == DepthPick::kEyeDepth;
+    const ReferenceLanes<Double4, Int4> lanes = ReferenceOf<Double4, Int4>(
+        eye_pick, load(eye_depth), load(denoted_hi), load(denoted_lo), load(near), load(depth_limit),
+        load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq), infinite_far);
+    store(k, lanes, [](double* to, Double4 v) { std::memcpy(to, &v, sizeof(v)); });
+    for (int lane = 0; lane < 4; ++lane) status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
+  }
+  for (; k < n; ++k) {  // the tail
+    const ReferenceLanes<double, std::int64_t> one = ReferenceOf<double, std::int64_t>(
+        pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], denoted_lo[k], near[k], depth_limit[k],
+        interest_min[k], interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
+    store(k, one, [](double* to, double v) { *to = v; });
+    status[k] = static_cast<ReferenceStatus>(one.status);
+  }
+  // Bands: stored-value picks (rare) take the decade of their denoted depth.
+  const std::uint8_t *depth_band = samples.depth_band.data() + first, *ratio_band = samples.ratio_band.data() + first;
+  std::uint8_t* joint_band = out.joint_band.data() + out_first;
+  for (k = 0; k < n; ++k) {
+    int depth = depth_band[k];
+    if (pick[k] != DepthPick::kEyeDepth) depth = DepthBand(true_depth[k] / near[k]);
+    joint_band[k] = static_cast<std::uint8_t>(JointBand(infinite_far ? kInfiniteRatioBand : ratio_band[k], depth));
   }
 }
 
