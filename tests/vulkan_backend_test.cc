@@ -205,7 +205,7 @@ TEST_F(VulkanBackendTest, EveryPassShapeGivesTheSamePositions) {
   // quad, so the quad shapes (4, 8, 64 per invocation) run it with a lead
   // and padding and gather the positions; the second is quad-aligned and
   // comes back as the device wrote it.
-  for (const auto [first, count] : {std::pair<std::uint64_t, std::uint32_t>{4101, 1000}, {4104, 1000}}) {
+  for (const auto& [first, count] : {std::pair<std::uint64_t, std::uint32_t>{4101, 1000}, {4104, 1000}}) {
     const Batch batch = BuildBatch(layout, first, count);
     std::vector<std::vector<float>> outputs;
     for (std::uint32_t per_invocation : {1u, 4u, 8u, 64u}) {
