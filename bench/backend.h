@@ -63,8 +63,10 @@ struct BackendOptions {
   std::string shader_dir;       // Vulkan: where the shaders/ sources are ("" = built-in default)
   bool validation = false;      // Vulkan: enable VK_LAYER_KHRONOS_validation, fail on its messages
   // Vulkan: samples each compute invocation reconstructs (a divisor of the
-  // samples per frame); 0 picks by device type: 8 on a CPU device, 1 on a GPU.
+  // samples per frame), and frames each workgroup takes in turn; 0 picks by
+  // device type: 8 and 8 on a CPU device, 1 and 1 on a GPU.
   std::uint32_t samples_per_invocation = 0;
+  std::uint32_t frames_per_workgroup = 0;
 };
 
 // "cpu" or "vulkan".

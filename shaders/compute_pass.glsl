@@ -3,11 +3,12 @@
 // defines RECONSTRUCT as its variant's <variant>_world_position function
 // from shared/variants/.
 //
-// One frame per workgroup: the frame's constants are the same for every
+// Whole frames per workgroup: a frame's constants are the same for every
 // invocation, as a real pass's are across a draw. Each invocation handles
 // SAMPLES_PER_INVOCATION samples of its frame, and the host sets the
 // workgroup size (specialization constant 0) so that the two multiply to
-// the samples per frame. A GPU gets one sample per invocation.
+// the samples per frame; a workgroup takes FRAMES_PER_WORKGROUP frames in
+// turn. A GPU gets one sample per invocation and one frame per workgroup.
 //
 // A software implementation runs the invocations in SIMD groups, and its
 // cost is in memory access, not arithmetic: Mesa 22.3's lavapipe loads and
@@ -16,6 +17,8 @@
 // components within one lane's turn. So there:
 //   - each invocation loops over several samples and reads its frame's
 //     constants once for them;
+//   - each workgroup takes several frames (lavapipe calls the C allocator
+//     at the start of every workgroup);
 //   - where the samples per invocation are a multiple of four, an
 //     invocation takes consecutive samples, and the per-sample inputs come
 //     in and the positions go out as four-component vectors: one lane loop
@@ -25,6 +28,7 @@
 // measured slower than this: its texel fetch runs the whole sampler.)
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SAMPLES_PER_INVOCATION = 1u;
+layout(constant_id = 2) const uint FRAMES_PER_WORKGROUP = 1u;
 
 layout(std430, set = 0, binding = 0) readonly buffer Frames { FrameParams frames[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_params[]; };
@@ -49,8 +53,8 @@ int slice_element(uint frame_index, uint in_frame) {
   return int(frame_index * pass.samples_per_frame + in_frame) - int(pass.first_in_frame);
 }
 
-void main() {
-  uint frame_index = gl_WorkGroupID.x;
+// One frame of the batch, reconstructed by this workgroup.
+void reconstruct_frame(uint frame_index) {
   FrameParams frame = frames[frame_index];
   DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
   uint n = pass.slice_length;
@@ -86,6 +90,15 @@ void main() {
       positions[o] = p.x;
       positions[o + n] = p.y;
       positions[o + 2u * n] = p.z;
+    }
+  }
+}
+
+void main() {
+  for (uint f = 0u; f < FRAMES_PER_WORKGROUP; ++f) {
+    uint frame_index = gl_WorkGroupID.x * FRAMES_PER_WORKGROUP + f;
+    if (frame_index < pass.frame_count) {
+      reconstruct_frame(frame_index);
     }
   }
 }

@@ -63,5 +63,5 @@ struct PassConstants {
   uint depth_offset;        // first element of this cell's stored-depth slice in the depth buffer
   uint output_offset;       // first float of this cell's positions: slices of x, then y, then z
   uint first_in_frame;      // position within its frame of a slice's first element
-  uint reserved0;
+  uint frame_count;         // frames the batch's samples fall in
 };

@@ -100,7 +100,7 @@ TEST_F(LayoutTest, PassConstantsMatchesStd430) {
   EXPECT_MEMBER_AT(pass, PassConstants, depth_offset);
   EXPECT_MEMBER_AT(pass, PassConstants, output_offset);
   EXPECT_MEMBER_AT(pass, PassConstants, first_in_frame);
-  EXPECT_MEMBER_AT(pass, PassConstants, reserved0);
+  EXPECT_MEMBER_AT(pass, PassConstants, frame_count);
   EXPECT_EQ(MembersOf("pass"), 8) << "a PassConstants member is not listed above";
   EXPECT_EQ(Offset("pass_end"), static_cast<int>(sizeof(f32::PassConstants)));
 }

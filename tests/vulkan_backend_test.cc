@@ -11,6 +11,7 @@
 #include <numeric>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -201,30 +202,40 @@ TEST_F(VulkanBackendTest, AllCellsMatchCpuBackend) {
 TEST_F(VulkanBackendTest, EveryPassShapeGivesTheSamePositions) {
   const RunLayout layout = MakeRunLayout(AllCells());
   const std::vector<std::uint32_t> which = AllIndices(layout);
-  // Both start and end inside a frame. The first starts one sample past a
-  // quad, so the quad shapes (4, 8, 64 per invocation) run it with a lead
+  // Both batches start and end inside a frame. The first (18 frames)
+  // leaves the last workgroup part empty at 8 frames per workgroup, the
+  // second (16 frames) at 3. The first starts one sample past a quad, so
+  // the quad shapes (4, 8 or 64 samples per invocation) run it with a lead
   // and padding and gather the positions; the second is quad-aligned and
   // comes back as the device wrote it.
-  for (const auto& [first, count] : {std::pair<std::uint64_t, std::uint32_t>{4101, 1000}, {4104, 1000}}) {
-    const Batch batch = BuildBatch(layout, first, count);
-    std::vector<std::vector<float>> outputs;
-    for (std::uint32_t per_invocation : {1u, 4u, 8u, 64u}) {
-      BackendOptions options;
-      options.samples_per_invocation = per_invocation;
-      auto backend = MakeVulkanBackend(context_, options);
-      ASSERT_TRUE(backend.ok()) << backend.status().message();
-      Status status = (*backend)->Prepare(layout.cells);
-      ASSERT_TRUE(status.ok()) << status.message();
+  const std::vector<Batch> batches = {BuildBatch(layout, 4101, 1100), BuildBatch(layout, 4104, 1000)};
+  // (samples per invocation, frames per workgroup): a GPU's shape first,
+  // lavapipe's default among the others.
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> shapes = {{1, 1}, {4, 8}, {8, 8}, {64, 8}, {8, 1},
+                                                                         {8, 3}};
+  std::vector<std::vector<std::vector<float>>> outputs(batches.size());  // [batch][shape]
+  for (const auto& [per_invocation, frames] : shapes) {
+    BackendOptions options;
+    options.samples_per_invocation = per_invocation;
+    options.frames_per_workgroup = frames;
+    auto backend = MakeVulkanBackend(context_, options);
+    ASSERT_TRUE(backend.ok()) << backend.status().message();
+    Status status = (*backend)->Prepare(layout.cells);
+    ASSERT_TRUE(status.ok()) << status.message();
+    for (std::size_t b = 0; b < batches.size(); ++b) {
       std::vector<float> scratch;
-      auto out = (*backend)->Run(batch, which, scratch);
+      auto out = (*backend)->Run(batches[b], which, scratch);
       ASSERT_TRUE(out.ok()) << out.status().message();
-      outputs.emplace_back(out->begin(), out->end());
+      outputs[b].emplace_back(out->begin(), out->end());
     }
-    for (std::size_t k = 1; k < outputs.size(); ++k) {
-      ASSERT_EQ(outputs[k].size(), outputs[0].size());
+  }
+  for (std::size_t b = 0; b < batches.size(); ++b) {
+    for (std::size_t k = 1; k < shapes.size(); ++k) {
+      ASSERT_EQ(outputs[b][k].size(), outputs[b][0].size());
       // Bitwise, so that NaN outputs compare too.
-      EXPECT_EQ(std::memcmp(outputs[k].data(), outputs[0].data(), outputs[0].size() * sizeof(float)), 0)
-          << "batch at " << first << ", shape " << k;
+      EXPECT_EQ(std::memcmp(outputs[b][k].data(), outputs[b][0].data(), outputs[b][0].size() * sizeof(float)), 0)
+          << "batch " << b << ", " << shapes[k].first << " samples per invocation, " << shapes[k].second
+          << " frames per workgroup";
     }
   }
   BackendOptions bad;

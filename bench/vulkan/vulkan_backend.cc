@@ -18,31 +18,45 @@
 namespace depthbench {
 namespace {
 
-// shaders/compute_pass.glsl runs one frame per workgroup: workgroup size
-// (specialization constant 0) times samples per invocation (constant 1) is
-// the samples per frame. On a CPU device (lavapipe) an invocation loops over
-// eight samples and reads its frame's constants once for them; a GPU runs
-// one sample per invocation.
+// shaders/compute_pass.glsl runs whole frames per workgroup: workgroup
+// size (specialization constant 0) times samples per invocation (constant 1)
+// is the samples per frame, and a workgroup takes `frames_per_workgroup`
+// frames (constant 2) in turn. On a CPU device (lavapipe) an invocation
+// loops over eight samples and reads its frame's constants once for them,
+// and a workgroup takes eight frames: lavapipe calls the C allocator at
+// the start of every workgroup (posix_memalign and malloc_consolidate,
+// called from its JIT code, took about 5% of a run at one frame per
+// workgroup). A GPU runs one sample per invocation and one frame per
+// workgroup.
 constexpr std::uint32_t kWorkgroupSizeConstant = 0;
 constexpr std::uint32_t kSamplesPerInvocationConstant = 1;
+constexpr std::uint32_t kFramesPerWorkgroupConstant = 2;
 struct PassShape {
   std::uint32_t workgroup_size;
   std::uint32_t samples_per_invocation;
+  std::uint32_t frames_per_workgroup;
 };
 constexpr std::uint32_t kCpuSamplesPerInvocation = 8;  // one SIMD group of lavapipe's 256-bit lanes per frame
+constexpr std::uint32_t kCpuFramesPerWorkgroup = 8;
 static_assert(kSamplesPerFrame % kCpuSamplesPerInvocation == 0);
-// `requested` is BackendOptions::samples_per_invocation (0: by device type).
-Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, std::uint32_t requested) {
+// `options` may request either number (0: by device type).
+Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, const BackendOptions& options) {
+  const bool cpu = type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const std::uint32_t per_invocation =
-      requested != 0 ? requested : type == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuSamplesPerInvocation : 1;
+      options.samples_per_invocation != 0 ? options.samples_per_invocation : cpu ? kCpuSamplesPerInvocation : 1;
+  const std::uint32_t frames =
+      options.frames_per_workgroup != 0 ? options.frames_per_workgroup : cpu ? kCpuFramesPerWorkgroup : 1;
   if (kSamplesPerFrame % per_invocation != 0) {
     return InvalidArgument(fmt::format("{} samples per invocation do not divide the {} samples of a frame",
                                        per_invocation, kSamplesPerFrame));
   }
-  return PassShape{kSamplesPerFrame / per_invocation, per_invocation};
+  return PassShape{kSamplesPerFrame / per_invocation, per_invocation, frames};
 }
 
-std::uint32_t WorkgroupsFor(const Batch& batch) { return static_cast<std::uint32_t>(batch.frame_count()); }
+std::uint32_t WorkgroupsFor(const Batch& batch, const PassShape& shape) {
+  return static_cast<std::uint32_t>((batch.frame_count() + shape.frames_per_workgroup - 1) /
+                                    shape.frames_per_workgroup);
+}
 
 // Where a batch's samples lie in the per-sample slices (one per depth
 // slot for the stored depths, one per cell and component for the
@@ -92,7 +106,7 @@ f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slice
           .depth_offset = plan.depth_slot * slices.length,
           .output_offset = static_cast<std::uint32_t>(k * slices.length * 3),
           .first_in_frame = batch.first_offset - slices.lead,
-          .reserved0 = 0};
+          .frame_count = static_cast<std::uint32_t>(batch.frame_count())};
 }
 
 std::size_t VariantIndex(Variant variant) { return static_cast<std::size_t>(variant); }
@@ -114,7 +128,7 @@ class VulkanBackend final : public Backend {
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
-                std::uint32_t samples_per_invocation);
+                const BackendOptions& options);
 
   VkDevice vk_device() const { return context_->device(); }
   std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
@@ -139,7 +153,7 @@ class VulkanBackend final : public Backend {
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
-  std::uint32_t samples_per_invocation_;  // 0: by device type (PassShapeFor)
+  BackendOptions options_;                // the requested pass shape (PassShapeFor)
   PassShape shape_{};                     // of the prepared pipelines
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
@@ -157,10 +171,8 @@ class VulkanBackend final : public Backend {
 };
 
 VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
-                             std::uint32_t samples_per_invocation)
-    : context_(std::move(context)),
-      shader_dir_(std::move(shader_dir)),
-      samples_per_invocation_(samples_per_invocation) {
+                             const BackendOptions& options)
+    : context_(std::move(context)), shader_dir_(std::move(shader_dir)), options_(options) {
   const VulkanDeviceProperties& properties = context_->properties();
   device_.name = properties.name;
   device_.driver = properties.DriverString();
@@ -176,7 +188,7 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
                                          ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
                                          : std::filesystem::path(options.shader_dir);
   std::unique_ptr<VulkanBackend> backend(
-      new VulkanBackend(std::move(context), std::move(shader_dir), options.samples_per_invocation));
+      new VulkanBackend(std::move(context), std::move(shader_dir), options));
   const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
   Status status = backend->CreateDescriptorObjects();
   if (status.ok()) status = backend->CreateCommandObjects();
@@ -221,7 +233,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
     return NotFound(fmt::format("shader directory '{}' does not exist", shader_dir_.string()));
   }
   // Built aside so that a failure leaves the previous preparation intact.
-  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, samples_per_invocation_));
+  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
   std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
   for (const CellPlan& plan : cells) {
     DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
@@ -237,9 +249,11 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
 Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape) const {
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
-  const std::array<VkSpecializationMapEntry, 2> entries = {
+  const std::array<VkSpecializationMapEntry, 3> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
+                               sizeof(std::uint32_t)},
+      VkSpecializationMapEntry{kFramesPerWorkgroupConstant, offsetof(PassShape, frames_per_workgroup),
                                sizeof(std::uint32_t)}};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
                                             sizeof(shape), &shape};
@@ -303,7 +317,7 @@ Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t
     }
   }
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
-  const std::uint32_t groups = WorkgroupsFor(batch);
+  const std::uint32_t groups = WorkgroupsFor(batch, shape_);
   if (groups > limits.maxComputeWorkGroupCount[0]) {
     return InvalidArgument(fmt::format("a batch of {} samples needs {} workgroups; the device dispatches at most {}",
                                        batch.count, groups, limits.maxComputeWorkGroupCount[0]));
@@ -383,7 +397,7 @@ Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, std:
   DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
   vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
                           &descriptor_set_, 0, nullptr);
-  const std::uint32_t groups = WorkgroupsFor(batch);
+  const std::uint32_t groups = WorkgroupsFor(batch, shape_);
   VkPipeline bound = VK_NULL_HANDLE;
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
   for (std::size_t k = 0; k < which.size(); ++k) {
