@@ -76,6 +76,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (backends.empty()) return InvalidArgument("no backend to run");
   if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
+  if (!ProcessorRuns(options.judge_isa)) return Unavailable("this processor does not run the requested judge");
   const std::vector<Cell> all = AllCells();
   const std::vector<Cell> cells =
       CellsForDomain(options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells),
@@ -144,7 +145,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       auto judge = [&](std::size_t slot, auto positions_of) {
         std::vector<JudgedCell> judged;
         for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
-        JudgeSlot(batch, static_cast<std::uint32_t>(slot), judged);
+        JudgeSlot(batch, static_cast<std::uint32_t>(slot), judged, options.judge_isa);
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (backend.concurrent()) {

@@ -13,6 +13,7 @@
 #include "bench/backend.h"
 #include "bench/cells.h"
 #include "bench/domain.h"
+#include "bench/judge.h"
 #include "bench/results.h"
 
 namespace depthbench {
@@ -35,6 +36,7 @@ struct SweepOptions {
   std::vector<Cell> cells;            // empty: every cell the domain allows
   std::uint32_t batch_size = 16384;
   unsigned threads = 0;               // 0: one per hardware thread
+  JudgeIsa judge_isa = JudgeIsa::kWidest;  // the same results whatever it is (tests compare them)
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

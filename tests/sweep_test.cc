@@ -11,8 +11,9 @@ namespace depthbench {
 namespace {
 
 Results RunCpu(std::uint64_t seed, std::uint64_t samples, Shard shard, std::uint32_t batch = 4096,
-               unsigned threads = 2) {
+               unsigned threads = 2, JudgeIsa judge_isa = JudgeIsa::kWidest) {
   SweepOptions options;
+  options.judge_isa = judge_isa;
   options.seed = seed;
   options.samples = samples;
   options.shard = shard;
@@ -42,6 +43,15 @@ TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
   EXPECT_EQ(a.run.reconstructions, 20000u * AllCells().size());
   Results other = RunCpu(43, 20000, {});
   EXPECT_FALSE(a.cells[0].stats == other.cells[0].stats);  // the seed matters
+}
+
+TEST(SweepTest, EveryJudgeInstructionSetGivesTheSameResults) {
+  // The judge is compiled for the build's baseline and for AVX-512 (picked
+  // at run time); both must count every error in the same bin, with the
+  // same maxima. 777-sample batches end inside frames, so the four-lane
+  // loops' scalar tails run too.
+  if (!ProcessorRuns(JudgeIsa::kAvx512)) GTEST_SKIP() << "this processor has no AVX-512";
+  ExpectSameStats(RunCpu(5, 30000, {}, 777, 2, JudgeIsa::kBaseline), RunCpu(5, 30000, {}, 777, 2, JudgeIsa::kAvx512));
 }
 
 TEST(SweepTest, ShardsAddUpToTheWhole) {
