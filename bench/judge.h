@@ -32,7 +32,8 @@ void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const Jud
                JudgeIsa isa = JudgeIsa::kWidest);
 
 // Records the storage error of one depth slot's samples.
-void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator);
+void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator,
+                   JudgeIsa isa = JudgeIsa::kWidest);
 
 // The squared errors of one output (for reproducers and tests): relative
 // total, relative arithmetic, absolute total.

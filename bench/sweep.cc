@@ -141,11 +141,15 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       Backend& backend = *backends[b];
       CellAccumulator* acc = accumulators.data() + b * cell_count;
       // The cells are judged a depth slot at a time: those that read the
-      // same encoding share its reference.
+      // same encoding share its reference. The slot's storage errors are
+      // recorded once per batch, with the first backend's cells, while its
+      // reference is in cache.
       auto judge = [&](std::size_t slot, auto positions_of) {
         std::vector<JudgedCell> judged;
         for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
-        JudgeSlot(batch, static_cast<std::uint32_t>(slot), judged, options.judge_isa);
+        const auto depth_slot = static_cast<std::uint32_t>(slot);
+        JudgeSlot(batch, depth_slot, judged, options.judge_isa);
+        if (b == 0) RecordStorage(batch, depth_slot, storage_accumulators[slot], options.judge_isa);
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (backend.concurrent()) {
@@ -176,9 +180,6 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         });
       }
     }
-    pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
-      for (std::size_t e = lo; e < hi; ++e) RecordStorage(batch, static_cast<std::uint32_t>(e), storage_accumulators[e]);
-    });
     for (std::size_t k = 0; k < accumulators.size(); ++k) {
       if (accumulators[k].pending() >= kFlushEvery) accumulators[k].FlushInto(stats[k]);
     }
