@@ -22,8 +22,8 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
   return layout;
 }
 
-BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings)
-    : sampler_(sampler), encodings_(std::move(encodings)) {
+BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
+    : sampler_(sampler), encodings_(std::move(encodings)), isa_(isa) {
   for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
     auto shares = [&](std::uint32_t k) {
       const Encoding a = encodings_[pipeline_slots_[k]], b = encodings_[s];
@@ -126,8 +126,8 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.depths[s * count + i] = edge.fetched;
       }
       DecodeEyeDepths(encoding, samples.near.data() + lo, samples.far.data() + lo, batch.codes.data() + at,
-                      batch.depths.data() + at, n, denoted_hi.data(), denoted_lo.data());
-      References(encoding, samples, lo, n, denoted_hi.data(), denoted_lo.data(), batch.reference, at);
+                      batch.depths.data() + at, n, denoted_hi.data(), denoted_lo.data(), isa_);
+      References(encoding, samples, lo, n, denoted_hi.data(), denoted_lo.data(), batch.reference, at, isa_);
     }
   });
 }

@@ -62,7 +62,8 @@ RunLayout MakeRunLayout(std::span<const Cell> cells);
 
 class BatchBuilder {
  public:
-  BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings);
+  // `isa`: what the decode and reference loops are compiled for (bench/isa.h).
+  BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa = Isa::kWidest);
 
   // Fills `batch` with samples [first, first + count).
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const;
@@ -70,6 +71,7 @@ class BatchBuilder {
  private:
   const SampleSource& sampler_;
   std::vector<Encoding> encodings_;
+  Isa isa_;
   // The formats of one convention share the pipeline's float (encode.h):
   // encodings_[s] reads pipeline value pipeline_of_slot_[s], which is
   // computed for encodings_[pipeline_slots_[k]].

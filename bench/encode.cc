@@ -258,7 +258,8 @@ namespace {
 
 // The decode of four texels. `texel` is the unorm code itself or the
 // float's value: both exact.
-DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 far, DoubleDouble4 texel) {
+[[gnu::always_inline]] inline DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 far,
+                                                        DoubleDouble4 texel) {
   using DD = DoubleDouble4;
   const FormatInfo& info = Info(encoding.format);
   // The texel's value v and 1 - v, both exact to double-double precision;
@@ -289,10 +290,9 @@ DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 f
   return DD(NAN);
 }
 
-}  // namespace
-
-void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
-                     const float* fetched, std::size_t n, double* hi, double* lo) {
+[[gnu::always_inline]] inline void DecodeEyeDepthsBody(Encoding encoding, const double* near, const double* far,
+                                                       const std::uint32_t* codes, const float* fetched,
+                                                       std::size_t n, double* hi, double* lo) {
   const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
   // Two groups of four per step: their dependency chains interleave.
   constexpr std::size_t kStep = 8;
@@ -316,6 +316,15 @@ void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, c
       lo[i + k] = z[k / 4].lo()[k % 4];
     }
   }
+}
+
+}  // namespace
+
+void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
+                     const float* fetched, std::size_t n, double* hi, double* lo, Isa isa) {
+  RunWith(isa, [&]() __attribute__((always_inline)) {
+    DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo);
+  });
 }
 
 DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored) {

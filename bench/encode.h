@@ -23,6 +23,7 @@
 
 #include "bench/cells.h"
 #include "bench/double_double.h"
+#include "bench/isa.h"
 #include "bench/sampler.h"
 
 namespace depthbench {
@@ -57,8 +58,9 @@ DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth s
 // The same for n texels, four lanes at a time (far is 0 for an infinite far
 // plane), as the two parts of each double-double. Every lane computes
 // exactly what the scalar form does.
+// Compiled for each instruction set `isa` can name (bench/isa.h).
 void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
-                     const float* fetched, std::size_t n, double* hi, double* lo);
+                     const float* fetched, std::size_t n, double* hi, double* lo, Isa isa = Isa::kWidest);
 
 // Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);

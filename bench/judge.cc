@@ -192,29 +192,6 @@ namespace {
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 
-// Runs `body` (a lambda marked always_inline) compiled for the chosen
-// instruction set: each template below gets its own copy of it. AVX-512
-// gives the same results (the same IEEE operations lane by lane, no
-// contraction) with more registers and mask compares: about 15% less
-// judging time where the processor has it.
-template <class Body>
-void RunBaseline(Body body) {
-  body();
-}
-template <class Body>
-[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw,avx512cd")]] void RunAvx512(Body body) {
-  body();
-}
-template <class Body>
-void RunWith(JudgeIsa isa, Body body) {
-  if (isa == JudgeIsa::kWidest) isa = ProcessorRuns(JudgeIsa::kAvx512) ? JudgeIsa::kAvx512 : JudgeIsa::kBaseline;
-  if (isa == JudgeIsa::kAvx512) {
-    RunAvx512(body);
-  } else {
-    RunBaseline(body);
-  }
-}
-
 [[gnu::always_inline]] inline void RecordStorageBody(const Batch& batch, std::uint32_t depth_slot,
                                                      CellAccumulator& accumulator) {
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * batch.count;
@@ -248,26 +225,11 @@ void RunWith(JudgeIsa isa, Body body) {
 
 }  // namespace
 
-bool ProcessorRuns(JudgeIsa isa) {
-  switch (isa) {
-    case JudgeIsa::kWidest:
-    case JudgeIsa::kBaseline:
-      return true;
-    case JudgeIsa::kAvx512: {
-      static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                              __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
-                              __builtin_cpu_supports("avx512cd");
-      return has;
-    }
-  }
-  return false;
-}
-
-void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, JudgeIsa isa) {
+void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa) {
   RunWith(isa, [&]() __attribute__((always_inline)) { JudgeSlotBody(batch, depth_slot, cells); });
 }
 
-void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, JudgeIsa isa) {
+void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
   RunWith(isa, [&]() __attribute__((always_inline)) { RecordStorageBody(batch, depth_slot, accumulator); });
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bench/batch.h"
+#include "bench/isa.h"
 #include "bench/stats.h"
 
 namespace depthbench {
@@ -18,22 +19,16 @@ struct JudgedCell {
   CellAccumulator* accumulator;
 };
 
-// The instruction sets JudgeSlot is compiled for: the build's baseline,
-// and AVX-512 (chosen at run time where the processor has it). Both give
-// identical results.
-enum class JudgeIsa { kWidest, kBaseline, kAvx512 };
-bool ProcessorRuns(JudgeIsa isa);
-
 // Judges every listed cell that reads depth slot `depth_slot` (they share
 // the slot's reference, read once). Records total, arithmetic and absolute
 // errors; storage errors belong to the encoding (RecordStorage). `isa` must
 // be one the processor runs.
 void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells,
-               JudgeIsa isa = JudgeIsa::kWidest);
+               Isa isa = Isa::kWidest);
 
 // Records the storage error of one depth slot's samples.
 void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator,
-                   JudgeIsa isa = JudgeIsa::kWidest);
+                   Isa isa = Isa::kWidest);
 
 // The squared errors of one output (for reproducers and tests): relative
 // total, relative arithmetic, absolute total.

@@ -81,7 +81,7 @@ struct ReferenceLanes {
   I status;  // ReferenceStatus
 };
 template <class D, class I>
-ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo, D near, D depth_limit,
+[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo, D near, D depth_limit,
                                  D interest_min, D interest_max, D ray_length_sq, D eye_inverse_distance_sq,
                                  bool infinite_far) {
   using DD = BasicDoubleDouble<D>;
@@ -118,10 +118,9 @@ ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denote
   return out;
 }
 
-}  // namespace
-
-void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
-                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first) {
+[[gnu::always_inline]] inline void ReferencesBody(Encoding encoding, const SampleArrays& samples, std::size_t first,
+                                                  std::size_t n, const double* denoted_hi, const double* denoted_lo,
+                                                  ReferenceArrays& out, std::size_t out_first) {
   const ConventionInfo& convention = Info(encoding.convention);
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
   // Plain pointers, read once: the stores below cannot then be taken for
@@ -173,6 +172,16 @@ void References(Encoding encoding, const SampleArrays& samples, std::size_t firs
     if (pick[k] != DepthPick::kEyeDepth) depth = DepthBand(true_depth[k] / near[k]);
     joint_band[k] = static_cast<std::uint8_t>(JointBand(infinite_far ? kInfiniteRatioBand : ratio_band[k], depth));
   }
+}
+
+}  // namespace
+
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
+                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
+                Isa isa) {
+  RunWith(isa, [&]() __attribute__((always_inline)) {
+    ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
+  });
 }
 
 }  // namespace depthbench

@@ -20,6 +20,7 @@
 
 #include "bench/cells.h"
 #include "bench/double_double.h"
+#include "bench/isa.h"
 #include "bench/sampler.h"
 
 namespace depthbench {
@@ -77,7 +78,9 @@ glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 // The references of samples [first, first + n) under an encoding whose
 // stored values denote eye depths denoted_hi[k] + denoted_lo[k]
 // (DecodeEyeDepths), written to out at [out_first, out_first + n).
+// Compiled for each instruction set `isa` can name (bench/isa.h).
 void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
-                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first);
+                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
+                Isa isa = Isa::kWidest);
 
 }  // namespace depthbench

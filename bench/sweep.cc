@@ -76,7 +76,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (backends.empty()) return InvalidArgument("no backend to run");
   if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
-  if (!ProcessorRuns(options.judge_isa)) return Unavailable("this processor does not run the requested judge");
+  if (!ProcessorRuns(options.isa)) return Unavailable("this processor does not run the requested instruction set");
   const std::vector<Cell> all = AllCells();
   const std::vector<Cell> cells =
       CellsForDomain(options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells),
@@ -106,7 +106,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (Backend* backend : backends) run.backends.push_back({backend->name(), backend->device()});
 
   const Sampler sampler(options.seed, options.domain);
-  const BatchBuilder builder(sampler, layout.encodings);
+  const BatchBuilder builder(sampler, layout.encodings, options.isa);
   ThreadPool pool(options.threads);
   const std::size_t cell_count = layout.cells.size();
   std::vector<CellAccumulator> accumulators(backends.size() * cell_count);
@@ -148,8 +148,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         std::vector<JudgedCell> judged;
         for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
         const auto depth_slot = static_cast<std::uint32_t>(slot);
-        JudgeSlot(batch, depth_slot, judged, options.judge_isa);
-        if (b == 0) RecordStorage(batch, depth_slot, storage_accumulators[slot], options.judge_isa);
+        JudgeSlot(batch, depth_slot, judged, options.isa);
+        if (b == 0) RecordStorage(batch, depth_slot, storage_accumulators[slot], options.isa);
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (backend.concurrent()) {

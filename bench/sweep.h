@@ -36,7 +36,7 @@ struct SweepOptions {
   std::vector<Cell> cells;            // empty: every cell the domain allows
   std::uint32_t batch_size = 16384;
   unsigned threads = 0;               // 0: one per hardware thread
-  JudgeIsa judge_isa = JudgeIsa::kWidest;  // the same results whatever it is (tests compare them)
+  Isa isa = Isa::kWidest;             // of the judge and the reference: the same results whatever it is
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

@@ -11,9 +11,9 @@ namespace depthbench {
 namespace {
 
 Results RunCpu(std::uint64_t seed, std::uint64_t samples, Shard shard, std::uint32_t batch = 4096,
-               unsigned threads = 2, JudgeIsa judge_isa = JudgeIsa::kWidest) {
+               unsigned threads = 2, Isa isa = Isa::kWidest) {
   SweepOptions options;
-  options.judge_isa = judge_isa;
+  options.isa = isa;
   options.seed = seed;
   options.samples = samples;
   options.shard = shard;
@@ -45,13 +45,13 @@ TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
   EXPECT_FALSE(a.cells[0].stats == other.cells[0].stats);  // the seed matters
 }
 
-TEST(SweepTest, EveryJudgeInstructionSetGivesTheSameResults) {
-  // The judge is compiled for the build's baseline and for AVX-512 (picked
-  // at run time); both must count every error in the same bin, with the
-  // same maxima. 777-sample batches end inside frames, so the four-lane
-  // loops' scalar tails run too.
-  if (!ProcessorRuns(JudgeIsa::kAvx512)) GTEST_SKIP() << "this processor has no AVX-512";
-  ExpectSameStats(RunCpu(5, 30000, {}, 777, 2, JudgeIsa::kBaseline), RunCpu(5, 30000, {}, 777, 2, JudgeIsa::kAvx512));
+TEST(SweepTest, EveryInstructionSetGivesTheSameResults) {
+  // The judge, the decode and the reference are compiled for the build's
+  // baseline and for AVX-512 (picked at run time); both must count every
+  // error in the same bin, with the same maxima. 777-sample batches end
+  // inside frames and chunks, so the four-lane loops' scalar tails run too.
+  if (!ProcessorRuns(Isa::kAvx512)) GTEST_SKIP() << "this processor has no AVX-512";
+  ExpectSameStats(RunCpu(5, 30000, {}, 777, 2, Isa::kBaseline), RunCpu(5, 30000, {}, 777, 2, Isa::kAvx512));
 }
 
 TEST(SweepTest, ShardsAddUpToTheWhole) {

@@ -1,0 +1,47 @@
+// Isa: the instruction sets the hot loops (judge, reference, encode) are
+// compiled for, chosen at run time. The build's baseline (x86-64-v3 where
+// the build machine has it) runs everywhere the program runs; AVX-512 runs
+// where the processor has it and gives the same results: the loops are
+// IEEE operations lane by lane with no contraction, and AVX-512 only adds
+// registers, mask compares and conversions AVX2 lacks.
+//
+// A hot function writes its body as an always_inline function and calls
+//   RunWith(isa, [&]() __attribute__((always_inline)) { Body(...); });
+// RunBaseline and RunAvx512 each get a whole copy of the body, compiled for
+// their instruction set; what the body calls and GCC does not inline stays
+// baseline code, so AVX-512 instructions never leak into the baseline copy.
+#pragma once
+
+namespace depthbench {
+
+enum class Isa {
+  kWidest,    // the widest this processor runs
+  kBaseline,
+  kAvx512,    // AVX-512 F, VL, DQ, BW and CD
+};
+
+bool ProcessorRuns(Isa isa);
+// kWidest made concrete.
+Isa Resolve(Isa isa);
+
+template <class Body>
+void RunBaseline(Body body) {
+  body();
+}
+
+template <class Body>
+[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw,avx512cd")]] void RunAvx512(Body body) {
+  body();
+}
+
+// `isa` must be one the processor runs.
+template <class Body>
+void RunWith(Isa isa, Body body) {
+  if (Resolve(isa) == Isa::kAvx512) {
+    RunAvx512(body);
+  } else {
+    RunBaseline(body);
+  }
+}
+
+}  // namespace depthbench
