@@ -1,5 +1,6 @@
-// Isa: the instruction sets the hot loops (judge, reference, encode) are
-// compiled for, chosen at run time. The build's baseline (x86-64-v3 where
+// Isa: the instruction sets the hot loops (the judge, the storage
+// statistics, the double-double decode and the reference) are compiled
+// for, chosen at run time. The build's baseline (x86-64-v3 where
 // the build machine has it) runs everywhere the program runs; AVX-512 runs
 // where the processor has it and gives the same results: the loops are
 // IEEE operations lane by lane with no contraction, and AVX-512 only adds

@@ -17,8 +17,9 @@ struct ErrorLanes {
   Real total_sq, arith_sq, absolute_sq;
 };
 template <class Real>
-[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera, Real ray_x, Real ray_y, Real ray_z,
-                        Real true_depth, Real denoted_depth, Real inverse_distance_sq) {
+[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera,
+                                                      Real ray_x, Real ray_y, Real ray_z, Real true_depth,
+                                                      Real denoted_depth, Real inverse_distance_sq) {
   const Real qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
   const Real tx = qx - true_depth * ray_x, ty = qy - true_depth * ray_y, tz = qz - true_depth * ray_z;
   const Real ax = qx - denoted_depth * ray_x, ay = qy - denoted_depth * ray_y, az = qz - denoted_depth * ray_z;
@@ -57,7 +58,8 @@ struct RunInputs {
 };
 
 // Pass 1: errors, bins and kinds of a run of samples, four at a time.
-[[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n, RunScratch& s) {
+[[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
+                                           RunScratch& s) {
   using Float4 = float __attribute__((vector_size(16)));
   const auto store = [](auto* to, auto lanes) { std::memcpy(to, &lanes, sizeof(lanes)); };
   const auto bins = [](Double4 square, int metric) { return DenseBinsOfSquares<Int4>(square, kLowestOctave[metric]); };
@@ -111,8 +113,9 @@ struct RunInputs {
 }
 
 // Pass 2: counts and histograms.
-[[gnu::always_inline]] inline void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint32_t n, const RunScratch& s,
-            CellAccumulator& accumulator, CellAccumulator::Slot& distance) {
+[[gnu::always_inline]] inline void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint32_t n,
+                                          const RunScratch& s, CellAccumulator& accumulator,
+                                          CellAccumulator::Slot& distance) {
   for (std::uint32_t i = 0; i < n; ++i) {
     CellAccumulator::Slot& joint = accumulator.Joint(joint_band[i]);
     const std::uint64_t index = first_index + i;

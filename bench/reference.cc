@@ -81,9 +81,10 @@ struct ReferenceLanes {
   I status;  // ReferenceStatus
 };
 template <class D, class I>
-[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo, D near, D depth_limit,
-                                 D interest_min, D interest_max, D ray_length_sq, D eye_inverse_distance_sq,
-                                 bool infinite_far) {
+[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi,
+                                                                D denoted_lo, D near, D depth_limit,
+                                                                D interest_min, D interest_max, D ray_length_sq,
+                                                                D eye_inverse_distance_sq, bool infinite_far) {
   using DD = BasicDoubleDouble<D>;
   const auto eye = eye_pick != 0.0;
   // Stored-value picks have no scene point of their own: the truth is what

@@ -13,7 +13,7 @@
 #include "bench/backend.h"
 #include "bench/cells.h"
 #include "bench/domain.h"
-#include "bench/judge.h"
+#include "bench/isa.h"
 #include "bench/results.h"
 
 namespace depthbench {
@@ -36,7 +36,7 @@ struct SweepOptions {
   std::vector<Cell> cells;            // empty: every cell the domain allows
   std::uint32_t batch_size = 16384;
   unsigned threads = 0;               // 0: one per hardware thread
-  Isa isa = Isa::kWidest;             // of the judge and the reference: the same results whatever it is
+  Isa isa = Isa::kWidest;             // of the hot loops (bench/isa.h): the same results whatever it is
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

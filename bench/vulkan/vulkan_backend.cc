@@ -154,7 +154,7 @@ class VulkanBackend final : public Backend {
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
   BackendOptions options_;                // the requested pass shape (PassShapeFor)
-  PassShape shape_{};                     // of the prepared pipelines
+  PassShape shape_{kSamplesPerFrame, 1, 1};  // of the prepared pipelines
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
 
