@@ -322,7 +322,7 @@ namespace {
 
 void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
                      const float* fetched, std::size_t n, double* hi, double* lo, Isa isa) {
-  RunWith(isa, [&]() __attribute__((always_inline)) {
+  RunWith(isa, [&](auto) __attribute__((always_inline)) {
     DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo);
   });
 }

@@ -7,11 +7,15 @@
 // registers, mask compares and conversions AVX2 lacks.
 //
 // A hot function writes its body as an always_inline function and calls
-//   RunWith(isa, [&]() __attribute__((always_inline)) { Body(...); });
+//   RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
+//     Body<decltype(lanes)::value>(...);
+//   });
 // RunBaseline and RunAvx512 each get a whole copy of the body, compiled for
 // their instruction set; what the body calls and GCC does not inline stays
 // baseline code, so AVX-512 instructions never leak into the baseline copy.
 #pragma once
+
+#include <type_traits>
 
 namespace depthbench {
 
@@ -25,14 +29,17 @@ bool ProcessorRuns(Isa isa);
 // kWidest made concrete.
 Isa Resolve(Isa isa);
 
+// The body is called with the lane count of its double-precision loops,
+// as a std::integral_constant: 4 (256-bit registers) in the baseline copy,
+// 8 (512-bit) in the AVX-512 one.
 template <class Body>
 void RunBaseline(Body body) {
-  body();
+  body(std::integral_constant<int, 4>{});
 }
 
 template <class Body>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw,avx512cd")]] void RunAvx512(Body body) {
-  body();
+  body(std::integral_constant<int, 8>{});
 }
 
 // `isa` must be one the processor runs.

@@ -8,8 +8,8 @@ namespace depthbench {
 namespace {
 
 // The arithmetic of the judge, written once for one sample (Real = double)
-// and for four SIMD lanes (Double4), each lane computing exactly what the
-// scalar form does. The output minus the camera position is exact in
+// and for N SIMD lanes (Lanes<N>::Double), each lane computing exactly what
+// the scalar form does. The output minus the camera position is exact in
 // double (both are float32 values), so world-space magnitudes never enter
 // the error; both reference points lie on the pixel's ray.
 template <class Real>
@@ -57,25 +57,30 @@ struct RunInputs {
   const ReferenceStatus* status;
 };
 
-// Pass 1: errors, bins and kinds of a run of samples, four at a time.
+// Pass 1: errors, bins and kinds of a run of samples, N at a time.
+template <int N>
 [[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
                                            RunScratch& s) {
-  using Float4 = float __attribute__((vector_size(16)));
-  const auto store = [](auto* to, auto lanes) { std::memcpy(to, &lanes, sizeof(lanes)); };
-  const auto bins = [](Double4 square, int metric) { return DenseBinsOfSquares<Int4>(square, kLowestOctave[metric]); };
+  using D = typename Lanes<N>::Double;
+  const auto store = [](auto* to, auto lanes) __attribute__((always_inline)) {
+    std::memcpy(to, &lanes, sizeof(lanes));
+  };
+  const auto bins = [](D square, int metric) __attribute__((always_inline)) {
+    return DenseBinsOfSquares<typename Lanes<N>::Int>(square, kLowestOctave[metric]);
+  };
   std::uint32_t i = 0;
-  for (; i + 4 <= n; i += 4) {
-    const auto wide = [&](const float* p) {
-      Float4 f;
+  for (; i + N <= n; i += N) {
+    const auto wide = [&](const float* p) __attribute__((always_inline)) {
+      typename Lanes<N>::Float f;
       std::memcpy(&f, p + i, sizeof(f));
-      return __builtin_convertvector(f, Double4);
+      return __builtin_convertvector(f, D);
     };
-    const auto load = [&](const double* p) {
-      Double4 d;
+    const auto load = [&](const double* p) __attribute__((always_inline)) {
+      D d;
       std::memcpy(&d, p + i, sizeof(d));
       return d;
     };
-    const ErrorLanes<Double4> e =
+    const ErrorLanes<D> e =
         Errors(wide(in.x), wide(in.y), wide(in.z), camera, load(in.ray_x), load(in.ray_y), load(in.ray_z),
                load(in.true_depth), load(in.denoted_depth), load(in.inverse_distance_sq));
     store(&s.total[i], e.total_sq);
@@ -168,6 +173,7 @@ SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm
 
 namespace {
 
+template <int N>
 [[gnu::always_inline]] inline void JudgeSlotBody(const Batch& batch, std::uint32_t depth_slot,
                                                  std::span<const JudgedCell> cells) {
   const std::uint32_t count = batch.count;
@@ -187,7 +193,7 @@ namespace {
                          batch.ray_x.data() + begin, batch.ray_y.data() + begin, batch.ray_z.data() + begin,
                          ref.true_depth.data() + at, ref.denoted_depth.data() + at,
                          ref.inverse_distance_sq.data() + at, ref.joint_band.data() + at, ref.status.data() + at};
-      Measure(in, camera, n, scratch);
+      Measure<N>(in, camera, n, scratch);
       Record(in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
              cell.accumulator->Distance(batch.distance_bands[frame]));
     }
@@ -195,6 +201,7 @@ namespace {
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 
+template <int N>
 [[gnu::always_inline]] inline void RecordStorageBody(const Batch& batch, std::uint32_t depth_slot,
                                                      CellAccumulator& accumulator) {
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * batch.count;
@@ -205,12 +212,12 @@ namespace {
   std::array<std::int64_t, kMaxRun> bins;
   ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end)
                              __attribute__((always_inline)) {
-    // The bins four at a time (as the judge's Measure does), then the counts.
+    // The bins N at a time (as the judge's Measure does), then the counts.
     std::uint32_t i = begin;
-    for (; i + 4 <= end; i += 4) {
-      Double4 squares;
+    for (; i + N <= end; i += N) {
+      typename Lanes<N>::Double squares;
       std::memcpy(&squares, storage + i, sizeof(squares));
-      const Int4 lanes = DenseBinsOfSquares<Int4>(squares, kLowestOctave[kStorage]);
+      const auto lanes = DenseBinsOfSquares<typename Lanes<N>::Int>(squares, kLowestOctave[kStorage]);
       std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
     }
     for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
@@ -229,11 +236,15 @@ namespace {
 }  // namespace
 
 void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa) {
-  RunWith(isa, [&]() __attribute__((always_inline)) { JudgeSlotBody(batch, depth_slot, cells); });
+  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
+    JudgeSlotBody<decltype(lanes)::value>(batch, depth_slot, cells);
+  });
 }
 
 void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
-  RunWith(isa, [&]() __attribute__((always_inline)) { RecordStorageBody(batch, depth_slot, accumulator); });
+  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
+    RecordStorageBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
+  });
 }
 
 }  // namespace depthbench

@@ -180,7 +180,7 @@ template <class D, class I>
 void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
                 const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
                 Isa isa) {
-  RunWith(isa, [&]() __attribute__((always_inline)) {
+  RunWith(isa, [&](auto) __attribute__((always_inline)) {
     ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
   });
 }

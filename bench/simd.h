@@ -17,6 +17,36 @@ namespace depthbench {
 // judge): GCC vector extensions, one IEEE operation per lane.
 using Double4 = double __attribute__((vector_size(32)));
 using Int4 = std::int64_t __attribute__((vector_size(32)));
+// Eight lanes, for the copies of the hot loops compiled for AVX-512
+// (bench/isa.h): one 512-bit register each.
+using Double8 = double __attribute__((vector_size(64)));
+using Int8 = std::int64_t __attribute__((vector_size(64)));
+
+// The lane types of an N-lane loop (N = 4 or 8): doubles, int64, and the
+// float32 values that widen into doubles.
+//
+// The N = 8 loops are written in functions compiled without AVX-512 and
+// inlined into ones compiled with it. GCC keeps arithmetic, comparisons of
+// doubles with one select, and shifts of the wide types whole, but splits
+// some other operations into lanes before that inlining (comparisons of
+// integers, conversions from bytes, chains of selects): check the
+// generated code when a loop changes.
+template <int N>
+struct Lanes;
+template <>
+struct Lanes<4> {
+  using Double = Double4;
+  using Int = Int4;
+  using Float = float __attribute__((vector_size(16)));
+  static constexpr int kCount = 4;
+};
+template <>
+struct Lanes<8> {
+  using Double = Double8;
+  using Int = Int8;
+  using Float = float __attribute__((vector_size(32)));
+  static constexpr int kCount = 8;
+};
 
 class Float8 {
  public:
