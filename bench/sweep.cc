@@ -192,11 +192,19 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     if (options.progress) options.progress(progress);
   }
 
-  for (std::size_t e = 0; e < slot_count; ++e) storage_accumulators[e].FlushInto(storage_stats[e]);
+  // The last flush, on the pool: each accumulator is its own.
+  pool.ParallelFor(slot_count + accumulators.size(), [&](std::size_t lo, std::size_t hi, unsigned) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      if (k < slot_count) {
+        storage_accumulators[k].FlushInto(storage_stats[k]);
+      } else {
+        accumulators[k - slot_count].FlushInto(stats[k - slot_count]);
+      }
+    }
+  });
   for (std::size_t b = 0; b < backends.size(); ++b) {
     for (std::size_t c = 0; c < cell_count; ++c) {
       const std::size_t k = b * cell_count + c;
-      accumulators[k].FlushInto(stats[k]);
       CopyStorageMetric(storage_stats[layout.cells[c].depth_slot], stats[k]);
       results.cells.push_back({layout.cells[c].cell, backends[b]->name(), std::move(stats[k])});
     }
