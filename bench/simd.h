@@ -30,7 +30,8 @@ using Int8 = std::int64_t __attribute__((vector_size(64)));
 // doubles with one select, and shifts of the wide types whole, but splits
 // some other operations into lanes before that inlining (comparisons of
 // integers, conversions from bytes, chains of selects): check the
-// generated code when a loop changes.
+// generated code when a loop changes. (One specialization per width: GCC
+// ignores a vector_size that depends on a template parameter.)
 template <int N>
 struct Lanes;
 template <>
