@@ -4,7 +4,10 @@
 // the build machine has it) runs everywhere the program runs; AVX-512 runs
 // where the processor has it and gives the same results: the loops are
 // IEEE operations lane by lane with no contraction, and AVX-512 only adds
-// registers, mask compares and conversions AVX2 lacks.
+// wider and more registers, mask compares and conversions AVX2 lacks. A
+// body may take the lane count it is given (4 or 8 doubles, simd.h's
+// Lanes) or ignore it: the judge's loops take it; the reference and the
+// decode stay at four, where eight measured slower.
 //
 // A hot function writes its body as an always_inline function and calls
 //   RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
