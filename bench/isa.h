@@ -6,8 +6,9 @@
 // IEEE operations lane by lane with no contraction, and AVX-512 only adds
 // wider and more registers, mask compares and conversions AVX2 lacks. A
 // body may take the lane count it is given (4 or 8 doubles, simd.h's
-// Lanes) or ignore it: the judge's loops take it; the reference and the
-// decode stay at four, where eight measured slower.
+// Lanes) or ignore it: the judge's loops take it; the reference stays at
+// four, where eight measured slower, and so does the decode (its
+// double-double formulas come through GLM, not measured at eight).
 //
 // A hot function writes its body as an always_inline function and calls
 //   RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {

@@ -17,19 +17,17 @@ namespace depthbench {
 // judge): GCC vector extensions, one IEEE operation per lane.
 using Double4 = double __attribute__((vector_size(32)));
 using Int4 = std::int64_t __attribute__((vector_size(32)));
-// Eight lanes, for the copies of the hot loops compiled for AVX-512
-// (bench/isa.h): one 512-bit register each.
-using Double8 = double __attribute__((vector_size(64)));
-using Int8 = std::int64_t __attribute__((vector_size(64)));
 
-// The lane types of an N-lane loop (N = 4 or 8): doubles, int64, and the
-// float32 values that widen into doubles.
+// The lane types of an N-lane loop: N = 4 in the baseline copies of the
+// hot loops, 8 (one 512-bit register each) in those compiled for AVX-512
+// (bench/isa.h). Doubles, int64, and the float32 values that widen into
+// doubles.
 //
 // The N = 8 loops are written in functions compiled without AVX-512 and
 // inlined into ones compiled with it. GCC keeps arithmetic, comparisons of
 // doubles with one select, and shifts of the wide types whole, but splits
-// some other operations into lanes before that inlining (comparisons of
-// integers, conversions from bytes, chains of selects): check the
+// some other operations into lanes before that inlining (two integer
+// comparisons joined, conversions from bytes, chains of selects): check the
 // generated code when a loop changes. (One specialization per width: GCC
 // ignores a vector_size that depends on a template parameter.)
 template <int N>
@@ -39,14 +37,12 @@ struct Lanes<4> {
   using Double = Double4;
   using Int = Int4;
   using Float = float __attribute__((vector_size(16)));
-  static constexpr int kCount = 4;
 };
 template <>
 struct Lanes<8> {
-  using Double = Double8;
-  using Int = Int8;
+  using Double = double __attribute__((vector_size(64)));
+  using Int = std::int64_t __attribute__((vector_size(64)));
   using Float = float __attribute__((vector_size(32)));
-  static constexpr int kCount = 8;
 };
 
 class Float8 {

@@ -45,6 +45,35 @@ TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
   EXPECT_FALSE(a.cells[0].stats == other.cells[0].stats);  // the seed matters
 }
 
+TEST(SweepTest, EverySampleIsCountedOnceInEachSplitAndMetric) {
+  // Each sample of a cell is finite, NaN, Inf, degenerate or outside, in
+  // one joint band and one distance band; a judged sample has a storage
+  // error, a finite one a total, arithmetic and absolute error. Fails when
+  // statistics are lost between the judge and the results (an accumulator
+  // not flushed, the storage errors not copied into the cells).
+  constexpr std::uint64_t kSamples = 20000;
+  const Results results = RunCpu(42, kSamples, {});
+  ASSERT_FALSE(results.cells.empty());
+  for (const CellResult& result : results.cells) {
+    const std::string name = result.cell.Name();
+    const BandStats all = result.stats.All();
+    EXPECT_EQ(all.judged() + all.degenerate + all.outside, kSamples) << name;
+    EXPECT_GT(all.finite, 0u) << name;
+    EXPECT_EQ(all[Metric::kTotal].Count(), all.finite) << name;
+    EXPECT_EQ(all[Metric::kArith].Count(), all.finite) << name;
+    EXPECT_EQ(all[Metric::kAbsolute].Count(), all.finite) << name;
+    EXPECT_EQ(all[Metric::kStorage].Count(), all.judged()) << name;
+    std::uint64_t by_distance = 0, storage_by_distance = 0;
+    for (int band = 0; band < kDistanceBands; ++band) {
+      const BandStats d = result.stats.ForDistance(band);
+      by_distance += d.judged() + d.degenerate + d.outside;
+      storage_by_distance += d[Metric::kStorage].Count();
+    }
+    EXPECT_EQ(by_distance, kSamples) << name;
+    EXPECT_EQ(storage_by_distance, all.judged()) << name;
+  }
+}
+
 TEST(SweepTest, EveryInstructionSetGivesTheSameResults) {
   // The hot loops are compiled for the build's baseline and for AVX-512
   // (bench/isa.h); both must count every error in the same bin, with the
