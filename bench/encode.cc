@@ -5,6 +5,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -296,22 +297,51 @@ namespace {
   const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
   // Two groups of four per step: their dependency chains interleave.
   constexpr std::size_t kStep = 8;
-  for (std::size_t i = 0; i < n; i += kStep) {
-    Double4 n4[2], f4[2], texel[2];
-    for (std::size_t k = 0; k < kStep; ++k) {
-      const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
-      n4[k / 4][k % 4] = near[at];
-      f4[k / 4][k % 4] = far[at];
-      // The texel as an exact number: the unorm code, or the float's value.
-      texel[k / 4][k % 4] = unorm ? static_cast<double>(codes[at]) : static_cast<double>(fetched[at]);
-    }
-    DoubleDouble4 z[2];
+  const auto decode = [&](const Double4 (&n4)[2], const Double4 (&f4)[2], const Double4 (&texel)[2])
+                          __attribute__((always_inline)) {
+    std::array<DoubleDouble4, 2> z;
     for (int g = 0; g < 2; ++g) {
       z[g] = DecodeTexel(encoding, DoubleDouble4::FromParts(n4[g], Double4{}),
-                                        DoubleDouble4::FromParts(f4[g], Double4{}),
-                                        DoubleDouble4::FromParts(texel[g], Double4{}));
+                         DoubleDouble4::FromParts(f4[g], Double4{}), DoubleDouble4::FromParts(texel[g], Double4{}));
     }
-    for (std::size_t k = 0; k < kStep && i + k < n; ++k) {
+    return z;
+  };
+  std::size_t i = 0;
+  for (; i + kStep <= n; i += kStep) {  // whole steps: lanes loaded and stored whole
+    Double4 n4[2], f4[2], texel[2];
+    for (int g = 0; g < 2; ++g) {
+      const std::size_t at = i + 4 * g;
+      std::memcpy(&n4[g], near + at, sizeof(Double4));
+      std::memcpy(&f4[g], far + at, sizeof(Double4));
+      // The texel as an exact number: the unorm code (below 2^24), or the
+      // float's value.
+      if (unorm) {
+        std::int32_t __attribute__((vector_size(16))) c;
+        std::memcpy(&c, codes + at, sizeof(c));
+        texel[g] = __builtin_convertvector(c, Double4);
+      } else {
+        Float4 f;
+        std::memcpy(&f, fetched + at, sizeof(f));
+        texel[g] = __builtin_convertvector(f, Double4);
+      }
+    }
+    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    for (int g = 0; g < 2; ++g) {
+      const Double4 h = z[g].hi(), l = z[g].lo();
+      std::memcpy(hi + i + 4 * g, &h, sizeof(h));
+      std::memcpy(lo + i + 4 * g, &l, sizeof(l));
+    }
+  }
+  if (i < n) {  // the tail, padded with its last sample
+    Double4 n4[2], f4[2], texel[2];
+    for (std::size_t k = 0; k < kStep; ++k) {
+      const std::size_t at = i + k < n ? i + k : n - 1;
+      n4[k / 4][k % 4] = near[at];
+      f4[k / 4][k % 4] = far[at];
+      texel[k / 4][k % 4] = unorm ? static_cast<double>(codes[at]) : static_cast<double>(fetched[at]);
+    }
+    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    for (std::size_t k = 0; i + k < n; ++k) {
       hi[i + k] = z[k / 4].hi()[k % 4];
       lo[i + k] = z[k / 4].lo()[k % 4];
     }
