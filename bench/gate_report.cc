@@ -21,7 +21,8 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
 // The command that replays the sample behind a worse band.
 std::string ReproFor(const GateRun& run, const std::string& cell_name, const BandChange& change) {
   const Cell cell = ParseCell(cell_name).value();
-  const bool nonfinite = change.after.nan + change.after.inf > change.before.nan + change.before.inf;
+  // (NaN and Inf each: one can appear while the other goes.)
+  const bool nonfinite = change.after.nan > change.before.nan || change.after.inf > change.before.inf;
   const std::uint64_t index = nonfinite ? change.after.first_nonfinite_index : change.after.worst_index;
   if (index == kNone) return "";
   std::string command = ReproCommand(run.current.plan.seed, index, run.current.plan.domain, cell, run.current.backend);

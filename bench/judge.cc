@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace depthbench {
 namespace {
@@ -106,11 +107,15 @@ template <int N>
                 static_cast<int>(ReferenceStatus::kDegenerate) == kDegenerate &&
                 static_cast<int>(ReferenceStatus::kOutside) == kOutside);
   for (std::uint32_t i = 0; i < n; ++i) {
-    // A non-finite output: the sum of its components is NaN or infinite
-    // exactly then (floats cannot overflow a double sum).
-    const double sum = static_cast<double>(in.x[i]) + in.y[i] + in.z[i];
-    const int nan = sum != sum;
-    const int inf = (sum - sum) != 0.0 && !nan;
+    // A NaN output has a NaN component; an infinite one an infinite
+    // component and none NaN, of either sign. The absolute error's square
+    // tells them apart: it is a sum of squares (so +inf and -inf components
+    // give +inf, not NaN), of the output minus a point that is finite
+    // wherever the sample is not degenerate, and a finite float output
+    // cannot overflow it.
+    const double absolute_sq = s.absolute[i];
+    const int nan = absolute_sq != absolute_sq;
+    const int inf = absolute_sq == std::numeric_limits<double>::infinity();
     const int status = static_cast<int>(in.status[i]);
     const int non_finite = status == kDegenerate ? 0 : nan | inf;
     s.kind[i] = static_cast<std::uint8_t>(non_finite ? kNan + inf : status);

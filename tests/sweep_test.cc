@@ -1,5 +1,6 @@
 // Determinism, shard additivity and the results file.
 #include <filesystem>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -71,6 +72,60 @@ TEST(SweepTest, EverySampleIsCountedOnceInEachSplitAndMetric) {
     }
     EXPECT_EQ(by_distance, kSamples) << name;
     EXPECT_EQ(storage_by_distance, all.judged()) << name;
+  }
+}
+
+// A backend whose outputs follow the sample index, non-finite on purpose:
+// index % 4 = 0: (+inf, -inf, 1), infinite components of both signs;
+//             1: (NaN, 1, 1);  2: (-inf, NaN, +inf);  3: (1, 2, 3).
+class NonFinitePatternBackend final : public Backend {
+ public:
+  std::string name() const override { return "pattern"; }
+  const DeviceInfo& device() const override { return device_; }
+  bool concurrent() const override { return true; }
+  Status Prepare(std::span<const CellPlan>, PassKind) override { return Status::Ok(); }
+  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                       std::vector<float>& scratch) override {
+    constexpr float kInf = std::numeric_limits<float>::infinity(), kNan = std::numeric_limits<float>::quiet_NaN();
+    constexpr float kPatterns[4][3] = {{kInf, -kInf, 1}, {kNan, 1, 1}, {-kInf, kNan, kInf}, {1, 2, 3}};
+    const std::size_t n = batch.count;
+    scratch.resize(which.size() * 3 * n);
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) scratch[(k * 3 + c) * n + i] = kPatterns[(batch.first_index + i) % 4][c];
+      }
+    }
+    return std::span<const float>(scratch);
+  }
+
+ private:
+  DeviceInfo device_{"pattern", "test", "none", "cpu", "none"};
+};
+
+TEST(SweepTest, NonFiniteOutputsAreCountedByTheirComponents) {
+  // NaN when a component is NaN; Inf when one is infinite and none is NaN,
+  // whatever the signs (+inf and -inf together are not a NaN output).
+  // Hardware formats with a finite far plane at moderate ratios: no sample
+  // is degenerate, so every output is counted by its pattern.
+  SweepOptions options;
+  options.samples = 4000;
+  options.domain.infinite_far = false;
+  options.domain.ratio = {10.0, 1e3};
+  for (const Cell& cell : CellsForDomain(AllCells(), options.domain)) {
+    if (Info(cell.format).stores == DepthInput::kHardware) options.cells.push_back(cell);
+  }
+  ASSERT_FALSE(options.cells.empty());
+  NonFinitePatternBackend pattern;
+  Backend* backends[] = {&pattern};
+  const auto results = RunSweep(options, backends);
+  ASSERT_TRUE(results.ok()) << results.status().message();
+  for (const CellResult& result : results->cells) {
+    const BandStats all = result.stats.All();
+    ASSERT_EQ(all.degenerate, 0u) << result.cell.Name();
+    EXPECT_EQ(all.inf, 1000u) << result.cell.Name();
+    EXPECT_EQ(all.nan, 2000u) << result.cell.Name();
+    EXPECT_EQ(all.finite + all.outside, 1000u) << result.cell.Name();
+    EXPECT_EQ(all.first_nonfinite_index, 0u) << result.cell.Name();
   }
 }
 
