@@ -28,9 +28,6 @@ template <class Real>
   return {absolute_sq * inverse_distance_sq, (ax * ax + ay * ay + az * az) * inverse_distance_sq, absolute_sq};
 }
 
-// What a sample is to one cell.
-enum Kind : std::uint8_t { kJudged, kDegenerate, kOutside, kNan, kInf };
-
 constexpr std::uint32_t kMaxRun = kSamplesPerFrame;  // a frame's samples at most
 
 // Everything JudgeSlot runs is inlined into it ([[gnu::always_inline]]), so
@@ -42,7 +39,6 @@ struct RunScratch {
   std::array<double, kMaxRun> total, arith, absolute;
   // (64-bit, as the four-lane arithmetic makes them: narrowing costs shuffles.)
   std::array<std::int64_t, kMaxRun> total_bin, arith_bin, absolute_bin;
-  std::array<std::uint8_t, kMaxRun> kind;
 };
 
 constexpr int kTotal = static_cast<int>(Metric::kTotal);
@@ -58,7 +54,7 @@ struct RunInputs {
   const ReferenceStatus* status;
 };
 
-// Pass 1: errors, bins and kinds of a run of samples, N at a time.
+// Pass 1: errors and bins of a run of samples, N at a time.
 template <int N>
 [[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
                                            RunScratch& s) {
@@ -102,54 +98,40 @@ template <int N>
     s.arith_bin[i] = DenseBinOfSquare(e.arith_sq, kLowestOctave[kArith]);
     s.absolute_bin[i] = DenseBinOfSquare(e.absolute_sq, kLowestOctave[kAbsolute]);
   }
-  // Kinds in a loop of their own, so that the one above stays vectorized.
-  static_assert(static_cast<int>(ReferenceStatus::kJudged) == kJudged &&
-                static_cast<int>(ReferenceStatus::kDegenerate) == kDegenerate &&
-                static_cast<int>(ReferenceStatus::kOutside) == kOutside);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    // A NaN output has a NaN component; an infinite one an infinite
-    // component and none NaN, of either sign. The absolute error's square
-    // tells them apart: it is a sum of squares (so +inf and -inf components
-    // give +inf, not NaN), of the output minus a point that is finite
-    // wherever the sample is not degenerate, and a finite float output
-    // cannot overflow it.
-    const double absolute_sq = s.absolute[i];
-    const int nan = absolute_sq != absolute_sq;
-    const int inf = absolute_sq == std::numeric_limits<double>::infinity();
-    const int status = static_cast<int>(in.status[i]);
-    const int non_finite = status == kDegenerate ? 0 : nan | inf;
-    s.kind[i] = static_cast<std::uint8_t>(non_finite ? kNan + inf : status);
-  }
 }
 
-// Pass 2: counts and histograms.
-[[gnu::always_inline]] inline void Record(const std::uint8_t* joint_band, std::uint64_t first_index, std::uint32_t n,
-                                          const RunScratch& s, CellAccumulator& accumulator,
-                                          CellAccumulator::Slot& distance) {
+// Pass 2: counts and histograms. What a sample is to the cell follows from
+// its reference's status and from its output, which is NaN when a component
+// is NaN, and infinite when one is infinite (of either sign) and none is
+// NaN. The absolute error's square tells those apart: it is a sum of
+// squares (+inf and -inf components both give +inf, never NaN), of the
+// output minus a point that is finite wherever the sample is not
+// degenerate, and a finite float output cannot overflow it.
+[[gnu::always_inline]] inline void Record(const ReferenceStatus* status, const std::uint8_t* joint_band,
+                                          std::uint64_t first_index, std::uint32_t n, const RunScratch& s,
+                                          CellAccumulator& accumulator, CellAccumulator::Slot& distance) {
   for (std::uint32_t i = 0; i < n; ++i) {
     CellAccumulator::Slot& joint = accumulator.Joint(joint_band[i]);
     const std::uint64_t index = first_index + i;
-    switch (s.kind[i]) {
-      case kJudged:
-        // Distance bands keep the total error only: what camera distance
-        // does to a reconstruction shows there whole.
-        joint.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
-        joint.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
-        joint.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), s.absolute[i], index);
-        distance.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
-        break;
-      case kDegenerate:
-        ++joint.degenerate;
-        ++distance.degenerate;
-        break;
-      case kOutside:
-        ++joint.outside;
-        ++distance.outside;
-        break;
-      default:
-        joint.RecordNonFinite(s.kind[i] == kNan, index);
-        distance.RecordNonFinite(s.kind[i] == kNan, index);
-        break;
+    const double absolute_sq = s.absolute[i];
+    const bool finite = absolute_sq < std::numeric_limits<double>::infinity();  // false for NaN
+    if (status[i] == ReferenceStatus::kJudged && finite) {
+      // Distance bands keep the total error only: what camera distance
+      // does to a reconstruction shows there whole.
+      joint.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+      joint.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
+      joint.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
+      distance.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+    } else if (status[i] == ReferenceStatus::kDegenerate) {
+      ++joint.degenerate;
+      ++distance.degenerate;
+    } else if (finite) {  // outside the frustum: only a non-finite output counts
+      ++joint.outside;
+      ++distance.outside;
+    } else {
+      const bool nan = absolute_sq != absolute_sq;
+      joint.RecordNonFinite(nan, index);
+      distance.RecordNonFinite(nan, index);
     }
   }
 }
@@ -199,7 +181,7 @@ template <int N>
                          ref.true_depth.data() + at, ref.denoted_depth.data() + at,
                          ref.inverse_distance_sq.data() + at, ref.joint_band.data() + at, ref.status.data() + at};
       Measure<N>(in, camera, n, scratch);
-      Record(in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
+      Record(in.status, in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
              cell.accumulator->Distance(batch.distance_bands[frame]));
     }
   });
