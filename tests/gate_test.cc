@@ -33,6 +33,21 @@ class GateTest : public ::testing::Test {
     return RunDepthbench({"gate", "--baseline", kBaseline, "--shaders", root_ + "/shaders"});
   }
 
+  // Runs the first reproducer the gate printed ("  reproduce: depthbench
+  // run ...").
+  static testing::CommandResult ReplayFirstReproducer(const testing::CommandResult& gate) {
+    const std::string marker = "reproduce: depthbench ";
+    const auto at = gate.out.find(marker);
+    EXPECT_NE(at, std::string::npos) << gate.out;
+    if (at == std::string::npos) return {};
+    std::istringstream words(gate.out.substr(at + marker.size(), gate.out.find('\n', at) - at - marker.size()));
+    std::vector<std::string> args;
+    for (std::string w; words >> w;) args.push_back(w);
+    auto replay = RunDepthbench(args);
+    EXPECT_EQ(replay.exit_code, 0) << replay.err;
+    return replay;
+  }
+
   std::string root_;
 };
 
@@ -99,17 +114,29 @@ TEST_F(GateTest, PlantedNanFailsAndItsReproducerReproducesIt) {
   const auto r = Gate();
   ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("NaN appeared"), std::string::npos) << r.out;
-  // The first reproducer printed: "  reproduce: depthbench run ...".
-  const std::string marker = "reproduce: depthbench ";
-  const auto at = r.out.find(marker);
-  ASSERT_NE(at, std::string::npos) << r.out;
-  std::istringstream words(r.out.substr(at + marker.size(), r.out.find('\n', at) - at - marker.size()));
-  std::vector<std::string> args;
-  for (std::string w; words >> w;) args.push_back(w);
-  const auto replay = RunDepthbench(args);
-  ASSERT_EQ(replay.exit_code, 0) << replay.err;
+  const auto replay = ReplayFirstReproducer(r);
   EXPECT_NE(replay.out.find("vulkan:"), std::string::npos) << replay.out;
   EXPECT_NE(replay.out.find("NaN"), std::string::npos) << replay.out;
+}
+
+TEST_F(GateTest, NanTurnedIntoInfFailsAndItsReproducerShowsTheInf) {
+  // Every NaN output of pq becomes +inf: as many non-finite outputs as
+  // before, but Inf appears where there was none, and the reproducer must
+  // replay a sample that gives Inf (not the worst finite one).
+  Edit("shared/variants/pq.h", "  return world_from_view(frame, view);",
+       "  vec3 p = world_from_view(frame, view);\n"
+       "  if (isnan(p.x) || isnan(p.y) || isnan(p.z)) p = vec3(uintBitsToFloat(0x7f800000u));\n"
+       "  return p;");
+  const auto r = Gate();
+  ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("Inf appeared"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("NaN appeared"), std::string::npos) << r.out;
+  const auto replay = ReplayFirstReproducer(r);
+  // The line of the GPU's output: "     vulkan: (inf, inf, inf)  Inf".
+  const auto at = replay.out.find("vulkan: (");
+  ASSERT_NE(at, std::string::npos) << replay.out;
+  const std::string line = replay.out.substr(at, replay.out.find('\n', at) - at);
+  EXPECT_EQ(line.substr(line.size() - 3), "Inf") << replay.out;
 }
 
 TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
