@@ -40,9 +40,11 @@ for ((r = 1; r <= runs; ++r)); do
     /usr/bin/time -v "$depthbench" run --quiet ${arguments[i]} >"$log" 2>&1 ||
       { cat "$log" >&2; exit 1; }
     # "... verified in 12.38 s: 85.65M/s": the rate, in millions per second.
-    rates[i]+="$(grep -o 'verified in [0-9.]* s: [0-9.]*[kMG]*/s' "$log" |
+    rate=$(grep -o 'verified in [0-9.]* s: [0-9.]*[kMG]*/s' "$log" |
       awk '{r = $5; u = substr(r, length(r) - 2, 1); v = r + 0
-            printf "%.1f ", u == "G" ? v * 1000 : u == "M" ? v : u == "k" ? v / 1000 : v / 1e6}')"
+            printf "%.1f", u == "G" ? v * 1000 : u == "M" ? v : u == "k" ? v / 1000 : v / 1e6}') ||
+      { echo "no 'verified in' line in the output of run ${arguments[i]}:" >&2; cat "$log" >&2; exit 1; }
+    rates[i]+="$rate "
     peaks[i]+="$(awk '/Maximum resident set size/ {printf "%.0f ", $6 / 1024}' "$log")"
   done
 done
