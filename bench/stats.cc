@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <new>
+#include <type_traits>
+
+#include <sys/mman.h>
 
 #include <fmt/format.h>
 
@@ -155,49 +160,41 @@ BandStats CellStats::ForDistance(int distance_band) const {
   return it == distance.end() ? BandStats{} : it->second;
 }
 
+static_assert(std::is_trivially_default_constructible_v<CellAccumulator::Slot>);
+
 CellAccumulator::CellAccumulator() {
-  joint_slot_.fill(-1);
-  // Reserve every slot up front: references stay valid, and untouched
-  // pages of the reservation cost no memory.
-  slots_.reserve(kDistanceBands + kJointBands);
-  slots_.resize(kDistanceBands);
+  // Fresh anonymous pages read as zeros and take memory only when written.
+  void* pages = mmap(nullptr, kSlots * sizeof(Slot), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (pages == MAP_FAILED) throw std::bad_alloc();
+  slots_.reset(static_cast<Slot*>(pages));
 }
 
-CellAccumulator::Slot& CellAccumulator::NewJoint(int band) {
-  joint_slot_[band] = static_cast<int>(slots_.size());
-  return slots_.emplace_back();
-}
+void CellAccumulator::Unmap::operator()(Slot* slots) const { munmap(slots, kSlots * sizeof(Slot)); }
 
 void CellAccumulator::FlushInto(CellStats& out) {
-  auto flush = [](Slot& slot, BandStats& band) {
+  constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+  for (int s = 0; s < kSlots; ++s) {
+    Slot& slot = slots_.get()[s];
+    // A slot in use has counted something; reading an untouched one maps
+    // no memory.
+    static const Slot kEmpty{};
+    if (std::memcmp(&slot, &kEmpty, sizeof(Slot)) == 0) continue;
     BandStats add;
     for (std::uint32_t n : slot.bins[static_cast<int>(Metric::kTotal)]) add.finite += n;
     add.nan = slot.nan;
     add.inf = slot.inf;
     add.degenerate = slot.degenerate;
     add.outside = slot.outside;
-    add.first_nonfinite_index = slot.first_nonfinite_index;
+    add.first_nonfinite_index = slot.nan + slot.inf > 0 ? slot.first_nonfinite_index : kNone;
     for (int m = 0; m < kMetricCount; ++m) {
       MetricStats& ms = add.metrics[m];
       for (int b = 0; b < kDenseBins; ++b)
         if (slot.bins[m][b] != 0) ms.bins[b] = slot.bins[m][b];
       ms.max_square = slot.max_square[m];
-      ms.worst_index = slot.worst_index[m];
+      ms.worst_index = slot.max_square[m] > 0.0 ? slot.worst_index[m] : kNone;
     }
-    band.Merge(add);
-    slot = Slot();
-  };
-  for (int band = 0; band < kDistanceBands; ++band) {
-    const Slot& d = slots_[band];
-    bool used = d.nan + d.inf + d.degenerate + d.outside > 0;
-    for (const auto& bins : d.bins)
-      for (std::uint32_t n : bins) used = used || n != 0;
-    if (used)
-      flush(slots_[band], out.distance[band]);
-  }
-  for (int band = 0; band < kJointBands; ++band) {
-    int s = joint_slot_[band];
-    if (s >= 0) flush(slots_[s], out.joint[band]);
+    (s < kDistanceBands ? out.distance[s] : out.joint[s - kDistanceBands]).Merge(add);
+    std::memset(&slot, 0, sizeof(Slot));
   }
   pending_ = 0;
 }

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -145,23 +146,26 @@ struct CellStats {
   friend bool operator==(const CellStats&, const CellStats&) = default;
 };
 
-// The hot accumulator for one cell: dense 32-bit bins for the joint bands a
-// run touches (allocated on first use) and the distance bands. Flush() moves
-// everything into a CellStats; the sweep flushes well before a 32-bit count
-// could overflow.
+// The hot accumulator for one cell: dense 32-bit bins for every joint band
+// and distance band, each band at a fixed place, so that the judge finds a
+// sample's bins by arithmetic alone. The slots live in memory mapped zeroed
+// and untouched: a band no sample reaches costs no memory, and all zeros is
+// an empty slot. Flush() moves everything into a CellStats; the sweep
+// flushes well before a 32-bit count could overflow.
 class CellAccumulator {
  public:
   CellAccumulator();
 
+  // All zeros is empty (worst_index and first_nonfinite_index mean nothing
+  // until a maximum or a non-finite output sets them).
   struct Slot {
-    std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins{};
-    std::array<double, kMetricCount> max_square{};
-    std::array<std::uint64_t, kMetricCount> worst_index{};
+    std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins;
+    std::array<double, kMetricCount> max_square;
+    std::array<std::uint64_t, kMetricCount> worst_index;
     // (Finite samples are not counted here: every one lands in a bin of the
     // total error, and the flush counts them from there.)
-    std::uint64_t nan = 0, inf = 0, degenerate = 0, outside = 0;
-    std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
-    Slot() { worst_index.fill(std::numeric_limits<std::uint64_t>::max()); }
+    std::uint64_t nan, inf, degenerate, outside;
+    std::uint64_t first_nonfinite_index;
 
     // One value (squared) of one metric, in dense bin `bin`. Samples come
     // in increasing index order, so on a tie the earlier sample stays the
@@ -178,16 +182,13 @@ class CellAccumulator {
       Record(metric, DenseBinOfSquare(square, kLowestOctave[static_cast<int>(metric)]), square, index);
     }
     void RecordNonFinite(bool is_nan, std::uint64_t index) {
+      if (nan + inf == 0 || index < first_nonfinite_index) first_nonfinite_index = index;
       ++(is_nan ? nan : inf);
-      if (index < first_nonfinite_index) first_nonfinite_index = index;
     }
   };
 
-  Slot& Joint(int band) {
-    int s = joint_slot_[band];
-    return s >= 0 ? slots_[s] : NewJoint(band);
-  }
-  Slot& Distance(int band) { return slots_[band]; }
+  Slot& Joint(int band) { return slots_.get()[kDistanceBands + band]; }
+  Slot& Distance(int band) { return slots_.get()[band]; }
 
   // Samples recorded since the last flush (the caller counts them).
   void Count(std::uint64_t samples) { pending_ += samples; }
@@ -195,9 +196,12 @@ class CellAccumulator {
   void FlushInto(CellStats& out);
 
  private:
-  Slot& NewJoint(int band);
-  std::array<int, kJointBands> joint_slot_;
-  std::vector<Slot> slots_;  // [0, kDistanceBands): distance bands; then joint bands
+  static constexpr int kSlots = kDistanceBands + kJointBands;
+  struct Unmap {
+    void operator()(Slot* slots) const;
+  };
+  // [0, kDistanceBands): distance bands; then joint bands.
+  std::unique_ptr<Slot, Unmap> slots_;
   std::uint64_t pending_ = 0;
 };
 
