@@ -45,12 +45,38 @@ std::uint64_t MetricStats::Count() const {
   return n;
 }
 
-void MetricStats::Merge(const MetricStats& other) {
-  for (const auto& [slot, count] : other.bins) bins[slot] += count;
+void MetricStats::MergeBins(const std::map<int, std::uint64_t>& other) {
+  // Both in slot order: one pass, inserting before the cursor.
+  auto at = bins.begin();
+  for (const auto& [slot, count] : other) {
+    while (at != bins.end() && at->first < slot) ++at;
+    if (at != bins.end() && at->first == slot) {
+      at->second += count;
+    } else {
+      at = bins.emplace_hint(at, slot, count);
+    }
+  }
+}
+
+void MetricStats::MergeMax(const MetricStats& other) {
   if (other.max_square > max_square || (other.max_square == max_square && other.worst_index < worst_index)) {
     max_square = other.max_square;
     worst_index = other.worst_index;
   }
+}
+
+void MetricStats::Merge(const MetricStats& other) {
+  MergeBins(other.bins);
+  MergeMax(other);
+}
+
+void MetricStats::Merge(MetricStats&& other) {
+  if (bins.empty()) {
+    bins = std::move(other.bins);
+  } else {
+    MergeBins(other.bins);
+  }
+  MergeMax(other);
 }
 
 double MetricStats::Quantile(double q, int lowest_octave) const {
@@ -103,14 +129,23 @@ double MetricStats::AtLevel(Level level, Metric metric) const {
   return level == Level::kMax ? max() : Quantile(LevelQuantile(level), kLowestOctave[static_cast<int>(metric)]);
 }
 
-void BandStats::Merge(const BandStats& other) {
+void BandStats::MergeCounts(const BandStats& other) {
   finite += other.finite;
   nan += other.nan;
   inf += other.inf;
   degenerate += other.degenerate;
   outside += other.outside;
   first_nonfinite_index = std::min(first_nonfinite_index, other.first_nonfinite_index);
+}
+
+void BandStats::Merge(const BandStats& other) {
+  MergeCounts(other);
   for (int m = 0; m < kMetricCount; ++m) metrics[m].Merge(other.metrics[m]);
+}
+
+void BandStats::Merge(BandStats&& other) {
+  MergeCounts(other);
+  for (int m = 0; m < kMetricCount; ++m) metrics[m].Merge(std::move(other.metrics[m]));
 }
 
 double BitsLost(double relative_error) {
@@ -189,11 +224,11 @@ void CellAccumulator::FlushInto(CellStats& out) {
     for (int m = 0; m < kMetricCount; ++m) {
       MetricStats& ms = add.metrics[m];
       for (int b = 0; b < kDenseBins; ++b)
-        if (slot.bins[m][b] != 0) ms.bins[b] = slot.bins[m][b];
+        if (slot.bins[m][b] != 0) ms.bins.emplace_hint(ms.bins.end(), b, slot.bins[m][b]);
       ms.max_square = slot.max_square[m];
       ms.worst_index = slot.max_square[m] > 0.0 ? slot.worst_index[m] : kNone;
     }
-    (s < kDistanceBands ? out.distance[s] : out.joint[s - kDistanceBands]).Merge(add);
+    (s < kDistanceBands ? out.distance[s] : out.joint[s - kDistanceBands]).Merge(std::move(add));
     std::memset(&slot, 0, sizeof(Slot));
   }
   pending_ = 0;

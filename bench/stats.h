@@ -100,12 +100,17 @@ struct MetricStats {
 
   std::uint64_t Count() const;
   void Merge(const MetricStats& other);
+  void Merge(MetricStats&& other);  // takes other's bins whole where this has none
   // The q-quantile (q in [0, 1]) of the metric's value; 0 when empty.
   // Underflow reads as the lowest kept edge, overflow as the exact max.
   double Quantile(double q, int lowest_octave) const;
   // The value at a level (a quantile, or the maximum) of metric `metric`.
   double AtLevel(Level level, Metric metric) const;
   friend bool operator==(const MetricStats&, const MetricStats&) = default;
+
+ private:
+  void MergeBins(const std::map<int, std::uint64_t>& other);
+  void MergeMax(const MetricStats& other);
 };
 
 // Statistics of one band of one cell.
@@ -119,9 +124,13 @@ struct BandStats {
   std::array<MetricStats, kMetricCount> metrics;
 
   void Merge(const BandStats& other);
+  void Merge(BandStats&& other);
   std::uint64_t judged() const { return finite + nan + inf; }
   const MetricStats& operator[](Metric m) const { return metrics[static_cast<int>(m)]; }
   friend bool operator==(const BandStats&, const BandStats&) = default;
+
+ private:
+  void MergeCounts(const BandStats& other);
 };
 
 // The quantile summary a table row shows.
