@@ -189,11 +189,29 @@ void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_
   const FormatInfo& info = Info(format);
   switch (info.texel) {
     case TexelKind::kUnorm: {
-      // value * (2^b - 1) is exact in double (24 + 24 bits); rint rounds half
-      // to even in the default rounding mode. The fetch: see FetchTexel.
+      // value * (2^b - 1) is exact in double (24 + 24 bits) and rounded to
+      // the nearest integer, ties to even: adding and taking away 2^52 does
+      // that in the default rounding mode for values below 2^52, four at a
+      // time. NaN clamps to 0. The fetch: see FetchTexel.
       const double scale = UnormScale(info.bits), inverse = 1.0 / scale;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double code = std::rint(std::clamp(static_cast<double>(values[i]), 0.0, 1.0) * scale);
+      const auto encode = [&](auto v) {
+        using D = decltype(v);
+        const D zero{}, one = zero + 1.0;
+        const D clamped = v > 0.0 ? (v < 1.0 ? v : one) : zero;
+        return (clamped * scale + 0x1p52) - 0x1p52;
+      };
+      std::size_t i = 0;
+      for (; i + 4 <= n; i += 4) {
+        Float4 f;
+        std::memcpy(&f, values + i, sizeof(f));
+        const Double4 code = encode(__builtin_convertvector(f, Double4));
+        const auto c = __builtin_convertvector(code, std::int32_t __attribute__((vector_size(16))));
+        const Float4 fetch = __builtin_convertvector(code * inverse, Float4);
+        std::memcpy(codes + i, &c, sizeof(c));
+        std::memcpy(fetched + i, &fetch, sizeof(fetch));
+      }
+      for (; i < n; ++i) {
+        const double code = encode(static_cast<double>(values[i]));
         codes[i] = static_cast<std::uint32_t>(code);
         fetched[i] = static_cast<float>(code * inverse);
       }

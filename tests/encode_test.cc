@@ -2,6 +2,7 @@
 #include <bit>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -39,6 +40,36 @@ TEST(EncodeTest, UnormConversionRoundsToNearestEven) {
   EXPECT_EQ(FloatToUnorm(0.5f, 16), 32768u);
   // 0.5 * (2^24 - 1) = 8388607.5: a tie, to the even code 8388608.
   EXPECT_EQ(FloatToUnorm(0.5f, 24), 8388608u);
+}
+
+// StoreFloats runs four values at a time where it can, one at a time in
+// the tail; both must round (ties to even), clamp (NaN to 0) and fetch
+// alike. Each value is stored once in a block of four (the wide path) and
+// once alone (the one-value path).
+TEST(EncodeTest, UnormStoresAgreeFourAtATimeAndOneByOne) {
+  std::vector<float> values = {0.0f, -0.0f, 1.0f, 0.5f, -0.5f, 1.5f, NAN, INFINITY, -INFINITY,
+                               std::nextafter(1.0f, 0.0f), std::nextafter(0.0f, 1.0f), 1e-30f};
+  for (int bits : {16, 24}) {
+    const double scale = std::ldexp(1.0, bits) - 1.0;
+    // Codes plus one half (ties, where the float holds them), and neighbours.
+    for (std::uint32_t c = 0; c < (1u << bits); c += 4099) {
+      const auto tie = static_cast<float>((c + 0.5) / scale);
+      values.insert(values.end(), {tie, std::nextafter(tie, 0.0f), std::nextafter(tie, 2.0f)});
+    }
+  }
+  while (values.size() % 4 != 0) values.push_back(0.25f);
+  for (Format format : {Format::kD16Unorm, Format::kX8D24Unorm}) {
+    std::vector<std::uint32_t> codes(values.size());
+    std::vector<float> fetched(values.size());
+    StoreFloats(format, values.data(), values.size(), codes.data(), fetched.data());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const StoredDepth one = StoreFloat(format, values[i]);
+      ASSERT_EQ(codes[i], one.code) << values[i];
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(fetched[i]), std::bit_cast<std::uint32_t>(one.fetched)) << values[i];
+      ASSERT_EQ(one.fetched, FetchTexel(format, one.code)) << values[i];
+    }
+  }
+  EXPECT_EQ(StoreFloat(Format::kD16Unorm, NAN).code, 0u);
 }
 
 TEST(EncodeTest, HalfConversionRoundTripsAndTiesToEven) {
