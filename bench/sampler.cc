@@ -50,41 +50,46 @@ double LogUniform(double u, double lo, double hi) { return LogUniform(u, Range{l
 
 Sampler::Sampler(std::uint64_t seed, Domain domain) : seed_(seed), domain_(std::move(domain)) {}
 
-std::uint32_t Sampler::Bits(std::uint64_t index, std::uint32_t stream) const {
-  return f32::random_bits(static_cast<std::uint32_t>(seed_), static_cast<std::uint32_t>(seed_ >> 32),
-                          static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32),
-                          stream);
+std::uint32_t Sampler::State(std::uint64_t index) const {
+  return f32::random_state(static_cast<std::uint32_t>(seed_), static_cast<std::uint32_t>(seed_ >> 32),
+                           static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32));
 }
 
-double Sampler::Unit(std::uint64_t index, std::uint32_t stream) const {
+std::uint32_t Sampler::Bits(std::uint32_t state, std::uint32_t stream) {
+  return f32::random_bits_from_state(state, stream);
+}
+
+double Sampler::Unit(std::uint32_t state, std::uint32_t stream) {
   // 27 + 26 bits from two consecutive streams.
-  std::uint64_t hi = Bits(index, stream) >> 5;
-  std::uint64_t lo = Bits(index, stream + 1) >> 6;
+  std::uint64_t hi = Bits(state, stream) >> 5;
+  std::uint64_t lo = Bits(state, stream + 1) >> 6;
   return static_cast<double>((hi << 26) | lo) * 0x1.0p-53;
 }
 
 FrameUnits Sampler::FrameUnitsAt(std::uint64_t i) const {
   FrameUnits u;
-  u.fov = Unit(i, kFrameFov);
-  u.aspect = Unit(i, kFrameAspect);
-  u.near = Unit(i, kFrameNear);
-  u.far = Unit(i, kFrameFar);
-  for (int k = 0; k < 3; ++k) u.rotation[k] = Unit(i, kFrameRotation + 2 * k);
-  for (int k = 0; k < 2; ++k) u.direction[k] = Unit(i, kFrameDirection + 2 * k);
-  u.distance = Unit(i, kFrameDistance);
-  u.at_origin = Unit(i, kFrameDistance + 2);
-  u.resolution = Bits(i, kFrameResolution) * 0x1.0p-32;  // exact: the pick below is floor(bits * n / 2^32)
-  u.volume = Unit(i, kFrameVolume);
+  const std::uint32_t state = State(i);
+  u.fov = Unit(state, kFrameFov);
+  u.aspect = Unit(state, kFrameAspect);
+  u.near = Unit(state, kFrameNear);
+  u.far = Unit(state, kFrameFar);
+  for (int k = 0; k < 3; ++k) u.rotation[k] = Unit(state, kFrameRotation + 2 * k);
+  for (int k = 0; k < 2; ++k) u.direction[k] = Unit(state, kFrameDirection + 2 * k);
+  u.distance = Unit(state, kFrameDistance);
+  u.at_origin = Unit(state, kFrameDistance + 2);
+  u.resolution = Bits(state, kFrameResolution) * 0x1.0p-32;  // exact: the pick below is floor(bits * n / 2^32)
+  u.volume = Unit(state, kFrameVolume);
   return u;
 }
 
 SampleUnits Sampler::SampleUnitsAt(std::uint64_t index) const {
   SampleUnits u;
-  u.pick = Unit(index, kPickStream);
-  u.depth = Unit(index, kDepthStream);
-  u.pixel_kind = Unit(index, kPixelKindStream);
-  u.x = Bits(index, kPixelXStream) * 0x1.0p-32;
-  u.y = Bits(index, kPixelYStream) * 0x1.0p-32;
+  const std::uint32_t state = State(index);
+  u.pick = Unit(state, kPickStream);
+  u.depth = Unit(state, kDepthStream);
+  u.pixel_kind = Unit(state, kPixelKindStream);
+  u.x = Bits(state, kPixelXStream) * 0x1.0p-32;
+  u.y = Bits(state, kPixelYStream) * 0x1.0p-32;
   return u;
 }
 

@@ -108,8 +108,11 @@ class Sampler : public SampleSource {
   const Domain& domain() const { return domain_; }
 
  private:
-  std::uint32_t Bits(std::uint64_t index, std::uint32_t stream) const;
-  double Unit(std::uint64_t index, std::uint32_t stream) const;  // [0, 1), 53 bits
+  // The mixing state of a sample (or frame) index, from which each of its
+  // streams is one more round (shared/random.h).
+  std::uint32_t State(std::uint64_t index) const;
+  static std::uint32_t Bits(std::uint32_t state, std::uint32_t stream);
+  static double Unit(std::uint32_t state, std::uint32_t stream);  // [0, 1), 53 bits
 
   std::uint64_t seed_;
   Domain domain_;

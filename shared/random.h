@@ -21,13 +21,17 @@ DB_FN uint random_mix(uint x) {
 // 64-bit values split into low and high words; each word is absorbed by
 // xor and a full mixing round, so inputs that differ in one word differ
 // everywhere. The constant keeps an all-zero input from mapping to zero.
-DB_FN uint random_bits(uint seed_lo, uint seed_hi, uint index_lo, uint index_hi, uint stream) {
+// The stream comes last, so the state before it (random_state) serves
+// every stream of one sample: the host computes it once per sample.
+DB_FN uint random_state(uint seed_lo, uint seed_hi, uint index_lo, uint index_hi) {
   uint h = random_mix(seed_lo ^ 0x9e3779b9u);
   h = random_mix(h ^ seed_hi);
   h = random_mix(h ^ index_hi);
-  h = random_mix(h ^ index_lo);
-  h = random_mix(h ^ stream);
-  return h;
+  return random_mix(h ^ index_lo);
+}
+DB_FN uint random_bits_from_state(uint state, uint stream) { return random_mix(state ^ stream); }
+DB_FN uint random_bits(uint seed_lo, uint seed_hi, uint index_lo, uint index_hi, uint stream) {
+  return random_bits_from_state(random_state(seed_lo, seed_hi, index_lo, index_hi), stream);
 }
 
 // Uniform float in [0, 1) with 24 random bits: every value is exact.
