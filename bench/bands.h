@@ -19,11 +19,13 @@ inline constexpr int kJointBands = kRatioBands * kDepthBands;
 inline constexpr int kDistanceBands = 5;  // [0,1), [1,1e2), [1e2,1e4), [1e4,1e6), 1e6 and above
 
 // floor(log10(x)) clamped to [0, count), by comparison with exact powers of
-// ten (cheaper than a logarithm, and exact at the edges).
+// ten (cheaper than a logarithm, and exact at the edges): the number of
+// powers up to x, counted without branches, which samples' random depths
+// would mispredict. NaN is in band 0.
 inline int DecadeBand(double x, int count) {
   constexpr double kPowers[] = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12};
   int band = 0;
-  while (band < count - 1 && x >= kPowers[band]) ++band;
+  for (int k = 0; k < count - 1; ++k) band += x >= kPowers[k] ? 1 : 0;
   return band;
 }
 
