@@ -5,8 +5,6 @@
 #include <cstring>
 #include <limits>
 
-#include <immintrin.h>
-
 namespace depthbench {
 namespace {
 
@@ -56,13 +54,6 @@ struct RunInputs {
   const ReferenceStatus* status;
 };
 
-// Float lanes made double: one instruction for eight lanes where AVX-512
-// runs it (GCC splits the generic conversion into halves; see bench/simd.h).
-inline Lanes<4>::Double Widen(Lanes<4>::Float f) { return __builtin_convertvector(f, Lanes<4>::Double); }
-[[gnu::target("avx512f")]] inline Lanes<8>::Double Widen(Lanes<8>::Float f) {
-  return reinterpret_cast<Lanes<8>::Double>(_mm512_maskz_cvtps_pd(0xFF, reinterpret_cast<__m256>(f)));
-}
-
 // Pass 1: errors and bins of a run of samples, N at a time.
 template <int N>
 [[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
@@ -79,7 +70,7 @@ template <int N>
     const auto wide = [&](const float* p) __attribute__((always_inline)) {
       typename Lanes<N>::Float f;
       std::memcpy(&f, p + i, sizeof(f));
-      return Widen(f);
+      return __builtin_convertvector(f, D);
     };
     const auto load = [&](const double* p) __attribute__((always_inline)) {
       D d;
