@@ -208,11 +208,11 @@ void CellAccumulator::Unmap::operator()(Slot* slots) const { munmap(slots, kSlot
 
 void CellAccumulator::FlushInto(CellStats& out) {
   constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+  static const Slot kEmpty{};
   for (int s = 0; s < kSlots; ++s) {
     Slot& slot = slots_.get()[s];
-    // A slot in use has counted something; reading an untouched one maps
-    // no memory.
-    static const Slot kEmpty{};
+    // A slot in use has counted something; reading an untouched one takes
+    // no memory (its pages map the kernel's zero page).
     if (std::memcmp(&slot, &kEmpty, sizeof(Slot)) == 0) continue;
     BandStats add;
     for (std::uint32_t n : slot.bins[static_cast<int>(Metric::kTotal)]) add.finite += n;

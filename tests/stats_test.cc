@@ -1,5 +1,6 @@
 // Binning, quantiles and merging of the streaming statistics.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -100,6 +101,38 @@ TEST(StatsTest, BitsLost) {
   EXPECT_EQ(BitsLost(std::ldexp(1.0, -30)), 0.0);  // floored at zero
   EXPECT_DOUBLE_EQ(BitsLost(std::ldexp(1.0, -14)), 10.0);
   EXPECT_EQ(BitsLost(0.0), 0.0);
+}
+
+// Slots start as zeros, and a flush leaves them so: an index is reported
+// only where something set it, a band nothing reached is not reported, and
+// a second flush adds only what came after the first.
+TEST(StatsTest, AccumulatorReportsOnlyWhatWasRecordedAndStartsAgainAfterAFlush) {
+  constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+  CellAccumulator acc;
+  acc.Joint(2).Record(Metric::kTotal, 0.0, 5);  // an exact result: no maximum above zero
+  CellStats stats;
+  acc.FlushInto(stats);
+  ASSERT_EQ(stats.joint.size(), 1u);
+  EXPECT_TRUE(stats.distance.empty());
+  const BandStats& first = stats.joint.at(2);
+  EXPECT_EQ(first.finite, 1u);
+  EXPECT_EQ(first[Metric::kTotal].max_square, 0.0);
+  EXPECT_EQ(first[Metric::kTotal].worst_index, kNone);
+  EXPECT_EQ(first[Metric::kArith].worst_index, kNone);
+  EXPECT_EQ(first.first_nonfinite_index, kNone);
+
+  acc.Joint(2).RecordNonFinite(true, 9);
+  acc.Joint(2).RecordNonFinite(false, 7);
+  acc.Distance(1).Record(Metric::kTotal, 0.25, 8);
+  acc.FlushInto(stats);
+  const BandStats& second = stats.joint.at(2);
+  EXPECT_EQ(second.finite, 1u);  // not counted twice
+  EXPECT_EQ(second.nan, 1u);
+  EXPECT_EQ(second.inf, 1u);
+  EXPECT_EQ(second.first_nonfinite_index, 7u);
+  ASSERT_EQ(stats.distance.size(), 1u);
+  EXPECT_EQ(stats.distance.at(1)[Metric::kTotal].worst_index, 8u);
+  EXPECT_EQ(stats.distance.at(1).first_nonfinite_index, kNone);
 }
 
 TEST(StatsTest, MergeIsExactAndKeepsTheEarliestWorstSample) {
