@@ -88,5 +88,6 @@ namespace depthbench {
 static_assert(sizeof(f32::FrameParams) == 15 * 16 + 64, "FrameParams std430 size");
 static_assert(sizeof(f32::DepthParams) == 64 + 16 + 16, "DepthParams std430 size");
 static_assert(sizeof(f32::PassConstants) == 32, "PassConstants size");
+static_assert(sizeof(f32::CellSlice) == 16, "CellSlice std430 size");
 
 }  // namespace depthbench

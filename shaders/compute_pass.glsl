@@ -10,6 +10,11 @@
 // the samples per frame; a workgroup takes FRAMES_PER_WORKGROUP frames in
 // turn. A GPU gets one sample per invocation and one frame per workgroup.
 //
+// One dispatch runs all the cells of its variant: workgroup row y
+// (gl_WorkGroupID.y) runs the cell that CellSlice entry first_cell + y
+// describes. On lavapipe every dispatch is a fork and join of its threads,
+// so fewer, larger dispatches leave the cores idle less.
+//
 // A software implementation runs the invocations in SIMD groups, and its
 // cost is in memory access, not arithmetic: Mesa 22.3's lavapipe loads and
 // stores storage buffers lane by lane, in a loop with a branch per lane
@@ -37,8 +42,9 @@ layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; }; 
 layout(std430, set = 0, binding = 2) readonly buffer PixelQuads { uvec4 pixel_quads[]; };
 layout(std430, set = 0, binding = 3) readonly buffer StoredDepths { float stored_depths[]; };
 layout(std430, set = 0, binding = 3) readonly buffer StoredDepthQuads { vec4 stored_depth_quads[]; };
-layout(std430, set = 0, binding = 4) writeonly buffer Positions { float positions[]; };
-layout(std430, set = 0, binding = 4) writeonly buffer PositionQuads { vec4 position_quads[]; };
+layout(std430, set = 0, binding = 4) readonly buffer CellSlices { CellSlice cell_slices[]; };
+layout(std430, set = 0, binding = 5) writeonly buffer Positions { float positions[]; };
+layout(std430, set = 0, binding = 5) writeonly buffer PositionQuads { vec4 position_quads[]; };
 layout(push_constant) uniform Pass { PassConstants pass; };
 
 // One sample, from its pixel and its stored depth.
@@ -53,10 +59,10 @@ int slice_element(uint frame_index, uint in_frame) {
   return int(frame_index * pass.samples_per_frame + in_frame) - int(pass.first_in_frame);
 }
 
-// One frame of the batch, reconstructed by this workgroup.
-void reconstruct_frame(uint frame_index) {
+// One frame of the batch, reconstructed by this workgroup for one cell.
+void reconstruct_frame(uint frame_index, CellSlice cell) {
   FrameParams frame = frames[frame_index];
-  DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + pass.convention_slot];
+  DepthParams depth = depth_params[frame_index * pass.conventions_per_frame + cell.convention_slot];
   uint n = pass.slice_length;
   // Chosen at pipeline creation: the other branch compiles away.
   if (SAMPLES_PER_INVOCATION % 4u == 0u) {
@@ -69,11 +75,11 @@ void reconstruct_frame(uint frame_index) {
       }
       uint i = uint(e);
       uvec4 px = pixel_quads[i / 4u];
-      vec4 sd = stored_depth_quads[(pass.depth_offset + i) / 4u];
+      vec4 sd = stored_depth_quads[(cell.depth_offset + i) / 4u];
       mat4x3 p = mat4x3(reconstruct_sample(frame, depth, px.x, sd.x), reconstruct_sample(frame, depth, px.y, sd.y),
                         reconstruct_sample(frame, depth, px.z, sd.z), reconstruct_sample(frame, depth, px.w, sd.w));
       mat3x4 t = transpose(p);  // rows: x, y, z of the four samples
-      uint o = (pass.output_offset + i) / 4u;
+      uint o = (cell.output_offset + i) / 4u;
       position_quads[o] = t[0];
       position_quads[o + n / 4u] = t[1];
       position_quads[o + n / 2u] = t[2];
@@ -85,8 +91,8 @@ void reconstruct_frame(uint frame_index) {
         continue;
       }
       uint i = uint(e);
-      vec3 p = reconstruct_sample(frame, depth, pixels[i], stored_depths[pass.depth_offset + i]);
-      uint o = pass.output_offset + i;
+      vec3 p = reconstruct_sample(frame, depth, pixels[i], stored_depths[cell.depth_offset + i]);
+      uint o = cell.output_offset + i;
       positions[o] = p.x;
       positions[o + n] = p.y;
       positions[o + 2u * n] = p.z;
@@ -95,10 +101,11 @@ void reconstruct_frame(uint frame_index) {
 }
 
 void main() {
+  CellSlice cell = cell_slices[pass.first_cell + gl_WorkGroupID.y];
   for (uint f = 0u; f < FRAMES_PER_WORKGROUP; ++f) {
     uint frame_index = gl_WorkGroupID.x * FRAMES_PER_WORKGROUP + f;
     if (frame_index < pass.frame_count) {
-      reconstruct_frame(frame_index);
+      reconstruct_frame(frame_index, cell);
     }
   }
 }

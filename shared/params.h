@@ -51,17 +51,27 @@ struct DepthParams {
   uint reserved2;
 };
 
-// Push constants of one compute dispatch: which slices of the batch's
-// buffers one cell reads and writes. A slice holds one value per sample:
-// the batch's samples, after `lead` unused elements where the host aligns
-// them (compute_pass.glsl), and padding to slice_length.
+// Push constants of one compute dispatch: how the batch's per-sample
+// buffers are laid out, and which cells the dispatch runs. A slice holds one
+// value per sample: the batch's samples, after `lead` unused elements where
+// the host aligns them (compute_pass.glsl), and padding to slice_length.
+// One dispatch runs every cell of one variant, a cell per workgroup row:
+// row y runs cell_slices[first_cell + y].
 struct PassConstants {
   uint slice_length;        // elements per slice
   uint samples_per_frame;   // element e belongs to frame (e + first_in_frame) / samples_per_frame
-  uint convention_slot;     // index of this cell's convention within a frame's DepthParams
   uint conventions_per_frame;
-  uint depth_offset;        // first element of this cell's stored-depth slice in the depth buffer
-  uint output_offset;       // first float of this cell's positions: slices of x, then y, then z
   uint first_in_frame;      // position within its frame of a slice's first element
   uint frame_count;         // frames the batch's samples fall in
+  uint first_cell;          // the dispatch's first entry in the CellSlice buffer
+  uint reserved0;
+  uint reserved1;
+};
+
+// Where one cell's inputs and outputs lie in the batch's buffers.
+struct CellSlice {
+  uint convention_slot;     // index of the cell's convention within a frame's DepthParams
+  uint depth_offset;        // first element of the cell's stored-depth slice in the depth buffer
+  uint output_offset;       // first float of the cell's positions: slices of x, then y, then z
+  uint reserved;
 };

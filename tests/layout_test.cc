@@ -25,10 +25,12 @@ layout(local_size_x = 1) in;
 layout(std430, binding = 0) buffer FrameBlock { FrameParams frame; uint frame_end; };
 layout(std430, binding = 1) buffer DepthBlock { DepthParams depth; uint depth_end; };
 layout(std430, binding = 2) buffer PassBlock { PassConstants pass; uint pass_end; };
+layout(std430, binding = 3) buffer CellBlock { CellSlice cell; uint cell_end; };
 void main() {
   frame_end = 0u;
   depth_end = 0u;
   pass_end = 0u;
+  cell_end = 0u;
 }
 )";
 
@@ -95,14 +97,23 @@ TEST_F(LayoutTest, DepthParamsMatchesStd430) {
 TEST_F(LayoutTest, PassConstantsMatchesStd430) {
   EXPECT_MEMBER_AT(pass, PassConstants, slice_length);
   EXPECT_MEMBER_AT(pass, PassConstants, samples_per_frame);
-  EXPECT_MEMBER_AT(pass, PassConstants, convention_slot);
   EXPECT_MEMBER_AT(pass, PassConstants, conventions_per_frame);
-  EXPECT_MEMBER_AT(pass, PassConstants, depth_offset);
-  EXPECT_MEMBER_AT(pass, PassConstants, output_offset);
   EXPECT_MEMBER_AT(pass, PassConstants, first_in_frame);
   EXPECT_MEMBER_AT(pass, PassConstants, frame_count);
+  EXPECT_MEMBER_AT(pass, PassConstants, first_cell);
+  EXPECT_MEMBER_AT(pass, PassConstants, reserved0);
+  EXPECT_MEMBER_AT(pass, PassConstants, reserved1);
   EXPECT_EQ(MembersOf("pass"), 8) << "a PassConstants member is not listed above";
   EXPECT_EQ(Offset("pass_end"), static_cast<int>(sizeof(f32::PassConstants)));
+}
+
+TEST_F(LayoutTest, CellSliceMatchesStd430) {
+  EXPECT_MEMBER_AT(cell, CellSlice, convention_slot);
+  EXPECT_MEMBER_AT(cell, CellSlice, depth_offset);
+  EXPECT_MEMBER_AT(cell, CellSlice, output_offset);
+  EXPECT_MEMBER_AT(cell, CellSlice, reserved);
+  EXPECT_EQ(MembersOf("cell"), 4) << "a CellSlice member is not listed above";
+  EXPECT_EQ(Offset("cell_end"), static_cast<int>(sizeof(f32::CellSlice)));
 }
 
 }  // namespace

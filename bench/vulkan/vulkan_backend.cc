@@ -82,6 +82,7 @@ enum Binding : std::uint32_t {
   kDepthParams,
   kPixels,
   kStoredDepths,
+  kCellSlices,
   kPositions,  // the only output
   kBindingCount,
 };
@@ -93,23 +94,55 @@ std::size_t DepthSlotsOf(const Batch& batch) { return batch.depths.size() / batc
 BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t cells) {
   return {batch.frame_params.size() * sizeof(f32::FrameParams), batch.depth_params.size() * sizeof(f32::DepthParams),
           std::size_t{slices.length} * sizeof(std::uint32_t),
-          DepthSlotsOf(batch) * slices.length * sizeof(float), cells * 3 * slices.length * sizeof(float)};
+          DepthSlotsOf(batch) * slices.length * sizeof(float), cells * sizeof(f32::CellSlice),
+          cells * 3 * slices.length * sizeof(float)};
 }
 
-// The k-th listed cell's slices of the batch, as compute_pass.glsl reads them.
-f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slices, const CellPlan& plan,
-                                    std::size_t k) {
+// The push constants of a dispatch whose cells start at CellSlice entry
+// `first_cell`.
+f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slices, std::uint32_t first_cell) {
   return {.slice_length = slices.length,
           .samples_per_frame = kSamplesPerFrame,
-          .convention_slot = plan.convention_slot,
           .conventions_per_frame = kHardwareConventionCount,
-          .depth_offset = plan.depth_slot * slices.length,
-          .output_offset = static_cast<std::uint32_t>(k * slices.length * 3),
           .first_in_frame = batch.first_offset - slices.lead,
-          .frame_count = static_cast<std::uint32_t>(batch.frame_count())};
+          .frame_count = static_cast<std::uint32_t>(batch.frame_count()),
+          .first_cell = first_cell,
+          .reserved0 = 0,
+          .reserved1 = 0};
 }
 
 std::size_t VariantIndex(Variant variant) { return static_cast<std::size_t>(variant); }
+
+// A run's dispatches, one per variant among the listed cells, and the
+// CellSlice entries they read: one dispatch's entries are consecutive. A
+// cell writes the output slices of its place k in the list, whatever its
+// dispatch.
+struct DispatchPlan {
+  struct Dispatch {
+    Variant variant;
+    std::uint32_t first_cell, cells;
+  };
+  std::vector<Dispatch> dispatches;
+  std::vector<f32::CellSlice> cell_slices;
+};
+DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std::uint32_t> which,
+                            const SliceLayout& slices) {
+  DispatchPlan plan;
+  for (std::size_t v = 0; v < kVariantCount; ++v) {
+    const auto first = static_cast<std::uint32_t>(plan.cell_slices.size());
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      const CellPlan& cell = cells[which[k]];
+      if (VariantIndex(cell.cell.variant) != v) continue;
+      plan.cell_slices.push_back({.convention_slot = cell.convention_slot,
+                                  .depth_offset = cell.depth_slot * slices.length,
+                                  .output_offset = static_cast<std::uint32_t>(k * slices.length * 3),
+                                  .reserved = 0});
+    }
+    const auto count = static_cast<std::uint32_t>(plan.cell_slices.size()) - first;
+    if (count > 0) plan.dispatches.push_back({static_cast<Variant>(v), first, count});
+  }
+  return plan;
+}
 
 class VulkanBackend final : public Backend {
  public:
@@ -144,9 +177,10 @@ class VulkanBackend final : public Backend {
                                                std::vector<float>& scratch);
   Status CheckRun(const Batch& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
-  Status Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes);
+  Status Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+                std::span<const f32::CellSlice> cell_slices);
   void BindBuffers(const BindingBytes& bytes);
-  Status Record(const Batch& batch, const SliceLayout& slices, std::span<const std::uint32_t> which);
+  Status Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan);
   Status SubmitAndWait();
   // Internal when the validation layer reported errors since `errors_before`.
   Status CheckValidation(std::uint64_t errors_before, std::string_view during) const;
@@ -278,8 +312,9 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, 
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const std::uint64_t errors_before = context_->validation_log()->error_count();
-  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes));
-  DB_RETURN_IF_ERROR(Record(batch, slices, which));
+  const DispatchPlan plan = PlanDispatches(cells_, which, slices);
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
+  DB_RETURN_IF_ERROR(Record(batch, slices, plan));
   DB_RETURN_IF_ERROR(SubmitAndWait());
   DB_RETURN_IF_ERROR(CheckValidation(errors_before, "Run"));
   const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
@@ -322,6 +357,11 @@ Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t
     return InvalidArgument(fmt::format("a batch of {} samples needs {} workgroups; the device dispatches at most {}",
                                        batch.count, groups, limits.maxComputeWorkGroupCount[0]));
   }
+  // A dispatch runs one variant's cells, a workgroup row each.
+  if (which.size() > limits.maxComputeWorkGroupCount[1]) {
+    return InvalidArgument(fmt::format("{} cells at once need as many workgroup rows; the device dispatches at most {}",
+                                       which.size(), limits.maxComputeWorkGroupCount[1]));
+  }
   // Within this limit every element offset also fits the shaders' uints.
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     if (bytes[binding] > limits.maxStorageBufferRange) {
@@ -346,12 +386,14 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
   return Status::Ok();
 }
 
-Status VulkanBackend::Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes) {
+Status VulkanBackend::Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+                             std::span<const f32::CellSlice> cell_slices) {
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
   }
   std::memcpy(buffers_[kFrames].mapped(), batch.frame_params.data(), bytes[kFrames]);
   std::memcpy(buffers_[kDepthParams].mapped(), batch.depth_params.data(), bytes[kDepthParams]);
+  std::memcpy(buffers_[kCellSlices].mapped(), cell_slices.data(), bytes[kCellSlices]);
   // The per-sample inputs, slice by slice; the lead and the padding are
   // zeros (the shader reconstructs them too, into positions nobody reads).
   static_assert(sizeof(batch.pixels[0]) == 4 && sizeof(batch.depths[0]) == 4);
@@ -390,7 +432,7 @@ void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
   vkUpdateDescriptorSets(vk_device(), kBindingCount, writes.data(), 0, nullptr);
 }
 
-Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, std::span<const std::uint32_t> which) {
+Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan) {
   VkCommandBufferBeginInfo begin_info{};
   begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -398,19 +440,14 @@ Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, std:
   vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
                           &descriptor_set_, 0, nullptr);
   const std::uint32_t groups = WorkgroupsFor(batch, shape_);
-  VkPipeline bound = VK_NULL_HANDLE;
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
-  for (std::size_t k = 0; k < which.size(); ++k) {
-    const CellPlan& plan = cells_[which[k]];
-    const VkPipeline pipeline = pipelines_[VariantIndex(plan.cell.variant)].get();
-    if (pipeline != bound) {
-      vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-      bound = pipeline;
-    }
-    const f32::PassConstants constants = PassConstantsFor(batch, slices, plan, k);
+  for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
+    const VkPipeline pipeline = pipelines_[VariantIndex(dispatch.variant)].get();
+    vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    const f32::PassConstants constants = PassConstantsFor(batch, slices, dispatch.first_cell);
     vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(constants),
                        &constants);
-    vkCmdDispatch(command_buffer_, groups, 1, 1);
+    vkCmdDispatch(command_buffer_, groups, dispatch.cells, 1);
   }
   // The host reads the positions once the fence signals.
   VkMemoryBarrier to_host{};
