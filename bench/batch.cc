@@ -118,10 +118,21 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       const std::size_t at = s * count + lo;
       StoreFloats(encoding.format, pipeline_floats_.data() + pipeline_of_slot_[s] * count + lo, n,
                   batch.codes.data() + at, batch.depths.data() + at);
+      // Stored-value picks: the edges of a hardware or linear format are
+      // the same in every frame; view z's depend on the frame's far plane.
+      const bool per_frame = Info(encoding.format).stores == DepthInput::kViewZ;
+      std::array<StoredDepth, kDepthPicks> edges{};
+      if (!per_frame) {
+        for (int pick = 0; pick < kDepthPicks; ++pick) {
+          edges[pick] = EncodeEdge(encoding, batch.frames.front(), static_cast<DepthPick>(pick));
+        }
+      }
       for (std::size_t i = lo; i < lo + n; ++i) {
-        if (samples.pick[i] == DepthPick::kEyeDepth) continue;
+        const DepthPick pick = samples.pick[i];
+        if (pick == DepthPick::kEyeDepth) continue;
         const StoredDepth edge =
-            EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], samples.pick[i]);
+            per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
+                      : edges[static_cast<int>(pick)];
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }

@@ -21,8 +21,10 @@
 // computes exactly what the scalar type computes.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "bench/simd.h"
 
@@ -180,6 +182,19 @@ inline bool operator<=(DoubleDouble a, DoubleDouble b) { return !(b < a); }
 inline bool operator>=(DoubleDouble a, DoubleDouble b) { return !(a < b); }
 
 
+// The float next to the finite float f: above it when `up`, else below
+// (what std::nextafter gives, without the library call, which the
+// per-frame rounding of shader constants made a visible cost). The bits
+// of a float's magnitude count its steps from zero.
+inline float NextFloat(float f, bool up) {
+  const auto bits = std::bit_cast<std::uint32_t>(f);
+  if ((bits & 0x7fffffffu) == 0) {
+    return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+  }
+  const bool away_from_zero = up == ((bits >> 31) == 0);
+  return std::bit_cast<float>(away_from_zero ? bits + 1 : bits - 1);
+}
+
 // The float nearest to hi + lo (ties to even), without double rounding: a
 // rounding of hi to float can only be wrong when hi lies exactly halfway
 // between two floats, and then the sign of lo decides.
@@ -189,7 +204,7 @@ inline float RoundToFloat(DoubleDouble a) {
   double back = static_cast<double>(f);
   if (back == a.hi()) return f;  // hi is a float; lo is far below its half-ulp
   // Is hi exactly halfway between f and its other neighbour?
-  float other = std::nextafter(f, back < a.hi() ? INFINITY : -INFINITY);
+  float other = NextFloat(f, back < a.hi());
   double midpoint = (back + static_cast<double>(other)) * 0.5;  // exact: 25 bits
   if (a.hi() != midpoint) return f;
   bool lo_points_to_other = (a.lo() > 0.0) == (static_cast<double>(other) > back);

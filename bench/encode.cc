@@ -60,7 +60,7 @@ float SettleLane(DoubleDouble x, Exact exact) {
   const double hi = x.hi();
   const float f = static_cast<float>(hi);
   if (!std::isfinite(f) || static_cast<double>(f) == hi) return f;
-  const float g = std::nextafter(f, hi > static_cast<double>(f) ? INFINITY : -INFINITY);
+  const float g = NextFloat(f, hi > static_cast<double>(f));
   if (hi != (static_cast<double>(f) + static_cast<double>(g)) * 0.5) return f;  // not a tie
   tie_fallbacks.fetch_add(1, std::memory_order_relaxed);
   if (std::fabs(x.lo()) > std::fabs(hi) * kDoubleDoubleError) return RoundToFloat(x);

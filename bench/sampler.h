@@ -55,6 +55,7 @@ enum class DepthPick : std::uint8_t {
   kStoredAfterZero,  // the smallest stored value above 0
   kStoredBeforeOne,  // the largest stored value below 1
 };
+inline constexpr int kDepthPicks = 5;
 
 struct PixelSample {
   std::uint64_t index = 0;

@@ -1,7 +1,10 @@
 // The reference against independent high-precision evaluations (MPFR), and
 // every variant's formula, evaluated in double-double with exact constants,
 // against the reference.
+#include <bit>
 #include <cmath>
+#include <limits>
+#include <vector>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -88,6 +91,34 @@ TEST(ReferenceTest, DoubleDoubleArithmeticMatchesMpfr) {
     }
   }
   EXPECT_LT(worst, std::ldexp(1.0, -100));  // double-double's ~106 bits, less a few roundings
+}
+
+// NextFloat steps through the bits instead of calling std::nextafter: the
+// same answer at zero of either sign, across the subnormal and normal
+// boundary, at the largest float (to infinity) and for random floats.
+// RoundToFloat relies on it to tell a tie between two floats.
+TEST(ReferenceTest, NextFloatIsNextafter) {
+  std::vector<float> values = {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
+                               -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::min(),
+                               -std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
+                               -std::numeric_limits<float>::max(), 1.0f, -1.0f, 0x1p-126f * 0.5f};
+  std::mt19937 rng(5);
+  for (int k = 0; k < 100000; ++k) {
+    const float f = std::bit_cast<float>(static_cast<std::uint32_t>(rng()));
+    if (std::isfinite(f)) values.push_back(f);
+  }
+  for (float f : values) {
+    for (bool up : {false, true}) {
+      const float expected = std::nextafter(f, up ? INFINITY : -INFINITY);
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(NextFloat(f, up)), std::bit_cast<std::uint32_t>(expected))
+          << f << (up ? " up" : " down");
+    }
+  }
+  // A tie between 1 and the next float: the low part decides.
+  const double tie = (1.0 + static_cast<double>(NextFloat(1.0f, true))) / 2.0;
+  EXPECT_EQ(RoundToFloat(DD::FromParts(tie, 0x1p-80)), NextFloat(1.0f, true));
+  EXPECT_EQ(RoundToFloat(DD::FromParts(tie, -0x1p-80)), 1.0f);
+  EXPECT_EQ(RoundToFloat(DD::FromParts(-tie, 0x1p-80)), -1.0f);
 }
 
 TEST(ReferenceTest, NaiveDoubleDecodeIsNotEnoughAtHighRatios) {
