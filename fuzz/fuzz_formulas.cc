@@ -12,7 +12,7 @@
 #include <set>
 #include <string>
 
-#include "bench/backend_cpu.h"
+#include "bench/backends/cpu/cpu_backend.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
 

@@ -8,9 +8,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "bench/baseline.h"
-#include "bench/json_reader.h"
-#include "bench/results.h"
+#include "bench/gate/baseline.h"
+#include "bench/base/json_reader.h"
+#include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
 
 namespace {

@@ -10,7 +10,7 @@
 //     real(...) where they meet a vector, so that every instantiation rounds
 //     them the same way (not at all).
 // Formula headers carry no include guard: C++ includes each of them once per
-// precision namespace (see bench/formulas.h), GLSL once per shader.
+// precision namespace (see bench/numerics/formulas.h), GLSL once per shader.
 #ifndef DEPTHBENCH_SHARED_COMPAT_H
 #define DEPTHBENCH_SHARED_COMPAT_H
 

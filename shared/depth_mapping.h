@@ -9,7 +9,7 @@
 // GL-style clip depth ([-1, 1]) keeps the same window depth: its NDC depth
 // is 2d - 1, so its NDC coefficients are (2a - 1, 2b). The difference
 // between the two clip conventions is therefore not in the mapping but in
-// the float32 arithmetic around it (bench/encode.cc, screen.h).
+// the float32 arithmetic around it (bench/pipeline/encode.cc, screen.h).
 //
 // Written as ratios of sums of positive terms, never as b / (d - a): the
 // latter cancels catastrophically near the far plane (at f/n = 1e9 it loses

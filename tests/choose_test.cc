@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backend.h"
-#include "bench/choose.h"
+#include "bench/backends/backend.h"
+#include "bench/choose/choose.h"
 #include "bench/fit/precision_fit.h"
 #include "tests/command_runner.h"
 

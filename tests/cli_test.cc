@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/results.h"
+#include "bench/results/results.h"
 #include "tests/command_runner.h"
 
 namespace depthbench {

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/encode.h"
-#include "bench/formulas_mpfr.h"
+#include "bench/pipeline/encode.h"
+#include "bench/numerics/formulas_mpfr.h"
 
 namespace depthbench {
 namespace {

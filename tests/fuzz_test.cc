@@ -9,13 +9,13 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backend_cpu.h"
+#include "bench/backends/cpu/cpu_backend.h"
 #include "bench/fuzz/campaign.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
 #include "bench/fuzz/worst_case.h"
-#include "bench/stats.h"
-#include "bench/sweep.h"
+#include "bench/pipeline/stats.h"
+#include "bench/sweep/sweep.h"
 #include "tests/command_runner.h"
 
 namespace depthbench {

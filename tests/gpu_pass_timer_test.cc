@@ -11,13 +11,13 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/encode.h"
-#include "bench/formulas.h"
+#include "bench/pipeline/encode.h"
+#include "bench/numerics/formulas.h"
 #include "bench/speed/depth_image.h"
 #include "bench/speed/gpu_pass_timer.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/thread_pool.h"
-#include "bench/vulkan/vulkan_context.h"
+#include "bench/base/thread_pool.h"
+#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 namespace {

@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backend_cpu.h"
-#include "bench/sweep.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench {
 namespace {

@@ -9,12 +9,12 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/encode.h"
-#include "bench/formulas.h"
-#include "bench/formulas_mpfr.h"
-#include "bench/reference.h"
-#include "bench/sampler.h"
-#include "bench/shader_constants.h"
+#include "bench/pipeline/encode.h"
+#include "bench/numerics/formulas.h"
+#include "bench/numerics/formulas_mpfr.h"
+#include "bench/pipeline/reference.h"
+#include "bench/pipeline/sampler.h"
+#include "bench/pipeline/shader_constants.h"
 
 namespace depthbench {
 namespace {

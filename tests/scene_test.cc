@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/scene.h"
+#include "bench/choose/scene.h"
 
 namespace depthbench {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/stats.h"
+#include "bench/pipeline/stats.h"
 
 namespace depthbench {
 namespace {

@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backend_cpu.h"
-#include "bench/results.h"
-#include "bench/sweep.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/results/results.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench {
 namespace {
@@ -131,7 +131,7 @@ TEST(SweepTest, NonFiniteOutputsAreCountedByTheirComponents) {
 
 TEST(SweepTest, EveryInstructionSetGivesTheSameResults) {
   // The hot loops are compiled for the build's baseline and for AVX-512
-  // (bench/isa.h); both must count every error in the same bin, with the
+  // (bench/base/isa.h); both must count every error in the same bin, with the
   // same maxima. 777-sample batches end inside frames and chunks, so the
   // four-lane loops' scalar tails run too. The widest the processor runs is
   // what a sweep picks by default.

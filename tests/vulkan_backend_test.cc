@@ -16,14 +16,14 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backend.h"
-#include "bench/backend_cpu.h"
-#include "bench/batch.h"
-#include "bench/cells.h"
-#include "bench/sampler.h"
-#include "bench/thread_pool.h"
-#include "bench/vulkan/vulkan_backend.h"
-#include "bench/vulkan/vulkan_context.h"
+#include "bench/backends/backend.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/pipeline/batch.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/sampler.h"
+#include "bench/base/thread_pool.h"
+#include "bench/backends/vulkan/vulkan_backend.h"
+#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 namespace {

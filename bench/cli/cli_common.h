@@ -8,10 +8,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "bench/backend.h"
-#include "bench/cells.h"
-#include "bench/domain.h"
-#include "bench/status.h"
+#include "bench/backends/backend.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/base/status.h"
 
 namespace depthbench::cli {
 

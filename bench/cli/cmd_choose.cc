@@ -4,11 +4,11 @@
 
 #include <fmt/format.h>
 
-#include "bench/choose.h"
+#include "bench/choose/choose.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/files.h"
-#include "bench/progress.h"
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
 
 namespace depthbench::cli {
 namespace {

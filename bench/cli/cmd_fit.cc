@@ -6,9 +6,9 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/files.h"
+#include "bench/base/files.h"
 #include "bench/fit/precision_fit.h"
-#include "bench/progress.h"
+#include "bench/base/progress.h"
 
 namespace depthbench::cli {
 namespace {

@@ -8,10 +8,10 @@
 #include "bench/cli/commands.h"
 #include "bench/fuzz/campaign.h"
 #include "bench/fuzz/worst_case.h"
-#include "bench/progress.h"
-#include "bench/stats.h"
-#include "bench/sweep.h"
-#include "bench/text_table.h"
+#include "bench/base/progress.h"
+#include "bench/pipeline/stats.h"
+#include "bench/sweep/sweep.h"
+#include "bench/base/text_table.h"
 
 namespace depthbench::cli {
 namespace {

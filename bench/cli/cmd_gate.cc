@@ -7,10 +7,10 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/files.h"
-#include "bench/gate_report.h"
-#include "bench/progress.h"
-#include "bench/sweep.h"
+#include "bench/base/files.h"
+#include "bench/gate/gate_report.h"
+#include "bench/base/progress.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench::cli {
 namespace {

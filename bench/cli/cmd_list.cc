@@ -6,8 +6,8 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/text_table.h"
-#include "bench/vulkan/vulkan_context.h"
+#include "bench/base/text_table.h"
+#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench::cli {
 namespace {

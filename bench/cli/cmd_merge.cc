@@ -5,7 +5,7 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/results_table.h"
+#include "bench/results/results_table.h"
 
 namespace depthbench::cli {
 namespace {

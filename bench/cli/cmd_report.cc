@@ -8,9 +8,9 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/environment.h"
-#include "bench/files.h"
-#include "bench/progress.h"
+#include "bench/base/environment.h"
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
 #include "bench/report/report.h"
 #include "bench/report/report_render.h"
 

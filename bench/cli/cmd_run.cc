@@ -6,15 +6,15 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/progress.h"
+#include "bench/base/progress.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
-#include "bench/repro.h"
-#include "bench/stats.h"
-#include "bench/results_table.h"
-#include "bench/files.h"
-#include "bench/sweep.h"
-#include "bench/text_table.h"
+#include "bench/sweep/repro.h"
+#include "bench/pipeline/stats.h"
+#include "bench/results/results_table.h"
+#include "bench/base/files.h"
+#include "bench/sweep/sweep.h"
+#include "bench/base/text_table.h"
 
 namespace depthbench::cli {
 namespace {

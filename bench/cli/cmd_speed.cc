@@ -8,12 +8,12 @@
 
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/progress.h"
-#include "bench/results.h"
+#include "bench/base/progress.h"
+#include "bench/results/results.h"
 #include "bench/speed/speed_run.h"
 #include "bench/speed/speed_table.h"
-#include "bench/sweep.h"
-#include "bench/vulkan/vulkan_backend.h"
+#include "bench/sweep/sweep.h"
+#include "bench/backends/vulkan/vulkan_backend.h"
 
 namespace depthbench::cli {
 namespace {

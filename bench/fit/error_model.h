@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

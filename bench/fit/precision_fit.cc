@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/bands.h"
-#include "bench/text_table.h"
+#include "bench/pipeline/bands.h"
+#include "bench/base/text_table.h"
 
 namespace depthbench {
 namespace {

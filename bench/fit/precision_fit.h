@@ -18,10 +18,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backend.h"
+#include "bench/backends/backend.h"
 #include "bench/fit/error_model.h"
-#include "bench/results.h"
-#include "bench/sweep.h"
+#include "bench/results/results.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench {
 

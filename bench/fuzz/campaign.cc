@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/files.h"
-#include "bench/stats.h"
+#include "bench/base/files.h"
+#include "bench/pipeline/stats.h"
 
 namespace depthbench {
 namespace {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/backend.h"
+#include "bench/backends/backend.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
 

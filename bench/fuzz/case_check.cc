@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "bench/fuzz/fuzz_case.h"
-#include "bench/judge.h"
+#include "bench/pipeline/judge.h"
 
 namespace depthbench {
 

@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "bench/backend.h"
-#include "bench/batch.h"
-#include "bench/cells.h"
-#include "bench/sampler.h"
-#include "bench/status.h"
-#include "bench/thread_pool.h"
+#include "bench/backends/backend.h"
+#include "bench/pipeline/batch.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/sampler.h"
+#include "bench/base/status.h"
+#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 

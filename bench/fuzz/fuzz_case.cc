@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/files.h"
-#include "bench/formulas.h"
+#include "bench/base/files.h"
+#include "bench/numerics/formulas.h"
 
 namespace depthbench {
 namespace {

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <functional>
 
-#include "bench/backend.h"
+#include "bench/backends/backend.h"
 #include "bench/fuzz/fuzz_case.h"
 
 namespace depthbench {

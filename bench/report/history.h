@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "bench/baseline.h"
-#include "bench/status.h"
+#include "bench/gate/baseline.h"
+#include "bench/base/status.h"
 
 struct sqlite3;
 

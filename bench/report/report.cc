@@ -8,11 +8,11 @@
 
 #include <fmt/format.h>
 
-#include "bench/bands.h"
-#include "bench/choose.h"
-#include "bench/environment.h"
-#include "bench/gate.h"
-#include "bench/repro.h"
+#include "bench/pipeline/bands.h"
+#include "bench/choose/choose.h"
+#include "bench/base/environment.h"
+#include "bench/gate/gate.h"
+#include "bench/sweep/repro.h"
 #include "bench/speed/trade.h"
 
 namespace depthbench {

@@ -25,14 +25,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backend.h"
-#include "bench/baseline.h"
+#include "bench/backends/backend.h"
+#include "bench/gate/baseline.h"
 #include "bench/fit/precision_fit.h"
 #include "bench/report/history.h"
-#include "bench/results.h"
+#include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
-#include "bench/status.h"
-#include "bench/sweep.h"
+#include "bench/base/status.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench {
 

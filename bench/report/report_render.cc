@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "bench/files.h"
+#include "bench/base/files.h"
 
 namespace depthbench {
 namespace {

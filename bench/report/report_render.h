@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

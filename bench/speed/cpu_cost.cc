@@ -6,11 +6,11 @@
 
 #include <fmt/format.h>
 
-#include "bench/backend_cpu.h"
-#include "bench/encode.h"
-#include "bench/shader_constants.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/pipeline/encode.h"
+#include "bench/pipeline/shader_constants.h"
 #include "bench/speed/depth_image.h"
-#include "bench/thread_pool.h"
+#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 namespace {

@@ -1,5 +1,5 @@
 // CPU cost: nanoseconds per reconstruction of the CPU backend's path (the
-// shared/ formulas in eight float32 SIMD lanes, bench/backend_cpu.cc), on
+// shared/ formulas in eight float32 SIMD lanes, bench/backends/cpu/cpu_backend.cc), on
 // one thread, over the pixels of the depth image the GPU passes read
 // (depth_image.h): ordinary depths, as a frame holds them. The backend is driven through its public interface, so
 // what is timed is exactly what `depthbench run` executes per cell.
@@ -10,11 +10,11 @@
 #include <span>
 #include <vector>
 
-#include "bench/backend.h"
-#include "bench/batch.h"
-#include "bench/cells.h"
+#include "bench/backends/backend.h"
+#include "bench/pipeline/batch.h"
+#include "bench/pipeline/cells.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

@@ -10,8 +10,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "bench/backend_cpu.h"
-#include "bench/cells.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/pipeline/cells.h"
 #include "bench/speed/cpu_cost.h"
 
 namespace depthbench {

@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/encode.h"
-#include "bench/shader_constants.h"
+#include "bench/pipeline/encode.h"
+#include "bench/pipeline/shader_constants.h"
 
 namespace depthbench {
 namespace {

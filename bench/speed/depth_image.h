@@ -3,19 +3,19 @@
 // far/near 1e4, the camera 100 units from the origin) at the pass's
 // resolution; every pixel an eye depth that grows up the screen with a
 // little per-pixel variation, encoded exactly as the accuracy bench encodes
-// (bench/encode.h) and packed into the texels of the Vulkan format.
+// (bench/pipeline/encode.h) and packed into the texels of the Vulkan format.
 #pragma once
 
 #include <cstdint>
 #include <span>
 #include <vector>
 
-#include "bench/cells.h"
-#include "bench/domain.h"
-#include "bench/formulas.h"
-#include "bench/sampler.h"
-#include "bench/status.h"
-#include "bench/thread_pool.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/numerics/formulas.h"
+#include "bench/pipeline/sampler.h"
+#include "bench/base/status.h"
+#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "bench/speed/timing_stats.h"
-#include "bench/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/shader_compiler.h"
 
 namespace depthbench {
 namespace {

@@ -38,10 +38,10 @@
 
 #include <vulkan/vulkan.h>
 
-#include "bench/cells.h"
+#include "bench/pipeline/cells.h"
 #include "bench/speed/depth_image.h"
-#include "bench/status.h"
-#include "bench/vulkan/vulkan_context.h"
+#include "bench/base/status.h"
+#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 

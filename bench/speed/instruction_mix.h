@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

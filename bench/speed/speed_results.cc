@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/files.h"
-#include "bench/json_reader.h"
+#include "bench/base/files.h"
+#include "bench/base/json_reader.h"
 
 namespace depthbench {
 

@@ -12,13 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backend.h"
-#include "bench/cells.h"
-#include "bench/domain.h"
+#include "bench/backends/backend.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
 #include "bench/speed/cpu_cost.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

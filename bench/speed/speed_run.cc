@@ -5,12 +5,12 @@
 
 #include <fmt/format.h>
 
-#include "bench/backend_cpu.h"
-#include "bench/environment.h"
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/base/environment.h"
 #include "bench/speed/depth_image.h"
 #include "bench/speed/trade.h"
-#include "bench/thread_pool.h"
-#include "bench/vulkan/shader_compiler.h"
+#include "bench/base/thread_pool.h"
+#include "bench/backends/vulkan/shader_compiler.h"
 
 namespace depthbench {
 

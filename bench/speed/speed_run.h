@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "bench/cells.h"
-#include "bench/domain.h"
-#include "bench/results.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/results/results.h"
 #include "bench/speed/cpu_cost.h"
 #include "bench/speed/gpu_pass_timer.h"
 #include "bench/speed/speed_results.h"
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "bench/text_table.h"
+#include "bench/base/text_table.h"
 
 namespace depthbench {
 namespace {

@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "bench/status.h"
+#include "bench/base/status.h"
 
 namespace depthbench {
 

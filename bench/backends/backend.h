@@ -1,0 +1,75 @@
+// Backend: executes reconstructions and returns raw world positions; it
+// never judges (the judge and the reference know nothing of backends).
+//
+// Lifecycle:
+//   1. create it for a device (MakeBackend below, or a backend's own
+//      factory that accepts an existing device);
+//   2. Prepare(cells) once: whatever running those cells needs (the Vulkan
+//      backend compiles the shaders and builds pipelines here);
+//   3. Run(batch, which, scratch) any number of times: the listed cells'
+//      world positions for every sample of the batch.
+// Every backend today runs the compute form (the rasterizer's interpolation
+// computed per pixel); PassKind leaves room for a raster mode that draws
+// real vertex/fragment passes, and for an on-device mode that samples and
+// judges on the GPU, without changing this interface's callers.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bench/pipeline/batch.h"
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+struct DeviceInfo {
+  std::string name;    // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
+  std::string driver;  // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
+  std::string api;     // "Vulkan 1.3.230"
+  std::string kind;    // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
+  std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
+};
+
+enum class PassKind { kCompute };
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  virtual std::string name() const = 0;  // "cpu", "vulkan"
+  virtual const DeviceInfo& device() const = 0;
+
+  virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
+
+  // World positions of the prepared cells listed in `which` (indices into
+  // Prepare's list) for every sample of `batch`, component by component:
+  // element ((k * 3 + c) * batch.count + i) is component c (x, y, z) of
+  // sample i for the k-th listed cell. The storage is `scratch` or the
+  // backend's own, valid until the next Run on the same thread.
+  virtual Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                               std::vector<float>& scratch) = 0;
+
+  // Whether Run may be called from several threads at once (with disjoint
+  // scratch). The sweep then spreads cells over threads.
+  virtual bool concurrent() const = 0;
+};
+
+// Options that select and configure a backend.
+struct BackendOptions {
+  std::string device;           // Vulkan: device name (substring, case-insensitive); "" picks lavapipe
+  std::string shader_dir;       // Vulkan: where the shaders/ sources are ("" = built-in default)
+  bool validation = false;      // Vulkan: enable VK_LAYER_KHRONOS_validation, fail on its messages
+  // Vulkan: samples each compute invocation reconstructs (a divisor of the
+  // samples per frame), and frames each workgroup takes in turn; 0 picks by
+  // device type: 8 and 8 on a CPU device, 1 and 1 on a GPU.
+  std::uint32_t samples_per_invocation = 0;
+  std::uint32_t frames_per_workgroup = 0;
+};
+
+// "cpu" or "vulkan".
+Expected<std::unique_ptr<Backend>> MakeBackend(const std::string& name, const BackendOptions& options);
+
+}  // namespace depthbench

@@ -1,0 +1,181 @@
+#include "bench/backends/vulkan/shader_compiler.h"
+
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <regex>
+#include <sstream>
+#include <type_traits>
+#include <utility>
+
+#include <fmt/format.h>
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+#include <glslang/build_info.h>
+
+namespace depthbench {
+namespace {
+
+// GlslangToSpv fills a std::vector<unsigned int>; we hand out uint32_t words.
+static_assert(std::is_same_v<unsigned int, std::uint32_t>, "SPIR-V words are 32-bit unsigned int");
+
+// Vulkan semantics and SPIR-V rules, as glslangValidator -V applies them.
+constexpr EShMessages kMessages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
+// Used only where a shader has no #version line.
+constexpr int kDefaultGlslVersion = 450;
+// The name glslang reports for source text that does not come from a file.
+constexpr char kInlineSourceName[] = "<inline source>";
+
+// glslang keeps process-wide tables that must exist before the first TShader,
+// whichever thread compiles first; a function-local static runs exactly once.
+void EnsureGlslangInitialized() {
+  static const bool initialized = glslang::InitializeProcess();
+  (void)initialized;
+}
+
+Expected<std::string> ReadSourceFile(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    return NotFound(fmt::format("shader source '{}' does not exist", path.string()));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return IoError(fmt::format("cannot open shader source '{}'", path.string()));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return IoError(fmt::format("cannot read shader source '{}'", path.string()));
+  return text;
+}
+
+// Resolves `#include "name"` relative to the directory of the including
+// file. glslang passes the including file's name: the root source's name for
+// the top-level file, and for an included file the name this includer gave
+// it, which is its normalized path, so nested includes and error messages
+// see real paths.
+class RelativeIncluder final : public glslang::TShader::Includer {
+ public:
+  RelativeIncluder(std::string root_name, std::filesystem::path root_dir)
+      : root_name_(std::move(root_name)), root_dir_(std::move(root_dir)) {}
+
+  IncludeResult* includeLocal(const char* header_name, const char* includer_name, size_t) override {
+    const std::filesystem::path base =
+        root_name_ == includer_name ? root_dir_ : std::filesystem::path(includer_name).parent_path();
+    const std::filesystem::path path = (base / header_name).lexically_normal();
+    Expected<std::string> text = ReadSourceFile(path);
+    // A null result makes glslang report the directive's file and line.
+    if (!text.ok()) return nullptr;
+    auto* contents = new std::string(std::move(text).value());
+    return new IncludeResult(path.string(), contents->data(), contents->size(), contents);
+  }
+
+  void releaseInclude(IncludeResult* result) override {
+    if (result == nullptr) return;
+    delete static_cast<std::string*>(result->userData);
+    delete result;
+  }
+
+ private:
+  std::string root_name_;
+  std::filesystem::path root_dir_;
+};
+
+// glslang's info log says "ERROR: <file>:<line>: <message>"; compilers and
+// editors expect "<file>:<line>: error: <message>". Lines without a location
+// (link errors) get the root source's name; the closing error count adds
+// nothing.
+std::string FormatInfoLog(const std::string& log, const std::string& source_name) {
+  static const std::regex kLocated(R"(^(ERROR|WARNING): (.+?):(\d+): (.*)$)");
+  static const std::regex kSummary(R"(^ERROR: \d+ compilation errors?\..*$)");
+  std::istringstream lines(log);
+  std::string formatted;
+  std::string line;
+  std::smatch match;
+  while (std::getline(lines, line)) {
+    line.erase(line.find_last_not_of(" \t\r") + 1);
+    if (line.empty() || std::regex_match(line, kSummary)) continue;
+    if (!formatted.empty()) formatted += '\n';
+    if (std::regex_match(line, match, kLocated)) {
+      const char* severity = match[1] == "ERROR" ? "error" : "warning";
+      formatted += fmt::format("{}:{}: {}: {}", match[2].str(), match[3].str(), severity, match[4].str());
+    } else {
+      const std::string_view kErrorPrefix = "ERROR: ";
+      const std::string_view message =
+          line.starts_with(kErrorPrefix) ? std::string_view(line).substr(kErrorPrefix.size()) : line;
+      formatted += fmt::format("{}: error: {}", source_name, message);
+    }
+  }
+  return formatted.empty() ? fmt::format("{}: error: glslang failed without a message", source_name) : formatted;
+}
+
+// A parsed and linked compute shader. The program refers to the shader, so
+// it is declared after it and destroyed before it.
+struct LinkedShader {
+  glslang::TShader shader{EShLangCompute};
+  glslang::TProgram program;
+};
+
+// `root_name` is what glslang reports for the source (its path, for a file);
+// includes in it resolve relative to `root_dir`.
+Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, const std::string& root_name,
+                                                     const std::filesystem::path& root_dir) {
+  EnsureGlslangInitialized();
+  auto linked = std::make_unique<LinkedShader>();
+  const char* text = source.data();
+  const int length = static_cast<int>(source.size());
+  const char* name = root_name.c_str();
+  glslang::TShader& shader = linked->shader;
+  shader.setStringsWithLengthsAndNames(&text, &length, &name, 1);
+  shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
+  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
+  RelativeIncluder includer(root_name, root_dir);
+  if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, kMessages, includer)) {
+    return CompileError(FormatInfoLog(shader.getInfoLog(), root_name));
+  }
+  linked->program.addShader(&shader);
+  if (!linked->program.link(kMessages)) {
+    return CompileError(FormatInfoLog(linked->program.getInfoLog(), root_name));
+  }
+  return linked;
+}
+
+}  // namespace
+
+std::string GlslangVersion() {
+  return fmt::format("glslang {}.{}.{}{}", GLSLANG_VERSION_MAJOR, GLSLANG_VERSION_MINOR, GLSLANG_VERSION_PATCH,
+                     GLSLANG_VERSION_FLAVOR);
+}
+
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path) {
+  DB_ASSIGN_OR_RETURN(const std::string source, ReadSourceFile(path));
+  const std::string name = path.string();
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path()));
+  std::vector<std::uint32_t> spirv;
+  spv::SpvBuildLogger logger;
+  glslang::SpvOptions options;
+  glslang::GlslangToSpv(*linked->program.getIntermediate(EShLangCompute), spirv, &logger, &options);
+  if (spirv.empty()) {
+    return CompileError(fmt::format("{}: error: SPIR-V generation failed: {}", name, logger.getAllMessages()));
+  }
+  return spirv;
+}
+
+Expected<std::vector<BufferMemberOffset>> ReflectBufferMembers(std::string_view source,
+                                                               const std::filesystem::path& include_dir) {
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked,
+                      ParseAndLink(std::string(source), kInlineSourceName, include_dir));
+  glslang::TProgram& program = linked->program;
+  // Unused members count too: the layout is the contract, not what one
+  // shader happens to read.
+  if (!program.buildReflection(EShReflectionAllBlockVariables | EShReflectionSeparateBuffers)) {
+    return Internal(fmt::format("{}: glslang could not build reflection", kInlineSourceName));
+  }
+  std::vector<BufferMemberOffset> members;
+  members.reserve(static_cast<std::size_t>(program.getNumBufferVariables()));
+  for (int i = 0; i < program.getNumBufferVariables(); ++i) {
+    const glslang::TObjectReflection& variable = program.getBufferVariable(i);
+    members.push_back({variable.name, variable.offset});
+  }
+  return members;
+}
+
+}  // namespace depthbench

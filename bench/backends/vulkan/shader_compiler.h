@@ -1,0 +1,42 @@
+// GLSL compute shaders to SPIR-V through glslang's C++ API, for Vulkan 1.1
+// (SPIR-V 1.3). `#include "..."` (GL_GOOGLE_include_directive) resolves
+// relative to the directory of the including file, so a copy of shaders/ and
+// shared/ compiles from the copy. Compile errors name the real path and line
+// of the file they occur in, included files too.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+// "glslang 12.0.0": the compiler the Vulkan backend's formulas go through.
+std::string GlslangVersion();
+
+// SPIR-V words of the compute shader in `path`. NotFound when the file does
+// not exist, IoError when it cannot be read, CompileError with glslang's
+// messages as "<path>:<line>: error: <message>" lines otherwise.
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path);
+
+// One member of a buffer block as glslang lays it out: its reflected name
+// ("frame.camera_world" for member camera_world of a block member `frame`)
+// and its byte offset from the start of the block.
+struct BufferMemberOffset {
+  std::string name;
+  int offset = 0;
+};
+
+// Compiles compute shader source text whose `#include "..."` directives
+// resolve relative to `include_dir`, and returns the offsets of every member
+// of its buffer blocks, used or not. glslang reflects only blocks the shader
+// uses, so main() must touch each block of interest. For checking that the
+// C++ structs of shared/params.h match the GLSL std430 layout.
+Expected<std::vector<BufferMemberOffset>> ReflectBufferMembers(std::string_view source,
+                                                               const std::filesystem::path& include_dir);
+
+}  // namespace depthbench

@@ -1,0 +1,490 @@
+#include "bench/backends/vulkan/vulkan_backend.h"
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "bench/numerics/formulas.h"
+#include "bench/backends/vulkan/shader_compiler.h"
+
+namespace depthbench {
+namespace {
+
+// shaders/compute_pass.glsl runs whole frames per workgroup: workgroup
+// size (specialization constant 0) times samples per invocation (constant 1)
+// is the samples per frame, and a workgroup takes `frames_per_workgroup`
+// frames (constant 2) in turn. On a CPU device (lavapipe) an invocation
+// loops over eight samples and reads its frame's constants once for them,
+// and a workgroup takes eight frames: lavapipe calls the C allocator at
+// the start of every workgroup (posix_memalign and malloc_consolidate,
+// called from its JIT code, took about 5% of a run at one frame per
+// workgroup). A GPU runs one sample per invocation and one frame per
+// workgroup.
+constexpr std::uint32_t kWorkgroupSizeConstant = 0;
+constexpr std::uint32_t kSamplesPerInvocationConstant = 1;
+constexpr std::uint32_t kFramesPerWorkgroupConstant = 2;
+struct PassShape {
+  std::uint32_t workgroup_size;
+  std::uint32_t samples_per_invocation;
+  std::uint32_t frames_per_workgroup;
+};
+constexpr std::uint32_t kCpuSamplesPerInvocation = 8;  // one SIMD group of lavapipe's 256-bit lanes per frame
+constexpr std::uint32_t kCpuFramesPerWorkgroup = 8;
+static_assert(kSamplesPerFrame % kCpuSamplesPerInvocation == 0);
+// `options` may request either number (0: by device type).
+Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, const BackendOptions& options) {
+  const bool cpu = type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const std::uint32_t per_invocation =
+      options.samples_per_invocation != 0 ? options.samples_per_invocation : cpu ? kCpuSamplesPerInvocation : 1;
+  const std::uint32_t frames =
+      options.frames_per_workgroup != 0 ? options.frames_per_workgroup : cpu ? kCpuFramesPerWorkgroup : 1;
+  if (kSamplesPerFrame % per_invocation != 0) {
+    return InvalidArgument(fmt::format("{} samples per invocation do not divide the {} samples of a frame",
+                                       per_invocation, kSamplesPerFrame));
+  }
+  return PassShape{kSamplesPerFrame / per_invocation, per_invocation, frames};
+}
+
+std::uint32_t WorkgroupsFor(const Batch& batch, const PassShape& shape) {
+  return static_cast<std::uint32_t>((batch.frame_count() + shape.frames_per_workgroup - 1) /
+                                    shape.frames_per_workgroup);
+}
+
+// Where a batch's samples lie in the per-sample slices (one per depth
+// slot for the stored depths, one per cell and component for the
+// positions). The quad form of the pass moves four consecutive samples
+// of a frame at once, from an element that is a multiple of four: there
+// the samples start `lead` elements into their slices, so that frame
+// positions and elements agree modulo four, and the slices are padded to
+// whole quads.
+struct SliceLayout {
+  std::uint32_t lead = 0;
+  std::uint32_t length = 0;
+  bool compact(const Batch& batch) const { return lead == 0 && length == batch.count; }
+};
+SliceLayout SliceLayoutFor(const Batch& batch, const PassShape& shape) {
+  if (shape.samples_per_invocation % 4 != 0) return {0, batch.count};
+  const std::uint32_t lead = batch.first_offset % 4;
+  return {lead, (lead + batch.count + 3) / 4 * 4};
+}
+
+// The storage buffers of shaders/compute_pass.glsl, by binding number.
+enum Binding : std::uint32_t {
+  kFrames,
+  kDepthParams,
+  kPixels,
+  kStoredDepths,
+  kCellSlices,
+  kPositions,  // the only output
+  kBindingCount,
+};
+using BindingBytes = std::array<VkDeviceSize, kBindingCount>;
+
+std::size_t DepthSlotsOf(const Batch& batch) { return batch.depths.size() / batch.count; }
+
+// Bytes each binding holds for a batch of `cells` cells.
+BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t cells) {
+  return {batch.frame_params.size() * sizeof(f32::FrameParams), batch.depth_params.size() * sizeof(f32::DepthParams),
+          std::size_t{slices.length} * sizeof(std::uint32_t),
+          DepthSlotsOf(batch) * slices.length * sizeof(float), cells * sizeof(f32::CellSlice),
+          cells * 3 * slices.length * sizeof(float)};
+}
+
+// The push constants of a dispatch whose cells start at CellSlice entry
+// `first_cell`.
+f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slices, std::uint32_t first_cell) {
+  return {.slice_length = slices.length,
+          .samples_per_frame = kSamplesPerFrame,
+          .conventions_per_frame = kHardwareConventionCount,
+          .first_in_frame = batch.first_offset - slices.lead,
+          .frame_count = static_cast<std::uint32_t>(batch.frame_count()),
+          .first_cell = first_cell,
+          .reserved0 = 0,
+          .reserved1 = 0};
+}
+
+std::size_t VariantIndex(Variant variant) { return static_cast<std::size_t>(variant); }
+
+// A run's dispatches, one per variant among the listed cells, and the
+// CellSlice entries they read: one dispatch's entries are consecutive. A
+// cell writes the output slices of its place k in the list, whatever its
+// dispatch.
+struct DispatchPlan {
+  struct Dispatch {
+    Variant variant;
+    std::uint32_t first_cell, cells;
+  };
+  std::vector<Dispatch> dispatches;
+  std::vector<f32::CellSlice> cell_slices;
+};
+DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std::uint32_t> which,
+                            const SliceLayout& slices) {
+  DispatchPlan plan;
+  for (std::size_t v = 0; v < kVariantCount; ++v) {
+    const auto first = static_cast<std::uint32_t>(plan.cell_slices.size());
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      const CellPlan& cell = cells[which[k]];
+      if (VariantIndex(cell.cell.variant) != v) continue;
+      plan.cell_slices.push_back({.convention_slot = cell.convention_slot,
+                                  .depth_offset = cell.depth_slot * slices.length,
+                                  .output_offset = static_cast<std::uint32_t>(k * slices.length * 3),
+                                  .reserved = 0});
+    }
+    const auto count = static_cast<std::uint32_t>(plan.cell_slices.size()) - first;
+    if (count > 0) plan.dispatches.push_back({static_cast<Variant>(v), first, count});
+  }
+  return plan;
+}
+
+class VulkanBackend final : public Backend {
+ public:
+  static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
+                                                   const BackendOptions& options);
+  ~VulkanBackend() override;
+
+  std::string name() const override { return "vulkan"; }
+  const DeviceInfo& device() const override { return device_; }
+  // One command buffer, one fence and one set of buffers: one Run at a time.
+  bool concurrent() const override { return false; }
+
+  Status Prepare(std::span<const CellPlan> cells, PassKind pass) override;
+  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                       std::vector<float>& scratch) override;
+
+ private:
+  VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
+                const BackendOptions& options);
+
+  VkDevice vk_device() const { return context_->device(); }
+  std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
+
+  // The objects every run uses, whatever the cells.
+  Status CreateDescriptorObjects();
+  Status CreateCommandObjects();
+
+  Status PrepareOnDevice(std::span<const CellPlan> cells);
+  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape) const;
+
+  Expected<std::span<const float>> RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+                                               std::vector<float>& scratch);
+  Status CheckRun(const Batch& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
+  Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
+  Status Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+                std::span<const f32::CellSlice> cell_slices);
+  void BindBuffers(const BindingBytes& bytes);
+  Status Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan);
+  Status SubmitAndWait();
+  // Internal when the validation layer reported errors since `errors_before`.
+  Status CheckValidation(std::uint64_t errors_before, std::string_view during) const;
+
+  std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
+  std::filesystem::path shader_dir_;
+  BackendOptions options_;                // the requested pass shape (PassShapeFor)
+  PassShape shape_{kSamplesPerFrame, 1, 1};  // of the prepared pipelines
+  DeviceInfo device_;
+  std::vector<CellPlan> cells_;
+
+  DeviceObject<VkDescriptorSetLayout> set_layout_;
+  DeviceObject<VkPipelineLayout> pipeline_layout_;
+  DeviceObject<VkDescriptorPool> descriptor_pool_;
+  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;  // freed with the pool
+  DeviceObject<VkFence> fence_;
+  // From the context's pool; the destructor frees it.
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  // Indexed by Variant; null for variants no prepared cell uses.
+  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines_;
+  std::array<VulkanBuffer, kBindingCount> buffers_;
+};
+
+VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
+                             const BackendOptions& options)
+    : context_(std::move(context)), shader_dir_(std::move(shader_dir)), options_(options) {
+  const VulkanDeviceProperties& properties = context_->properties();
+  device_.name = properties.name;
+  device_.driver = properties.DriverString();
+  device_.api = "Vulkan " + VulkanVersionString(properties.api_version);
+  device_.kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu";
+  device_.compiler = GlslangVersion();
+}
+
+Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanContext> context,
+                                                         const BackendOptions& options) {
+  if (context == nullptr) return InvalidArgument("the Vulkan backend needs a Vulkan context");
+  std::filesystem::path shader_dir = options.shader_dir.empty()
+                                         ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
+                                         : std::filesystem::path(options.shader_dir);
+  std::unique_ptr<VulkanBackend> backend(
+      new VulkanBackend(std::move(context), std::move(shader_dir), options));
+  const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
+  Status status = backend->CreateDescriptorObjects();
+  if (status.ok()) status = backend->CreateCommandObjects();
+  if (status.ok()) status = backend->CheckValidation(errors_before, "backend creation");
+  if (!status.ok()) return status.WithContext(backend->DeviceContext());
+  return std::unique_ptr<Backend>(std::move(backend));
+}
+
+VulkanBackend::~VulkanBackend() {
+  // A run that failed after submitting may still be executing.
+  if (context_->queue() != VK_NULL_HANDLE) vkQueueWaitIdle(context_->queue());
+  if (command_buffer_ != VK_NULL_HANDLE) {
+    vkFreeCommandBuffers(vk_device(), context_->command_pool(), 1, &command_buffer_);
+  }
+}
+
+Status VulkanBackend::CreateDescriptorObjects() {
+  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  }
+  DB_ASSIGN_OR_RETURN(ComputeLayout layout, context_->CreateComputeLayout(bindings, sizeof(f32::PassConstants)));
+  set_layout_ = std::move(layout.set_layout);
+  pipeline_layout_ = std::move(layout.pipeline_layout);
+  descriptor_pool_ = std::move(layout.pool);
+  descriptor_set_ = layout.set;
+  return Status::Ok();
+}
+
+Status VulkanBackend::CreateCommandObjects() { return context_->CreateCommandObjects(command_buffer_, fence_); }
+
+Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  Status status = PrepareOnDevice(cells);
+  if (status.ok()) status = CheckValidation(errors_before, "Prepare");
+  return status.WithContext(DeviceContext());
+}
+
+Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(shader_dir_, error)) {
+    return NotFound(fmt::format("shader directory '{}' does not exist", shader_dir_.string()));
+  }
+  // Built aside so that a failure leaves the previous preparation intact.
+  DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
+  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
+  for (const CellPlan& plan : cells) {
+    DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
+    if (pipeline.get() != VK_NULL_HANDLE) continue;
+    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape));
+  }
+  pipelines_ = std::move(pipelines);
+  shape_ = shape;
+  cells_.assign(cells.begin(), cells.end());
+  return Status::Ok();
+}
+
+Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape) const {
+  const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
+  const std::array<VkSpecializationMapEntry, 3> entries = {
+      VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
+      VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
+                               sizeof(std::uint32_t)},
+      VkSpecializationMapEntry{kFramesPerWorkgroupConstant, offsetof(PassShape, frames_per_workgroup),
+                               sizeof(std::uint32_t)}};
+  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                                            sizeof(shape), &shape};
+  return context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
+                                         fmt::format("'{}'", path.string()));
+}
+
+// The positions stay in the mapped readback buffer when their slices are
+// compact; otherwise they are gathered into `scratch`.
+Expected<std::span<const float>> VulkanBackend::Run(const Batch& batch, std::span<const std::uint32_t> which,
+                                                    std::vector<float>& scratch) {
+  Expected<std::span<const float>> positions = RunOnDevice(batch, which, scratch);
+  if (!positions.ok()) return positions.status().WithContext(DeviceContext());
+  return positions;
+}
+
+Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+                                                            std::vector<float>& scratch) {
+  const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
+  if (output_floats == 0) return std::span<const float>();
+  const SliceLayout slices = SliceLayoutFor(batch, shape_);
+  const BindingBytes bytes = BytesFor(batch, slices, which.size());
+  DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
+  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const DispatchPlan plan = PlanDispatches(cells_, which, slices);
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
+  DB_RETURN_IF_ERROR(Record(batch, slices, plan));
+  DB_RETURN_IF_ERROR(SubmitAndWait());
+  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "Run"));
+  const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
+  if (slices.compact(batch)) return std::span<const float>(device_positions, output_floats);
+  // Every slice's samples, without the lead and the padding.
+  scratch.resize(output_floats);
+  for (std::size_t slice = 0; slice < 3 * which.size(); ++slice) {
+    std::memcpy(scratch.data() + slice * batch.count, device_positions + slice * slices.length + slices.lead,
+                batch.count * sizeof(float));
+  }
+  return std::span<const float>(scratch);
+}
+
+// What the shaders would otherwise read or write out of bounds, and what
+// the device cannot address or dispatch.
+Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t> which,
+                               const BindingBytes& bytes) const {
+  const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
+  if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
+      batch.pixels.size() < batch.count || batch.depths.size() % batch.count != 0) {
+    return InvalidArgument(
+        fmt::format("batch of {} samples has {} frame parameters, {} depth parameters, {} "
+                    "pixels and {} stored depths; it needs {}, {}, {} and a multiple of {}",
+                    batch.count, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(),
+                    batch.depths.size(), frames, frames * kHardwareConventionCount, batch.count, batch.count));
+  }
+  for (std::uint32_t index : which) {
+    if (index >= cells_.size()) {
+      return InvalidArgument(fmt::format("cell index {} out of range; {} cells prepared", index, cells_.size()));
+    }
+    const std::size_t depths_needed = (std::size_t{cells_[index].depth_slot} + 1) * batch.count;
+    if (batch.depths.size() < depths_needed) {
+      return InvalidArgument(fmt::format("cell {} reads {} stored depths; the batch has {}", cells_[index].cell.Name(),
+                                         depths_needed, batch.depths.size()));
+    }
+  }
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  const std::uint32_t groups = WorkgroupsFor(batch, shape_);
+  if (groups > limits.maxComputeWorkGroupCount[0]) {
+    return InvalidArgument(fmt::format("a batch of {} samples needs {} workgroups; the device dispatches at most {}",
+                                       batch.count, groups, limits.maxComputeWorkGroupCount[0]));
+  }
+  // A dispatch runs one variant's cells, a workgroup row each.
+  if (which.size() > limits.maxComputeWorkGroupCount[1]) {
+    return InvalidArgument(fmt::format("{} cells at once need as many workgroup rows; the device dispatches at most {}",
+                                       which.size(), limits.maxComputeWorkGroupCount[1]));
+  }
+  // Within this limit every element offset also fits the shaders' uints.
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    if (bytes[binding] > limits.maxStorageBufferRange) {
+      return InvalidArgument(
+          fmt::format("binding {} needs {} bytes; the device binds at most {} (run fewer samples "
+                      "or cells at once)",
+                      binding, bytes[binding], limits.maxStorageBufferRange));
+    }
+  }
+  return Status::Ok();
+}
+
+Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
+  VulkanBuffer& buffer = buffers_[binding];
+  if (buffer.size() >= bytes) return Status::Ok();
+  // Growing geometrically keeps reallocations rare when batches vary a little.
+  const VkDeviceSize size = std::max(bytes, buffer.size() + buffer.size() / 2);
+  const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
+  // The previous run has completed (Run waits), so the old buffer can go.
+  buffer = VulkanBuffer();
+  DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, access));
+  return Status::Ok();
+}
+
+Status VulkanBackend::Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+                             std::span<const f32::CellSlice> cell_slices) {
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
+  }
+  std::memcpy(buffers_[kFrames].mapped(), batch.frame_params.data(), bytes[kFrames]);
+  std::memcpy(buffers_[kDepthParams].mapped(), batch.depth_params.data(), bytes[kDepthParams]);
+  std::memcpy(buffers_[kCellSlices].mapped(), cell_slices.data(), bytes[kCellSlices]);
+  // The per-sample inputs, slice by slice; the lead and the padding are
+  // zeros (the shader reconstructs them too, into positions nobody reads).
+  static_assert(sizeof(batch.pixels[0]) == 4 && sizeof(batch.depths[0]) == 4);
+  const auto put_slice = [&](Binding binding, std::size_t slice, const void* samples) {
+    auto* to = static_cast<std::byte*>(buffers_[binding].mapped()) + slice * slices.length * 4;
+    const std::size_t end = std::size_t{slices.lead} + batch.count;
+    std::memset(to, 0, std::size_t{slices.lead} * 4);
+    std::memcpy(to + std::size_t{slices.lead} * 4, samples, std::size_t{batch.count} * 4);
+    std::memset(to + end * 4, 0, (slices.length - end) * 4);
+  };
+  put_slice(kPixels, 0, batch.pixels.data());
+  for (std::size_t slot = 0; slot < DepthSlotsOf(batch); ++slot) {
+    put_slice(kStoredDepths, slot, batch.depths.data() + slot * batch.count);
+  }
+  for (std::uint32_t binding = 0; binding < kPositions; ++binding) {
+    DB_RETURN_IF_ERROR(buffers_[binding].FlushHostWrites());
+  }
+  BindBuffers(bytes);
+  return Status::Ok();
+}
+
+// Points the descriptors at exactly the bytes this run uses: buffers may
+// have been reallocated, and a range past the data would hide overruns.
+void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
+  std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
+  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+  for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+    infos[binding] = {buffers_[binding].handle(), 0, bytes[binding]};
+    writes[binding].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[binding].dstSet = descriptor_set_;
+    writes[binding].dstBinding = binding;
+    writes[binding].descriptorCount = 1;
+    writes[binding].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[binding].pBufferInfo = &infos[binding];
+  }
+  vkUpdateDescriptorSets(vk_device(), kBindingCount, writes.data(), 0, nullptr);
+}
+
+Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan) {
+  VkCommandBufferBeginInfo begin_info{};
+  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
+                          &descriptor_set_, 0, nullptr);
+  const std::uint32_t groups = WorkgroupsFor(batch, shape_);
+  // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
+  for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
+    const VkPipeline pipeline = pipelines_[VariantIndex(dispatch.variant)].get();
+    vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    const f32::PassConstants constants = PassConstantsFor(batch, slices, dispatch.first_cell);
+    vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(constants),
+                       &constants);
+    vkCmdDispatch(command_buffer_, groups, dispatch.cells, 1);
+  }
+  // The host reads the positions once the fence signals.
+  VkMemoryBarrier to_host{};
+  to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
+  return CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer");
+}
+
+Status VulkanBackend::SubmitAndWait() {
+  DB_RETURN_IF_ERROR(context_->SubmitAndWait(command_buffer_, fence_));
+  return buffers_[kPositions].InvalidateForHostReads();
+}
+
+Status VulkanBackend::CheckValidation(std::uint64_t errors_before, std::string_view during) const {
+  const std::shared_ptr<ValidationLog> log = context_->validation_log();
+  const std::uint64_t errors = log->error_count() - errors_before;
+  if (errors == 0) return Status::Ok();
+  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) during {}; the last: {}", errors,
+                              during, log->last_error()));
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {
+  VulkanContextOptions context_options;
+  context_options.device = options.device;
+  context_options.validation = options.validation;
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> context, VulkanContext::Create(context_options));
+  return VulkanBackend::Create(std::move(context), options);
+}
+
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanContext> context,
+                                                     const BackendOptions& options) {
+  return VulkanBackend::Create(std::move(context), options);
+}
+
+}  // namespace depthbench

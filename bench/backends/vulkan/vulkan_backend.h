@@ -1,0 +1,23 @@
+// The Vulkan backend: the shaders/ compute shaders, compiled with glslang at
+// Prepare time and dispatched once per cell over a batch. Inputs go up and
+// positions come back through host-visible buffers; Run waits for the device.
+#pragma once
+
+#include <memory>
+
+#include "bench/backends/backend.h"
+#include "bench/backends/vulkan/vulkan_context.h"
+
+namespace depthbench {
+
+// A backend on the device that options.device names (lavapipe when empty),
+// with validation when options.validation or DEPTHBENCH_VALIDATION=1.
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options);
+
+// A backend on a device the caller created. The caller may keep `context`,
+// for instance to read its validation log after the backend is gone;
+// options.device and options.validation do not apply (the context decided).
+Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanContext> context,
+                                                     const BackendOptions& options);
+
+}  // namespace depthbench

@@ -1,0 +1,572 @@
+#include "bench/backends/vulkan/vulkan_context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string_view>
+
+#include <fmt/format.h>
+
+namespace depthbench {
+namespace {
+
+constexpr char kValidationLayer[] = "VK_LAYER_KHRONOS_validation";
+constexpr char kValidationEnvironment[] = "DEPTHBENCH_VALIDATION";
+// The SPIR-V the shaders compile to (1.3) needs Vulkan 1.1. The instance asks
+// for 1.2 so that devices that have it report their driver's name.
+constexpr std::uint32_t kMinimumDeviceApi = VK_API_VERSION_1_1;
+constexpr std::uint32_t kInstanceApi = VK_API_VERSION_1_2;
+constexpr char kDriverHint[] =
+    "install mesa-vulkan-drivers for lavapipe (Mesa's CPU implementation), or point VK_ICD_FILENAMES "
+    "at a driver's ICD manifest (e.g. /usr/share/vulkan/icd.d/lvp_icd.x86_64.json)";
+
+std::string Lower(std::string_view text) {
+  std::string lower(text);
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return lower;
+}
+
+bool ValidationRequestedByEnvironment() {
+  const char* value = std::getenv(kValidationEnvironment);
+  return value != nullptr && std::string_view(value) == "1";
+}
+
+
+VKAPI_ATTR VkBool32 VKAPI_CALL RecordValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                       VkDebugUtilsMessageTypeFlagsEXT,
+                                                       const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                       void* user_data) {
+  const bool is_error = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) != 0;
+  const char* message = data != nullptr && data->pMessage != nullptr ? data->pMessage : "(no message)";
+  static_cast<ValidationLog*>(user_data)->Record(is_error,
+                                                 fmt::format("[{}] {}", is_error ? "error" : "warning", message));
+  // VK_FALSE: the call that triggered the message proceeds as the API says.
+  return VK_FALSE;
+}
+
+VkDebugUtilsMessengerCreateInfoEXT MessengerInfo(ValidationLog* log) {
+  VkDebugUtilsMessengerCreateInfoEXT info{};
+  info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  info.pfnUserCallback = RecordValidationMessage;
+  info.pUserData = log;
+  return info;
+}
+
+Status CheckValidationLayerInstalled() {
+  std::uint32_t count = 0;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkEnumerateInstanceLayerProperties(&count, nullptr), "vkEnumerateInstanceLayerProperties"));
+  std::vector<VkLayerProperties> layers(count);
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkEnumerateInstanceLayerProperties(&count, layers.data()), "vkEnumerateInstanceLayerProperties"));
+  for (const VkLayerProperties& layer : layers) {
+    if (std::strcmp(layer.layerName, kValidationLayer) == 0) return Status::Ok();
+  }
+  return Unavailable(
+      fmt::format("Vulkan validation was requested (--validation or {}=1) but the layer {} is not "
+                  "installed; install the Debian package vulkan-validationlayers",
+                  kValidationEnvironment, kValidationLayer));
+}
+
+// An instance; with `messenger_info`, one with the validation layer whose
+// messages during vkCreateInstance and vkDestroyInstance go to that
+// messenger too.
+Expected<VkInstance> NewInstance(const VkDebugUtilsMessengerCreateInfoEXT* messenger_info) {
+  VkApplicationInfo application{};
+  application.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+  application.pApplicationName = "depthbench";
+  application.pEngineName = "depthbench";
+  application.apiVersion = kInstanceApi;
+
+  const char* const layers[] = {kValidationLayer};
+  const char* const extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+  VkInstanceCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+  info.pApplicationInfo = &application;
+  if (messenger_info != nullptr) {
+    info.pNext = messenger_info;
+    info.enabledLayerCount = 1;
+    info.ppEnabledLayerNames = layers;
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = extensions;
+  }
+  VkInstance instance = VK_NULL_HANDLE;
+  const VkResult result = vkCreateInstance(&info, nullptr, &instance);
+  if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+    return Unavailable(
+        fmt::format("no Vulkan driver found (vkCreateInstance: {}); {}", VkResultName(result), kDriverHint));
+  }
+  DB_RETURN_IF_ERROR(CheckVk(result, "vkCreateInstance"));
+  return instance;
+}
+
+Expected<std::vector<VkPhysicalDevice>> EnumerateDevices(VkInstance instance) {
+  std::uint32_t count = 0;
+  DB_RETURN_IF_ERROR(CheckVk(vkEnumeratePhysicalDevices(instance, &count, nullptr), "vkEnumeratePhysicalDevices"));
+  std::vector<VkPhysicalDevice> devices(count);
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkEnumeratePhysicalDevices(instance, &count, devices.data()), "vkEnumeratePhysicalDevices"));
+  devices.resize(count);
+  if (devices.empty()) return Unavailable(fmt::format("no Vulkan devices found; {}", kDriverHint));
+  return devices;
+}
+
+std::vector<VkQueueFamilyProperties> QueueFamilies(VkPhysicalDevice device) {
+  std::uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+  return families;
+}
+
+// The queue family the context uses: the first that can run compute,
+// preferring one that can also write timestamps.
+std::optional<std::uint32_t> ChooseComputeQueueFamily(const std::vector<VkQueueFamilyProperties>& families) {
+  std::optional<std::uint32_t> chosen;
+  for (std::uint32_t i = 0; i < families.size(); ++i) {
+    if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
+    if (families[i].timestampValidBits > 0) return i;
+    if (!chosen) chosen = i;
+  }
+  return chosen;
+}
+
+struct DeviceCandidate {
+  VkPhysicalDevice handle = VK_NULL_HANDLE;
+  VulkanDeviceProperties properties;
+  bool has_compute_queue = false;
+};
+
+DeviceCandidate DescribeDevice(VkPhysicalDevice device) {
+  DeviceCandidate candidate;
+  candidate.handle = device;
+  VulkanDeviceProperties& properties = candidate.properties;
+
+  VkPhysicalDeviceProperties basic{};
+  vkGetPhysicalDeviceProperties(device, &basic);
+  properties.name = basic.deviceName;
+  properties.api_version = basic.apiVersion;
+  properties.driver_version = basic.driverVersion;
+  properties.type = basic.deviceType;
+  properties.limits = basic.limits;
+  if (basic.apiVersion >= VK_API_VERSION_1_2) {
+    VkPhysicalDeviceDriverProperties driver{};
+    driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+    VkPhysicalDeviceProperties2 extended{};
+    extended.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    extended.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(device, &extended);
+    properties.driver_id = driver.driverID;
+    properties.driver_name = driver.driverName;
+    properties.driver_info = driver.driverInfo;
+  }
+
+  const std::vector<VkQueueFamilyProperties> families = QueueFamilies(device);
+  if (std::optional<std::uint32_t> family = ChooseComputeQueueFamily(families)) {
+    candidate.has_compute_queue = true;
+    properties.queue_family = *family;
+    properties.queue_timestamp_valid_bits = families[*family].timestampValidBits;
+  }
+  return candidate;
+}
+
+bool IsLavapipe(const VulkanDeviceProperties& properties) {
+  return properties.driver_id == VK_DRIVER_ID_MESA_LLVMPIPE ||
+         Lower(properties.name).find("llvmpipe") != std::string::npos;
+}
+
+// The candidate `wanted` names (a case-insensitive substring of the device
+// name), or with no name lavapipe, else the first device.
+Expected<const DeviceCandidate*> SelectDevice(const std::vector<DeviceCandidate>& candidates,
+                                              const std::string& wanted) {
+  if (wanted.empty()) {
+    auto lavapipe = std::find_if(candidates.begin(), candidates.end(),
+                                 [](const DeviceCandidate& c) { return IsLavapipe(c.properties); });
+    return lavapipe != candidates.end() ? &*lavapipe : &candidates.front();
+  }
+  const std::string key = Lower(wanted);
+  std::string available;
+  for (const DeviceCandidate& candidate : candidates) {
+    if (Lower(candidate.properties.name).find(key) != std::string::npos) return &candidate;
+    available += (available.empty() ? "" : ", ") + candidate.properties.name;
+  }
+  return NotFound(fmt::format("no Vulkan device matches '{}'; available: {}", wanted, available));
+}
+
+}  // namespace
+
+std::string DeviceTypeName(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete gpu";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual gpu";
+    default: return "other";
+  }
+}
+
+std::string VkResultName(VkResult result) {
+  switch (result) {
+    case VK_SUCCESS: return "VK_SUCCESS";
+    case VK_NOT_READY: return "VK_NOT_READY";
+    case VK_TIMEOUT: return "VK_TIMEOUT";
+    case VK_EVENT_SET: return "VK_EVENT_SET";
+    case VK_EVENT_RESET: return "VK_EVENT_RESET";
+    case VK_INCOMPLETE: return "VK_INCOMPLETE";
+    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_MEMORY_MAP_FAILED: return "VK_ERROR_MEMORY_MAP_FAILED";
+    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_TOO_MANY_OBJECTS: return "VK_ERROR_TOO_MANY_OBJECTS";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED: return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    case VK_ERROR_FRAGMENTED_POOL: return "VK_ERROR_FRAGMENTED_POOL";
+    case VK_ERROR_UNKNOWN: return "VK_ERROR_UNKNOWN";
+    case VK_ERROR_OUT_OF_POOL_MEMORY: return "VK_ERROR_OUT_OF_POOL_MEMORY";
+    case VK_ERROR_INVALID_EXTERNAL_HANDLE: return "VK_ERROR_INVALID_EXTERNAL_HANDLE";
+    case VK_ERROR_FRAGMENTATION: return "VK_ERROR_FRAGMENTATION";
+    case VK_ERROR_INVALID_OPAQUE_CAPTURE_ADDRESS: return "VK_ERROR_INVALID_OPAQUE_CAPTURE_ADDRESS";
+    case VK_PIPELINE_COMPILE_REQUIRED: return "VK_PIPELINE_COMPILE_REQUIRED";
+    case VK_ERROR_VALIDATION_FAILED_EXT: return "VK_ERROR_VALIDATION_FAILED_EXT";
+    default: return fmt::format("VkResult({})", static_cast<int>(result));
+  }
+}
+
+Status CheckVk(VkResult result, const std::string& what) {
+  if (result == VK_SUCCESS) return Status::Ok();
+  return Unavailable(fmt::format("{} failed: {}", what, VkResultName(result)));
+}
+
+std::string VulkanVersionString(std::uint32_t version) {
+  return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(version), VK_API_VERSION_MINOR(version),
+                     VK_API_VERSION_PATCH(version));
+}
+
+std::string VulkanDeviceProperties::DriverString() const {
+  if (driver_name.empty()) return fmt::format("driver version {:#x}", driver_version);
+  return driver_info.empty() ? driver_name : driver_name + " " + driver_info;
+}
+
+Expected<std::vector<VulkanDeviceSummary>> ListVulkanDevices() {
+  DB_ASSIGN_OR_RETURN(VkInstance instance, NewInstance(nullptr));
+  Expected<std::vector<VkPhysicalDevice>> devices = EnumerateDevices(instance);
+  std::vector<VulkanDeviceSummary> summaries;
+  if (devices.ok()) {
+    for (VkPhysicalDevice device : *devices) {
+      const VulkanDeviceProperties properties = DescribeDevice(device).properties;
+      summaries.push_back({properties.name, DeviceTypeName(properties.type), properties.DriverString(),
+                           VulkanVersionString(properties.api_version)});
+    }
+  }
+  vkDestroyInstance(instance, nullptr);
+  if (!devices.ok()) return devices.status();
+  return summaries;
+}
+
+void ValidationLog::Record(bool is_error, std::string message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (is_error) {
+    ++error_count_;
+    last_error_ = message;
+  }
+  messages_.push_back(std::move(message));
+}
+
+std::vector<std::string> ValidationLog::TakeMessages() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return std::exchange(messages_, {});
+}
+
+std::uint64_t ValidationLog::error_count() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_count_;
+}
+
+std::string ValidationLog::last_error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_error_;
+}
+
+VulkanBuffer::VulkanBuffer(VulkanBuffer&& other) noexcept { *this = std::move(other); }
+
+VulkanBuffer& VulkanBuffer::operator=(VulkanBuffer&& other) noexcept {
+  if (this != &other) {
+    // The buffer goes before its memory, as the destructor does it.
+    buffer_ = std::move(other.buffer_);
+    memory_ = std::move(other.memory_);
+    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+    coherent_ = std::exchange(other.coherent_, false);
+  }
+  return *this;
+}
+
+Status VulkanBuffer::FlushHostWrites() const {
+  if (coherent_) return Status::Ok();
+  const VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, memory_.get(), 0, VK_WHOLE_SIZE};
+  return CheckVk(vkFlushMappedMemoryRanges(device_, 1, &range), "vkFlushMappedMemoryRanges");
+}
+
+Status VulkanBuffer::InvalidateForHostReads() const {
+  if (coherent_) return Status::Ok();
+  const VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, memory_.get(), 0, VK_WHOLE_SIZE};
+  return CheckVk(vkInvalidateMappedMemoryRanges(device_, 1, &range), "vkInvalidateMappedMemoryRanges");
+}
+
+Expected<std::unique_ptr<VulkanContext>> VulkanContext::Create(const VulkanContextOptions& options) {
+  std::unique_ptr<VulkanContext> context(new VulkanContext());
+  DB_RETURN_IF_ERROR(context->CreateInstance(options.validation || ValidationRequestedByEnvironment()));
+  DB_RETURN_IF_ERROR(context->PickPhysicalDevice(options.device));
+  DB_RETURN_IF_ERROR(context->CreateDevice().WithContext(context->properties_.name));
+  return context;
+}
+
+VulkanContext::~VulkanContext() {
+  if (device_ != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device_);
+    if (command_pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(device_, command_pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (messenger_ != VK_NULL_HANDLE) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(instance_, messenger_, nullptr);
+  }
+  if (instance_ != VK_NULL_HANDLE) vkDestroyInstance(instance_, nullptr);
+}
+
+Status VulkanContext::CreateInstance(bool validation) {
+  if (!validation) {
+    DB_ASSIGN_OR_RETURN(instance_, NewInstance(nullptr));
+    return Status::Ok();
+  }
+  DB_RETURN_IF_ERROR(CheckValidationLayerInstalled());
+  const VkDebugUtilsMessengerCreateInfoEXT messenger_info = MessengerInfo(validation_log_.get());
+  DB_ASSIGN_OR_RETURN(instance_, NewInstance(&messenger_info));
+  validation_enabled_ = true;
+  auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+  if (create == nullptr) {
+    return Unavailable("vkCreateDebugUtilsMessengerEXT is missing although VK_EXT_debug_utils is enabled");
+  }
+  return CheckVk(create(instance_, &messenger_info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+}
+
+Status VulkanContext::PickPhysicalDevice(const std::string& wanted) {
+  DB_ASSIGN_OR_RETURN(const std::vector<VkPhysicalDevice> devices, EnumerateDevices(instance_));
+  std::vector<DeviceCandidate> candidates;
+  candidates.reserve(devices.size());
+  for (VkPhysicalDevice device : devices) candidates.push_back(DescribeDevice(device));
+  DB_ASSIGN_OR_RETURN(const DeviceCandidate* chosen, SelectDevice(candidates, wanted));
+
+  const std::string& name = chosen->properties.name;
+  if (!chosen->has_compute_queue) return Unavailable(fmt::format("Vulkan device '{}' has no compute queue", name));
+  if (chosen->properties.api_version < kMinimumDeviceApi) {
+    return Unavailable(fmt::format("Vulkan device '{}' supports Vulkan {}; depthbench needs {}", name,
+                                   VulkanVersionString(chosen->properties.api_version),
+                                   VulkanVersionString(kMinimumDeviceApi)));
+  }
+  physical_device_ = chosen->handle;
+  properties_ = chosen->properties;
+  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+  return Status::Ok();
+}
+
+Status VulkanContext::CreateDevice() {
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{};
+  queue_info.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  queue_info.queueFamilyIndex = properties_.queue_family;
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+
+  VkDeviceCreateInfo device_info{};
+  device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  device_info.queueCreateInfoCount = 1;
+  device_info.pQueueCreateInfos = &queue_info;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDevice(physical_device_, &device_info, nullptr, &device_), "vkCreateDevice"));
+  vkGetDeviceQueue(device_, properties_.queue_family, 0, &queue_);
+
+  VkCommandPoolCreateInfo pool_info{};
+  pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  // Backends re-record one command buffer per run.
+  pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool_info.queueFamilyIndex = properties_.queue_family;
+  return CheckVk(vkCreateCommandPool(device_, &pool_info, nullptr, &command_pool_), "vkCreateCommandPool");
+}
+
+Expected<std::uint32_t> VulkanContext::FindMemoryType(std::uint32_t type_bits,
+                                                      std::initializer_list<VkMemoryPropertyFlags> candidates) const {
+  for (VkMemoryPropertyFlags wanted : candidates) {
+    for (std::uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i) {
+      const bool allowed = (type_bits & (1u << i)) != 0;
+      if (allowed && (memory_properties_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+    }
+  }
+  return Unavailable(
+      fmt::format("Vulkan device '{}' has no suitable memory type (allowed types {:#x})", properties_.name, type_bits));
+}
+
+Expected<VulkanBuffer> VulkanContext::CreateHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage,
+                                                       HostAccess access) const {
+  VulkanBuffer buffer;
+  buffer.device_ = device_;
+  buffer.size_ = size;
+
+  VkBufferCreateInfo buffer_info{};
+  buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  buffer_info.size = size;
+  buffer_info.usage = usage;
+  buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkBuffer handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateBuffer(device_, &buffer_info, nullptr, &handle), "vkCreateBuffer"));
+  buffer.buffer_ = DeviceObject<VkBuffer>(device_, handle, vkDestroyBuffer);
+
+  VkMemoryRequirements requirements{};
+  vkGetBufferMemoryRequirements(device_, handle, &requirements);
+  constexpr VkMemoryPropertyFlags kVisible = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
+  constexpr VkMemoryPropertyFlags kCoherent = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  constexpr VkMemoryPropertyFlags kCached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+  DB_ASSIGN_OR_RETURN(
+      const std::uint32_t memory_type,
+      access == HostAccess::kReadback
+          ? FindMemoryType(requirements.memoryTypeBits,
+                           {kVisible | kCoherent | kCached, kVisible | kCached, kVisible | kCoherent, kVisible})
+          : FindMemoryType(requirements.memoryTypeBits, {kVisible | kCoherent, kVisible}));
+
+  VkMemoryAllocateInfo allocate_info{};
+  allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  allocate_info.allocationSize = requirements.size;
+  allocate_info.memoryTypeIndex = memory_type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(device_, &allocate_info, nullptr, &memory),
+                             fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
+  buffer.memory_ = DeviceObject<VkDeviceMemory>(device_, memory, vkFreeMemory);
+  DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(device_, handle, memory, 0), "vkBindBufferMemory"));
+  DB_RETURN_IF_ERROR(CheckVk(vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped_), "vkMapMemory"));
+  buffer.coherent_ = (memory_properties_.memoryTypes[memory_type].propertyFlags & kCoherent) != 0;
+  return buffer;
+}
+
+Expected<ComputeLayout> VulkanContext::CreateComputeLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
+                                                           std::uint32_t push_constant_bytes) const {
+  ComputeLayout out;
+  VkDescriptorSetLayoutCreateInfo set_layout_info{};
+  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  set_layout_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
+  set_layout_info.pBindings = bindings.data();
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(device_, &set_layout_info, nullptr, &set_layout),
+                             "vkCreateDescriptorSetLayout"));
+  out.set_layout = DeviceObject<VkDescriptorSetLayout>(device_, set_layout, vkDestroyDescriptorSetLayout);
+
+  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
+  VkPipelineLayoutCreateInfo pipeline_layout_info{};
+  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pipeline_layout_info.setLayoutCount = 1;
+  pipeline_layout_info.pSetLayouts = &set_layout;
+  pipeline_layout_info.pushConstantRangeCount = push_constant_bytes > 0 ? 1 : 0;
+  pipeline_layout_info.pPushConstantRanges = &push_constants;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(device_, &pipeline_layout_info, nullptr, &pipeline_layout),
+                             "vkCreatePipelineLayout"));
+  out.pipeline_layout = DeviceObject<VkPipelineLayout>(device_, pipeline_layout, vkDestroyPipelineLayout);
+
+  // The pool holds exactly what the one set needs, type by type.
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (const VkDescriptorSetLayoutBinding& b : bindings) {
+    auto it = std::find_if(sizes.begin(), sizes.end(), [&](const auto& s) { return s.type == b.descriptorType; });
+    if (it == sizes.end()) {
+      sizes.push_back({b.descriptorType, b.descriptorCount});
+    } else {
+      it->descriptorCount += b.descriptorCount;
+    }
+  }
+  VkDescriptorPoolCreateInfo pool_info{};
+  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+  pool_info.pPoolSizes = sizes.data();
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorPool(device_, &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
+  out.pool = DeviceObject<VkDescriptorPool>(device_, pool, vkDestroyDescriptorPool);
+
+  VkDescriptorSetAllocateInfo set_info{};
+  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  set_info.descriptorPool = pool;
+  set_info.descriptorSetCount = 1;
+  set_info.pSetLayouts = &set_layout;
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateDescriptorSets(device_, &set_info, &out.set), "vkAllocateDescriptorSets"));
+  return out;
+}
+
+Status VulkanContext::CreateCommandObjects(VkCommandBuffer& command_buffer, DeviceObject<VkFence>& fence) const {
+  VkCommandBufferAllocateInfo command_info{};
+  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  command_info.commandPool = command_pool_;
+  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  command_info.commandBufferCount = 1;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkAllocateCommandBuffers(device_, &command_info, &command_buffer), "vkAllocateCommandBuffers"));
+  VkFenceCreateInfo fence_info{};
+  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VkFence handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device_, &fence_info, nullptr, &handle), "vkCreateFence"));
+  fence = DeviceObject<VkFence>(device_, handle, vkDestroyFence);
+  return Status::Ok();
+}
+
+Status VulkanContext::SubmitAndWait(VkCommandBuffer command_buffer, const DeviceObject<VkFence>& fence_object) const {
+  const VkFence fence = fence_object.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(device_, 1, &fence), "vkResetFences"));
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer;
+  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit"));
+  return CheckVk(vkWaitForFences(device_, 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()),
+                 "vkWaitForFences");
+}
+
+Expected<DeviceObject<VkPipeline>> VulkanContext::CreateComputePipeline(std::span<const std::uint32_t> spirv,
+                                                                        VkPipelineLayout layout,
+                                                                        const VkSpecializationInfo& specialization,
+                                                                        const std::string& what) const {
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+  module_info.pCode = spirv.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(device_, &module_info, nullptr, &module),
+                             "vkCreateShaderModule for " + what));
+  // The pipeline keeps what it needs; the module goes when this returns.
+  const DeviceObject<VkShaderModule> module_owner(device_, module, vkDestroyShaderModule);
+
+  VkComputePipelineCreateInfo pipeline_info{};
+  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeline_info.stage.module = module;
+  pipeline_info.stage.pName = "main";
+  pipeline_info.stage.pSpecializationInfo = &specialization;
+  pipeline_info.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
+                             "vkCreateComputePipelines for " + what));
+  return DeviceObject<VkPipeline>(device_, pipeline, vkDestroyPipeline);
+}
+
+}  // namespace depthbench

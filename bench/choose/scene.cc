@@ -1,0 +1,296 @@
+#include "bench/choose/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "bench/base/files.h"
+#include "bench/sweep/sweep.h"
+
+namespace depthbench {
+namespace {
+
+// Reads typed fields out of a TOML table; every error names the file,
+// line and column, the field, and what is allowed.
+class SceneReader {
+ public:
+  explicit SceneReader(std::string source) : source_(std::move(source)) {}
+
+  Status Error(const toml::node* node, const std::string& field, const std::string& message) const {
+    if (node != nullptr && node->source().begin.line > 0) {
+      return InvalidArgument(fmt::format("{}:{}:{}: {}: {}", source_, node->source().begin.line,
+                                         node->source().begin.column, field, message));
+    }
+    return InvalidArgument(fmt::format("{}: {}: {}", source_, field, message));
+  }
+
+  // Refuses keys a table does not know (most often a typo).
+  Status OnlyKeys(const toml::table& table, const std::string& where, std::initializer_list<std::string_view> keys) {
+    for (const auto& [key, node] : table) {
+      if (std::find(keys.begin(), keys.end(), key.str()) == keys.end()) {
+        std::string allowed;
+        for (auto k : keys) allowed += (allowed.empty() ? "" : ", ") + std::string(k);
+        return Error(&node, where.empty() ? std::string(key.str()) : where + "." + std::string(key.str()),
+                     "unknown field; allowed here: " + allowed);
+      }
+    }
+    return Status::Ok();
+  }
+
+  Expected<const toml::table*> Table(const toml::table& parent, const std::string& key, bool required) {
+    const toml::node* node = parent.get(key);
+    if (node == nullptr) {
+      if (required) return Error(&parent, "[" + key + "]", "missing table");
+      return static_cast<const toml::table*>(nullptr);
+    }
+    if (!node->is_table()) return Error(node, key, "expected a table [" + key + "]");
+    return node->as_table();
+  }
+
+  Expected<double> Number(const toml::node* node, const std::string& field) {
+    if (node == nullptr) return Error(nullptr, field, "missing");
+    if (auto v = node->value<double>()) return *v;
+    return Error(node, field, "expected a number");
+  }
+
+  // A number, or [min, max].
+  Expected<Range> NumberOrRange(const toml::node* node, const std::string& field) {
+    if (node == nullptr) return Error(nullptr, field, "missing");
+    if (const toml::array* a = node->as_array()) {
+      if (a->size() != 2) return Error(node, field, "expected a number or [min, max]");
+      DB_ASSIGN_OR_RETURN(double lo, Number(a->get(0), field + "[0]"));
+      DB_ASSIGN_OR_RETURN(double hi, Number(a->get(1), field + "[1]"));
+      return Range{lo, hi};
+    }
+    DB_ASSIGN_OR_RETURN(double v, Number(node, field));
+    return Range{v, v};
+  }
+
+  Status Check(const Range& range, const toml::node* node, const std::string& field, const RangeLimits& limits) {
+    Status s = CheckRange(range, field, limits);
+    if (s.ok()) return s;
+    // CheckRange starts with the field's name; keep its explanation.
+    std::string message = s.message().substr(field.size() + 2);
+    return Error(node, field, message);
+  }
+
+  // "any", or a list of names each `parse` accepts.
+  template <class T, class Parse>
+  Status Names(const toml::table& table, const std::string& key, const std::string& field, Parse parse,
+               std::vector<T>& out) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return Status::Ok();  // any
+    if (auto s = node->value<std::string>()) {
+      if (*s == "any") return Status::Ok();
+      return Error(node, field, "expected \"any\" or a list of names");
+    }
+    const toml::array* a = node->as_array();
+    if (a == nullptr || a->empty()) return Error(node, field, "expected \"any\" or a non-empty list of names");
+    for (const toml::node& item : *a) {
+      auto name = item.value<std::string>();
+      if (!name) return Error(&item, field, "expected a name (a string)");
+      Expected<T> parsed = parse(*name);
+      if (!parsed.ok()) return Error(&item, field, parsed.status().message());
+      out.push_back(*parsed);
+    }
+    return Status::Ok();
+  }
+
+ private:
+  std::string source_;
+};
+
+}  // namespace
+
+double Requirement::RelativeLimit() const {
+  switch (kind) {
+    case Kind::kAbsolute: return value / at_depth.value_or(1.0);
+    case Kind::kRelative: return value;
+    case Kind::kBitsLost: return std::ldexp(1.0, -24) * std::exp2(value);
+  }
+  return 0.0;
+}
+
+std::string Requirement::Describe() const {
+  std::string what;
+  switch (kind) {
+    case Kind::kAbsolute: what = fmt::format("absolute error <= {:g} world units", value); break;
+    case Kind::kRelative: what = fmt::format("relative error <= {:g}", value); break;
+    case Kind::kBitsLost: what = fmt::format("bits lost <= {:g}", value); break;
+  }
+  if (at_depth) what += fmt::format(" at eye depth {:g}", *at_depth);
+  return what + fmt::format(" ({})", LevelName(level));
+}
+
+std::vector<Cell> Scene::Candidates() const {
+  CellFilter filter{variants, conventions, formats};
+  std::vector<Cell> cells;
+  for (const Cell& c : AllCells())
+    if (filter.Keeps(c)) cells.push_back(c);
+  return CellsForDomain(cells, domain);
+}
+
+Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
+  SceneReader r(source);
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    return InvalidArgument(fmt::format("{}:{}:{}: not valid TOML: {}", source, e.source().begin.line,
+                                       e.source().begin.column, e.description()));
+  }
+  DB_RETURN_IF_ERROR(r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "engine", "requirement", "cost"}));
+  Scene scene;
+  scene.source = source;
+  scene.name = root["name"].value_or(std::string(std::filesystem::path(source).stem()));
+  Domain& d = scene.domain;
+
+  DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
+  DB_RETURN_IF_ERROR(
+      r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));
+  const toml::node* near_node = projection->get("near");
+  DB_ASSIGN_OR_RETURN(double near, r.Number(near_node, "projection.near"));
+  if (!(near > 0.0)) return r.Error(near_node, "projection.near", fmt::format("must be greater than 0 (got {:g})", near));
+  d.near = {near, near};
+  const toml::node* far_node = projection->get("far");
+  if (far_node == nullptr) return r.Error(projection, "projection.far", "missing (a number, or \"inf\")");
+  double far = INFINITY;
+  if (auto s = far_node->value<std::string>()) {
+    if (*s != "inf") return r.Error(far_node, "projection.far", "expected a number or \"inf\"");
+    d.finite_far = false;
+    d.infinite_far = true;
+  } else {
+    DB_ASSIGN_OR_RETURN(far, r.Number(far_node, "projection.far"));
+    if (!(far > near)) {
+      return r.Error(far_node, "projection.far",
+                     fmt::format("must be greater than near ({:g}); got {:g}", near, far));
+    }
+    d.far = Range{far, far};
+    d.finite_far = true;
+    d.infinite_far = false;
+  }
+  DB_ASSIGN_OR_RETURN(d.fov_degrees, r.NumberOrRange(projection->get("fov_degrees"), "projection.fov_degrees"));
+  DB_RETURN_IF_ERROR(r.Check(d.fov_degrees, projection->get("fov_degrees"), "projection.fov_degrees", kFovLimits));
+  DB_ASSIGN_OR_RETURN(d.aspect, r.NumberOrRange(projection->get("aspect"), "projection.aspect"));
+  DB_RETURN_IF_ERROR(r.Check(d.aspect, projection->get("aspect"), "projection.aspect", kAspectLimits));
+  if (const toml::node* res = projection->get("resolution")) {
+    const toml::array* a = res->as_array();
+    // value_exact: whole numbers only. toml++'s value<int64_t>() converts a
+    // float such as 1e300 to an integer before it checks the range, which is
+    // undefined behaviour (found by fuzz_scene).
+    auto w = a && a->size() == 2 ? a->get(0)->value_exact<std::int64_t>() : std::nullopt;
+    auto h = a && a->size() == 2 ? a->get(1)->value_exact<std::int64_t>() : std::nullopt;
+    if (!w || !h || *w < 1 || *h < 1 || *w > 65535 || *h > 65535) {
+      return r.Error(res, "projection.resolution", "expected [width, height] in pixels, 1 to 65535 each");
+    }
+    d.resolutions = {{static_cast<std::uint32_t>(*w), static_cast<std::uint32_t>(*h)}};
+  }
+
+  DB_ASSIGN_OR_RETURN(const toml::table* camera, r.Table(root, "camera", false));
+  d.camera_distance = {0.0, 0.0};
+  if (camera != nullptr) {
+    DB_RETURN_IF_ERROR(r.OnlyKeys(*camera, "camera", {"distance_from_origin"}));
+    if (const toml::node* node = camera->get("distance_from_origin")) {
+      DB_ASSIGN_OR_RETURN(d.camera_distance, r.NumberOrRange(node, "camera.distance_from_origin"));
+      DB_RETURN_IF_ERROR(r.Check(d.camera_distance, node, "camera.distance_from_origin", kCameraDistanceLimits));
+    }
+  }
+
+  DB_ASSIGN_OR_RETURN(const toml::table* depth, r.Table(root, "depth", false));
+  if (depth != nullptr) {
+    DB_RETURN_IF_ERROR(r.OnlyKeys(*depth, "depth", {"range"}));
+    if (const toml::node* node = depth->get("range")) {
+      DB_ASSIGN_OR_RETURN(Range range, r.NumberOrRange(node, "depth.range"));
+      const double limit = d.finite_far ? far : near * Domain::kInfiniteDepthSpan;
+      if (range.min < near || range.max > limit || range.min > range.max) {
+        return r.Error(node, "depth.range",
+                       fmt::format("must lie within [near, far] = [{:g}, {:g}]; got {}", near, limit,
+                                   range.ToString()));
+      }
+      d.eye_depth = range;
+    }
+  }
+
+  DB_ASSIGN_OR_RETURN(const toml::table* engine, r.Table(root, "engine", false));
+  if (engine != nullptr) {
+    DB_RETURN_IF_ERROR(r.OnlyKeys(*engine, "engine", {"variants", "conventions", "formats"}));
+    DB_RETURN_IF_ERROR(r.Names<Variant>(*engine, "variants", "engine.variants", ParseVariant, scene.variants));
+    DB_RETURN_IF_ERROR(
+        r.Names<Convention>(*engine, "conventions", "engine.conventions", ParseConvention, scene.conventions));
+    DB_RETURN_IF_ERROR(r.Names<Format>(*engine, "formats", "engine.formats", ParseFormat, scene.formats));
+  }
+
+  DB_ASSIGN_OR_RETURN(const toml::table* requirement, r.Table(root, "requirement", true));
+  DB_RETURN_IF_ERROR(r.OnlyKeys(*requirement, "requirement",
+                                {"absolute_error", "relative_error", "bits_lost", "at_depth", "level"}));
+  Requirement& req = scene.requirement;
+  int kinds = 0;
+  for (const auto& [key, kind] : {std::pair{"absolute_error", Requirement::Kind::kAbsolute},
+                                  std::pair{"relative_error", Requirement::Kind::kRelative},
+                                  std::pair{"bits_lost", Requirement::Kind::kBitsLost}}) {
+    const toml::node* node = requirement->get(key);
+    if (node == nullptr) continue;
+    ++kinds;
+    req.kind = kind;
+    DB_ASSIGN_OR_RETURN(req.value, r.Number(node, std::string("requirement.") + key));
+    if (!(req.value > 0.0) && kind != Requirement::Kind::kBitsLost) {
+      return r.Error(node, std::string("requirement.") + key, "must be greater than 0");
+    }
+    if (kind == Requirement::Kind::kBitsLost && !(req.value >= 0.0 && req.value <= 24.0)) {
+      return r.Error(node, "requirement.bits_lost", "must lie in [0, 24]");
+    }
+  }
+  if (kinds != 1) {
+    return r.Error(requirement, "[requirement]",
+                   "needs exactly one of absolute_error (world units), relative_error, bits_lost");
+  }
+  if (const toml::node* node = requirement->get("at_depth")) {
+    DB_ASSIGN_OR_RETURN(double at, r.Number(node, "requirement.at_depth"));
+    const double lo = d.eye_depth ? d.eye_depth->min : near;
+    const double hi = d.eye_depth ? d.eye_depth->max : (d.finite_far ? far : near * Domain::kInfiniteDepthSpan);
+    if (!(at >= lo && at <= hi)) {
+      return r.Error(node, "requirement.at_depth",
+                     fmt::format("must lie in the scene's eye-depth range [{:g}, {:g}]; got {:g}", lo, hi, at));
+    }
+    req.at_depth = at;
+  } else if (req.kind == Requirement::Kind::kAbsolute) {
+    return r.Error(requirement, "requirement.at_depth",
+                   "an absolute error needs the eye depth it applies at (\"1 cm at 5 km\")");
+  }
+  if (const toml::node* node = requirement->get("level")) {
+    auto name = node->value<std::string>();
+    auto level = name ? ParseLevel(*name) : Expected<Level>(InvalidArgument("expected a string"));
+    if (!level.ok() || (*level != Level::kP999 && *level != Level::kMax)) {
+      return r.Error(node, "requirement.level", "allowed: \"p99.9\", \"max\"");
+    }
+    req.level = *level;
+  }
+
+  DB_ASSIGN_OR_RETURN(const toml::table* cost, r.Table(root, "cost", false));
+  if (cost != nullptr) {
+    DB_RETURN_IF_ERROR(r.OnlyKeys(*cost, "cost", {"max_cost"}));
+    if (const toml::node* node = cost->get("max_cost")) {
+      DB_ASSIGN_OR_RETURN(double max_cost, r.Number(node, "cost.max_cost"));
+      if (!(max_cost > 0.0)) return r.Error(node, "cost.max_cost", "must be greater than 0");
+      scene.max_cost = max_cost;
+    }
+  }
+  DB_RETURN_IF_ERROR(d.Validate().WithContext(source));
+  if (scene.Candidates().empty()) {
+    return InvalidArgument(fmt::format(
+        "{}: [engine]: no cell can run in this scene (linear z/far formats and finite-far conventions need a "
+        "finite far plane; infinite-far conventions an infinite one)",
+        source));
+  }
+  return scene;
+}
+
+Expected<Scene> LoadScene(const std::filesystem::path& path) {
+  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
+  return ParseScene(text, path.string());
+}
+
+}  // namespace depthbench

@@ -1,0 +1,72 @@
+// Scene files: one scene's ranges and requirement, in TOML, so that the
+// bench samples and models only what that scene needs. Example (every
+// table but [cost] is required):
+//
+//   name = "open world"
+//   [projection]
+//   near = 0.5                # world units
+//   far = 50000               # or "inf"
+//   fov_degrees = [60, 90]    # a value or [min, max]
+//   aspect = [1.33, 2.39]
+//   resolution = [2560, 1440]
+//   [camera]
+//   distance_from_origin = [0, 20000]
+//   [depth]
+//   range = [1, 50000]        # eye depths that matter (default: near to far)
+//   [engine]
+//   conventions = "any"       # or a list: ["standard", "reversed"]
+//   formats = ["x8_d24_unorm", "d32_sfloat"]
+//   variants = "any"
+//   [requirement]             # exactly one of absolute_error, relative_error, bits_lost
+//   absolute_error = 0.01     # world units ...
+//   at_depth = 50000          # ... at this eye depth ("1 cm at 50 km")
+//   level = "p99.9"           # or "max"
+//   [cost]
+//   max_cost = 60             # in the cost unit choose uses
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/pipeline/stats.h"
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+struct Requirement {
+  enum class Kind { kAbsolute, kRelative, kBitsLost };
+  Kind kind = Kind::kRelative;
+  double value = 0.0;
+  std::optional<double> at_depth;  // eye depth the requirement applies at
+  Level level = Level::kP999;
+
+  // The largest relative error that meets it at eye depth z (bits lost
+  // and relative errors ignore z).
+  double RelativeLimit() const;
+  std::string Describe() const;  // "absolute error <= 0.01 at eye depth 50000 (p99.9)"
+};
+
+struct Scene {
+  std::string source;  // the file it came from
+  std::string name;
+  Domain domain;
+  std::vector<Variant> variants;        // empty: any
+  std::vector<Convention> conventions;  // empty: any
+  std::vector<Format> formats;          // empty: any
+  Requirement requirement;
+  std::optional<double> max_cost;
+
+  // The catalog's cells this scene's engine can use and its domain allows.
+  std::vector<Cell> Candidates() const;
+};
+
+// Errors name the file, line and column, the field, and what is allowed.
+Expected<Scene> ParseScene(std::string_view text, const std::string& source);
+Expected<Scene> LoadScene(const std::filesystem::path& path);
+
+}  // namespace depthbench

@@ -1,0 +1,70 @@
+// Baseline: the headline figures of every cell and band of a gate sweep, as
+// committed under reports/baselines/ (one file per backend), with how they
+// were made. Schema "depthbench.baseline", version 1.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/backends/backend.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/base/json_reader.h"
+#include "bench/results/results.h"
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+inline constexpr const char* kBaselineSchema = "depthbench.baseline";
+inline constexpr int kBaselineSchemaVersion = 1;
+
+// What a gate compares in one band of one cell: bits lost of the total and
+// of the arithmetic error, and the NaN/Inf counts.
+struct BandFigures {
+  double total_p999 = 0, total_max = 0;
+  double arith_p999 = 0, arith_max = 0;
+  std::uint64_t judged = 0, nan = 0, inf = 0;
+  std::uint64_t worst_index = 0;           // the sample with the largest total error
+  std::uint64_t first_nonfinite_index = 0;  // UINT64_MAX when there is none
+  friend bool operator==(const BandFigures&, const BandFigures&) = default;
+};
+
+// Band keys: "all", "ratio 1e3", "depth 1e2", "distance <1".
+using CellFigures = std::map<std::string, BandFigures>;
+
+// How the figures were made; a gate refuses to compare across any of this.
+struct SamplePlan {
+  std::uint64_t seed = 0;
+  std::uint64_t samples = 0;
+  std::uint32_t samples_per_frame = 0;
+  Domain domain;
+  friend bool operator==(const SamplePlan&, const SamplePlan&) = default;
+};
+
+struct Baseline {
+  std::string backend;  // "cpu", "vulkan"
+  DeviceInfo device;
+  std::string version;  // depthbench's
+  std::string commit;
+  std::string made_at;
+  SamplePlan plan;
+  std::map<std::string, CellFigures> cells;  // by Cell::Name()
+};
+
+// The figures of one backend's cells in a run.
+Baseline BaselineFromResults(const Results& results, const std::string& backend);
+
+nlohmann::json SamplePlanToJson(const SamplePlan& plan);
+Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan);
+
+nlohmann::json BaselineToJson(const Baseline& baseline);
+Expected<Baseline> BaselineFromJson(const nlohmann::json& json, const std::string& source);
+Status WriteBaseline(const std::filesystem::path& path, const Baseline& baseline);
+Expected<Baseline> ReadBaseline(const std::filesystem::path& path);
+
+}  // namespace depthbench

@@ -1,0 +1,57 @@
+// Gate: compares a run's figures with a committed baseline, cell by cell
+// and band by band, and says what got worse and what got better.
+//
+// With the same seed, device and build, results are identical to the bit;
+// the tolerances absorb what a driver or compiler update may legitimately
+// change (the order of a float sum: a few units in the last place), not
+// noise. In bits lost, a few ulps at the p99.9 (where errors are at least a
+// few ulps) move the figure by under 0.25 bit; the maximum is one sample
+// and may move by up to 0.5 bit.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bench/gate/baseline.h"
+
+namespace depthbench {
+
+struct GateTolerance {
+  double p999_bits = 0.25;
+  double max_bits = 0.5;
+};
+
+// The sweep a gate runs: fixed seed, every cell, the camera at the world
+// origin (so that what a shader edit does to the arithmetic is not hidden
+// under world-space rounding), sized to run in seconds.
+SamplePlan GatePlan();
+
+struct BandChange {
+  std::string band;
+  BandFigures before, after;
+  std::vector<std::string> reasons;  // "total p99.9 +1.3 bits", "NaN appeared (0 -> 12)"
+};
+
+struct CellVerdict {
+  std::string cell;
+  std::vector<BandChange> worse;
+  std::vector<BandChange> better;
+  bool disappeared = false;  // in the baseline, not in the run
+  bool appeared = false;     // in the run, not in the baseline
+  bool failed() const { return disappeared || !worse.empty(); }
+};
+
+struct GateComparison {
+  std::string backend;
+  std::vector<CellVerdict> cells;  // every cell of either side
+  std::vector<std::string> notes;  // different driver or compiler versions
+  int failures() const;
+  int improvements() const;
+};
+
+// Why the two cannot be compared (another device, another sample plan), or
+// the comparison.
+Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Baseline& run,
+                                             const GateTolerance& tolerance);
+
+}  // namespace depthbench

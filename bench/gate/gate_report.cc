@@ -1,0 +1,183 @@
+#include "bench/gate/gate_report.h"
+
+#include <algorithm>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "bench/sweep/repro.h"
+
+namespace depthbench {
+namespace {
+
+constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
+
+std::string Join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (const auto& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
+
+// The command that replays the sample behind a worse band.
+std::string ReproFor(const GateRun& run, const std::string& cell_name, const BandChange& change) {
+  const Cell cell = ParseCell(cell_name).value();
+  // (NaN and Inf each: one can appear while the other goes.)
+  const bool nonfinite = change.after.nan > change.before.nan || change.after.inf > change.before.inf;
+  const std::uint64_t index = nonfinite ? change.after.first_nonfinite_index : change.after.worst_index;
+  if (index == kNone) return "";
+  std::string command = ReproCommand(run.current.plan.seed, index, run.current.plan.domain, cell, run.current.backend);
+  if (!run.shader_dir.empty()) command += " --shaders " + run.shader_dir;
+  return command;
+}
+
+std::string XmlEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string DescribeWorse(const CellVerdict& v) {
+  if (v.disappeared) return "the cell disappeared";
+  std::vector<std::string> parts;
+  for (const BandChange& c : v.worse) parts.push_back(c.band + ": " + Join(c.reasons, ", "));
+  return Join(parts, "; ");
+}
+
+}  // namespace
+
+void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out) {
+  int failures = 0, improvements = 0, cells = 0;
+  for (const GateRun& r : runs) {
+    failures += r.comparison.failures();
+    improvements += r.comparison.improvements();
+    cells += static_cast<int>(r.comparison.cells.size());
+  }
+  std::vector<std::string> backends;
+  for (const GateRun& r : runs) backends.push_back(fmt::format("{} on {}", r.current.backend, r.current.device.name));
+  out << (failures == 0 ? fmt::format("PASS: no cell got worse ({} cells; {})", cells, Join(backends, ", "))
+                        : fmt::format("FAIL: {} of {} cells got worse ({})", failures, cells, Join(backends, ", ")))
+      << "\n";
+  if (improvements > 0) out << fmt::format("{} cells improved\n", improvements);
+  out << fmt::format("(tolerance: {} bit at p99.9, {} bit at the maximum; NaN or Inf appearing always counts)\n",
+                     tolerance.p999_bits, tolerance.max_bits);
+  for (const GateRun& r : runs) {
+    for (const std::string& note : r.comparison.notes) out << "note (" << r.current.backend << "): " << note << "\n";
+  }
+  for (const GateRun& r : runs) {
+    for (const CellVerdict& v : r.comparison.cells) {
+      if (!v.failed()) continue;
+      out << fmt::format("\nworse: {} on {}\n", v.cell, r.current.backend);
+      if (v.disappeared) {
+        out << "  the cell is in the baseline but did not run\n";
+        continue;
+      }
+      // The bands that changed most first; a handful tells the story.
+      std::vector<BandChange> bands = v.worse;
+      std::stable_sort(bands.begin(), bands.end(), [](const BandChange& a, const BandChange& b) {
+        auto growth = [](const BandChange& c) {
+          return std::max(c.after.total_p999 - c.before.total_p999, c.after.arith_p999 - c.before.arith_p999);
+        };
+        return growth(a) > growth(b);
+      });
+      constexpr std::size_t kShown = 4;
+      for (std::size_t k = 0; k < bands.size() && k < kShown; ++k) {
+        out << fmt::format("  {}: {}\n", bands[k].band, Join(bands[k].reasons, ", "));
+      }
+      if (bands.size() > kShown) out << fmt::format("  ... and {} more bands (--json has them all)\n", bands.size() - kShown);
+      // One reproducer, for the band that changed most.
+      const std::string repro = ReproFor(r, v.cell, v.worse.front());
+      if (!repro.empty()) out << "  reproduce: " << repro << "\n";
+    }
+  }
+  for (const GateRun& r : runs) {
+    for (const CellVerdict& v : r.comparison.cells) {
+      if (v.better.empty()) continue;
+      out << fmt::format("better: {} on {}: {}: {}\n", v.cell, r.current.backend, v.better.front().band,
+                         Join(v.better.front().reasons, ", "));
+    }
+    for (const CellVerdict& v : r.comparison.cells) {
+      if (v.appeared) out << fmt::format("new cell (not in the baseline): {} on {}\n", v.cell, r.current.backend);
+    }
+  }
+}
+
+std::string GateJUnit(const std::vector<GateRun>& runs) {
+  int tests = 0, failures = 0;
+  for (const GateRun& r : runs) {
+    tests += static_cast<int>(r.comparison.cells.size());
+    failures += r.comparison.failures();
+  }
+  std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  xml += fmt::format("<testsuites name=\"depthbench gate\" tests=\"{}\" failures=\"{}\">\n", tests, failures);
+  for (const GateRun& r : runs) {
+    xml += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\">\n", XmlEscape(r.current.backend),
+                       r.comparison.cells.size(), r.comparison.failures());
+    for (const CellVerdict& v : r.comparison.cells) {
+      xml += fmt::format("    <testcase classname=\"depthbench.gate.{}\" name=\"{}\"", XmlEscape(r.current.backend),
+                         XmlEscape(v.cell));
+      if (!v.failed()) {
+        xml += "/>\n";
+        continue;
+      }
+      const std::string repro = v.disappeared ? "" : ReproFor(r, v.cell, v.worse.front());
+      xml += fmt::format(">\n      <failure message=\"{}\">{}</failure>\n    </testcase>\n",
+                         XmlEscape(DescribeWorse(v)), XmlEscape(repro.empty() ? "" : "reproduce: " + repro));
+    }
+    xml += "  </testsuite>\n";
+  }
+  xml += "</testsuites>\n";
+  return xml;
+}
+
+nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
+  auto figures = [](const BandFigures& f) {
+    return nlohmann::json{{"total_p999_bits", f.total_p999}, {"total_max_bits", f.total_max},
+                          {"arith_p999_bits", f.arith_p999}, {"arith_max_bits", f.arith_max},
+                          {"nan", f.nan},                    {"inf", f.inf}};
+  };
+  auto changes = [&](const std::vector<BandChange>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const BandChange& c : list) {
+      out.push_back({{"band", c.band}, {"reasons", c.reasons}, {"before", figures(c.before)}, {"after", figures(c.after)}});
+    }
+    return out;
+  };
+  nlohmann::json backends = nlohmann::json::array();
+  bool pass = true;
+  for (const GateRun& r : runs) {
+    nlohmann::json cells = nlohmann::json::array();
+    for (const CellVerdict& v : r.comparison.cells) {
+      nlohmann::json cell = {{"cell", v.cell},
+                             {"verdict", v.failed() ? "worse" : v.better.empty() ? "same" : "better"},
+                             {"disappeared", v.disappeared},
+                             {"appeared", v.appeared},
+                             {"worse", changes(v.worse)},
+                             {"better", changes(v.better)}};
+      if (v.failed() && !v.disappeared) cell["reproduce"] = ReproFor(r, v.cell, v.worse.front());
+      cells.push_back(cell);
+    }
+    pass = pass && r.comparison.failures() == 0;
+    backends.push_back({{"backend", r.current.backend},
+                        {"device", r.current.device.name},
+                        {"baseline_commit", r.baseline.commit},
+                        {"notes", r.comparison.notes},
+                        {"failures", r.comparison.failures()},
+                        {"improvements", r.comparison.improvements()},
+                        {"cells", cells}});
+  }
+  return {{"schema", "depthbench.gate"},
+          {"schema_version", 1},
+          {"verdict", pass ? "pass" : "fail"},
+          {"tolerance", {{"p999_bits", tolerance.p999_bits}, {"max_bits", tolerance.max_bits}}},
+          {"backends", backends}};
+}
+
+}  // namespace depthbench

@@ -1,0 +1,26 @@
+// Formats gate comparisons: the verdict and details for people, JUnit XML
+// for CI systems, JSON for tools. Formatting only; the comparing is gate.h's.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/gate/gate.h"
+
+namespace depthbench {
+
+struct GateRun {
+  GateComparison comparison;
+  Baseline baseline;  // what the run was compared with
+  Baseline current;   // what the run measured
+  std::string shader_dir;  // "" when the built-in shaders ran
+};
+
+void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out);
+std::string GateJUnit(const std::vector<GateRun>& runs);
+nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance);
+
+}  // namespace depthbench

@@ -1,0 +1,146 @@
+#include "bench/pipeline/batch.h"
+
+#include <algorithm>
+#include <array>
+
+#include "bench/pipeline/bands.h"
+#include "bench/pipeline/encode.h"
+#include "bench/pipeline/shader_constants.h"
+
+namespace depthbench {
+
+RunLayout MakeRunLayout(std::span<const Cell> cells) {
+  RunLayout layout;
+  for (const Cell& cell : cells) {
+    auto it = std::find(layout.encodings.begin(), layout.encodings.end(), cell.encoding());
+    auto slot = static_cast<std::uint32_t>(it - layout.encodings.begin());
+    if (it == layout.encodings.end()) layout.encodings.push_back(cell.encoding());
+    std::uint32_t convention_slot =
+        Info(cell.convention).hardware ? static_cast<std::uint32_t>(cell.convention) : 0u;
+    layout.cells.push_back({cell, slot, convention_slot});
+  }
+  return layout;
+}
+
+BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
+    : sampler_(sampler), encodings_(std::move(encodings)), isa_(isa) {
+  for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
+    auto shares = [&](std::uint32_t k) {
+      const Encoding a = encodings_[pipeline_slots_[k]], b = encodings_[s];
+      return a.convention == b.convention && Info(a.format).stores == Info(b.format).stores;
+    };
+    std::uint32_t k = 0;
+    while (k < pipeline_slots_.size() && !shares(k)) ++k;
+    if (k == pipeline_slots_.size()) pipeline_slots_.push_back(s);
+    pipeline_of_slot_.push_back(k);
+  }
+}
+
+void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const {
+  const std::size_t slots = encodings_.size();
+  batch.first_index = first;
+  batch.count = count;
+  batch.first_offset = static_cast<std::uint32_t>(first % kSamplesPerFrame);
+  const std::uint64_t first_frame = first / kSamplesPerFrame;
+  const std::size_t frames =
+      count == 0 ? 0 : static_cast<std::size_t>((first + count - 1) / kSamplesPerFrame - first_frame + 1);
+
+  // Frames: exact parameters and the shader constants rounded from them.
+  batch.frames.resize(frames);
+  batch.distance_bands.resize(frames);
+  batch.frame_params.resize(frames);
+  batch.depth_params.resize(frames * kHardwareConventionCount);
+  pool.ParallelFor(frames, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t f = begin; f < end; ++f) {
+      Frame& frame = batch.frames[f];
+      frame = sampler_.FrameAt(first_frame + f);
+      batch.distance_bands[f] = static_cast<std::uint8_t>(DistanceBand(frame.camera_distance()));
+      hp::FrameParams exact = BuildFrameParams(frame);
+      batch.frame_params[f] = RoundToFloat(exact);
+      for (int c = 0; c < kHardwareConventionCount; ++c) {
+        const auto convention = static_cast<Convention>(c);
+        f32::DepthParams& out = batch.depth_params[f * kHardwareConventionCount + c];
+        // Conventions with a finite far plane have no constants on frames
+        // that have none (infinite-only domains); their cells do not run.
+        bool needs_far = (Info(convention).bits & f32::DB_CONVENTION_INFINITE) == 0u;
+        out = needs_far && !frame.finite() ? f32::DepthParams{}
+                                           : RoundToFloat(BuildDepthParams(frame, exact, convention));
+      }
+    }
+  });
+
+  // Samples: pixel, ray and depth pick.
+  batch.pixels.resize(count);
+  for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
+  batch.samples.Resize(count);
+  pool.ParallelFor(
+      count,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
+          const PixelSample sample = sampler_.SampleAt(first + i, frame);
+          batch.pixels[i] = sample.x | (sample.y << 16);
+          const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);
+          batch.ray_x[i] = ray.x;
+          batch.ray_y[i] = ray.y;
+          batch.ray_z[i] = ray.z;
+          batch.samples.Set(i, frame, sample, ray);
+        }
+      },
+      256);
+
+  // Encodings, in chunks of samples, each loop over arrays: the pipeline's
+  // floats (shared by a convention's formats), then per depth slot the
+  // stored texels, their decode and the reference.
+  const SampleArrays& samples = batch.samples;
+  const std::size_t pipelines = pipeline_slots_.size();
+  pipeline_floats_.resize(pipelines * count);
+  constexpr std::size_t kChunk = 1024;
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      const std::size_t k = job / chunks;
+      const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
+      PipelineFloats(encodings_[pipeline_slots_[k]], samples.near.data() + lo, samples.far.data() + lo,
+                     samples.eye_depth.data() + lo, n, pipeline_floats_.data() + k * count + lo);
+    }
+  });
+
+  batch.depths.resize(slots * count);
+  batch.codes.resize(slots * count);
+  batch.reference.Resize(slots * count);
+  pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    std::array<double, kChunk> denoted_hi, denoted_lo;
+    for (std::size_t job = begin; job < end; ++job) {
+      const std::size_t s = job / chunks;
+      const Encoding encoding = encodings_[s];
+      const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
+      const std::size_t at = s * count + lo;
+      StoreFloats(encoding.format, pipeline_floats_.data() + pipeline_of_slot_[s] * count + lo, n,
+                  batch.codes.data() + at, batch.depths.data() + at);
+      // Stored-value picks: the edges of a hardware or linear format are
+      // the same in every frame; view z's depend on the frame's far plane.
+      const bool per_frame = Info(encoding.format).stores == DepthInput::kViewZ;
+      std::array<StoredDepth, kDepthPicks> edges{};
+      if (!per_frame) {
+        for (int pick = 0; pick < kDepthPicks; ++pick) {
+          edges[pick] = EncodeEdge(encoding, batch.frames.front(), static_cast<DepthPick>(pick));
+        }
+      }
+      for (std::size_t i = lo; i < lo + n; ++i) {
+        const DepthPick pick = samples.pick[i];
+        if (pick == DepthPick::kEyeDepth) continue;
+        const StoredDepth edge =
+            per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
+                      : edges[static_cast<int>(pick)];
+        batch.codes[s * count + i] = edge.code;
+        batch.depths[s * count + i] = edge.fetched;
+      }
+      DecodeEyeDepths(encoding, samples.near.data() + lo, samples.far.data() + lo, batch.codes.data() + at,
+                      batch.depths.data() + at, n, denoted_hi.data(), denoted_lo.data(), isa_);
+      References(encoding, samples, lo, n, denoted_hi.data(), denoted_lo.data(), batch.reference, at, isa_);
+    }
+  });
+}
+
+}  // namespace depthbench

@@ -1,0 +1,125 @@
+#include "bench/pipeline/cells.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "bench/numerics/formulas.h"
+
+namespace depthbench {
+
+static_assert(catalog::kRev == f32::DB_CONVENTION_REVERSED && catalog::kInf == f32::DB_CONVENTION_INFINITE &&
+                  catalog::kGl == f32::DB_CONVENTION_CLIP_MINUS_ONE,
+              "convention bits must match shared/params.h");
+
+namespace {
+using catalog::kConventions;
+using catalog::kFormats;
+using catalog::kVariants;
+
+std::string Lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+template <class Table, class NameOf>
+std::string JoinNames(const Table& table, NameOf name_of) {
+  std::string out;
+  for (const auto& entry : table) {
+    if (!out.empty()) out += ", ";
+    out += name_of(entry);
+  }
+  return out;
+}
+
+}  // namespace
+
+
+bool Reads(Variant v, Convention c, Format f) {
+  DepthInput input = Info(v).input;
+  return Info(f).stores == input && Info(c).hardware == (input == DepthInput::kHardware);
+}
+
+std::string Cell::Name() const {
+  return std::string(Info(variant).name) + "/" + std::string(Info(convention).name) + "/" +
+         std::string(Info(format).name);
+}
+
+std::vector<Cell> AllCells() {
+  std::vector<Cell> cells;
+  for (const auto& v : kVariants)
+    for (const auto& c : kConventions)
+      for (const auto& f : kFormats)
+        if (Reads(v.id, c.id, f.id)) cells.push_back({v.id, c.id, f.id});
+  return cells;
+}
+
+std::vector<Encoding> AllEncodings() {
+  std::vector<Encoding> encodings;
+  for (const auto& c : kConventions)
+    for (const auto& f : kFormats) {
+      bool read = std::any_of(kVariants.begin(), kVariants.end(),
+                              [&](const VariantInfo& v) { return Reads(v.id, c.id, f.id); });
+      if (read) encodings.push_back({c.id, f.id});
+    }
+  return encodings;
+}
+
+Expected<Variant> ParseVariant(std::string_view name) {
+  std::string key = Lower(name);
+  for (const auto& v : kVariants)
+    if (v.name == key) return v.id;
+  return InvalidArgument("unknown variant '" + std::string(name) + "'; allowed: " +
+                         JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }));
+}
+
+Expected<Convention> ParseConvention(std::string_view name) {
+  std::string key = Lower(name);
+  for (const auto& c : kConventions)
+    if (c.name == key) return c.id;
+  return InvalidArgument("unknown convention '" + std::string(name) + "'; allowed: " +
+                         JoinNames(kConventions, [](const ConventionInfo& c) { return c.name; }));
+}
+
+Expected<Format> ParseFormat(std::string_view name) {
+  std::string key = Lower(name);
+  for (const auto& f : kFormats)
+    if (f.name == key || f.short_name == key) return f.id;
+  // VK_FORMAT_R32_SFLOAT names two of our formats; it means the linear one.
+  for (const auto& f : kFormats)
+    if (Lower(f.vulkan_name) == key) return f.id;
+  return InvalidArgument("unknown format '" + std::string(name) + "'; allowed: " +
+                         JoinNames(kFormats, [](const FormatInfo& f) {
+                           return std::string(f.name) + " (" + std::string(f.short_name) + ")";
+                         }));
+}
+
+Expected<Cell> ParseCell(std::string_view name) {
+  auto first = name.find('/');
+  auto second = first == std::string_view::npos ? first : name.find('/', first + 1);
+  if (second == std::string_view::npos) {
+    return InvalidArgument("cell '" + std::string(name) +
+                           "' is not of the form variant/convention/format");
+  }
+  DB_ASSIGN_OR_RETURN(Variant v, ParseVariant(name.substr(0, first)));
+  DB_ASSIGN_OR_RETURN(Convention c, ParseConvention(name.substr(first + 1, second - first - 1)));
+  DB_ASSIGN_OR_RETURN(Format f, ParseFormat(name.substr(second + 1)));
+  if (!Reads(v, c, f)) {
+    return InvalidArgument("cell '" + std::string(name) + "' does not exist: " +
+                           std::string(Info(v).name) + " does not read " +
+                           std::string(Info(f).name) + " under the " +
+                           std::string(Info(c).name) + " convention");
+  }
+  return Cell{v, c, f};
+}
+
+bool CellFilter::Keeps(const Cell& cell) const {
+  auto keeps = [](const auto& list, auto value) {
+    return list.empty() || std::find(list.begin(), list.end(), value) != list.end();
+  };
+  return keeps(variants, cell.variant) && keeps(conventions, cell.convention) &&
+         keeps(formats, cell.format);
+}
+
+}  // namespace depthbench

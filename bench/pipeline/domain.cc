@@ -1,0 +1,168 @@
+#include "bench/pipeline/domain.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+namespace depthbench {
+
+const RangeLimits kFovLimits{0.0, 180.0, true, true, "degrees"};
+const RangeLimits kAspectLimits{1e-4, 1e4, false, false, ""};
+const RangeLimits kNearLimits{0.0, 1e6, true, false, "world units"};
+const RangeLimits kFarLimits{0.0, 1e30, true, false, "world units"};
+const RangeLimits kRatioLimits{1.0, 1e15, true, false, ""};
+const RangeLimits kCameraDistanceLimits{0.0, 1e9, false, false, "world units"};
+const RangeLimits kEyeDepthLimits{0.0, 1e30, true, false, "world units"};
+
+namespace {
+
+Expected<double> ParseNumber(std::string_view text, std::string_view what) {
+  std::string s(text);
+  if (s.empty()) return InvalidArgument(fmt::format("{}: empty value", what));
+  errno = 0;
+  char* end = nullptr;
+  double value = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(value)) {
+    return InvalidArgument(fmt::format("{}: '{}' is not a finite number", what, s));
+  }
+  return value;
+}
+
+std::string DescribeLimits(const RangeLimits& limits) {
+  return fmt::format("{}{:g}, {:g}{}{}{}", limits.lowest_exclusive ? "(" : "[", limits.lowest,
+                     limits.highest, limits.highest_exclusive ? ")" : "]",
+                     limits.unit.empty() ? "" : " ", limits.unit);
+}
+
+}  // namespace
+
+std::string Range::ToString() const {
+  return fixed() ? fmt::format("{:g}", min) : fmt::format("{:g}:{:g}", min, max);
+}
+
+Status CheckRange(const Range& range, std::string_view what, const RangeLimits& limits) {
+  auto outside = [&](double x) {
+    return (limits.lowest_exclusive ? x <= limits.lowest : x < limits.lowest) ||
+           (limits.highest_exclusive ? x >= limits.highest : x > limits.highest);
+  };
+  if (range.min > range.max) {
+    return InvalidArgument(
+        fmt::format("{}: minimum {:g} is above maximum {:g}", what, range.min, range.max));
+  }
+  if (outside(range.min) || outside(range.max)) {
+    return InvalidArgument(fmt::format("{}: {} is out of range; allowed {}", what,
+                                       range.ToString(), DescribeLimits(limits)));
+  }
+  return Status::Ok();
+}
+
+Expected<Range> ParseRange(std::string_view text, std::string_view what, const RangeLimits& limits) {
+  Range range;
+  auto colon = text.find(':');
+  if (colon == std::string_view::npos) {
+    DB_ASSIGN_OR_RETURN(double value, ParseNumber(text, what));
+    range = {value, value};
+  } else {
+    DB_ASSIGN_OR_RETURN(double lo, ParseNumber(text.substr(0, colon), what));
+    DB_ASSIGN_OR_RETURN(double hi, ParseNumber(text.substr(colon + 1), what));
+    range = {lo, hi};
+  }
+  DB_RETURN_IF_ERROR(CheckRange(range, what, limits));
+  return range;
+}
+
+Status ParseRatioInto(std::string_view text, Domain& domain) {
+  std::string_view finite_part = text;
+  bool infinite = false;
+  if (text == "inf" || text == "infinite") {
+    domain.finite_far = false;
+    domain.infinite_far = true;
+    return Status::Ok();
+  }
+  auto comma = text.find(',');
+  if (comma != std::string_view::npos) {
+    std::string_view rest = text.substr(comma + 1);
+    if (rest != "inf" && rest != "infinite") {
+      return InvalidArgument(fmt::format(
+          "--ratio: '{}' is not understood; use VALUE, MIN:MAX, inf, or MIN:MAX,inf", text));
+    }
+    infinite = true;
+    finite_part = text.substr(0, comma);
+  }
+  DB_ASSIGN_OR_RETURN(Range ratio, ParseRange(finite_part, "--ratio", kRatioLimits));
+  domain.ratio = ratio;
+  domain.finite_far = true;
+  domain.infinite_far = infinite;
+  return Status::Ok();
+}
+
+Status Domain::Validate() const {
+  DB_RETURN_IF_ERROR(CheckRange(fov_degrees, "fov", kFovLimits));
+  DB_RETURN_IF_ERROR(CheckRange(aspect, "aspect", kAspectLimits));
+  DB_RETURN_IF_ERROR(CheckRange(near, "near", kNearLimits));
+  DB_RETURN_IF_ERROR(CheckRange(camera_distance, "camera distance", kCameraDistanceLimits));
+  if (!finite_far && !infinite_far) {
+    return InvalidArgument("the domain has neither finite nor infinite far planes");
+  }
+  if (finite_far) {
+    if (far) {
+      DB_RETURN_IF_ERROR(CheckRange(*far, "far", kFarLimits));
+      if (far->min <= near.max) {
+        return InvalidArgument(fmt::format(
+            "far must be greater than near: far {} does not exceed near {} everywhere",
+            far->ToString(), near.ToString()));
+      }
+    } else {
+      DB_RETURN_IF_ERROR(CheckRange(ratio, "ratio", kRatioLimits));
+    }
+  }
+  if (eye_depth) DB_RETURN_IF_ERROR(CheckRange(*eye_depth, "eye depth", kEyeDepthLimits));
+  if (resolutions.empty()) return InvalidArgument("the domain has no resolution");
+  for (const auto& r : resolutions) {
+    if (r.width == 0 || r.height == 0 || r.width > 65535 || r.height > 65535) {
+      return InvalidArgument(
+          fmt::format("resolution {}x{} is out of range; allowed 1 to 65535 pixels a side",
+                      r.width, r.height));
+    }
+  }
+  return Status::Ok();
+}
+
+std::string Domain::ToFlags() const {
+  auto range = [](const Range& r) {
+    return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max);
+  };
+  std::string flags = fmt::format("--fov {} --aspect {} --near {}", range(fov_degrees), range(aspect), range(near));
+  if (!finite_far) {
+    flags += " --ratio inf";
+  } else if (far) {
+    flags += " --far " + range(*far);
+  } else {
+    flags += " --ratio " + range(ratio) + (infinite_far ? ",inf" : "");
+  }
+  flags += " --camera-distance " + range(camera_distance);
+  if (eye_depth) flags += " --depth " + range(*eye_depth);
+  if (resolutions != Domain{}.resolutions) {
+    flags += fmt::format(" --resolution {}x{}", resolutions.front().width, resolutions.front().height);
+  }
+  return flags;
+}
+
+std::string Domain::Describe() const {
+  std::string far_text;
+  if (finite_far) {
+    far_text = far ? fmt::format("far {}", far->ToString()) : fmt::format("far/near {}", ratio.ToString());
+    if (infinite_far) far_text += " and infinite";
+  } else {
+    far_text = "infinite far";
+  }
+  std::string text = fmt::format("fov {} deg, aspect {}, near {}, {}, camera distance {}",
+                                 fov_degrees.ToString(), aspect.ToString(), near.ToString(),
+                                 far_text, camera_distance.ToString());
+  if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
+  return text;
+}
+
+}  // namespace depthbench

@@ -1,0 +1,385 @@
+#include "bench/pipeline/encode.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+#include "bench/numerics/double_double.h"
+#include "bench/numerics/formulas.h"
+#include "bench/numerics/formulas_mpfr.h"
+
+namespace depthbench {
+namespace {
+
+using DD = DoubleDouble;
+
+// Relative error bound of the double-double evaluations of step 2: a
+// handful of operations, each below 2^-103.
+constexpr double kDoubleDoubleError = 0x1p-96;
+
+std::atomic<std::uint64_t> tie_fallbacks{0};
+std::atomic<std::uint64_t> mpfr_fallbacks{0};
+
+double FarOrZero(const Frame& frame) { return frame.finite() ? frame.far : 0.0; }
+constexpr double UnormScale(int bits) { return static_cast<double>((std::uint64_t{1} << bits) - 1); }
+
+using Float4 = float __attribute__((vector_size(16)));
+using Bits4 = std::uint64_t __attribute__((vector_size(32)));
+
+// The float nearest to the exact value x that `v` approximates (relative
+// error below kDoubleDoubleError), four lanes at a time. float(hi) is right
+// unless hi lies exactly halfway between two floats: then the low 29 of its
+// 52 fraction bits read 1000...0 (in the normal range of floats). Those
+// lanes, and float subnormals and non-finite values, go through `scalar`,
+// which is given the lane's index. Only the first `lanes` lanes are real.
+template <class Scalar>
+Float4 RoundToFloat4(DoubleDouble4 v, int lanes, Scalar scalar) {
+  const Double4 hi = v.hi();
+  Float4 f = __builtin_convertvector(hi, Float4);
+  const Bits4 bits = reinterpret_cast<Bits4>(hi);
+  const Double4 magnitude = reinterpret_cast<Double4>(bits & 0x7fffffffffffffffull);
+  const auto midpoint = (bits & 0x1fffffffull) == 0x10000000ull;
+  const auto ordinary = magnitude >= 0x1p-126 && magnitude < 0x1p127;
+  const auto special = midpoint | !ordinary;
+  for (int k = 0; k < lanes; ++k) {
+    if (special[k]) f[k] = scalar(k, DoubleDouble::FromParts(hi[k], v.lo()[k]));
+  }
+  return f;
+}
+
+// A lane RoundToFloat4 could not settle: outside the normal range of
+// floats, or on a midpoint between two floats, where the low part decides
+// unless it is within the error bound (then MPFR does).
+template <class Exact>
+float SettleLane(DoubleDouble x, Exact exact) {
+  const double hi = x.hi();
+  const float f = static_cast<float>(hi);
+  if (!std::isfinite(f) || static_cast<double>(f) == hi) return f;
+  const float g = NextFloat(f, hi > static_cast<double>(f));
+  if (hi != (static_cast<double>(f) + static_cast<double>(g)) * 0.5) return f;  // not a tie
+  tie_fallbacks.fetch_add(1, std::memory_order_relaxed);
+  if (std::fabs(x.lo()) > std::fabs(hi) * kDoubleDoubleError) return RoundToFloat(x);
+  mpfr_fallbacks.fetch_add(1, std::memory_order_relaxed);
+  return exact().ToFloat();
+}
+
+// Steps 1 and 2 for four samples: the exact value in double-double, then
+// correctly rounded to float32 (GL-style clip depth: NDC depth, then the
+// viewport transform in float32, exact in double with one rounding).
+Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, const double* z, int lanes) {
+  const std::uint32_t bits = Info(encoding.convention).bits;
+  Double4 n, f, depth;
+  for (int k = 0; k < 4; ++k) {
+    n[k] = near[k];
+    f[k] = far[k];
+    depth[k] = z[k];
+  }
+  const auto wide = [](Double4 x) { return DoubleDouble4::FromParts(x, Double4{}); };
+  auto exact_window = [&](int k) { return mp::window_depth_from_eye_depth(near[k], far[k], bits, z[k]); };
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: {
+      const DoubleDouble4 window = hp4::window_depth_from_eye_depth(wide(n), wide(f), bits, wide(depth));
+      if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) {
+        return RoundToFloat4(window, lanes, [&](int k, DoubleDouble x) { return SettleLane(x, [&] { return exact_window(k); }); });
+      }
+      const Float4 ndc = RoundToFloat4(window * DoubleDouble4(2.0) - DoubleDouble4(1.0), lanes, [&](int k, DoubleDouble x) {
+        return SettleLane(x, [&] { return exact_window(k) * mp::real(2.0) - mp::real(1.0); });
+      });
+      return __builtin_convertvector(0.5 * __builtin_convertvector(ndc, Double4) + 0.5, Float4);
+    }
+    case DepthInput::kLinear:
+      return RoundToFloat4(wide(depth) / wide(f), lanes, [&](int k, DoubleDouble x) {
+        return SettleLane(x, [&] { return mp::real(z[k]) / mp::real(far[k]); });
+      });
+    case DepthInput::kViewZ:
+      return __builtin_convertvector(-depth, Float4);
+  }
+  return Float4{};
+}
+
+}  // namespace
+
+EncodeFallbacks EncodeFallbackCounts() { return {tie_fallbacks.load(), mpfr_fallbacks.load()}; }
+
+void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth,
+                    std::size_t n, float* out) {
+  for (std::size_t i = 0; i < n; i += 4) {
+    double lanes[3][4];
+    for (std::size_t k = 0; k < 4; ++k) {
+      const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
+      lanes[0][k] = near[at];
+      lanes[1][k] = far[at];
+      lanes[2][k] = eye_depth[at];
+    }
+    const Float4 f = PipelineFloat4(encoding, lanes[0], lanes[1], lanes[2], static_cast<int>(std::min<std::size_t>(4, n - i)));
+    for (std::size_t k = 0; k < 4 && i + k < n; ++k) out[i + k] = f[k];
+  }
+}
+
+float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth) {
+  const double far = FarOrZero(frame);
+  float out;
+  PipelineFloats(encoding, &frame.near, &far, &eye_depth, 1, &out);
+  return out;
+}
+
+std::uint32_t FloatToUnorm(float value, int bits) {
+  const Format format = bits == 16 ? Format::kD16Unorm : Format::kX8D24Unorm;
+  return StoreFloat(format, value).code;
+}
+
+std::uint16_t FloatToHalf(float value) {
+  std::uint16_t sign = std::signbit(value) ? 0x8000 : 0;
+  double v = std::fabs(static_cast<double>(value));
+  if (std::isnan(value)) return 0x7e00;
+  if (v >= 65520.0) return sign | 0x7c00;  // rounds to infinity
+  if (v < 0x1p-14) {                        // subnormal half: multiples of 2^-24
+    return sign | static_cast<std::uint16_t>(std::nearbyint(v * 0x1p24));
+  }
+  int exponent;
+  double mantissa = std::frexp(v, &exponent);  // v = mantissa * 2^exponent, mantissa in [0.5, 1)
+  // Significand in [1024, 2048]: ten fraction bits, rounded half to even;
+  // a carry to 2048 lands on the next binade, which the packing absorbs.
+  auto significand = static_cast<std::uint32_t>(std::nearbyint(mantissa * 2048.0));
+  std::uint32_t biased = static_cast<std::uint32_t>(exponent - 1 + 15);
+  return static_cast<std::uint16_t>(sign | ((biased << 10) + (significand - 1024)));
+}
+
+float HalfToFloat(std::uint16_t half) {
+  const bool negative = (half & 0x8000) != 0;
+  const int exponent = (half >> 10) & 0x1f;
+  const int fraction = half & 0x3ff;
+  double magnitude;
+  if (exponent == 0) {
+    magnitude = std::ldexp(static_cast<double>(fraction), -24);
+  } else if (exponent == 31) {
+    magnitude = fraction == 0 ? INFINITY : NAN;
+  } else {
+    magnitude = std::ldexp(1024.0 + fraction, exponent - 25);
+  }
+  return static_cast<float>(negative ? -magnitude : magnitude);
+}
+
+float FetchTexel(Format format, std::uint32_t code) {
+  const FormatInfo& info = Info(format);
+  switch (info.texel) {
+    case TexelKind::kFloat32:
+      return std::bit_cast<float>(code);
+    case TexelKind::kFloat16:
+      return HalfToFloat(static_cast<std::uint16_t>(code));
+    case TexelKind::kUnorm:
+      break;
+  }
+  // code / (2^b - 1) rounded to double and then to float is correctly
+  // rounded for b <= 24: the exact quotient's binary expansion repeats with
+  // period b, so it never lies within the double's 29 extra bits of a float
+  // midpoint unless it is exactly representable. tests/encode_test.cc
+  // checks every 16- and 24-bit code against an exact rounding.
+  // (The product with the rounded reciprocal is within 2^-52 of the
+  // quotient: still 28 bits of room.)
+  return static_cast<float>(static_cast<double>(code) * (1.0 / UnormScale(info.bits)));
+}
+
+void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_t* codes, float* fetched) {
+  const FormatInfo& info = Info(format);
+  switch (info.texel) {
+    case TexelKind::kUnorm: {
+      // value * (2^b - 1) is exact in double (24 + 24 bits) and rounded to
+      // the nearest integer, ties to even: adding and taking away 2^52 does
+      // that in the default rounding mode for values below 2^52, four at a
+      // time. NaN clamps to 0. The fetch: see FetchTexel.
+      const double scale = UnormScale(info.bits), inverse = 1.0 / scale;
+      const auto encode = [&](auto v) {
+        using D = decltype(v);
+        const D zero{}, one = zero + 1.0;
+        const D clamped = v > 0.0 ? (v < 1.0 ? v : one) : zero;
+        return (clamped * scale + 0x1p52) - 0x1p52;
+      };
+      std::size_t i = 0;
+      for (; i + 4 <= n; i += 4) {
+        Float4 f;
+        std::memcpy(&f, values + i, sizeof(f));
+        const Double4 code = encode(__builtin_convertvector(f, Double4));
+        const auto c = __builtin_convertvector(code, std::int32_t __attribute__((vector_size(16))));
+        const Float4 fetch = __builtin_convertvector(code * inverse, Float4);
+        std::memcpy(codes + i, &c, sizeof(c));
+        std::memcpy(fetched + i, &fetch, sizeof(fetch));
+      }
+      for (; i < n; ++i) {
+        const double code = encode(static_cast<double>(values[i]));
+        codes[i] = static_cast<std::uint32_t>(code);
+        fetched[i] = static_cast<float>(code * inverse);
+      }
+      return;
+    }
+    case TexelKind::kFloat16:
+      for (std::size_t i = 0; i < n; ++i) {
+        codes[i] = FloatToHalf(values[i]);
+        fetched[i] = HalfToFloat(static_cast<std::uint16_t>(codes[i]));
+      }
+      return;
+    case TexelKind::kFloat32:
+      for (std::size_t i = 0; i < n; ++i) {
+        codes[i] = std::bit_cast<std::uint32_t>(values[i]);
+        fetched[i] = values[i];
+      }
+      return;
+  }
+}
+
+StoredDepth StoreFloat(Format format, float value) {
+  StoredDepth stored;
+  StoreFloats(format, &value, 1, &stored.code, &stored.fetched);
+  return stored;
+}
+
+StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
+  const Format format = encoding.format;
+  const FormatInfo& info = Info(format);
+  if (info.stores == DepthInput::kViewZ) {
+    // View z runs from 0 (the camera) to -far: the edges of that range.
+    float far_z = static_cast<float>(-frame.depth_limit);
+    float value = 0.0f;
+    switch (pick) {
+      case DepthPick::kStoredZero: value = -0.0f; break;
+      case DepthPick::kStoredOne: value = far_z; break;
+      case DepthPick::kStoredAfterZero: value = -std::numeric_limits<float>::denorm_min(); break;
+      case DepthPick::kStoredBeforeOne: value = std::nextafter(far_z, 0.0f); break;
+      case DepthPick::kEyeDepth: break;
+    }
+    return StoreFloat(format, value);
+  }
+  std::uint32_t one = 0;
+  switch (info.texel) {
+    case TexelKind::kUnorm: one = static_cast<std::uint32_t>(UnormScale(info.bits)); break;
+    case TexelKind::kFloat16: one = 0x3c00; break;
+    case TexelKind::kFloat32: one = std::bit_cast<std::uint32_t>(1.0f); break;
+  }
+  // For every format the codes of [0, 1] are consecutive integers, so the
+  // steps next to the ends are one code away.
+  std::uint32_t code = 0;
+  switch (pick) {
+    case DepthPick::kStoredZero: code = 0; break;
+    case DepthPick::kStoredOne: code = one; break;
+    case DepthPick::kStoredAfterZero: code = 1; break;
+    case DepthPick::kStoredBeforeOne: code = one - 1; break;
+    case DepthPick::kEyeDepth: break;
+  }
+  return {code, FetchTexel(format, code)};
+}
+
+namespace {
+
+// The decode of four texels. `texel` is the unorm code itself or the
+// float's value: both exact.
+[[gnu::always_inline]] inline DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 far,
+                                                        DoubleDouble4 texel) {
+  using DD = DoubleDouble4;
+  const FormatInfo& info = Info(encoding.format);
+  // The texel's value v and 1 - v, both exact to double-double precision;
+  // for unorm codes c, v = c / (2^b - 1) and 1 - v = (2^b - 1 - c) / (2^b - 1).
+  DD value, complement;
+  if (info.texel == TexelKind::kUnorm) {
+    // Times the double-double reciprocal of 2^b - 1 (good to 2^-104): two
+    // multiplications instead of two divisions.
+    static const DoubleDouble kInverse16 = DoubleDouble(1.0) / DoubleDouble(UnormScale(16));
+    static const DoubleDouble kInverse24 = DoubleDouble(1.0) / DoubleDouble(UnormScale(24));
+    const DoubleDouble inverse = info.bits == 16 ? kInverse16 : kInverse24;
+    const DD scale(UnormScale(info.bits));
+    const DD inverse_lanes = DD::FromParts(inverse.hi() + texel.hi() * 0.0, inverse.lo() + texel.hi() * 0.0);
+    value = texel * inverse_lanes;
+    complement = (scale - texel) * inverse_lanes;
+  } else {
+    value = texel;
+    complement = DD(1.0) - texel;
+  }
+  switch (info.stores) {
+    case DepthInput::kHardware:
+      return hp4::eye_depth_from_window_depth(near, far, Info(encoding.convention).bits, value, complement);
+    case DepthInput::kLinear:
+      return value * far;
+    case DepthInput::kViewZ:
+      return -value;
+  }
+  return DD(NAN);
+}
+
+[[gnu::always_inline]] inline void DecodeEyeDepthsBody(Encoding encoding, const double* near, const double* far,
+                                                       const std::uint32_t* codes, const float* fetched,
+                                                       std::size_t n, double* hi, double* lo) {
+  const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
+  // Two groups of four per step: their dependency chains interleave.
+  constexpr std::size_t kStep = 8;
+  const auto decode = [&](const Double4 (&n4)[2], const Double4 (&f4)[2], const Double4 (&texel)[2])
+                          __attribute__((always_inline)) {
+    std::array<DoubleDouble4, 2> z;
+    for (int g = 0; g < 2; ++g) {
+      z[g] = DecodeTexel(encoding, DoubleDouble4::FromParts(n4[g], Double4{}),
+                         DoubleDouble4::FromParts(f4[g], Double4{}), DoubleDouble4::FromParts(texel[g], Double4{}));
+    }
+    return z;
+  };
+  std::size_t i = 0;
+  for (; i + kStep <= n; i += kStep) {  // whole steps: lanes loaded and stored whole
+    Double4 n4[2], f4[2], texel[2];
+    for (int g = 0; g < 2; ++g) {
+      const std::size_t at = i + 4 * g;
+      std::memcpy(&n4[g], near + at, sizeof(Double4));
+      std::memcpy(&f4[g], far + at, sizeof(Double4));
+      // The texel as an exact number: the unorm code (below 2^24), or the
+      // float's value.
+      if (unorm) {
+        std::int32_t __attribute__((vector_size(16))) c;
+        std::memcpy(&c, codes + at, sizeof(c));
+        texel[g] = __builtin_convertvector(c, Double4);
+      } else {
+        Float4 f;
+        std::memcpy(&f, fetched + at, sizeof(f));
+        texel[g] = __builtin_convertvector(f, Double4);
+      }
+    }
+    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    for (int g = 0; g < 2; ++g) {
+      const Double4 h = z[g].hi(), l = z[g].lo();
+      std::memcpy(hi + i + 4 * g, &h, sizeof(h));
+      std::memcpy(lo + i + 4 * g, &l, sizeof(l));
+    }
+  }
+  if (i < n) {  // the tail, padded with its last sample
+    Double4 n4[2], f4[2], texel[2];
+    for (std::size_t k = 0; k < kStep; ++k) {
+      const std::size_t at = i + k < n ? i + k : n - 1;
+      n4[k / 4][k % 4] = near[at];
+      f4[k / 4][k % 4] = far[at];
+      texel[k / 4][k % 4] = unorm ? static_cast<double>(codes[at]) : static_cast<double>(fetched[at]);
+    }
+    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    for (std::size_t k = 0; i + k < n; ++k) {
+      hi[i + k] = z[k / 4].hi()[k % 4];
+      lo[i + k] = z[k / 4].lo()[k % 4];
+    }
+  }
+}
+
+}  // namespace
+
+void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
+                     const float* fetched, std::size_t n, double* hi, double* lo, Isa isa) {
+  RunWith(isa, [&](auto) __attribute__((always_inline)) {
+    DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo);
+  });
+}
+
+DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored) {
+  const double far = FarOrZero(frame);
+  double hi, lo;
+  DecodeEyeDepths(encoding, &frame.near, &far, &stored.code, &stored.fetched, 1, &hi, &lo);
+  return DoubleDouble::FromParts(hi, lo);
+}
+
+}  // namespace depthbench

@@ -1,0 +1,237 @@
+#include "bench/pipeline/judge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace depthbench {
+namespace {
+
+// The arithmetic of the judge, written once for one sample (Real = double)
+// and for N SIMD lanes (Lanes<N>::Double), each lane computing exactly what
+// the scalar form does. The output minus the camera position is exact in
+// double (both are float32 values), so world-space magnitudes never enter
+// the error; both reference points lie on the pixel's ray.
+template <class Real>
+struct ErrorLanes {
+  Real total_sq, arith_sq, absolute_sq;
+};
+template <class Real>
+[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera,
+                                                      Real ray_x, Real ray_y, Real ray_z, Real true_depth,
+                                                      Real denoted_depth, Real inverse_distance_sq) {
+  const Real qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
+  const Real tx = qx - true_depth * ray_x, ty = qy - true_depth * ray_y, tz = qz - true_depth * ray_z;
+  const Real ax = qx - denoted_depth * ray_x, ay = qy - denoted_depth * ray_y, az = qz - denoted_depth * ray_z;
+  const Real absolute_sq = tx * tx + ty * ty + tz * tz;
+  return {absolute_sq * inverse_distance_sq, (ax * ax + ay * ay + az * az) * inverse_distance_sq, absolute_sq};
+}
+
+constexpr std::uint32_t kMaxRun = kSamplesPerFrame;  // a frame's samples at most
+
+// Everything JudgeSlot runs is inlined into it ([[gnu::always_inline]]), so
+// that its two copies below are each compiled whole for their instruction
+// set.
+
+// Per-cell working set of one frame run, small enough to stay in L1.
+struct RunScratch {
+  std::array<double, kMaxRun> total, arith, absolute;
+  // (64-bit, as the four-lane arithmetic makes them: narrowing costs shuffles.)
+  std::array<std::int64_t, kMaxRun> total_bin, arith_bin, absolute_bin;
+};
+
+constexpr int kTotal = static_cast<int>(Metric::kTotal);
+constexpr int kArith = static_cast<int>(Metric::kArith);
+constexpr int kAbsolute = static_cast<int>(Metric::kAbsolute);
+
+// Where one run of samples lives in the batch's arrays.
+struct RunInputs {
+  const float *x, *y, *z;                 // the cell's output components
+  const double *ray_x, *ray_y, *ray_z;
+  const double *true_depth, *denoted_depth, *inverse_distance_sq;
+  const std::uint8_t* joint_band;
+  const ReferenceStatus* status;
+};
+
+// Pass 1: errors and bins of a run of samples, N at a time.
+template <int N>
+[[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
+                                           RunScratch& s) {
+  using D = typename Lanes<N>::Double;
+  const auto store = [](auto* to, auto lanes) __attribute__((always_inline)) {
+    std::memcpy(to, &lanes, sizeof(lanes));
+  };
+  const auto bins = [](D square, int metric) __attribute__((always_inline)) {
+    return DenseBinsOfSquares<typename Lanes<N>::Int>(square, kLowestOctave[metric]);
+  };
+  std::uint32_t i = 0;
+  for (; i + N <= n; i += N) {
+    const auto wide = [&](const float* p) __attribute__((always_inline)) {
+      typename Lanes<N>::Float f;
+      std::memcpy(&f, p + i, sizeof(f));
+      return __builtin_convertvector(f, D);
+    };
+    const auto load = [&](const double* p) __attribute__((always_inline)) {
+      D d;
+      std::memcpy(&d, p + i, sizeof(d));
+      return d;
+    };
+    const ErrorLanes<D> e =
+        Errors(wide(in.x), wide(in.y), wide(in.z), camera, load(in.ray_x), load(in.ray_y), load(in.ray_z),
+               load(in.true_depth), load(in.denoted_depth), load(in.inverse_distance_sq));
+    store(&s.total[i], e.total_sq);
+    store(&s.arith[i], e.arith_sq);
+    store(&s.absolute[i], e.absolute_sq);
+    store(&s.total_bin[i], bins(e.total_sq, kTotal));
+    store(&s.arith_bin[i], bins(e.arith_sq, kArith));
+    store(&s.absolute_bin[i], bins(e.absolute_sq, kAbsolute));
+  }
+  for (; i < n; ++i) {  // the tail of a batch that ends inside a frame
+    const ErrorLanes<double> e = Errors<double>(in.x[i], in.y[i], in.z[i], camera, in.ray_x[i], in.ray_y[i],
+                                                in.ray_z[i], in.true_depth[i], in.denoted_depth[i],
+                                                in.inverse_distance_sq[i]);
+    s.total[i] = e.total_sq;
+    s.arith[i] = e.arith_sq;
+    s.absolute[i] = e.absolute_sq;
+    s.total_bin[i] = DenseBinOfSquare(e.total_sq, kLowestOctave[kTotal]);
+    s.arith_bin[i] = DenseBinOfSquare(e.arith_sq, kLowestOctave[kArith]);
+    s.absolute_bin[i] = DenseBinOfSquare(e.absolute_sq, kLowestOctave[kAbsolute]);
+  }
+}
+
+// Pass 2: counts and histograms. What a sample is to the cell follows from
+// its reference's status and from its output, which is NaN when a component
+// is NaN, and infinite when one is infinite (of either sign) and none is
+// NaN. The absolute error's square tells those apart: it is a sum of
+// squares (+inf and -inf components both give +inf, never NaN), of the
+// output minus a point that is finite wherever the sample is not
+// degenerate, and a finite float output cannot overflow it.
+[[gnu::always_inline]] inline void Record(const ReferenceStatus* status, const std::uint8_t* joint_band,
+                                          std::uint64_t first_index, std::uint32_t n, const RunScratch& s,
+                                          CellAccumulator& accumulator, CellAccumulator::Slot& distance) {
+  for (std::uint32_t i = 0; i < n; ++i) {
+    CellAccumulator::Slot& joint = accumulator.Joint(joint_band[i]);
+    const std::uint64_t index = first_index + i;
+    const double absolute_sq = s.absolute[i];
+    const bool finite = absolute_sq < std::numeric_limits<double>::infinity();  // false for NaN
+    if (status[i] == ReferenceStatus::kJudged && finite) {
+      // Distance bands keep the total error only: what camera distance
+      // does to a reconstruction shows there whole.
+      joint.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+      joint.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
+      joint.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
+      distance.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+    } else if (status[i] == ReferenceStatus::kDegenerate) {
+      ++joint.degenerate;
+      ++distance.degenerate;
+    } else if (finite) {  // outside the frustum: only a non-finite output counts
+      ++joint.outside;
+      ++distance.outside;
+    } else {
+      const bool nan = absolute_sq != absolute_sq;
+      joint.RecordNonFinite(nan, index);
+      distance.RecordNonFinite(nan, index);
+    }
+  }
+}
+
+// Calls run(frame, begin, end) for each frame's samples [begin, end) of
+// the batch, in order: the camera and the distance band are the frame's.
+template <class Run>
+[[gnu::always_inline]] inline void ForEachFrameRun(const Batch& batch, Run run) {
+  for (std::uint32_t begin = 0; begin < batch.count;) {
+    const std::uint32_t frame = batch.FrameOf(begin);
+    const std::uint32_t end =
+        std::min<std::uint32_t>(batch.count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
+    run(frame, begin, end);
+    begin = end;
+  }
+}
+
+}  // namespace
+
+SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm::dvec3& camera,
+                      const float* position) {
+  const ErrorLanes<double> e = Errors<double>(position[0], position[1], position[2], camera, ray.x, ray.y, ray.z,
+                                              r.true_depth, r.denoted_depth, r.inverse_distance_sq);
+  return {e.total_sq, e.arith_sq, e.absolute_sq};
+}
+
+namespace {
+
+template <int N>
+[[gnu::always_inline]] inline void JudgeSlotBody(const Batch& batch, std::uint32_t depth_slot,
+                                                 std::span<const JudgedCell> cells) {
+  const std::uint32_t count = batch.count;
+  const std::size_t offset = static_cast<std::size_t>(depth_slot) * count;
+  const ReferenceArrays& ref = batch.reference;
+  RunScratch scratch;
+  // Frame by frame: a frame's reference stays in cache while every cell
+  // reads it.
+  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end)
+                             __attribute__((always_inline)) {
+    const std::uint32_t n = end - begin;
+    const glm::dvec3 camera = batch.frames[frame].camera_position;
+    const std::size_t at = offset + begin;
+    for (const JudgedCell& cell : cells) {
+      const float* p = cell.positions.data();
+      const RunInputs in{p + begin, p + count + begin, p + 2 * std::size_t{count} + begin,
+                         batch.ray_x.data() + begin, batch.ray_y.data() + begin, batch.ray_z.data() + begin,
+                         ref.true_depth.data() + at, ref.denoted_depth.data() + at,
+                         ref.inverse_distance_sq.data() + at, ref.joint_band.data() + at, ref.status.data() + at};
+      Measure<N>(in, camera, n, scratch);
+      Record(in.status, in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
+             cell.accumulator->Distance(batch.distance_bands[frame]));
+    }
+  });
+  for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
+}
+
+template <int N>
+[[gnu::always_inline]] inline void RecordStorageBody(const Batch& batch, std::uint32_t depth_slot,
+                                                     CellAccumulator& accumulator) {
+  const std::size_t offset = static_cast<std::size_t>(depth_slot) * batch.count;
+  const ReferenceStatus* status = batch.reference.status.data() + offset;
+  const std::uint8_t* joint_band = batch.reference.joint_band.data() + offset;
+  const double* storage = batch.reference.storage_square.data() + offset;
+  constexpr int kStorage = static_cast<int>(Metric::kStorage);
+  std::array<std::int64_t, kMaxRun> bins;
+  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end)
+                             __attribute__((always_inline)) {
+    // The bins N at a time (as the judge's Measure does), then the counts.
+    std::uint32_t i = begin;
+    for (; i + N <= end; i += N) {
+      typename Lanes<N>::Double squares;
+      std::memcpy(&squares, storage + i, sizeof(squares));
+      const auto lanes = DenseBinsOfSquares<typename Lanes<N>::Int>(squares, kLowestOctave[kStorage]);
+      std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
+    }
+    for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
+    CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
+    for (i = begin; i < end; ++i) {
+      if (status[i] != ReferenceStatus::kJudged) continue;
+      const std::uint64_t index = batch.first_index + i;
+      const int bin = static_cast<int>(bins[i - begin]);
+      accumulator.Joint(joint_band[i]).Record(Metric::kStorage, bin, storage[i], index);
+      distance.Record(Metric::kStorage, bin, storage[i], index);
+    }
+  });
+  accumulator.Count(batch.count);
+}
+
+}  // namespace
+
+void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa) {
+  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
+    JudgeSlotBody<decltype(lanes)::value>(batch, depth_slot, cells);
+  });
+}
+
+void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
+  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
+    RecordStorageBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
+  });
+}
+
+}  // namespace depthbench

@@ -1,0 +1,43 @@
+// Judge: compares backends' raw outputs with the reference and records the
+// errors. It works on host memory and knows nothing of backends.
+#pragma once
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "bench/pipeline/batch.h"
+#include "bench/base/isa.h"
+#include "bench/pipeline/stats.h"
+
+namespace depthbench {
+
+// One cell's outputs to judge: world x, y and z of every sample of the
+// batch, and where its errors go.
+struct JudgedCell {
+  std::span<const float> positions;
+  CellAccumulator* accumulator;
+};
+
+// Judges every listed cell that reads depth slot `depth_slot` (they share
+// the slot's reference, read once). Records total, arithmetic and absolute
+// errors; storage errors belong to the encoding (RecordStorage). `isa` must
+// be one the processor runs.
+void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells,
+               Isa isa = Isa::kWidest);
+
+// Records the storage error of one depth slot's samples.
+void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator,
+                   Isa isa = Isa::kWidest);
+
+// The squared errors of one output (for reproducers and tests): relative
+// total, relative arithmetic, absolute total.
+struct SampleErrors {
+  double total_sq = 0.0;
+  double arith_sq = 0.0;
+  double absolute_sq = 0.0;
+};
+SampleErrors ErrorsOf(const ReferenceSample& reference, const glm::dvec3& ray, const glm::dvec3& camera,
+                      const float* position);
+
+}  // namespace depthbench

@@ -1,0 +1,188 @@
+#include "bench/pipeline/reference.h"
+
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+
+#include "bench/pipeline/bands.h"
+#include "bench/numerics/formulas.h"
+
+namespace depthbench {
+namespace {
+
+// Relative slack on the frustum's planes: stored values at the planes
+// themselves decode to within a few float32 steps of them.
+constexpr double kPlaneSlack = 0x1p-20;
+// The largest float32, squared: distances beyond it overflow a world position.
+constexpr double kLargestFloatSquared = static_cast<double>(FLT_MAX) * static_cast<double>(FLT_MAX);
+
+}  // namespace
+
+void ReferenceArrays::Resize(std::size_t n) {
+  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square}) v->resize(n);
+  joint_band.resize(n);
+  status.resize(n);
+}
+
+ReferenceSample ReferenceArrays::Get(std::size_t at) const {
+  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at], joint_band[at], status[at]};
+}
+
+void SampleArrays::Resize(std::size_t n) {
+  pick.resize(n);
+  for (auto* v : {&eye_depth, &near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq,
+                  &inverse_distance_sq}) {
+    v->resize(n);
+  }
+  depth_band.resize(n);
+  ratio_band.resize(n);
+}
+
+void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
+  const bool eye = sample.pick == DepthPick::kEyeDepth;
+  pick[i] = sample.pick;
+  eye_depth[i] = eye ? sample.eye_depth : frame.near;
+  near[i] = frame.near;
+  far[i] = frame.finite() ? frame.far : 0.0;
+  depth_limit[i] = frame.depth_limit;
+  interest_min[i] = frame.depth_restricted ? frame.eye_depth_min : frame.near;
+  interest_max[i] = frame.depth_restricted ? frame.eye_depth_max : INFINITY;
+  ray_length_sq[i] = glm::dot(ray, ray);
+  inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
+  depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
+  ratio_band[i] = static_cast<std::uint8_t>(RatioBand(frame.ratio()));
+}
+
+glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+  using L = long double;
+  const L tan_y = frame.tan_half_fov_y;
+  const L tan_x = static_cast<L>(frame.aspect) * tan_y;
+  const ld::vec4 resolution(frame.width, frame.height, 1.0L / frame.width, 1.0L / frame.height);
+  const ld::vec2 ndc = ld::ndc_from_uv(ld::uv_from_pixel(static_cast<L>(x), static_cast<L>(y), resolution));
+  const ld::vec3 view(ndc.x * tan_x, ndc.y * tan_y, -1.0L);
+  const glm::dmat3& r = frame.rotation;
+  glm::dvec3 ray;
+  for (int row = 0; row < 3; ++row) {
+    ray[row] = static_cast<double>(r[0][row] * view.x + r[1][row] * view.y + r[2][row] * view.z);
+  }
+  return ray;
+}
+
+namespace {
+
+// The per-lane arithmetic of References, written once for one sample
+// (D = double, I = int64_t) and for four SIMD lanes (Double4, Int4); each
+// lane computes exactly what the scalar form does. Bands are left to the
+// caller: they are integer work, and stored-value picks need a decade of
+// their own.
+template <class D, class I>
+struct ReferenceLanes {
+  D true_depth, denoted_depth, inverse_distance_sq, storage_square;
+  I status;  // ReferenceStatus
+};
+template <class D, class I>
+[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi,
+                                                                D denoted_lo, D near, D depth_limit,
+                                                                D interest_min, D interest_max, D ray_length_sq,
+                                                                D eye_inverse_distance_sq, bool infinite_far) {
+  using DD = BasicDoubleDouble<D>;
+  const auto eye = eye_pick != 0.0;
+  // Stored-value picks have no scene point of their own: the truth is what
+  // the stored value denotes, and their storage error is zero.
+  const DD denoted = DD::FromParts(denoted_hi, denoted_lo);
+  const D zero = D{} * 0.0;
+  const DD truth = DD::FromParts(eye ? eye_depth : denoted_hi, eye ? zero : denoted_lo);
+  const D t = truth.hi();
+  ReferenceLanes<D, I> out;
+  out.true_depth = t;
+  out.denoted_depth = (denoted_hi - denoted_hi) == 0.0 ? denoted_hi : zero + DBL_MAX;  // finite, or DBL_MAX
+  // A point float32 world coordinates cannot hold (an overflowing
+  // reconstruction is then the right answer) is no more judged than one at
+  // infinity.
+  const auto holdable = (t > 0.0) & (t * t * ray_length_sq < kLargestFloatSquared);
+  const D limit = infinite_far ? zero + INFINITY : depth_limit;
+  const D far = interest_max < limit ? interest_max : limit;     // std::min(limit, interest_max)
+  const D nearest = near < interest_min ? interest_min : near;  // std::max(near, interest_min)
+  const auto outside = (t < nearest * (1.0 - kPlaneSlack)) | (t > far * (1.0 + kPlaneSlack));
+  const I judged = I{} + static_cast<std::int64_t>(ReferenceStatus::kJudged);
+  const I degenerate = I{} + static_cast<std::int64_t>(ReferenceStatus::kDegenerate);
+  const I outside_status = I{} + static_cast<std::int64_t>(ReferenceStatus::kOutside);
+  out.status = holdable ? (outside ? outside_status : judged) : degenerate;
+  const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (t * t * ray_length_sq);
+  out.inverse_distance_sq = out.status == judged ? inverse : zero;
+  // The difference of the two depths is taken in double-double (they may
+  // be close); its ratio to the distance needs no more than double. Both
+  // points lie on the same ray, so the relative error of the position is
+  // the relative error of the depth.
+  const D difference = (denoted - truth).hi();
+  out.storage_square = difference * difference * out.inverse_distance_sq * ray_length_sq;
+  return out;
+}
+
+[[gnu::always_inline]] inline void ReferencesBody(Encoding encoding, const SampleArrays& samples, std::size_t first,
+                                                  std::size_t n, const double* denoted_hi, const double* denoted_lo,
+                                                  ReferenceArrays& out, std::size_t out_first) {
+  const ConventionInfo& convention = Info(encoding.convention);
+  const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
+  // Plain pointers, read once: the stores below cannot then be taken for
+  // changes to the vectors' own pointers.
+  const DepthPick* pick = samples.pick.data() + first;
+  const double *eye_depth = samples.eye_depth.data() + first, *near = samples.near.data() + first,
+               *depth_limit = samples.depth_limit.data() + first,
+               *interest_min = samples.interest_min.data() + first,
+               *interest_max = samples.interest_max.data() + first,
+               *ray_length_sq = samples.ray_length_sq.data() + first,
+               *eye_inverse_distance_sq = samples.inverse_distance_sq.data() + first;
+  double *true_depth = out.true_depth.data() + out_first, *denoted_depth = out.denoted_depth.data() + out_first,
+         *inverse_distance_sq = out.inverse_distance_sq.data() + out_first,
+         *storage_square = out.storage_square.data() + out_first;
+  ReferenceStatus* status = out.status.data() + out_first;
+  const auto store = [&](std::size_t k, const auto& lanes, auto put) {
+    put(true_depth + k, lanes.true_depth);
+    put(denoted_depth + k, lanes.denoted_depth);
+    put(inverse_distance_sq + k, lanes.inverse_distance_sq);
+    put(storage_square + k, lanes.storage_square);
+  };
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const auto load = [&](const double* p) {
+      Double4 d;
+      std::memcpy(&d, p + k, sizeof(d));
+      return d;
+    };
+    Double4 eye_pick;
+    for (int lane = 0; lane < 4; ++lane) eye_pick[lane] = pick[k + lane] == DepthPick::kEyeDepth;
+    const ReferenceLanes<Double4, Int4> lanes = ReferenceOf<Double4, Int4>(
+        eye_pick, load(eye_depth), load(denoted_hi), load(denoted_lo), load(near), load(depth_limit),
+        load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq), infinite_far);
+    store(k, lanes, [](double* to, Double4 v) { std::memcpy(to, &v, sizeof(v)); });
+    for (int lane = 0; lane < 4; ++lane) status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
+  }
+  for (; k < n; ++k) {  // the tail
+    const ReferenceLanes<double, std::int64_t> one = ReferenceOf<double, std::int64_t>(
+        pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], denoted_lo[k], near[k], depth_limit[k],
+        interest_min[k], interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
+    store(k, one, [](double* to, double v) { *to = v; });
+    status[k] = static_cast<ReferenceStatus>(one.status);
+  }
+  // Bands: stored-value picks (rare) take the decade of their denoted depth.
+  const std::uint8_t *depth_band = samples.depth_band.data() + first, *ratio_band = samples.ratio_band.data() + first;
+  std::uint8_t* joint_band = out.joint_band.data() + out_first;
+  for (k = 0; k < n; ++k) {
+    int depth = depth_band[k];
+    if (pick[k] != DepthPick::kEyeDepth) depth = DepthBand(true_depth[k] / near[k]);
+    joint_band[k] = static_cast<std::uint8_t>(JointBand(infinite_far ? kInfiniteRatioBand : ratio_band[k], depth));
+  }
+}
+
+}  // namespace
+
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
+                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
+                Isa isa) {
+  RunWith(isa, [&](auto) __attribute__((always_inline)) {
+    ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
+  });
+}
+
+}  // namespace depthbench

@@ -1,0 +1,86 @@
+// Reference: for each sample, the true scene point and the point that the
+// stored depth value denotes, from the frame's exact parameters.
+//
+// Both points lie on the pixel's ray through the camera, so the reference
+// keeps, per sample, the world-space ray at unit eye depth, and per
+// (encoding, sample) two eye depths: the true one and the denoted one.
+// The ray runs in long double (the ld:: instantiation of shared/: pixel
+// centre and NDC) and the decode in double-double (hp4::, the
+// cancellation-free depth mapping), so every figure is accurate to 2^-60 or
+// better before the final rounding to double; tests/reference_test.cc
+// checks this against MPFR at far/near up to 1e12. The judge then forms
+// camera-relative positions in double, where a float32 output minus the
+// float32 camera position is exact.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bench/pipeline/cells.h"
+#include "bench/numerics/double_double.h"
+#include "bench/base/isa.h"
+#include "bench/pipeline/sampler.h"
+
+namespace depthbench {
+
+enum class ReferenceStatus : std::uint8_t {
+  kJudged,      // a finite point inside the frustum
+  kDegenerate,  // the point is the camera, at infinity, or beyond what float32
+                // world coordinates can hold: nothing to measure
+  kOutside,     // a finite point outside the frustum (nearer than near,
+                // beyond a finite far plane) or outside the domain's eye-depth
+                // range of interest: only NaN/Inf outputs count
+};
+
+// The reference of one (encoding, sample).
+struct ReferenceSample {
+  double true_depth = 0.0;     // eye depth of the true point
+  double denoted_depth = 0.0;  // eye depth the stored value denotes (DBL_MAX for infinity)
+  double inverse_distance_sq = 0.0;  // 1 / |true point - camera|^2 (0 unless judged)
+  std::uint8_t joint_band = 0;
+  ReferenceStatus status = ReferenceStatus::kDegenerate;
+};
+
+// ReferenceSample fields, one array each (the judge reads them in SIMD
+// lanes), plus the square of the relative storage error.
+struct ReferenceArrays {
+  std::vector<double> true_depth, denoted_depth, inverse_distance_sq, storage_square;
+  std::vector<std::uint8_t> joint_band;
+  std::vector<ReferenceStatus> status;
+
+  void Resize(std::size_t n);
+  ReferenceSample Get(std::size_t at) const;
+};
+
+// What the reference needs of each sample, whatever the encoding.
+struct SampleArrays {
+  std::vector<DepthPick> pick;
+  std::vector<double> eye_depth;            // for eye-depth picks (near for the others)
+  std::vector<double> near, far;            // the frame's planes (far 0 when infinite)
+  std::vector<double> depth_limit;          // the frame's largest eye depth
+  std::vector<double> interest_min, interest_max;  // eye depths the domain is about (near..inf when unrestricted)
+  std::vector<double> ray_length_sq;        // |PixelRay|^2
+  std::vector<double> inverse_distance_sq;  // 1 / (eye depth * |ray|)^2, for eye-depth picks
+  std::vector<std::uint8_t> depth_band;     // of the eye depth, for eye-depth picks
+  std::vector<std::uint8_t> ratio_band;     // the frame's far/near band
+
+  void Resize(std::size_t n);
+  // Fills entry i for a sample of `frame` whose ray is `ray`.
+  void Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray);
+};
+
+// World-space ray through the pixel centre at unit eye depth:
+// R * (ndc.x * tan_x, ndc.y * tan_y, -1).
+glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
+
+// The references of samples [first, first + n) under an encoding whose
+// stored values denote eye depths denoted_hi[k] + denoted_lo[k]
+// (DecodeEyeDepths), written to out at [out_first, out_first + n).
+// Compiled for each instruction set `isa` can name (bench/base/isa.h).
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
+                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
+                Isa isa = Isa::kWidest);
+
+}  // namespace depthbench

@@ -1,0 +1,217 @@
+// Stats: streaming, exactly mergeable error statistics.
+//
+// Every error value x > 0 falls into a quarter-octave bin k = floor(4 log2 x),
+// decided exactly from the bits of x^2 (no logarithm is evaluated). Bins
+// are plain counts, so statistics of shards, batches and threads add up to
+// exactly the statistics of the whole; the maximum is kept exactly, with the
+// index of the sample that reached it (ties: the smallest index).
+// Quantiles are read from the bins, interpolated within a bin.
+//
+// Four metrics per sample (relative ones are over the distance from the
+// camera to the true point):
+//   total    |p - truth| / distance       what the engine gets
+//   arith    |p - denoted| / distance     the variant's arithmetic alone
+//   storage  |denoted - truth| / distance what the format's rounding costs
+//   absolute |p - truth|                  in world units
+// Bits lost = max(0, log2(relative error / 2^-24)).
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/pipeline/bands.h"
+#include "bench/base/simd.h"
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+enum class Metric : int { kTotal = 0, kArith = 1, kStorage = 2, kAbsolute = 3 };
+inline constexpr int kMetricCount = 4;
+const char* MetricName(Metric m);
+
+inline constexpr int kBinsPerOctave = 4;
+inline constexpr int kOctavesKept = 64;
+inline constexpr int kBinsKept = kBinsPerOctave * kOctavesKept;
+// Lowest kept octave per metric: relative errors from 2^-56 (32 bits below
+// float32's rounding, where every bit-lost figure is 0 anyway) up to 2^8;
+// absolute errors from 2^-48 to 2^16 world units. Values outside fall into
+// an underflow or overflow bin; exact zeros into the underflow bin.
+inline constexpr std::array<int, kMetricCount> kLowestOctave = {-56, -56, -56, -48};
+
+// The bin arithmetic below is written once for one value (Int = int64_t,
+// Real = double) and for four SIMD lanes (Int4, Double4): GCC's vector
+// extensions give comparisons and ?: lane by lane, so each lane computes
+// exactly what the scalar form does.
+
+// floor(4 * log2(sqrt(q))) for q > 0 finite, from q's bits: the exponent
+// gives whole octaves of q (half octaves of sqrt(q)); the significand is
+// compared with sqrt(2)'s, which splits an octave of q in two.
+template <class Int, class Real>
+Int QuarterOctavesOfSqrt(Real q) {
+  constexpr std::int64_t kSqrt2Fraction = 0x6A09E667F3BCDll;  // ceil(frac(sqrt 2) * 2^52)
+  const Int bits = std::bit_cast<Int>(q);
+  const Int exponent = (bits >> 52) - 1023;
+  const Int upper = (bits & 0xFFFFFFFFFFFFFll) >= kSqrt2Fraction ? Int{} + 1 : Int{};
+  return 2 * exponent + upper;
+}
+inline int QuarterOctaveOfSqrt(double q) { return static_cast<int>(QuarterOctavesOfSqrt<std::int64_t>(q)); }
+
+// Bin slot of a squared error value in a dense histogram: 0 underflow
+// (including 0 and subnormal squares), 1..kBinsKept kept bins, kBinsKept + 1
+// overflow.
+// Branch-free, so that loops over samples vectorize; NaN lands in the
+// underflow bin (callers keep NaN outputs out).
+template <class Int, class Real>
+Int DenseBinsOfSquares(Real q, int lowest_octave) {
+  Int slot = QuarterOctavesOfSqrt<Int>(q) - lowest_octave * kBinsPerOctave + 1;
+  slot = slot < 0 ? Int{} : slot;
+  slot = slot > kBinsKept + 1 ? Int{} + (kBinsKept + 1) : slot;
+  return q >= 0x1p-1022 ? slot : Int{};
+}
+inline int DenseBinOfSquare(double q, int lowest_octave) {
+  return static_cast<int>(DenseBinsOfSquares<std::int64_t>(q, lowest_octave));
+}
+inline constexpr int kDenseBins = kBinsKept + 2;
+
+// The levels reported and modelled: three quantiles and the maximum.
+enum class Level { kP50, kP99, kP999, kMax };
+inline constexpr Level kAllLevels[] = {Level::kP50, Level::kP99, Level::kP999, Level::kMax};
+const char* LevelName(Level level);
+Expected<Level> ParseLevel(const std::string& name);
+// The quantile a level stands for (1 for the maximum).
+double LevelQuantile(Level level);
+
+// Statistics of one metric in one band: sparse bins keyed by dense slot.
+struct MetricStats {
+  std::map<int, std::uint64_t> bins;  // dense slot -> count
+  // The largest value's square, exactly as recorded: squares are what the
+  // judge compares, and the square root would merge values that differ.
+  double max_square = 0.0;
+  double max() const { return std::sqrt(max_square); }
+  std::uint64_t worst_index = std::numeric_limits<std::uint64_t>::max();
+
+  std::uint64_t Count() const;
+  void Merge(const MetricStats& other);
+  void Merge(MetricStats&& other);  // takes other's bins whole where this has none
+  // The q-quantile (q in [0, 1]) of the metric's value; 0 when empty.
+  // Underflow reads as the lowest kept edge, overflow as the exact max.
+  double Quantile(double q, int lowest_octave) const;
+  // The value at a level (a quantile, or the maximum) of metric `metric`.
+  double AtLevel(Level level, Metric metric) const;
+  friend bool operator==(const MetricStats&, const MetricStats&) = default;
+
+ private:
+  void MergeBins(const std::map<int, std::uint64_t>& other);
+  void MergeMax(const MetricStats& other);
+};
+
+// Statistics of one band of one cell.
+struct BandStats {
+  std::uint64_t finite = 0;      // samples with a finite output and a finite reference
+  std::uint64_t nan = 0;         // outputs with a NaN component (reference finite)
+  std::uint64_t inf = 0;         // outputs with an infinite component and no NaN
+  std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
+  std::uint64_t outside = 0;     // finite point outside the frustum: only NaN/Inf judged
+  std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
+  std::array<MetricStats, kMetricCount> metrics;
+
+  void Merge(const BandStats& other);
+  void Merge(BandStats&& other);
+  std::uint64_t judged() const { return finite + nan + inf; }
+  const MetricStats& operator[](Metric m) const { return metrics[static_cast<int>(m)]; }
+  friend bool operator==(const BandStats&, const BandStats&) = default;
+
+ private:
+  void MergeCounts(const BandStats& other);
+};
+
+// The quantile summary a table row shows.
+struct Summary {
+  double p50 = 0, p99 = 0, p999 = 0, max = 0;
+  std::uint64_t worst_index = 0;
+};
+Summary Summarize(const BandStats& band, Metric metric);
+// Bits lost of a relative error: max(0, log2(x / 2^-24)).
+double BitsLost(double relative_error);
+
+// All statistics of one cell on one backend.
+struct CellStats {
+  std::map<int, BandStats> joint;     // JointBand(ratio, depth) -> stats
+  std::map<int, BandStats> distance;  // DistanceBand -> stats
+
+  void Merge(const CellStats& other);
+  BandStats All() const;
+  BandStats ForRatio(int ratio_band) const;
+  BandStats ForDepth(int depth_band) const;
+  BandStats ForDistance(int distance_band) const;
+  friend bool operator==(const CellStats&, const CellStats&) = default;
+};
+
+// The hot accumulator for one cell: dense 32-bit bins for every joint band
+// and distance band, each band at a fixed place, so that the judge finds a
+// sample's bins by arithmetic alone. The slots live in memory mapped zeroed
+// and untouched: a band no sample reaches costs no memory, and all zeros is
+// an empty slot. Flush() moves everything into a CellStats; the sweep
+// flushes well before a 32-bit count could overflow.
+class CellAccumulator {
+ public:
+  CellAccumulator();
+
+  // All zeros is empty (worst_index and first_nonfinite_index mean nothing
+  // until a maximum or a non-finite output sets them).
+  struct Slot {
+    std::array<std::array<std::uint32_t, kDenseBins>, kMetricCount> bins;
+    std::array<double, kMetricCount> max_square;
+    std::array<std::uint64_t, kMetricCount> worst_index;
+    // (Finite samples are not counted here: every one lands in a bin of the
+    // total error, and the flush counts them from there.)
+    std::uint64_t nan, inf, degenerate, outside;
+    std::uint64_t first_nonfinite_index;
+
+    // One value (squared) of one metric, in dense bin `bin`. Samples come
+    // in increasing index order, so on a tie the earlier sample stays the
+    // worst, as MetricStats::Merge decides across shards.
+    void Record(Metric metric, int bin, double square, std::uint64_t index) {
+      const int m = static_cast<int>(metric);
+      ++bins[m][bin];
+      if (square > max_square[m]) {
+        max_square[m] = square;
+        worst_index[m] = index;
+      }
+    }
+    void Record(Metric metric, double square, std::uint64_t index) {
+      Record(metric, DenseBinOfSquare(square, kLowestOctave[static_cast<int>(metric)]), square, index);
+    }
+    void RecordNonFinite(bool is_nan, std::uint64_t index) {
+      if (nan + inf == 0 || index < first_nonfinite_index) first_nonfinite_index = index;
+      ++(is_nan ? nan : inf);
+    }
+  };
+
+  Slot& Joint(int band) { return slots_.get()[kDistanceBands + band]; }
+  Slot& Distance(int band) { return slots_.get()[band]; }
+
+  // Samples recorded since the last flush (the caller counts them).
+  void Count(std::uint64_t samples) { pending_ += samples; }
+  std::uint64_t pending() const { return pending_; }
+  void FlushInto(CellStats& out);
+
+ private:
+  static constexpr int kSlots = kDistanceBands + kJointBands;
+  struct Unmap {
+    void operator()(Slot* slots) const;
+  };
+  // [0, kDistanceBands): distance bands; then joint bands.
+  std::unique_ptr<Slot, Unmap> slots_;
+  std::uint64_t pending_ = 0;
+};
+
+}  // namespace depthbench

@@ -1,0 +1,411 @@
+#include "bench/results/results.h"
+
+#include <algorithm>
+#include <charconv>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "bench/base/files.h"
+#include "bench/base/json_reader.h"
+
+namespace depthbench {
+
+using nlohmann::json;
+
+std::uint64_t Shard::Begin(std::uint64_t total) const {
+  return static_cast<std::uint64_t>(static_cast<unsigned __int128>(total) * (index - 1) / count);
+}
+std::uint64_t Shard::End(std::uint64_t total) const {
+  return static_cast<std::uint64_t>(static_cast<unsigned __int128>(total) * index / count);
+}
+std::string Shard::ToString() const { return fmt::format("{}/{}", index, count); }
+
+Expected<Shard> ParseShard(std::string_view text) {
+  auto slash = text.find('/');
+  Shard shard;
+  auto parse = [](std::string_view s, std::uint32_t& out) {
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size();
+  };
+  if (slash == std::string_view::npos || !parse(text.substr(0, slash), shard.index) ||
+      !parse(text.substr(slash + 1), shard.count) || shard.count == 0 || shard.index == 0 ||
+      shard.index > shard.count) {
+    return InvalidArgument(fmt::format(
+        "--shard: '{}' is not K/N with 1 <= K <= N (shard K of N, e.g. 2/4)", text));
+  }
+  return shard;
+}
+
+const CellResult* Results::Find(const Cell& cell, const std::string& backend) const {
+  for (const CellResult& c : cells)
+    if (c.cell == cell && c.backend == backend) return &c;
+  return nullptr;
+}
+
+// ---------------------------------------------------------------- writing
+
+namespace {
+
+json RangeToJson(const Range& r) { return json::array({r.min, r.max}); }
+
+json MetricToJson(const MetricStats& m) {
+  json bins = json::array();
+  for (const auto& [slot, count] : m.bins) bins.push_back(json::array({slot, count}));
+  return {{"max_square", JsonNumber(m.max_square)},
+          {"max", JsonNumber(m.max())},  // for readers; max_square is the exact record
+          {"worst_index", JsonIndex(m.worst_index)},
+          {"bins", bins}};
+}
+
+json BandToJson(const BandStats& b) {
+  json metrics = json::object();
+  for (int m = 0; m < kMetricCount; ++m) metrics[MetricName(static_cast<Metric>(m))] = MetricToJson(b.metrics[m]);
+  return {{"finite", b.finite},
+          {"nan", b.nan},
+          {"inf", b.inf},
+          {"degenerate", b.degenerate},
+          {"outside", b.outside},
+          {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
+          {"metrics", metrics}};
+}
+
+json SummaryToJson(const BandStats& all) {
+  json out = json::object();
+  for (int m = 0; m < kMetricCount; ++m) {
+    Metric metric = static_cast<Metric>(m);
+    Summary s = Summarize(all, metric);
+    json entry = {{"p50", JsonNumber(s.p50)},
+                  {"p99", JsonNumber(s.p99)},
+                  {"p999", JsonNumber(s.p999)},
+                  {"max", JsonNumber(s.max)},
+                  {"worst_index", JsonIndex(s.worst_index)}};
+    if (metric != Metric::kAbsolute) {
+      entry["p50_bits"] = BitsLost(s.p50);
+      entry["p99_bits"] = BitsLost(s.p99);
+      entry["p999_bits"] = BitsLost(s.p999);
+      entry["max_bits"] = JsonNumber(BitsLost(s.max));
+    }
+    out[MetricName(metric)] = entry;
+  }
+  return out;
+}
+
+}  // namespace
+
+json DeviceToJson(const DeviceInfo& d) {
+  return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", d.kind}, {"compiler", d.compiler}};
+}
+
+Expected<DeviceInfo> DeviceFromJson(const JsonReader& r) {
+  DeviceInfo d;
+  DB_ASSIGN_OR_RETURN(d.name, r.String("name"));
+  DB_ASSIGN_OR_RETURN(d.driver, r.String("driver"));
+  DB_ASSIGN_OR_RETURN(d.api, r.String("api"));
+  DB_ASSIGN_OR_RETURN(d.kind, r.String("kind"));
+  DB_ASSIGN_OR_RETURN(d.compiler, r.String("compiler"));
+  return d;
+}
+
+json DomainToJson(const Domain& d) {
+  json resolutions = json::array();
+  for (const auto& r : d.resolutions) resolutions.push_back(json::array({r.width, r.height}));
+  json out = {{"fov_degrees", RangeToJson(d.fov_degrees)},
+              {"aspect", RangeToJson(d.aspect)},
+              {"near", RangeToJson(d.near)},
+              {"ratio", RangeToJson(d.ratio)},
+              {"finite_far", d.finite_far},
+              {"infinite_far", d.infinite_far},
+              {"far", d.far ? RangeToJson(*d.far) : json(nullptr)},
+              {"camera_distance", RangeToJson(d.camera_distance)},
+              {"eye_depth", d.eye_depth ? RangeToJson(*d.eye_depth) : json(nullptr)},
+              {"resolutions", resolutions}};
+  return out;
+}
+
+json ToJson(const Results& results) {
+  const RunInfo& run = results.run;
+  json shards = json::array();
+  for (const Shard& s : run.shards) shards.push_back(s.ToString());
+  json backends = json::array();
+  for (const auto& b : run.backends) backends.push_back({{"name", b.name}, {"device", DeviceToJson(b.device)}});
+
+  json cells = json::array();
+  for (const CellResult& c : results.cells) {
+    BandStats all = c.stats.All();
+    json joint = json::array();
+    for (const auto& [band, stats] : c.stats.joint) {
+      json entry = BandToJson(stats);
+      entry["ratio_band"] = RatioOfJoint(band);
+      entry["depth_band"] = DepthOfJoint(band);
+      entry["ratio"] = RatioBandName(RatioOfJoint(band));
+      entry["depth"] = DepthBandName(DepthOfJoint(band));
+      joint.push_back(entry);
+    }
+    json distance = json::array();
+    for (const auto& [band, stats] : c.stats.distance) {
+      json entry = BandToJson(stats);
+      entry["distance_band"] = band;
+      entry["distance"] = DistanceBandName(band);
+      distance.push_back(entry);
+    }
+    cells.push_back({{"cell", c.cell.Name()},
+                     {"variant", Info(c.cell.variant).name},
+                     {"convention", Info(c.cell.convention).name},
+                     {"format", Info(c.cell.format).name},
+                     {"backend", c.backend},
+                     {"counts",
+                      {{"finite", all.finite},
+                       {"nan", all.nan},
+                       {"inf", all.inf},
+                       {"degenerate", all.degenerate},
+                       {"outside", all.outside},
+                       {"first_nonfinite_index", JsonIndex(all.first_nonfinite_index)}}},
+                     {"summary", SummaryToJson(all)},
+                     {"bands", {{"joint", joint}, {"distance", distance}}}});
+  }
+
+  return {{"schema", kResultsSchema},
+          {"schema_version", kResultsSchemaVersion},
+          {"run",
+           {{"version", run.version},
+            {"commit", run.commit},
+            {"started_at", run.started_at},
+            {"host", run.host},
+            {"seed", run.seed},
+            {"samples", run.samples},
+            {"samples_per_frame", run.samples_per_frame},
+            {"shards", shards},
+            {"domain", DomainToJson(run.domain)},
+            {"backends", backends},
+            {"seconds", run.seconds},
+            {"reconstructions", run.reconstructions}}},
+          {"cells", cells}};
+}
+
+Status WriteResults(const std::filesystem::path& path, const Results& results) {
+  return WriteFileAtomically(path, ToJson(results).dump(1) + "\n");
+}
+
+// ---------------------------------------------------------------- reading
+
+namespace {
+
+Expected<Range> RangeFrom(const JsonReader& r) {
+  DB_ASSIGN_OR_RETURN(std::size_t n, r.ArraySize());
+  if (n != 2) return r.Error("expected [min, max]");
+  DB_ASSIGN_OR_RETURN(JsonReader lo, r.Element(0));
+  DB_ASSIGN_OR_RETURN(JsonReader hi, r.Element(1));
+  DB_ASSIGN_OR_RETURN(double min, lo.Number());
+  DB_ASSIGN_OR_RETURN(double max, hi.Number());
+  return Range{min, max};
+}
+
+Expected<MetricStats> MetricFrom(const JsonReader& r) {
+  MetricStats m;
+  DB_ASSIGN_OR_RETURN(m.max_square, r.Number("max_square"));
+  DB_ASSIGN_OR_RETURN(m.worst_index, r.Unsigned("worst_index"));
+  DB_ASSIGN_OR_RETURN(JsonReader bins, r.Field("bins"));
+  DB_ASSIGN_OR_RETURN(std::size_t n, bins.ArraySize());
+  for (std::size_t i = 0; i < n; ++i) {
+    DB_ASSIGN_OR_RETURN(JsonReader pair, bins.Element(i));
+    DB_ASSIGN_OR_RETURN(JsonReader slot, pair.Element(0));
+    DB_ASSIGN_OR_RETURN(JsonReader count, pair.Element(1));
+    DB_ASSIGN_OR_RETURN(std::int64_t s, slot.Integer());
+    DB_ASSIGN_OR_RETURN(std::uint64_t c, count.Unsigned());
+    if (s < 0 || s >= kDenseBins) return slot.Error(fmt::format("bin {} outside [0, {})", s, kDenseBins));
+    m.bins[static_cast<int>(s)] += c;
+  }
+  return m;
+}
+
+Expected<BandStats> BandFrom(const JsonReader& r) {
+  BandStats b;
+  DB_ASSIGN_OR_RETURN(b.finite, r.Unsigned("finite"));
+  DB_ASSIGN_OR_RETURN(b.nan, r.Unsigned("nan"));
+  DB_ASSIGN_OR_RETURN(b.inf, r.Unsigned("inf"));
+  DB_ASSIGN_OR_RETURN(b.degenerate, r.Unsigned("degenerate"));
+  DB_ASSIGN_OR_RETURN(b.outside, r.Unsigned("outside"));
+  DB_ASSIGN_OR_RETURN(b.first_nonfinite_index, r.Unsigned("first_nonfinite_index"));
+  DB_ASSIGN_OR_RETURN(JsonReader metrics, r.Field("metrics"));
+  for (int m = 0; m < kMetricCount; ++m) {
+    DB_ASSIGN_OR_RETURN(JsonReader metric, metrics.Field(MetricName(static_cast<Metric>(m))));
+    DB_ASSIGN_OR_RETURN(b.metrics[m], MetricFrom(metric));
+  }
+  return b;
+}
+
+Expected<int> BandIndex(const JsonReader& r, const std::string& key, int count) {
+  DB_ASSIGN_OR_RETURN(std::int64_t v, r.Integer(key));
+  if (v < 0 || v >= count) return r.Error(fmt::format("{} {} outside [0, {})", key, v, count));
+  return static_cast<int>(v);
+}
+
+
+}  // namespace
+
+Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
+  JsonReader r(j, source, "run.domain");
+  Domain d;
+  auto range = [&](const std::string& key) -> Expected<Range> {
+    DB_ASSIGN_OR_RETURN(JsonReader f, r.Field(key));
+    return RangeFrom(f);
+  };
+  auto optional_range = [&](const std::string& key, std::optional<Range>& out) -> Status {
+    DB_ASSIGN_OR_RETURN(JsonReader f, r.Field(key));
+    if (f.json().is_null()) return Status::Ok();
+    DB_ASSIGN_OR_RETURN(Range value, RangeFrom(f));
+    out = value;
+    return Status::Ok();
+  };
+  DB_ASSIGN_OR_RETURN(d.fov_degrees, range("fov_degrees"));
+  DB_ASSIGN_OR_RETURN(d.aspect, range("aspect"));
+  DB_ASSIGN_OR_RETURN(d.near, range("near"));
+  DB_ASSIGN_OR_RETURN(d.ratio, range("ratio"));
+  DB_ASSIGN_OR_RETURN(d.finite_far, r.Bool("finite_far"));
+  DB_ASSIGN_OR_RETURN(d.infinite_far, r.Bool("infinite_far"));
+  DB_RETURN_IF_ERROR(optional_range("far", d.far));
+  DB_ASSIGN_OR_RETURN(d.camera_distance, range("camera_distance"));
+  DB_RETURN_IF_ERROR(optional_range("eye_depth", d.eye_depth));
+  DB_ASSIGN_OR_RETURN(JsonReader res, r.Field("resolutions"));
+  DB_ASSIGN_OR_RETURN(std::size_t n, res.ArraySize());
+  d.resolutions.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    DB_ASSIGN_OR_RETURN(JsonReader pair, res.Element(i));
+    DB_ASSIGN_OR_RETURN(JsonReader w, pair.Element(0));
+    DB_ASSIGN_OR_RETURN(JsonReader h, pair.Element(1));
+    DB_ASSIGN_OR_RETURN(std::uint64_t width, w.Unsigned());
+    DB_ASSIGN_OR_RETURN(std::uint64_t height, h.Unsigned());
+    d.resolutions.push_back({static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
+  }
+  Status valid = d.Validate();
+  if (!valid.ok()) return r.Error(valid.message());
+  return d;
+}
+
+Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
+  JsonReader top(j, source);
+  DB_ASSIGN_OR_RETURN(std::string schema, top.String("schema"));
+  if (schema != kResultsSchema) {
+    return top.Error(fmt::format("schema is '{}', expected '{}'", schema, kResultsSchema));
+  }
+  DB_ASSIGN_OR_RETURN(std::int64_t version, top.Integer("schema_version"));
+  if (version != kResultsSchemaVersion) {
+    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})",
+                                 version, kResultsSchemaVersion));
+  }
+  Results results;
+  RunInfo& run = results.run;
+  DB_ASSIGN_OR_RETURN(JsonReader r, top.Field("run"));
+  DB_ASSIGN_OR_RETURN(run.version, r.String("version"));
+  DB_ASSIGN_OR_RETURN(run.commit, r.String("commit"));
+  DB_ASSIGN_OR_RETURN(run.started_at, r.String("started_at"));
+  DB_ASSIGN_OR_RETURN(run.host, r.String("host"));
+  DB_ASSIGN_OR_RETURN(run.seed, r.Unsigned("seed"));
+  DB_ASSIGN_OR_RETURN(run.samples, r.Unsigned("samples"));
+  DB_ASSIGN_OR_RETURN(std::uint64_t per_frame, r.Unsigned("samples_per_frame"));
+  run.samples_per_frame = static_cast<std::uint32_t>(per_frame);
+  DB_ASSIGN_OR_RETURN(run.seconds, r.Number("seconds"));
+  DB_ASSIGN_OR_RETURN(run.reconstructions, r.Unsigned("reconstructions"));
+  DB_ASSIGN_OR_RETURN(JsonReader shards, r.Field("shards"));
+  DB_ASSIGN_OR_RETURN(std::size_t shard_count, shards.ArraySize());
+  for (std::size_t i = 0; i < shard_count; ++i) {
+    DB_ASSIGN_OR_RETURN(JsonReader s, shards.Element(i));
+    DB_ASSIGN_OR_RETURN(std::string text, s.String());
+    Expected<Shard> shard = ParseShard(text);
+    if (!shard.ok()) return s.Error(shard.status().message());
+    run.shards.push_back(*shard);
+  }
+  DB_ASSIGN_OR_RETURN(JsonReader domain, r.Field("domain"));
+  DB_ASSIGN_OR_RETURN(run.domain, DomainFromJson(domain.json(), source));
+  DB_ASSIGN_OR_RETURN(JsonReader backends, r.Field("backends"));
+  DB_ASSIGN_OR_RETURN(std::size_t backend_count, backends.ArraySize());
+  for (std::size_t i = 0; i < backend_count; ++i) {
+    DB_ASSIGN_OR_RETURN(JsonReader b, backends.Element(i));
+    BackendRecord record;
+    DB_ASSIGN_OR_RETURN(record.name, b.String("name"));
+    DB_ASSIGN_OR_RETURN(JsonReader device, b.Field("device"));
+    DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
+    run.backends.push_back(record);
+  }
+
+  DB_ASSIGN_OR_RETURN(JsonReader cells, top.Field("cells"));
+  DB_ASSIGN_OR_RETURN(std::size_t cell_count, cells.ArraySize());
+  for (std::size_t i = 0; i < cell_count; ++i) {
+    DB_ASSIGN_OR_RETURN(JsonReader c, cells.Element(i));
+    CellResult result;
+    DB_ASSIGN_OR_RETURN(std::string name, c.String("cell"));
+    Expected<Cell> cell = ParseCell(name);
+    if (!cell.ok()) return c.Error(cell.status().message());
+    result.cell = *cell;
+    DB_ASSIGN_OR_RETURN(result.backend, c.String("backend"));
+    DB_ASSIGN_OR_RETURN(JsonReader bands, c.Field("bands"));
+    DB_ASSIGN_OR_RETURN(JsonReader joint, bands.Field("joint"));
+    DB_ASSIGN_OR_RETURN(std::size_t joint_count, joint.ArraySize());
+    for (std::size_t k = 0; k < joint_count; ++k) {
+      DB_ASSIGN_OR_RETURN(JsonReader b, joint.Element(k));
+      DB_ASSIGN_OR_RETURN(int ratio, BandIndex(b, "ratio_band", kRatioBands));
+      DB_ASSIGN_OR_RETURN(int depth, BandIndex(b, "depth_band", kDepthBands));
+      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
+      result.stats.joint[JointBand(ratio, depth)].Merge(stats);
+    }
+    DB_ASSIGN_OR_RETURN(JsonReader distance, bands.Field("distance"));
+    DB_ASSIGN_OR_RETURN(std::size_t distance_count, distance.ArraySize());
+    for (std::size_t k = 0; k < distance_count; ++k) {
+      DB_ASSIGN_OR_RETURN(JsonReader b, distance.Element(k));
+      DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "distance_band", kDistanceBands));
+      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
+      result.stats.distance[band].Merge(stats);
+    }
+    results.cells.push_back(std::move(result));
+  }
+  return results;
+}
+
+Expected<Results> ReadResults(const std::filesystem::path& path) {
+  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
+  DB_ASSIGN_OR_RETURN(json j, JsonReader::Parse(text, path.string()));
+  return ResultsFromJson(j, path.string());
+}
+
+// ---------------------------------------------------------------- merging
+
+Expected<Results> MergeResults(const std::vector<Results>& parts) {
+  if (parts.empty()) return InvalidArgument("nothing to merge");
+  Results merged = parts.front();
+  for (std::size_t p = 1; p < parts.size(); ++p) {
+    const Results& part = parts[p];
+    const RunInfo& a = merged.run;
+    const RunInfo& b = part.run;
+    if (a.seed != b.seed || a.samples != b.samples || a.samples_per_frame != b.samples_per_frame ||
+        DomainToJson(a.domain) != DomainToJson(b.domain)) {
+      return InvalidArgument(fmt::format(
+          "part {} is not a shard of the same sweep (seed, sample count, plan and domain must match)", p + 1));
+    }
+    for (const Shard& s : b.shards) {
+      for (const Shard& held : a.shards) {
+        bool overlap = s.Begin(a.samples) < held.End(a.samples) && held.Begin(a.samples) < s.End(a.samples);
+        if (overlap) {
+          return InvalidArgument(fmt::format("shards {} and {} overlap", s.ToString(), held.ToString()));
+        }
+      }
+      merged.run.shards.push_back(s);
+    }
+    merged.run.seconds += b.seconds;
+    merged.run.reconstructions += b.reconstructions;
+    for (const CellResult& c : part.cells) {
+      auto it = std::find_if(merged.cells.begin(), merged.cells.end(), [&](const CellResult& m) {
+        return m.cell == c.cell && m.backend == c.backend;
+      });
+      if (it == merged.cells.end()) {
+        merged.cells.push_back(c);
+      } else {
+        it->stats.Merge(c.stats);
+      }
+    }
+  }
+  std::sort(merged.run.shards.begin(), merged.run.shards.end());
+  return merged;
+}
+
+}  // namespace depthbench

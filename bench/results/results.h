@@ -1,0 +1,87 @@
+// Results: what a run measured, per cell and backend, with how it was made.
+// Saved as versioned JSON (schema "depthbench.results", version 1; see
+// reports/results.schema.json). The JSON keeps the full histograms, so
+// results of shards merge exactly into the results of the whole sweep.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/backends/backend.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/base/json_reader.h"
+#include "bench/pipeline/stats.h"
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+inline constexpr const char* kResultsSchema = "depthbench.results";
+inline constexpr int kResultsSchemaVersion = 1;
+
+// Shard K of N (1-based, as "--shard K/N" spells it): samples
+// [total * (K-1) / N, total * K / N) of the sweep.
+struct Shard {
+  std::uint32_t index = 1;
+  std::uint32_t count = 1;
+  std::uint64_t Begin(std::uint64_t total) const;
+  std::uint64_t End(std::uint64_t total) const;
+  std::string ToString() const;
+  friend bool operator==(const Shard&, const Shard&) = default;
+  friend auto operator<=>(const Shard&, const Shard&) = default;
+};
+Expected<Shard> ParseShard(std::string_view text);
+
+struct BackendRecord {
+  std::string name;  // "cpu", "vulkan"
+  DeviceInfo device;
+};
+
+struct RunInfo {
+  std::string version;
+  std::string commit;
+  std::string started_at;
+  std::string host;
+  std::uint64_t seed = 0;
+  std::uint64_t samples = 0;  // of the whole sweep, every shard together
+  std::uint32_t samples_per_frame = 0;
+  std::vector<Shard> shards;  // the shards these results hold
+  Domain domain;
+  std::vector<BackendRecord> backends;
+  double seconds = 0.0;                   // wall time (summed over merged shards)
+  std::uint64_t reconstructions = 0;      // cell evaluations judged against the reference
+};
+
+struct CellResult {
+  Cell cell;
+  std::string backend;
+  CellStats stats;
+};
+
+struct Results {
+  RunInfo run;
+  std::vector<CellResult> cells;
+
+  const CellResult* Find(const Cell& cell, const std::string& backend) const;
+};
+
+nlohmann::json ToJson(const Results& results);
+// `source` names the input in error messages (a file path).
+Expected<Results> ResultsFromJson(const nlohmann::json& json, const std::string& source);
+Status WriteResults(const std::filesystem::path& path, const Results& results);
+Expected<Results> ReadResults(const std::filesystem::path& path);
+
+// Adds up the results of shards of one sweep. They must share seed, sample
+// count, plan and domain, and hold disjoint shards.
+Expected<Results> MergeResults(const std::vector<Results>& parts);
+
+nlohmann::json DomainToJson(const Domain& domain);
+Expected<Domain> DomainFromJson(const nlohmann::json& json, const std::string& source);
+nlohmann::json DeviceToJson(const DeviceInfo& device);
+Expected<DeviceInfo> DeviceFromJson(const JsonReader& json);
+
+}  // namespace depthbench

@@ -1,0 +1,114 @@
+#include "bench/results/results_table.h"
+
+#include <set>
+
+#include <fmt/format.h>
+
+#include "bench/base/text_table.h"
+
+namespace depthbench {
+namespace {
+
+std::string Bits(double relative) { return fmt::format("{:.1f}", BitsLost(relative)); }
+std::string Count(std::uint64_t n) { return n == 0 ? "0" : fmt::format("{}", n); }
+
+std::string SiCount(double x) {
+  if (x >= 1e9) return fmt::format("{:.2f}G", x / 1e9);
+  if (x >= 1e6) return fmt::format("{:.2f}M", x / 1e6);
+  if (x >= 1e3) return fmt::format("{:.1f}k", x / 1e3);
+  return fmt::format("{:.0f}", x);
+}
+
+}  // namespace
+
+void PrintRunHeader(const Results& results, std::ostream& out) {
+  const RunInfo& run = results.run;
+  out << fmt::format("depthbench {} (commit {}), seed {}, {} samples", run.version, run.commit, run.seed,
+                     run.samples);
+  if (!(run.shards.size() == 1 && run.shards[0].count == 1)) {
+    std::string shards;
+    for (const Shard& s : run.shards) shards += (shards.empty() ? "" : ",") + s.ToString();
+    out << fmt::format(" (shards {})", shards);
+  }
+  out << "\n";
+  out << "domain: " << run.domain.Describe() << "\n";
+  for (const auto& b : run.backends) {
+    out << fmt::format("backend {}: {} [{}; {}; {}]", b.name, b.device.name, b.device.driver, b.device.api,
+                       b.device.compiler);
+    if (b.name == "vulkan" && b.device.kind == "cpu") out << " (software rasterizer on the CPU)";
+    out << "\n";
+  }
+  if (run.seconds > 0) {
+    out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions),
+                       run.seconds, SiCount(run.reconstructions / run.seconds));
+  }
+  out << "bits lost = max(0, log2(relative error / 2^-24)); relative to the distance from the camera\n\n";
+}
+
+void PrintResultsTable(const Results& results, std::ostream& out) {
+  using Align = TextTable::Align;
+  TextTable table({{"cell", Align::kLeft},
+                   {"backend", Align::kLeft},
+                   {"judged"},
+                   {"p50"},
+                   {"p99"},
+                   {"p99.9"},
+                   {"max"},
+                   {"arith p99.9"},
+                   {"storage p99.9"},
+                   {"abs p99.9"},
+                   {"abs max"},
+                   {"NaN"},
+                   {"Inf"},
+                   {"degen"}});
+  for (const CellResult& c : results.cells) {
+    const BandStats all = c.stats.All();
+    const Summary total = Summarize(all, Metric::kTotal);
+    const Summary absolute = Summarize(all, Metric::kAbsolute);
+    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99),
+                  Bits(total.p999), Bits(total.max), Bits(Summarize(all, Metric::kArith).p999),
+                  Bits(Summarize(all, Metric::kStorage).p999), fmt::format("{:.2g}", absolute.p999),
+                  fmt::format("{:.2g}", absolute.max), Count(all.nan), Count(all.inf), Count(all.degenerate)});
+  }
+  out << "bits lost of the total error (p50 / p99 / p99.9 / max), of its arithmetic and storage parts,\n"
+         "and the absolute error in world units\n";
+  table.Print(out);
+}
+
+void PrintBandTable(const Results& results, BandFamily family, std::ostream& out) {
+  std::set<int> bands;
+  for (const CellResult& c : results.cells) {
+    if (family == BandFamily::kDistance) {
+      for (const auto& [band, stats] : c.stats.distance) bands.insert(band);
+    } else {
+      for (const auto& [band, stats] : c.stats.joint)
+        bands.insert(family == BandFamily::kRatio ? RatioOfJoint(band) : DepthOfJoint(band));
+    }
+  }
+  const char* title = family == BandFamily::kRatio   ? "far/near ratio"
+                      : family == BandFamily::kDepth ? "eye depth / near"
+                                                     : "camera distance from the origin";
+  std::vector<TextTable::Column> columns{{"cell", TextTable::Align::kLeft}, {"backend", TextTable::Align::kLeft}};
+  for (int band : bands) {
+    columns.push_back({family == BandFamily::kRatio   ? RatioBandName(band)
+                       : family == BandFamily::kDepth ? DepthBandName(band)
+                                                      : DistanceBandName(band)});
+  }
+  TextTable table(columns);
+  for (const CellResult& c : results.cells) {
+    std::vector<std::string> row{c.cell.Name(), c.backend};
+    for (int band : bands) {
+      BandStats s = family == BandFamily::kRatio   ? c.stats.ForRatio(band)
+                    : family == BandFamily::kDepth ? c.stats.ForDepth(band)
+                                                   : c.stats.ForDistance(band);
+      std::string text = s.finite == 0 ? "-" : Bits(Summarize(s, Metric::kTotal).p999);
+      if (s.nan + s.inf > 0) text += "!";
+      row.push_back(text);
+    }
+    table.AddRow(std::move(row));
+  }
+  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples)\n", title);
+  table.Print(out);
+}
+
+}  // namespace depthbench

@@ -1,0 +1,217 @@
+#include "bench/sweep/sweep.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "bench/pipeline/batch.h"
+#include "bench/base/environment.h"
+#include "bench/pipeline/judge.h"
+#include "bench/pipeline/sampler.h"
+#include "bench/base/text_table.h"
+#include "bench/base/thread_pool.h"
+
+namespace depthbench {
+
+double SweepProgress::fraction() const {
+  return samples_total == 0 ? 1.0 : static_cast<double>(samples_done) / static_cast<double>(samples_total);
+}
+
+std::string SweepProgress::Describe() const {
+  return fmt::format("{}/{} samples, {} reconstructions/s", ShortCount(static_cast<double>(samples_done)),
+                     ShortCount(static_cast<double>(samples_total)),
+                     ShortCount(static_cast<double>(reconstructions_done) / std::max(seconds, 1e-9)));
+}
+namespace {
+
+// A 32-bit bin can count 4.29e9 samples; flush well before.
+constexpr std::uint64_t kFlushEvery = std::uint64_t{1} << 31;
+
+// The first error any worker reports.
+class FirstError {
+ public:
+  void Set(const Status& s) {
+    std::lock_guard lock(mutex_);
+    if (status_.ok()) status_ = s;
+  }
+  Status Get() {
+    std::lock_guard lock(mutex_);
+    return status_;
+  }
+
+ private:
+  std::mutex mutex_;
+  Status status_;
+};
+
+// Storage statistics live per encoding; each cell reports its encoding's.
+void CopyStorageMetric(const CellStats& from, CellStats& to) {
+  constexpr int kStorage = static_cast<int>(Metric::kStorage);
+  for (const auto& [band, stats] : from.joint) to.joint[band].metrics[kStorage] = stats.metrics[kStorage];
+  for (const auto& [band, stats] : from.distance) to.distance[band].metrics[kStorage] = stats.metrics[kStorage];
+}
+
+}  // namespace
+
+std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& domain) {
+  std::vector<Cell> out;
+  for (const Cell& cell : cells) {
+    const ConventionInfo& c = Info(cell.convention);
+    const DepthInput stores = Info(cell.format).stores;
+    bool needs_finite = (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) ||
+                        stores == DepthInput::kLinear;
+    bool needs_infinite = c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) != 0u;
+    if (needs_finite && !domain.finite_far) continue;
+    if (needs_infinite && !domain.infinite_far) continue;
+    out.push_back(cell);
+  }
+  return out;
+}
+
+Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const> backends) {
+  DB_RETURN_IF_ERROR(options.domain.Validate());
+  if (backends.empty()) return InvalidArgument("no backend to run");
+  if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
+  if (!ProcessorRuns(options.isa)) return Unavailable("this processor does not run the requested instruction set");
+  const std::vector<Cell> all = AllCells();
+  const std::vector<Cell> cells =
+      CellsForDomain(options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells),
+                     options.domain);
+  if (cells.empty()) {
+    return InvalidArgument(
+        "none of the selected cells can run in this domain (finite-far conventions and linear formats need "
+        "a finite far plane; infinite-far conventions need --ratio to allow inf)");
+  }
+  const RunLayout layout = MakeRunLayout(cells);
+  for (Backend* backend : backends) {
+    DB_RETURN_IF_ERROR(backend->Prepare(layout.cells).WithContext("preparing the " + backend->name() + " backend"));
+  }
+
+  const auto started = std::chrono::steady_clock::now();
+  Results results;
+  RunInfo& run = results.run;
+  run.version = DEPTHBENCH_VERSION;
+  run.commit = CurrentCommit();
+  run.started_at = CurrentTimeUtc();
+  run.host = HostName();
+  run.seed = options.seed;
+  run.samples = options.samples;
+  run.samples_per_frame = kSamplesPerFrame;
+  run.shards = {options.shard};
+  run.domain = options.domain;
+  for (Backend* backend : backends) run.backends.push_back({backend->name(), backend->device()});
+
+  const Sampler sampler(options.seed, options.domain);
+  const BatchBuilder builder(sampler, layout.encodings, options.isa);
+  ThreadPool pool(options.threads);
+  const std::size_t cell_count = layout.cells.size();
+  std::vector<CellAccumulator> accumulators(backends.size() * cell_count);
+  std::vector<CellStats> stats(backends.size() * cell_count);
+  // Storage errors belong to an encoding, whatever reads it: one
+  // accumulator per depth slot, copied into its cells at the end.
+  const std::size_t slot_count = layout.encodings.size();
+  std::vector<CellAccumulator> storage_accumulators(slot_count);
+  std::vector<CellStats> storage_stats(slot_count);
+  std::vector<std::vector<float>> scratch(pool.size());
+  std::vector<std::vector<std::uint32_t>> cells_of_slot(slot_count);
+  for (std::uint32_t c = 0; c < cell_count; ++c) cells_of_slot[layout.cells[c].depth_slot].push_back(c);
+  // Depth slots, those with the most cells first: the threads take them in
+  // this order, and the small ones at the end even out the finish.
+  std::vector<std::uint32_t> slot_order(slot_count);
+  std::iota(slot_order.begin(), slot_order.end(), 0u);
+  std::stable_sort(slot_order.begin(), slot_order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return cells_of_slot[a].size() > cells_of_slot[b].size();
+  });
+  std::vector<std::uint32_t> every_cell(cell_count);
+  std::iota(every_cell.begin(), every_cell.end(), 0u);
+
+  const std::uint64_t begin = options.shard.Begin(options.samples);
+  const std::uint64_t end = options.shard.End(options.samples);
+  SweepProgress progress;
+  progress.samples_total = end - begin;
+  Batch batch;
+  for (std::uint64_t first = begin; first < end; first += options.batch_size) {
+    const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(options.batch_size, end - first));
+    builder.Build(first, count, batch, pool);
+    for (std::size_t b = 0; b < backends.size(); ++b) {
+      Backend& backend = *backends[b];
+      CellAccumulator* acc = accumulators.data() + b * cell_count;
+      // The cells are judged a depth slot at a time: those that read the
+      // same encoding share its reference. The slot's storage errors are
+      // recorded once per batch, with the first backend's cells, while its
+      // reference is in cache.
+      auto judge = [&](std::size_t slot, auto positions_of) {
+        std::vector<JudgedCell> judged;
+        for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
+        const auto depth_slot = static_cast<std::uint32_t>(slot);
+        JudgeSlot(batch, depth_slot, judged, options.isa);
+        if (b == 0) RecordStorage(batch, depth_slot, storage_accumulators[slot], options.isa);
+      };
+      const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
+      if (backend.concurrent()) {
+        FirstError error;
+        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
+          for (std::size_t next = lo; next < hi; ++next) {
+            const std::uint32_t slot = slot_order[next];
+            auto out = backend.Run(batch, cells_of_slot[slot], scratch[worker]);
+            if (!out.ok()) {
+              error.Set(out.status());
+              return;
+            }
+            const std::span<const float> positions = *out;
+            std::size_t k = 0;
+            judge(slot, [&](std::uint32_t) { return positions.subspan(per_cell * k++, per_cell); });
+          }
+        });
+        DB_RETURN_IF_ERROR(error.Get().WithContext("running the " + backend.name() + " backend"));
+      } else {
+        auto out = backend.Run(batch, every_cell, scratch[0]);
+        if (!out.ok()) return out.status().WithContext("running the " + backend.name() + " backend");
+        const std::span<const float> positions = *out;
+        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t next = lo; next < hi; ++next) {
+            const std::uint32_t slot = slot_order[next];
+            judge(slot, [&](std::uint32_t c) { return positions.subspan(c * per_cell, per_cell); });
+          }
+        });
+      }
+    }
+    for (std::size_t k = 0; k < accumulators.size(); ++k) {
+      if (accumulators[k].pending() >= kFlushEvery) accumulators[k].FlushInto(stats[k]);
+    }
+    for (std::size_t e = 0; e < slot_count; ++e) {
+      if (storage_accumulators[e].pending() >= kFlushEvery) storage_accumulators[e].FlushInto(storage_stats[e]);
+    }
+    progress.samples_done += count;
+    progress.reconstructions_done += static_cast<std::uint64_t>(count) * cell_count * backends.size();
+    progress.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (options.progress) options.progress(progress);
+  }
+
+  // The last flush, on the pool: each accumulator is its own.
+  pool.ParallelFor(slot_count + accumulators.size(), [&](std::size_t lo, std::size_t hi, unsigned) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      if (k < slot_count) {
+        storage_accumulators[k].FlushInto(storage_stats[k]);
+      } else {
+        accumulators[k - slot_count].FlushInto(stats[k - slot_count]);
+      }
+    }
+  });
+  for (std::size_t b = 0; b < backends.size(); ++b) {
+    for (std::size_t c = 0; c < cell_count; ++c) {
+      const std::size_t k = b * cell_count + c;
+      CopyStorageMetric(storage_stats[layout.cells[c].depth_slot], stats[k]);
+      results.cells.push_back({layout.cells[c].cell, backends[b]->name(), std::move(stats[k])});
+    }
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  run.reconstructions = progress.reconstructions_done;
+  return results;
+}
+
+}  // namespace depthbench

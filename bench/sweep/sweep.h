@@ -1,0 +1,51 @@
+// Sweep: the run loop. Draws the samples of a shard in batches, runs every
+// cell on every backend, judges the outputs against the reference, and
+// streams the errors into fixed-size statistics, so memory stays flat
+// however many samples run.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bench/backends/backend.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/base/isa.h"
+#include "bench/results/results.h"
+
+namespace depthbench {
+
+struct SweepProgress {
+  std::uint64_t samples_done = 0;
+  std::uint64_t samples_total = 0;
+  std::uint64_t reconstructions_done = 0;
+  double seconds = 0.0;
+  double fraction() const;
+  // "4.20M/10.00M samples, 61.3M reconstructions/s"
+  std::string Describe() const;
+};
+
+struct SweepOptions {
+  std::uint64_t seed = 1;
+  std::uint64_t samples = 1'000'000;  // of the whole sweep (all shards)
+  Shard shard;
+  Domain domain;
+  std::vector<Cell> cells;            // empty: every cell the domain allows
+  std::uint32_t batch_size = 16384;
+  unsigned threads = 0;               // 0: one per hardware thread
+  Isa isa = Isa::kWidest;             // of the hot loops (bench/base/isa.h): the same results whatever it is
+  std::function<void(const SweepProgress&)> progress;  // called after every batch
+};
+
+// The cells of `cells` that the domain can exercise (finite-far cells need
+// finite frames, infinite-far cells need the domain to allow them).
+std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& domain);
+
+// Runs the sweep on each backend (prepared by this call) and returns the
+// results, one CellResult per (cell, backend).
+Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const> backends);
+
+}  // namespace depthbench

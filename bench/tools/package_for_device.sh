@@ -1,0 +1,107 @@
+#!/bin/sh
+# Packs depthbench for a machine that has a Vulkan driver but no package
+# registry (a GPU box reached only by copying files to it): the program, the
+# shaders and shared/ headers it compiles at run time, and every shared
+# library it loads that such a machine may lack, the Vulkan loader
+# (libvulkan.so.1) included. Run it again after every build; the folder it
+# writes is self-contained.
+#
+#   bench/tools/package_for_device.sh BUILD_DIR OUT_DIR
+#   (copy OUT_DIR to the GPU machine, then there:)
+#   OUT_DIR/run.sh list
+#   OUT_DIR/run.sh speed --shaders OUT_DIR/shaders --json speed.json
+#
+# Left out on purpose: the C library family (libc, libm, libpthread, libdl,
+# librt, the dynamic loader) and the C++ runtime (libstdc++, libgcc_s),
+# which every Linux machine has, in a version at least as new as the one
+# this was built with (glibc 2.34 at most is required), and which the GPU
+# driver loads too: two copies of them in one process is what breaks.
+# The NVIDIA Vulkan driver (libGLX_nvidia.so.0) does not start without
+# glvnd (libGLdispatch.so.0, libEGL.so.1, libGLX.so.0, libGL.so.1,
+# libOpenGL.so.0, libGLESv2.so.2), which a GPU container image may lack:
+# they are packed with what they need when this machine has them (Debian's
+# libglvnd0, libegl1, libglx0, libgl1, libopengl0, libgles2), and run.sh
+# points glvnd at the NVIDIA EGL vendor file when there is one.
+set -eu
+
+if [ $# -ne 2 ]; then
+  echo "usage: $0 BUILD_DIR OUT_DIR" >&2
+  exit 2
+fi
+build=$1
+out=$2
+source_dir=$(cd "$(dirname "$0")/../.." && pwd)
+binary="$build/bench/depthbench"
+if [ ! -x "$binary" ]; then
+  echo "$0: $binary does not exist or is not executable; build first (cmake --build $build)" >&2
+  exit 2
+fi
+
+rm -rf "$out"
+mkdir -p "$out/lib"
+cp "$binary" "$out/depthbench"
+cp -r "$source_dir/shaders" "$source_dir/shared" "$out/"
+
+# Every library ldd resolves for the program and for glvnd, but the C and
+# C++ runtimes.
+glvnd=""
+for name in libGLdispatch.so.0 libEGL.so.1 libGLX.so.0 libGL.so.1 libOpenGL.so.0 libGLESv2.so.2; do
+  for dir in /usr/lib/x86_64-linux-gnu /lib/x86_64-linux-gnu; do
+    if [ -e "$dir/$name" ]; then
+      glvnd="$glvnd $dir/$name"
+      break
+    fi
+  done
+done
+for object in "$binary" $glvnd; do
+  if [ "$object" != "$binary" ]; then cp -L "$object" "$out/lib/"; fi
+  ldd "$object" | awk '$2 == "=>" && $3 ~ /^\// { print $3 }' | while read -r library; do
+    case $(basename "$library") in
+      libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*|libstdc++.so.*|libgcc_s.so.*) ;;
+      *) cp -L "$library" "$out/lib/" ;;
+    esac
+  done
+done
+if [ ! -e "$out/lib/libvulkan.so.1" ]; then
+  echo "$0: ldd did not find libvulkan.so.1 for $binary" >&2
+  exit 1
+fi
+
+# The commit the package was built from travels in run.sh: the GPU machine
+# has no checkout to ask.
+commit=$(git -C "$source_dir" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git -C "$source_dir" status --porcelain --untracked-files=no 2>/dev/null)" ]; then
+  commit="$commit-modified"
+fi
+
+cat > "$out/run.sh" <<'SCRIPT'
+#!/bin/sh
+# Runs the packed depthbench with its own libraries. Where no Vulkan driver
+# is named (VK_DRIVER_FILES, VK_ICD_FILENAMES), the NVIDIA driver's manifest
+# is used if one of its usual places holds it; likewise its glvnd EGL
+# vendor file.
+here=$(cd "$(dirname "$0")" && pwd)
+export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+if [ -z "${VK_DRIVER_FILES:-}" ] && [ -z "${VK_ICD_FILENAMES:-}" ]; then
+  for manifest in /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json /usr/share/vulkan/icd.d/nvidia_icd.json \
+                  /etc/vulkan/icd.d/nvidia_icd.json; do
+    if [ -f "$manifest" ]; then
+      export VK_DRIVER_FILES="$manifest"
+      break
+    fi
+  done
+fi
+if [ -z "${__EGL_VENDOR_LIBRARY_FILENAMES:-}" ]; then
+  for vendor in /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json; do
+    if [ -f "$vendor" ]; then
+      export __EGL_VENDOR_LIBRARY_FILENAMES="$vendor"
+      break
+    fi
+  done
+fi
+export DEPTHBENCH_COMMIT="${DEPTHBENCH_COMMIT:-@COMMIT@}"
+exec "$here/depthbench" "$@"
+SCRIPT
+sed -i "s/@COMMIT@/$commit/" "$out/run.sh"
+chmod +x "$out/run.sh"
+du -sh "$out"

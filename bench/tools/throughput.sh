@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Throughput and memory of `depthbench run` end to end: verified
+# reconstructions per second on the CPU backend and on lavapipe, and the
+# peak resident memory for 10^6 and 10^8 samples (it must not grow with the
+# sample count). Usage: bench/tools/throughput.sh [BUILD_DIR] [RUNS]
+#
+# Each configuration runs RUNS times (default 3), the configurations in
+# turn (A B C ... A B C ...), so that the drift of a shared machine's speed
+# falls on all of them alike. A row gives the median rate, the range of
+# the runs, and the largest peak.
+set -euo pipefail
+build=${1:-build}
+runs=${2:-3}
+depthbench="$build/bench/depthbench"
+[[ -x $depthbench ]] || { echo "no $depthbench: build first (see README.md)" >&2; exit 2; }
+[[ $runs =~ ^[1-9][0-9]*$ ]] || { echo "RUNS must be a whole number of at least 1, not '$runs'" >&2; exit 2; }
+
+labels=(
+  "cpu backend, 1e6 samples (106 cells)"
+  "cpu backend, 1e7 samples"
+  "cpu backend, 1e8 samples"
+  "lavapipe, 1e6 samples (106 cells)"
+  "lavapipe, 1e7 samples"
+)
+arguments=(
+  "--backend cpu --samples 1e6"
+  "--backend cpu --samples 1e7"
+  "--backend cpu --samples 1e8"
+  "--backend vulkan --samples 1e6"
+  "--backend vulkan --samples 1e7"
+)
+declare -a rates peaks  # per configuration: space-separated figures of its runs
+
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+for ((r = 1; r <= runs; ++r)); do
+  for i in "${!labels[@]}"; do
+    echo "run $r of $runs: ${labels[i]}" >&2
+    # shellcheck disable=SC2086  # the arguments are words on purpose
+    /usr/bin/time -v "$depthbench" run --quiet ${arguments[i]} >"$log" 2>&1 ||
+      { cat "$log" >&2; exit 1; }
+    # "... verified in 12.38 s: 85.65M/s": the rate, in millions per second.
+    rate=$(grep -o 'verified in [0-9.]* s: [0-9.]*[kMG]*/s' "$log" |
+      awk '{r = $5; u = substr(r, length(r) - 2, 1); v = r + 0
+            printf "%.1f", u == "G" ? v * 1000 : u == "M" ? v : u == "k" ? v / 1000 : v / 1e6}') ||
+      { echo "no 'verified in' line in the output of run ${arguments[i]}:" >&2; cat "$log" >&2; exit 1; }
+    rates[i]+="$rate "
+    peaks[i]+="$(awk '/Maximum resident set size/ {printf "%.0f ", $6 / 1024}' "$log")"
+  done
+done
+
+printf '%-40s %22s %12s\n' "" "M reconstructions/s" "peak MiB"
+printf '%-40s %22s %12s\n' "" "median (min-max)" "(largest)"
+for i in "${!labels[@]}"; do
+  summary=$(tr ' ' '\n' <<<"${rates[i]}" | grep . | sort -g |
+    awk '{v[NR] = $1} END {m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+                           printf "%.1f (%.1f-%.1f)", m, v[1], v[NR]}')
+  peak=$(tr ' ' '\n' <<<"${peaks[i]}" | grep . | sort -g | tail -1)
+  printf '%-40s %22s %12s\n' "${labels[i]}" "$summary" "$peak"
+done
