@@ -70,7 +70,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     file.cells = {cell};
     file.backends = {"cpu"};
     file.finding = {{"signature", signature}, {"kind", FindingKindName(j.kind())}};
-    if (Status s = WriteReproFile(path, file); !s.ok()) std::fprintf(stderr, "fuzz_formulas: %s\n", s.message().c_str());
+    if (Status s = WriteReproFile(path, file); !s.ok())
+      std::fprintf(stderr, "fuzz_formulas: %s\n", s.message().c_str());
     std::fprintf(stderr, "fuzz_formulas: finding %s, written to %s\n", signature.c_str(), path.c_str());
   }
   return 0;

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "bench/gate/baseline.h"
 #include "bench/base/json_reader.h"
+#include "bench/gate/baseline.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
 

@@ -22,20 +22,20 @@ DB_CONST_UINT(DB_CONVENTION_CLIP_MINUS_ONE, 4u)  // GL clip depth: NDC z in [-1,
 // members are the attribute's value at uv (0, 0) (the top-left corner of the
 // screen); "du"/"dv" are its change from uv (0, 0) to uv (1, 0) and (0, 1).
 struct FrameParams {
-  mat4 camera_world;             // view space -> world space (rotation + translation)
-  vec4 camera_position;          // xyz: camera position in world space; w: far plane distance (0 when infinite)
-  vec4 lens;                     // x: tan(fovY/2)*aspect, y: tan(fovY/2), z: H = 1/x, w: V = 1/y
-  vec4 resolution;               // x: width, y: height, z: 1/width, w: 1/height (pixels)
-  vec4 frustum_ray_origin;       // seed 000: world-space camera->far-plane ray, full-screen pass
+  mat4 camera_world;        // view space -> world space (rotation + translation)
+  vec4 camera_position;     // xyz: camera position in world space; w: far plane distance (0 when infinite)
+  vec4 lens;                // x: tan(fovY/2)*aspect, y: tan(fovY/2), z: H = 1/x, w: V = 1/y
+  vec4 resolution;          // x: width, y: height, z: 1/width, w: 1/height (pixels)
+  vec4 frustum_ray_origin;  // seed 000: world-space camera->far-plane ray, full-screen pass
   vec4 frustum_ray_du;
   vec4 frustum_ray_dv;
-  vec4 volume_position_origin;   // seed 000: view-space position on a light volume's surface
+  vec4 volume_position_origin;  // seed 000: view-space position on a light volume's surface
   vec4 volume_position_du;
   vec4 volume_position_dv;
-  vec4 eye_ray_view_origin;      // seed 003: view-space eye ray (x*tan*aspect, y*tan, -w)
+  vec4 eye_ray_view_origin;  // seed 003: view-space eye ray (x*tan*aspect, y*tan, -w)
   vec4 eye_ray_view_du;
   vec4 eye_ray_view_dv;
-  vec4 eye_ray_world_origin;     // seed 003: the same ray rotated by the inverse view matrix
+  vec4 eye_ray_world_origin;  // seed 003: the same ray rotated by the inverse view matrix
   vec4 eye_ray_world_du;
   vec4 eye_ray_world_dv;
 };
@@ -58,20 +58,20 @@ struct DepthParams {
 // One dispatch runs every cell of one variant, a cell per workgroup row:
 // row y runs cell_slices[first_cell + y].
 struct PassConstants {
-  uint slice_length;        // elements per slice
-  uint samples_per_frame;   // element e belongs to frame (e + first_in_frame) / samples_per_frame
+  uint slice_length;       // elements per slice
+  uint samples_per_frame;  // element e belongs to frame (e + first_in_frame) / samples_per_frame
   uint conventions_per_frame;
-  uint first_in_frame;      // position within its frame of a slice's first element
-  uint frame_count;         // frames the batch's samples fall in
-  uint first_cell;          // the dispatch's first entry in the CellSlice buffer
+  uint first_in_frame;  // position within its frame of a slice's first element
+  uint frame_count;     // frames the batch's samples fall in
+  uint first_cell;      // the dispatch's first entry in the CellSlice buffer
   uint reserved0;
   uint reserved1;
 };
 
 // Where one cell's inputs and outputs lie in the batch's buffers.
 struct CellSlice {
-  uint convention_slot;     // index of the cell's convention within a frame's DepthParams
-  uint depth_offset;        // first element of the cell's stored-depth slice in the depth buffer
-  uint output_offset;       // first float of the cell's positions: slices of x, then y, then z
+  uint convention_slot;  // index of the cell's convention within a frame's DepthParams
+  uint depth_offset;     // first element of the cell's stored-depth slice in the depth buffer
+  uint output_offset;    // first float of the cell's positions: slices of x, then y, then z
   uint reserved;
 };

@@ -35,6 +35,4 @@ DB_FN uint random_bits(uint seed_lo, uint seed_hi, uint index_lo, uint index_hi,
 }
 
 // Uniform float in [0, 1) with 24 random bits: every value is exact.
-DB_FN real random_unit(uint bits) {
-  return real(bits >> 8u) * (1.0f / 16777216.0f);
-}
+DB_FN real random_unit(uint bits) { return real(bits >> 8u) * (1.0f / 16777216.0f); }

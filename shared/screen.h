@@ -17,9 +17,7 @@ DB_FN vec2 uv_from_pixel(real pixel_x, real pixel_y, vec4 resolution) {
 }
 
 // Normalized device coordinates with y up: uv (0, 0) is NDC (-1, 1).
-DB_FN vec2 ndc_from_uv(vec2 uv) {
-  return vec2(uv.x * 2.0f - 1.0f, 1.0f - uv.y * 2.0f);
-}
+DB_FN vec2 ndc_from_uv(vec2 uv) { return vec2(uv.x * 2.0f - 1.0f, 1.0f - uv.y * 2.0f); }
 
 // The value a rasterizer produces at uv for an attribute that varies
 // linearly across a screen-covering primitive: its value at the top-left

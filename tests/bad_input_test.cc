@@ -72,7 +72,8 @@ TEST_F(BadInputTest, RunRefusesAnOutputItCannotCreateBeforeSampling) {
 }
 
 TEST_F(BadInputTest, RunRefusesAnOutputThatIsAFolder) {
-  ExpectRefused({"run", "--backend", "cpu", "--samples", "1e4", "--json", dir_}, "--json: '" + dir_ + "' is a directory");
+  ExpectRefused({"run", "--backend", "cpu", "--samples", "1e4", "--json", dir_},
+                "--json: '" + dir_ + "' is a directory");
   EXPECT_EQ(out_, "");
 }
 
@@ -90,9 +91,9 @@ TEST_F(BadInputTest, FitRefusesAnOutputItCannotCreateBeforeSweeping) {
 }
 
 TEST_F(BadInputTest, ChooseRefusesAnOutputItCannotCreateBeforeMeasuring) {
-  ExpectRefused({"choose", "--scene", kScene, "--backend", "cpu", "--samples", "1e3", "--json",
-                 kNoFilesHere + "/choice.json"},
-                "--json: cannot write '/proc/choice.json'");
+  ExpectRefused(
+      {"choose", "--scene", kScene, "--backend", "cpu", "--samples", "1e3", "--json", kNoFilesHere + "/choice.json"},
+      "--json: cannot write '/proc/choice.json'");
   EXPECT_EQ(out_, "");
 }
 
@@ -108,9 +109,8 @@ TEST_F(BadInputTest, GateRefusesJUnitAndJsonOutputsItCannotCreateBeforeSweeping)
 
 TEST_F(BadInputTest, GateUpdateRefusesABaselineItCannotWriteBeforeSweeping) {
   // A new baseline in a folder where no file can be created...
-  double seconds =
-      ExpectRefused({"gate", "--update", "--baseline", kNoFilesHere + "/new.json", "--backend", "cpu"},
-                    "--update: --baseline: cannot write '/proc/new.json'");
+  double seconds = ExpectRefused({"gate", "--update", "--baseline", kNoFilesHere + "/new.json", "--backend", "cpu"},
+                                 "--update: --baseline: cannot write '/proc/new.json'");
   EXPECT_LT(seconds, kBeforeTheWorkSeconds);
   EXPECT_EQ(out_, "");
   // ...and a baseline path that names a folder.
@@ -121,8 +121,8 @@ TEST_F(BadInputTest, GateUpdateRefusesABaselineItCannotWriteBeforeSweeping) {
 }
 
 TEST_F(BadInputTest, SpeedRefusesAnOutputItCannotCreateBeforeTiming) {
-  const double seconds = ExpectRefused({"speed", "--json", kNoFilesHere + "/speed.json"},
-                                       "--json: cannot write '/proc/speed.json'");
+  const double seconds =
+      ExpectRefused({"speed", "--json", kNoFilesHere + "/speed.json"}, "--json: cannot write '/proc/speed.json'");
   EXPECT_LT(seconds, kBeforeTheWorkSeconds);
   EXPECT_EQ(out_, "");
 }
@@ -170,9 +170,9 @@ TEST_F(BadInputTest, UnknownDeviceNamesTheDevicesThereAre) {
 TEST_F(BadInputTest, ABaselineThatIsAnotherKindOfFile) {
   const std::string path = dir_ + "/results.json";
   std::ofstream(path) << R"({"schema": "depthbench.results", "schema_version": 1, "cells": []})";
-  ExpectRefused({"gate", "--baseline", path},
-                "the baseline does not parse: " + path + ": (top level): schema is 'depthbench.results', expected "
-                "'depthbench.baseline'");
+  ExpectRefused({"gate", "--baseline", path}, "the baseline does not parse: " + path +
+                                                  ": (top level): schema is 'depthbench.results', expected "
+                                                  "'depthbench.baseline'");
 }
 
 // A number beyond the range of a double in a results file: once an escaping

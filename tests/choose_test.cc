@@ -128,8 +128,8 @@ TEST_F(RealFitTest, ReversedFloatAndLinearFloatAreFlat) {
     if (f.cell.convention == Convention::kStandard) continue;
     // No far/near term, or a slope within 0.1 bit of zero.
     const bool no_ratio_term = !Info(f.model.kind).uses_ratio;
-    EXPECT_TRUE(no_ratio_term || std::fabs(f.slope) < 0.1) << f.cell.Name() << ": " << Info(f.model.kind).name
-                                                            << ", slope " << f.slope;
+    EXPECT_TRUE(no_ratio_term || std::fabs(f.slope) < 0.1)
+        << f.cell.Name() << ": " << Info(f.model.kind).name << ", slope " << f.slope;
     EXPECT_LT(std::fabs(f.slope), 0.1) << f.cell.Name();
     ++checked;
   }

@@ -79,7 +79,8 @@ TEST(CliTest, HelpTeachesAndExitsWithZero) {
 TEST(CliTest, ListNamesVariantsWithSeedsAndDevices) {
   const auto r = RunDepthbench({"list"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  for (const char* text : {"frustum_ray", "000", "pq", "004", "reversed-inf-gl", "x8_d24_unorm", "106 cells", "llvmpipe"}) {
+  for (const char* text :
+       {"frustum_ray", "000", "pq", "004", "reversed-inf-gl", "x8_d24_unorm", "106 cells", "llvmpipe"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
 }
@@ -87,8 +88,8 @@ TEST(CliTest, ListNamesVariantsWithSeedsAndDevices) {
 TEST(CliTest, RunWritesTheTableAndVersionedJson) {
   const std::string dir = testing::MakeTempDir("cli_run");
   const std::string json = dir + "/out.json";
-  const auto r = RunDepthbench({"run", "--samples", "2000", "--variant", "pq", "--convention", "reversed",
-                                "--json", json, "--split", "ratio"});
+  const auto r = RunDepthbench(
+      {"run", "--samples", "2000", "--variant", "pq", "--convention", "reversed", "--json", json, "--split", "ratio"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("pq/reversed/d32_sfloat"), std::string::npos);
   EXPECT_NE(r.out.find("p99.9 bits lost by far/near ratio band"), std::string::npos);
@@ -100,8 +101,8 @@ TEST(CliTest, RunWritesTheTableAndVersionedJson) {
 }
 
 TEST(CliTest, IndexReplaysOneSampleOnBothBackends) {
-  const auto r = RunDepthbench({"run", "--index", "77", "--variant", "divide", "--convention", "standard",
-                                "--format", "d24"});
+  const auto r =
+      RunDepthbench({"run", "--index", "77", "--variant", "divide", "--convention", "standard", "--format", "d24"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("sample 77 of seed 1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("divide/standard/x8_d24_unorm"), std::string::npos);

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/pipeline/encode.h"
 #include "bench/numerics/formulas_mpfr.h"
+#include "bench/pipeline/encode.h"
 
 namespace depthbench {
 namespace {
@@ -47,8 +47,18 @@ TEST(EncodeTest, UnormConversionRoundsToNearestEven) {
 // alike. Each value is stored once in a block of four (the wide path) and
 // once alone (the one-value path).
 TEST(EncodeTest, UnormStoresAgreeFourAtATimeAndOneByOne) {
-  std::vector<float> values = {0.0f, -0.0f, 1.0f, 0.5f, -0.5f, 1.5f, NAN, INFINITY, -INFINITY,
-                               std::nextafter(1.0f, 0.0f), std::nextafter(0.0f, 1.0f), 1e-30f};
+  std::vector<float> values = {0.0f,
+                               -0.0f,
+                               1.0f,
+                               0.5f,
+                               -0.5f,
+                               1.5f,
+                               NAN,
+                               INFINITY,
+                               -INFINITY,
+                               std::nextafter(1.0f, 0.0f),
+                               std::nextafter(0.0f, 1.0f),
+                               1e-30f};
   for (int bits : {16, 24}) {
     const double scale = std::ldexp(1.0, bits) - 1.0;
     // Codes plus one half (ties, where the float holds them), and neighbours.
@@ -83,9 +93,9 @@ TEST(EncodeTest, HalfConversionRoundTripsAndTiesToEven) {
   EXPECT_EQ(FloatToHalf(1.0f + std::ldexp(1.0f, -11)), 0x3c00);
   // 1 + 3 * 2^-11 lies halfway between 1 + 2^-10 and 1 + 2^-9: to even.
   EXPECT_EQ(FloatToHalf(1.0f + 3.0f * std::ldexp(1.0f, -11)), 0x3c02);
-  EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25)), 0x0000);          // half the smallest subnormal: to even (0)
-  EXPECT_EQ(FloatToHalf(std::ldexp(1.5f, -25)), 0x0001);          // above the tie
-  EXPECT_EQ(FloatToHalf(65520.0f), 0x7c00);                        // rounds to infinity
+  EXPECT_EQ(FloatToHalf(std::ldexp(1.0f, -25)), 0x0000);  // half the smallest subnormal: to even (0)
+  EXPECT_EQ(FloatToHalf(std::ldexp(1.5f, -25)), 0x0001);  // above the tie
+  EXPECT_EQ(FloatToHalf(65520.0f), 0x7c00);               // rounds to infinity
   EXPECT_EQ(FloatToHalf(65519.0f), 0x7bff);
 }
 
@@ -110,9 +120,9 @@ float ExactPipelineFloat(Encoding e, const Frame& frame, double z) {
 TEST(EncodeTest, PipelineFloatIsCorrectlyRoundedEverywhere) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (Convention c : {Convention::kStandard, Convention::kReversed, Convention::kStandardInf,
-                       Convention::kReversedInf, Convention::kStandardGl, Convention::kReversedGl,
-                       Convention::kStandardInfGl, Convention::kReversedInfGl}) {
+  for (Convention c :
+       {Convention::kStandard, Convention::kReversed, Convention::kStandardInf, Convention::kReversedInf,
+        Convention::kStandardGl, Convention::kReversedGl, Convention::kStandardInfGl, Convention::kReversedInfGl}) {
     const Encoding e{c, Format::kD32Sfloat};
     for (int k = 0; k < 3000; ++k) {
       const double near = std::exp(std::log(1e-6) + unit(rng) * std::log(1e7));
@@ -120,8 +130,8 @@ TEST(EncodeTest, PipelineFloatIsCorrectlyRoundedEverywhere) {
       const bool infinite = (Info(c).bits & 2u) != 0u;
       const Frame frame = TestFrame(near, infinite ? INFINITY : near * ratio);
       // Depths spread log-uniformly, and bunched against the far plane.
-      double z = k % 3 == 0 ? near * ratio * (1.0 - std::ldexp(unit(rng), -20))
-                            : near * std::exp(unit(rng) * std::log(ratio));
+      double z =
+          k % 3 == 0 ? near * ratio * (1.0 - std::ldexp(unit(rng), -20)) : near * std::exp(unit(rng) * std::log(ratio));
       ASSERT_EQ(PipelineFloat(e, frame, z), ExactPipelineFloat(e, frame, z))
           << Info(c).name << " near " << near << " ratio " << ratio << " z " << z;
     }
@@ -161,10 +171,22 @@ TEST(EncodeTest, StoredPlanesDecodeToThePlanes) {
   const Frame finite = TestFrame(0.25, 4000.0);
   const Frame infinite = TestFrame(0.25, INFINITY);
   for (Format f : {Format::kD16Unorm, Format::kX8D24Unorm, Format::kD32Sfloat}) {
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero)).hi(), 0.25);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite, EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne)).hi(), 4000.0);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne)).hi(), 0.25);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite, EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero)).hi(), 4000.0);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite,
+                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero))
+                  .hi(),
+              0.25);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite,
+                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne))
+                  .hi(),
+              4000.0);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite,
+                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne))
+                  .hi(),
+              0.25);
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite,
+                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero))
+                  .hi(),
+              4000.0);
     EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kStandardInf, f}, infinite,
                                           EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne))
                                .hi()));

@@ -196,28 +196,67 @@ const std::set<std::string> kProjectiveNaN = {"divide nan", "reciprocal nan", "p
 
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, ExtremeTest,
-    ::testing::Values(
-        Extreme{"near_1e_6", [](Domain& d) { d.near = {1e-6, 1e-6}; }, {}, {}},
-        Extreme{"near_1e_7", [](Domain& d) { d.near = {1e-7, 1e-7}; }, {}, {}},
-        // Far/near beyond 2^24: f/(f - n) rounds to 1 in float32 and the
-        // projective variants divide by zero at the far plane.
-        Extreme{"ratio_1e9", [](Domain& d) { d.ratio = {1e9, 1e9}; }, {}, kProjectiveNaN},
-        // divide forms ndc_z/B - A/B: on [-1, 1] infinite conventions the
-        // two quotients are equal in float32 for depths far enough, the
-        // difference is exactly 0 and the position NaN (seed 004's trap).
-        Extreme{"infinite_far", [](Domain& d) { d.finite_far = false; }, {}, {"divide nan"}},
-        Extreme{"fov_0_01", [](Domain& d) { d.fov_degrees = {0.01, 0.01}; }, {}, {}},
-        Extreme{"fov_179_9", [](Domain& d) { d.fov_degrees = {179.9, 179.9}; }, {}, {}},
-        Extreme{"aspect_1e_3", [](Domain& d) { d.aspect = {1e-3, 1e-3}; }, {}, {}},
-        Extreme{"aspect_1e3", [](Domain& d) { d.aspect = {1e3, 1e3}; }, {}, {}},
-        Extreme{"camera_1e7", [](Domain& d) { d.camera_distance = {1e7, 1e7}; }, {}, {}},
-        Extreme{"stored_zero", [](Domain&) {}, {{kPick, 0.005}}, {}},
-        Extreme{"stored_one", [](Domain&) {}, {{kPick, 0.018}}, {}},
-        Extreme{"smallest_subnormal", [](Domain&) {}, {{kPick, 0.03}}, {}},
-        // The same trap on standard infinite Z: ndc_z = 1 - 2^-24 and A = 1.
-        Extreme{"one_step_below_one", [](Domain&) {}, {{kPick, 0.045}}, {"divide nan"}},
-        Extreme{"corner_top_left", [](Domain&) {}, {{kPixelKind, 0.001}}, {}},
-        Extreme{"corner_bottom_right", [](Domain&) {}, {{kPixelKind, 0.031}}, {}}),
+    ::testing::Values(Extreme{"near_1e_6",
+                              [](Domain& d) {
+                                d.near = {1e-6, 1e-6};
+                              },
+                              {},
+                              {}},
+                      Extreme{"near_1e_7",
+                              [](Domain& d) {
+                                d.near = {1e-7, 1e-7};
+                              },
+                              {},
+                              {}},
+                      // Far/near beyond 2^24: f/(f - n) rounds to 1 in float32 and the
+                      // projective variants divide by zero at the far plane.
+                      Extreme{"ratio_1e9",
+                              [](Domain& d) {
+                                d.ratio = {1e9, 1e9};
+                              },
+                              {},
+                              kProjectiveNaN},
+                      // divide forms ndc_z/B - A/B: on [-1, 1] infinite conventions the
+                      // two quotients are equal in float32 for depths far enough, the
+                      // difference is exactly 0 and the position NaN (seed 004's trap).
+                      Extreme{"infinite_far", [](Domain& d) { d.finite_far = false; }, {}, {"divide nan"}},
+                      Extreme{"fov_0_01",
+                              [](Domain& d) {
+                                d.fov_degrees = {0.01, 0.01};
+                              },
+                              {},
+                              {}},
+                      Extreme{"fov_179_9",
+                              [](Domain& d) {
+                                d.fov_degrees = {179.9, 179.9};
+                              },
+                              {},
+                              {}},
+                      Extreme{"aspect_1e_3",
+                              [](Domain& d) {
+                                d.aspect = {1e-3, 1e-3};
+                              },
+                              {},
+                              {}},
+                      Extreme{"aspect_1e3",
+                              [](Domain& d) {
+                                d.aspect = {1e3, 1e3};
+                              },
+                              {},
+                              {}},
+                      Extreme{"camera_1e7",
+                              [](Domain& d) {
+                                d.camera_distance = {1e7, 1e7};
+                              },
+                              {},
+                              {}},
+                      Extreme{"stored_zero", [](Domain&) {}, {{kPick, 0.005}}, {}},
+                      Extreme{"stored_one", [](Domain&) {}, {{kPick, 0.018}}, {}},
+                      Extreme{"smallest_subnormal", [](Domain&) {}, {{kPick, 0.03}}, {}},
+                      // The same trap on standard infinite Z: ndc_z = 1 - 2^-24 and A = 1.
+                      Extreme{"one_step_below_one", [](Domain&) {}, {{kPick, 0.045}}, {"divide nan"}},
+                      Extreme{"corner_top_left", [](Domain&) {}, {{kPixelKind, 0.001}}, {}},
+                      Extreme{"corner_bottom_right", [](Domain&) {}, {{kPixelKind, 0.031}}, {}}),
     [](const ::testing::TestParamInfo<Extreme>& info) { return info.param.name; });
 
 // A search of one second finds an error at least as large as the largest of
@@ -241,9 +280,9 @@ TEST(WorstCaseTest, SearchFindsAtLeastTheRandomMaximum) {
     options.seconds = std::max(0.5, random->run.seconds / 4);
     auto found = SearchWorstCase(options, *cpu);
     ASSERT_TRUE(found.ok()) << found.status().message();
-    EXPECT_GE(found->worst, random_worst) << name << ": search " << BitsLost(found->worst) << " bits in "
-                                          << found->seconds << " s, random " << BitsLost(random_worst)
-                                          << " bits in " << random->run.seconds << " s";
+    EXPECT_GE(found->worst, random_worst)
+        << name << ": search " << BitsLost(found->worst) << " bits in " << found->seconds << " s, random "
+        << BitsLost(random_worst) << " bits in " << random->run.seconds << " s";
   }
 }
 

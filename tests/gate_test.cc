@@ -107,8 +107,7 @@ TEST_F(GateTest, SyntaxErrorExitsWithTwoNamingFileAndLine) {
 
 TEST_F(GateTest, PlantedNanFailsAndItsReproducerReproducesIt) {
   // NaN for stored depths in one range only.
-  Edit("shared/variants/pq.h",
-       "  real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);",
+  Edit("shared/variants/pq.h", "  real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);",
        "  real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);\n"
        "  if (stored > 0.25f && stored < 0.5f) inverse_w = inverse_w * (stored - stored) / (stored - stored);");
   const auto r = Gate();

@@ -11,13 +11,13 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/pipeline/encode.h"
+#include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/thread_pool.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/encode.h"
 #include "bench/speed/depth_image.h"
 #include "bench/speed/gpu_pass_timer.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/base/thread_pool.h"
-#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 namespace {
@@ -76,8 +76,8 @@ TEST_F(GpuPassTimerTest, HeavierPassMeasuresSlowerInTheSameRun) {
   // spread, the rule that decides any ranking. (So many taps that a busy
   // machine, which widens the spread, cannot hide the difference.)
   EXPECT_EQ(Compare(heavy, light), Ordering::kSlower)
-      << "1 tap " << light.median << " ns (spread " << light.spread() << "), 16 taps " << heavy.median
-      << " ns (spread " << heavy.spread() << ")";
+      << "1 tap " << light.median << " ns (spread " << light.spread() << "), 16 taps " << heavy.median << " ns (spread "
+      << heavy.spread() << ")";
 }
 
 TEST_F(GpuPassTimerTest, TimestampsAreInTheDevicesPeriod) {
@@ -119,8 +119,8 @@ void ExpectPassComputesFormula(const DepthImage& image, const std::vector<float>
   for (std::uint32_t y = 0; y < image.resolution.height; ++y) {
     for (std::uint32_t x = 0; x < image.resolution.width; ++x) {
       const float stored = FetchTexel(image.encoding.format, image.Code(x, y));
-      const glm::vec2 uv = f32::uv_from_pixel(static_cast<float>(x), static_cast<float>(y),
-                                              image.frame_params.resolution);
+      const glm::vec2 uv =
+          f32::uv_from_pixel(static_cast<float>(x), static_cast<float>(y), image.frame_params.resolution);
       glm::vec3 p;
       switch (variant) {
         case Variant::kPq: p = f32::pq_world_position(image.frame_params, depth, uv, stored); break;

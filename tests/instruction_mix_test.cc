@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/pipeline/cells.h"
 #include "bench/speed/instruction_mix.h"
-#include "bench/backends/vulkan/shader_compiler.h"
 #include "tests/command_runner.h"
 
 namespace depthbench {

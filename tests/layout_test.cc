@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/numerics/formulas.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/numerics/formulas.h"
 
 namespace depthbench {
 namespace {

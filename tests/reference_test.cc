@@ -4,14 +4,14 @@
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <vector>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
-#include "bench/pipeline/encode.h"
 #include "bench/numerics/formulas.h"
 #include "bench/numerics/formulas_mpfr.h"
+#include "bench/pipeline/encode.h"
 #include "bench/pipeline/reference.h"
 #include "bench/pipeline/sampler.h"
 #include "bench/pipeline/shader_constants.h"
@@ -98,10 +98,17 @@ TEST(ReferenceTest, DoubleDoubleArithmeticMatchesMpfr) {
 // boundary, at the largest float (to infinity) and for random floats.
 // RoundToFloat relies on it to tell a tie between two floats.
 TEST(ReferenceTest, NextFloatIsNextafter) {
-  std::vector<float> values = {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
-                               -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::min(),
-                               -std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
-                               -std::numeric_limits<float>::max(), 1.0f, -1.0f, 0x1p-126f * 0.5f};
+  std::vector<float> values = {0.0f,
+                               -0.0f,
+                               std::numeric_limits<float>::denorm_min(),
+                               -std::numeric_limits<float>::denorm_min(),
+                               std::numeric_limits<float>::min(),
+                               -std::numeric_limits<float>::min(),
+                               std::numeric_limits<float>::max(),
+                               -std::numeric_limits<float>::max(),
+                               1.0f,
+                               -1.0f,
+                               0x1p-126f * 0.5f};
   std::mt19937 rng(5);
   for (int k = 0; k < 100000; ++k) {
     const float f = std::bit_cast<float>(static_cast<std::uint32_t>(rng()));
@@ -130,8 +137,8 @@ TEST(ReferenceTest, NaiveDoubleDecodeIsNotEnoughAtHighRatios) {
   const std::uint32_t code = (1u << 24) - 2;
   const double d = code / (std::ldexp(1.0, 24) - 1.0);
   const double naive = b / (d - a);
-  const mp::real exact = TextbookDecode(Convention::kStandard, near, far,
-                                        mp::real(code) / mp::real(std::ldexp(1.0, 24) - 1.0));
+  const mp::real exact =
+      TextbookDecode(Convention::kStandard, near, far, mp::real(code) / mp::real(std::ldexp(1.0, 24) - 1.0));
   EXPECT_GT(std::fabs(((mp::real(naive) - exact) / exact).ToDouble()), std::ldexp(1.0, -30));
   Frame frame;
   frame.near = near;
@@ -165,9 +172,8 @@ TEST(ReferenceTest, EveryVariantFormulaIsExactInHighPrecision) {
     for (std::uint64_t f = 0; f < 40; ++f) {
       const Frame frame = sampler.FrameAt(f);
       const hp::FrameParams params = BuildFrameParams(frame);
-      const hp::DepthParams depth = Info(cell.convention).hardware
-                                        ? BuildDepthParams(frame, params, cell.convention)
-                                        : hp::DepthParams{};
+      const hp::DepthParams depth =
+          Info(cell.convention).hardware ? BuildDepthParams(frame, params, cell.convention) : hp::DepthParams{};
       for (std::uint64_t i = f * kSamplesPerFrame; i < f * kSamplesPerFrame + 8; ++i) {
         const PixelSample sample = sampler.SampleAt(i, frame);
         if (sample.pick != DepthPick::kEyeDepth) continue;

@@ -24,9 +24,9 @@ using testing::RunDepthbench;
 // A small report: two variants, two conventions, two formats, both
 // backends, quick sample counts. Enough for every part of the document.
 std::vector<std::string> SmallReport(const std::string& root, const std::string& out) {
-  return {"report",     "--quick",    "--out",         out,       "--history", root + "/history.sqlite",
-          "--shaders",  root + "/shaders", "--variant", "divide,pq", "--convention", "standard,reversed",
-          "--format",   "d24,d32f",   "--no-speed"};
+  return {"report",    "--quick",         "--out",     out,         "--history",    root + "/history.sqlite",
+          "--shaders", root + "/shaders", "--variant", "divide,pq", "--convention", "standard,reversed",
+          "--format",  "d24,d32f",        "--no-speed"};
 }
 
 class ReportTest : public ::testing::Test {
@@ -52,7 +52,9 @@ class ReportTest : public ::testing::Test {
     delete root_;
   }
 
-  static json Document(const std::string& night) { return json::parse(ReadText(*root_ + "/" + night + "/results.json")); }
+  static json Document(const std::string& night) {
+    return json::parse(ReadText(*root_ + "/" + night + "/results.json"));
+  }
 
   static std::string* root_;
   static testing::CommandResult* first_;
@@ -97,7 +99,8 @@ TEST_F(ReportTest, PlantedRegressionIsFlaggedAndOnlyThere) {
   const json doc = Document("night2");
   std::set<std::string> worse_cells;
   for (const json& c : doc["history"]["changes"]) {
-    if (c["direction"] == "worse") worse_cells.insert(c["cell"].get<std::string>() + " on " + c["backend"].get<std::string>());
+    if (c["direction"] == "worse")
+      worse_cells.insert(c["cell"].get<std::string>() + " on " + c["backend"].get<std::string>());
   }
   // The GPU ran the edited shader; the CPU backend's formulas are compiled
   // in, and pq was not touched: with a fixed seed nothing else may move.

@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "bench/pipeline/cells.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/pipeline/cells.h"
 
 namespace depthbench {
 namespace {

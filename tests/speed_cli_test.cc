@@ -57,9 +57,19 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(SpeedCliTest, QuickRunPrintsTheTradeAndWritesItsFile) {
   const std::string dir = testing::MakeTempDir("speed_cli");
   const std::string json = dir + "/speed.json";
-  const std::vector<std::string> args = {"speed", "--variant", "divide,pq,inverse_vp", "--convention", "reversed",
-                                         "--format", "d32f", "--resolution", "64x64", "--quick", "--quiet",
-                                         "--json", json};
+  const std::vector<std::string> args = {"speed",
+                                         "--variant",
+                                         "divide,pq,inverse_vp",
+                                         "--convention",
+                                         "reversed",
+                                         "--format",
+                                         "d32f",
+                                         "--resolution",
+                                         "64x64",
+                                         "--quick",
+                                         "--quiet",
+                                         "--json",
+                                         json};
   const auto r = RunDepthbench(args);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("is a CPU implementation of Vulkan: its timings are of JIT-compiled CPU code"),

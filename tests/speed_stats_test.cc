@@ -68,8 +68,7 @@ TEST(TimestampTest, NarrowCounterWrapsAndUpperBitsAreIgnored) {
   // A 36-bit counter that wrapped: 10 ticks to the wrap, 5 after.
   EXPECT_DOUBLE_EQ(TimestampIntervalNs(kTop36 - 10, 5, 36, 1.0), 15.0);
   // Bits above the valid ones are not part of the time.
-  EXPECT_DOUBLE_EQ(TimestampIntervalNs((std::uint64_t{0xabc} << 36) | 100, (std::uint64_t{0x123} << 36) | 300, 36,
-                                       2.0),
+  EXPECT_DOUBLE_EQ(TimestampIntervalNs((std::uint64_t{0xabc} << 36) | 100, (std::uint64_t{0x123} << 36) | 300, 36, 2.0),
                    400.0);
   // A full 64-bit counter wraps modulo 2^64.
   EXPECT_DOUBLE_EQ(TimestampIntervalNs(std::numeric_limits<std::uint64_t>::max() - 1, 3, 64, 1.0), 5.0);
@@ -88,8 +87,8 @@ TEST(TimestampTest, RefusesQueuesThatCannotTime) {
 }
 
 TEST(CompareTest, DifferencesWithinTheSpreadAreIndistinguishable) {
-  const TimingSummary a = Summary(9, 10, 11);    // spread 2
-  const TimingSummary b = Summary(12, 12.5, 13);  // spread 1: differs by 2.5 > 2
+  const TimingSummary a = Summary(9, 10, 11);         // spread 2
+  const TimingSummary b = Summary(12, 12.5, 13);      // spread 1: differs by 2.5 > 2
   const TimingSummary c = Summary(11.5, 11.9, 12.5);  // differs from a by 1.9 <= 2
   EXPECT_EQ(Compare(a, b), Ordering::kFaster);
   EXPECT_EQ(Compare(b, a), Ordering::kSlower);

@@ -11,8 +11,8 @@
 namespace depthbench {
 namespace {
 
-Results RunCpu(std::uint64_t seed, std::uint64_t samples, Shard shard, std::uint32_t batch = 4096,
-               unsigned threads = 2, Isa isa = Isa::kWidest) {
+Results RunCpu(std::uint64_t seed, std::uint64_t samples, Shard shard, std::uint32_t batch = 4096, unsigned threads = 2,
+               Isa isa = Isa::kWidest) {
   SweepOptions options;
   options.isa = isa;
   options.seed = seed;
@@ -199,7 +199,6 @@ TEST(SweepTest, BadResultsFilesNameTheFieldThatIsWrong) {
   j["schema_version"] = 99;
   EXPECT_NE(ResultsFromJson(j, "x.json").status().message().find("schema_version 99"), std::string::npos);
 }
-
 
 }  // namespace
 }  // namespace depthbench

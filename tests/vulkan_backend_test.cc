@@ -4,9 +4,9 @@
 // matrix-vector product in another order than GLM). Runs with the validation
 // layer on and fails on anything it reports.
 #include <cmath>
-#include <cstring>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -18,12 +18,12 @@
 
 #include "bench/backends/backend.h"
 #include "bench/backends/cpu/cpu_backend.h"
+#include "bench/backends/vulkan/vulkan_backend.h"
+#include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/sampler.h"
-#include "bench/base/thread_pool.h"
-#include "bench/backends/vulkan/vulkan_backend.h"
-#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 namespace {
@@ -211,8 +211,7 @@ TEST_F(VulkanBackendTest, EveryPassShapeGivesTheSamePositions) {
   const std::vector<Batch> batches = {BuildBatch(layout, 4101, 1100), BuildBatch(layout, 4104, 1000)};
   // (samples per invocation, frames per workgroup): a GPU's shape first,
   // lavapipe's default among the others.
-  const std::vector<std::pair<std::uint32_t, std::uint32_t>> shapes = {{1, 1}, {4, 8}, {8, 8}, {64, 8}, {8, 1},
-                                                                         {8, 3}};
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> shapes = {{1, 1}, {4, 8}, {8, 8}, {64, 8}, {8, 1}, {8, 3}};
   std::vector<std::vector<std::vector<float>>> outputs(batches.size());  // [batch][shape]
   for (const auto& [per_invocation, frames] : shapes) {
     BackendOptions options;

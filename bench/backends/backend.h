@@ -20,16 +20,16 @@
 #include <string>
 #include <vector>
 
-#include "bench/pipeline/batch.h"
 #include "bench/base/status.h"
+#include "bench/pipeline/batch.h"
 
 namespace depthbench {
 
 struct DeviceInfo {
-  std::string name;    // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
-  std::string driver;  // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
-  std::string api;     // "Vulkan 1.3.230"
-  std::string kind;    // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
+  std::string name;      // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
+  std::string driver;    // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
+  std::string api;       // "Vulkan 1.3.230"
+  std::string kind;      // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
   std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
 };
 
@@ -59,9 +59,9 @@ class Backend {
 
 // Options that select and configure a backend.
 struct BackendOptions {
-  std::string device;           // Vulkan: device name (substring, case-insensitive); "" picks lavapipe
-  std::string shader_dir;       // Vulkan: where the shaders/ sources are ("" = built-in default)
-  bool validation = false;      // Vulkan: enable VK_LAYER_KHRONOS_validation, fail on its messages
+  std::string device;       // Vulkan: device name (substring, case-insensitive); "" picks lavapipe
+  std::string shader_dir;   // Vulkan: where the shaders/ sources are ("" = built-in default)
+  bool validation = false;  // Vulkan: enable VK_LAYER_KHRONOS_validation, fail on its messages
   // Vulkan: samples each compute invocation reconstructs (a divisor of the
   // samples per frame), and frames each workgroup takes in turn; 0 picks by
   // device type: 8 and 8 on a CPU device, 1 and 1 on a GPU.

@@ -35,8 +35,7 @@ Status WriteFileAtomically(const std::filesystem::path& path, std::string_view c
   if (std::filesystem::is_directory(target, ec)) {
     return IoError("cannot write '" + path.string() + "': it is a directory");
   }
-  const std::filesystem::path temp =
-      dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
+  const std::filesystem::path temp = dir / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
   std::FILE* f = std::fopen(temp.c_str(), "wb");
   if (f == nullptr) return IoError("cannot write '" + path.string() + "': " + std::strerror(errno));
   bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();

@@ -5,8 +5,7 @@ namespace depthbench {
 bool ProcessorRuns(Isa isa) {
   switch (isa) {
     case Isa::kWidest:
-    case Isa::kBaseline:
-      return true;
+    case Isa::kBaseline: return true;
     case Isa::kAvx512: {
       static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
                               __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&

@@ -24,9 +24,9 @@
 namespace depthbench {
 
 enum class Isa {
-  kWidest,    // the widest this processor runs
+  kWidest,  // the widest this processor runs
   kBaseline,
-  kAvx512,    // AVX-512 F, VL, DQ, BW and CD
+  kAvx512,  // AVX-512 F, VL, DQ, BW and CD
 };
 
 bool ProcessorRuns(Isa isa);

@@ -38,8 +38,8 @@ Expected<nlohmann::json> JsonReader::Parse(const std::string& text, const std::s
   } catch (const nlohmann::json::parse_error& e) {
     byte = e.byte;
   } catch (const nlohmann::json::out_of_range& e) {
-    return InvalidArgument(fmt::format("{}: not valid JSON: a number beyond the range of a double ({})", source,
-                                       e.what()));
+    return InvalidArgument(
+        fmt::format("{}: not valid JSON: a number beyond the range of a double ({})", source, e.what()));
   } catch (const nlohmann::json::exception& e) {
     return InvalidArgument(fmt::format("{}: not valid JSON ({})", source, e.what()));
   }

@@ -23,12 +23,12 @@ class JsonReader {
 
   bool Has(const std::string& key) const { return json_.is_object() && json_.contains(key); }
   Expected<JsonReader> Field(const std::string& key) const;  // must exist
-  Expected<JsonReader> Element(std::size_t index) const;      // of an array
-  Expected<std::size_t> ArraySize() const;                    // must be an array
+  Expected<JsonReader> Element(std::size_t index) const;     // of an array
+  Expected<std::size_t> ArraySize() const;                   // must be an array
 
   Expected<std::string> String() const;
-  Expected<double> Number() const;            // also "inf", "-inf", "nan" strings
-  Expected<std::uint64_t> Unsigned() const;   // null reads as UINT64_MAX (no value)
+  Expected<double> Number() const;           // also "inf", "-inf", "nan" strings
+  Expected<std::uint64_t> Unsigned() const;  // null reads as UINT64_MAX (no value)
   Expected<std::int64_t> Integer() const;
   Expected<bool> Bool() const;
 

@@ -19,9 +19,8 @@ void Progress::Update(double fraction, const std::string& detail) {
   if (open_ && now - last_ < std::chrono::milliseconds(100) && fraction < 1.0) return;
   last_ = now;
   double elapsed = std::chrono::duration<double>(now - start_).count();
-  std::string left = fraction > 0.0 && fraction < 1.0
-                         ? fmt::format(", {:.0f} s left", elapsed * (1.0 - fraction) / fraction)
-                         : "";
+  std::string left =
+      fraction > 0.0 && fraction < 1.0 ? fmt::format(", {:.0f} s left", elapsed * (1.0 - fraction) / fraction) : "";
   std::fputs(fmt::format("\r\x1b[K[{}] {:3.0f}% {}{}", stage_, 100.0 * fraction, detail, left).c_str(), stderr);
   std::fflush(stderr);
   open_ = true;

@@ -40,16 +40,10 @@ class [[nodiscard]] Status {
   std::string message_;
 };
 
-inline Status InvalidArgument(std::string message) {
-  return Status(StatusCode::kInvalidArgument, std::move(message));
-}
+inline Status InvalidArgument(std::string message) { return Status(StatusCode::kInvalidArgument, std::move(message)); }
 inline Status NotFound(std::string message) { return Status(StatusCode::kNotFound, std::move(message)); }
-inline Status Unavailable(std::string message) {
-  return Status(StatusCode::kUnavailable, std::move(message));
-}
-inline Status CompileError(std::string message) {
-  return Status(StatusCode::kCompileError, std::move(message));
-}
+inline Status Unavailable(std::string message) { return Status(StatusCode::kUnavailable, std::move(message)); }
+inline Status CompileError(std::string message) { return Status(StatusCode::kCompileError, std::move(message)); }
 inline Status IoError(std::string message) { return Status(StatusCode::kIoError, std::move(message)); }
 inline Status Internal(std::string message) { return Status(StatusCode::kInternal, std::move(message)); }
 
@@ -57,7 +51,7 @@ inline Status Internal(std::string message) { return Status(StatusCode::kInterna
 template <class T>
 class [[nodiscard]] Expected {
  public:
-  Expected(T value) : state_(std::move(value)) {}  // NOLINT: implicit by design
+  Expected(T value) : state_(std::move(value)) {}         // NOLINT: implicit by design
   Expected(Status status) : state_(std::move(status)) {}  // NOLINT: implicit by design
 
   bool ok() const { return std::holds_alternative<T>(state_); }
@@ -89,18 +83,17 @@ Status StoreInto(Expected<U> from, T& target) {
 }  // namespace depthbench
 
 // Returns early with the Status of an expression that failed.
-#define DB_RETURN_IF_ERROR(expr)            \
-  do {                                      \
+#define DB_RETURN_IF_ERROR(expr)              \
+  do {                                        \
     ::depthbench::Status db_status_ = (expr); \
-    if (!db_status_.ok()) return db_status_; \
+    if (!db_status_.ok()) return db_status_;  \
   } while (false)
 
 #define DB_CONCAT_INNER(a, b) a##b
 #define DB_CONCAT(a, b) DB_CONCAT_INNER(a, b)
 // Declares `lhs` from an Expected, or returns its Status. Several
 // statements: never the body of an unbraced if or loop (use StoreInto).
-#define DB_ASSIGN_OR_RETURN(lhs, expr)                               \
-  auto DB_CONCAT(db_expected_, __LINE__) = (expr);                   \
-  if (!DB_CONCAT(db_expected_, __LINE__).ok())                       \
-    return DB_CONCAT(db_expected_, __LINE__).status();               \
+#define DB_ASSIGN_OR_RETURN(lhs, expr)                                                            \
+  auto DB_CONCAT(db_expected_, __LINE__) = (expr);                                                \
+  if (!DB_CONCAT(db_expected_, __LINE__).ok()) return DB_CONCAT(db_expected_, __LINE__).status(); \
   lhs = std::move(DB_CONCAT(db_expected_, __LINE__)).value()

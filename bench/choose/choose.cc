@@ -8,18 +8,18 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/text_table.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/speed_results.h"
 #include "bench/sweep/sweep.h"
-#include "bench/base/text_table.h"
-#include "bench/backends/vulkan/shader_compiler.h"
 
 namespace depthbench {
 namespace {
 
 std::uint32_t ArithmeticLanes(const InstructionMix& m) {
-  return m.fdiv.lanes + m.fmul.lanes + m.fadd.lanes + m.fneg.lanes + m.fma.lanes + m.dot.lanes +
-         m.matrix_vector.lanes + m.matrix_matrix.lanes + m.extended.lanes;
+  return m.fdiv.lanes + m.fmul.lanes + m.fadd.lanes + m.fneg.lanes + m.fma.lanes + m.dot.lanes + m.matrix_vector.lanes +
+         m.matrix_matrix.lanes + m.extended.lanes;
 }
 
 // The requirement's unit, from a band's statistics.
@@ -85,9 +85,8 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
     by_variant[v.id] = {static_cast<double>(ArithmeticLanes(mix)), "SPIR-V arithmetic lanes",
                         "the compiled shader's instruction mix"};
   }
-  return CostLookup([by_variant](const Cell& cell) -> std::optional<CandidateCost> {
-    return by_variant.at(cell.variant);
-  });
+  return CostLookup(
+      [by_variant](const Cell& cell) -> std::optional<CandidateCost> { return by_variant.at(cell.variant); });
 }
 
 Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, CostLookup fallback) {
@@ -162,15 +161,17 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
   // then failing, closest first. Ties go to the more precise.
   auto group = [](const CandidateVerdict& v) { return !v.meets ? 2 : v.over_budget ? 1 : 0; };
   auto cost_of = [](const CandidateVerdict& v) { return v.cost ? v.cost->value : INFINITY; };
-  std::stable_sort(result.ranked.begin(), result.ranked.end(), [&](const CandidateVerdict& a, const CandidateVerdict& b) {
-    if (group(a) != group(b)) return group(a) < group(b);
-    if (group(a) < 2 && cost_of(a) != cost_of(b)) return cost_of(a) < cost_of(b);
-    if (a.nonfinite != b.nonfinite) return a.nonfinite < b.nonfinite;
-    return a.measured < b.measured;
-  });
+  std::stable_sort(result.ranked.begin(), result.ranked.end(),
+                   [&](const CandidateVerdict& a, const CandidateVerdict& b) {
+                     if (group(a) != group(b)) return group(a) < group(b);
+                     if (group(a) < 2 && cost_of(a) != cost_of(b)) return cost_of(a) < cost_of(b);
+                     if (a.nonfinite != b.nonfinite) return a.nonfinite < b.nonfinite;
+                     return a.measured < b.measured;
+                   });
 
   const double limit = req.value;
-  const CandidateVerdict* cheapest = result.ranked.empty() || !result.ranked.front().meets ? nullptr : &result.ranked.front();
+  const CandidateVerdict* cheapest =
+      result.ranked.empty() || !result.ranked.front().meets ? nullptr : &result.ranked.front();
   for (CandidateVerdict& v : result.ranked) {
     const std::string measured = InUnitText(req, v.measured);
     const std::string cost =
@@ -185,9 +186,9 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
     } else if (v.nonfinite > 0) {
       v.reason = fmt::format("fails: {} NaN or Inf outputs inside the scene", v.nonfinite);
     } else {
-      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.measured / limit,
-                             v.storage_share > 0.5 ? "the format's storage error dominates"
-                                                   : "the arithmetic dominates");
+      v.reason =
+          fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.measured / limit,
+                      v.storage_share > 0.5 ? "the format's storage error dominates" : "the arithmetic dominates");
     }
   }
 
@@ -218,12 +219,12 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
       const double distance = scene.domain.camera_distance.max;
       result.suggestions.push_back(fmt::format(
           "the arithmetic dominates{}: a variant with fewer roundings, or positions computed camera-relative{}",
-          distance > 0.0 ? fmt::format(" (the camera goes {:g} from the world origin, where float32 world "
-                                       "coordinates are {:.3g} apart)",
-                                       distance,
-                                       std::nextafter(static_cast<float>(distance), INFINITY) -
-                                           static_cast<float>(distance))
-                         : "",
+          distance > 0.0
+              ? fmt::format(" (the camera goes {:g} from the world origin, where float32 world "
+                            "coordinates are {:.3g} apart)",
+                            distance,
+                            std::nextafter(static_cast<float>(distance), INFINITY) - static_cast<float>(distance))
+              : "",
           distance > 0.0 ? " (subtract the camera position before, not after, reconstructing)" : ""));
     }
   }
@@ -263,22 +264,22 @@ void PrintChoice(const ChooseResult& r, std::ostream& out) {
 nlohmann::json ChoiceToJson(const ChooseResult& r) {
   nlohmann::json ranked = nlohmann::json::array();
   for (const CandidateVerdict& v : r.ranked) {
-    ranked.push_back({{"cell", v.cell.Name()},
-                      {"variant", Info(v.cell.variant).name},
-                      {"convention", Info(v.cell.convention).name},
-                      {"format", Info(v.cell.format).name},
-                      {"measured_p999", JsonNumber(v.measured_p999)},
-                      {"measured_max", JsonNumber(v.measured_max)},
-                      {"predicted_far_end", JsonNumber(v.predicted)},
-                      {"model", v.model},
-                      {"nonfinite", v.nonfinite},
-                      {"storage_share", JsonNumber(v.storage_share)},
-                      {"meets", v.meets},
-                      {"over_budget", v.over_budget},
-                      {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"unit", v.cost->unit},
-                                                       {"source", v.cost->source}}
-                                      : nlohmann::json(nullptr)},
-                      {"reason", v.reason}});
+    ranked.push_back(
+        {{"cell", v.cell.Name()},
+         {"variant", Info(v.cell.variant).name},
+         {"convention", Info(v.cell.convention).name},
+         {"format", Info(v.cell.format).name},
+         {"measured_p999", JsonNumber(v.measured_p999)},
+         {"measured_max", JsonNumber(v.measured_max)},
+         {"predicted_far_end", JsonNumber(v.predicted)},
+         {"model", v.model},
+         {"nonfinite", v.nonfinite},
+         {"storage_share", JsonNumber(v.storage_share)},
+         {"meets", v.meets},
+         {"over_budget", v.over_budget},
+         {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"unit", v.cost->unit}, {"source", v.cost->source}}
+                         : nlohmann::json(nullptr)},
+         {"reason", v.reason}});
   }
   return {{"schema", "depthbench.choose"},
           {"schema_version", 1},

@@ -14,8 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
-#include "bench/fit/error_model.h"
 #include "bench/choose/scene.h"
+#include "bench/fit/error_model.h"
 
 namespace depthbench {
 
@@ -58,8 +58,8 @@ struct ChooseResult {
   std::string scene;
   std::string requirement;
   std::string backend, device;
-  std::vector<CandidateVerdict> ranked;    // best first
-  std::vector<std::string> suggestions;    // when nothing meets the requirement
+  std::vector<CandidateVerdict> ranked;  // best first
+  std::vector<std::string> suggestions;  // when nothing meets the requirement
   double seconds = 0.0;
 };
 

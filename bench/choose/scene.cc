@@ -149,11 +149,11 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   Domain& d = scene.domain;
 
   DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
-  DB_RETURN_IF_ERROR(
-      r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));
+  DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));
   const toml::node* near_node = projection->get("near");
   DB_ASSIGN_OR_RETURN(double near, r.Number(near_node, "projection.near"));
-  if (!(near > 0.0)) return r.Error(near_node, "projection.near", fmt::format("must be greater than 0 (got {:g})", near));
+  if (!(near > 0.0))
+    return r.Error(near_node, "projection.near", fmt::format("must be greater than 0 (got {:g})", near));
   d.near = {near, near};
   const toml::node* far_node = projection->get("far");
   if (far_node == nullptr) return r.Error(projection, "projection.far", "missing (a number, or \"inf\")");
@@ -165,8 +165,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   } else {
     DB_ASSIGN_OR_RETURN(far, r.Number(far_node, "projection.far"));
     if (!(far > near)) {
-      return r.Error(far_node, "projection.far",
-                     fmt::format("must be greater than near ({:g}); got {:g}", near, far));
+      return r.Error(far_node, "projection.far", fmt::format("must be greater than near ({:g}); got {:g}", near, far));
     }
     d.far = Range{far, far};
     d.finite_far = true;
@@ -206,9 +205,9 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
       DB_ASSIGN_OR_RETURN(Range range, r.NumberOrRange(node, "depth.range"));
       const double limit = d.finite_far ? far : near * Domain::kInfiniteDepthSpan;
       if (range.min < near || range.max > limit || range.min > range.max) {
-        return r.Error(node, "depth.range",
-                       fmt::format("must lie within [near, far] = [{:g}, {:g}]; got {}", near, limit,
-                                   range.ToString()));
+        return r.Error(
+            node, "depth.range",
+            fmt::format("must lie within [near, far] = [{:g}, {:g}]; got {}", near, limit, range.ToString()));
       }
       d.eye_depth = range;
     }
@@ -224,8 +223,8 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   }
 
   DB_ASSIGN_OR_RETURN(const toml::table* requirement, r.Table(root, "requirement", true));
-  DB_RETURN_IF_ERROR(r.OnlyKeys(*requirement, "requirement",
-                                {"absolute_error", "relative_error", "bits_lost", "at_depth", "level"}));
+  DB_RETURN_IF_ERROR(
+      r.OnlyKeys(*requirement, "requirement", {"absolute_error", "relative_error", "bits_lost", "at_depth", "level"}));
   Requirement& req = scene.requirement;
   int kinds = 0;
   for (const auto& [key, kind] : {std::pair{"absolute_error", Requirement::Kind::kAbsolute},

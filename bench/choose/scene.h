@@ -31,10 +31,10 @@
 #include <string_view>
 #include <vector>
 
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 #include "bench/pipeline/stats.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 

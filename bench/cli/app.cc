@@ -15,8 +15,9 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(std::function<int()>& action) {
       "(Vulkan) and the CPU",
       "depthbench");
   app->require_subcommand(1);
-  app->footer("Run 'depthbench SUBCOMMAND --help' for a subcommand's flags.\n"
-              "Exit codes: 0 success, 1 a finding (a gate that fails, a fuzz finding), 2 could not run.");
+  app->footer(
+      "Run 'depthbench SUBCOMMAND --help' for a subcommand's flags.\n"
+      "Exit codes: 0 success, 1 a finding (a gate that fails, a fuzz finding), 2 could not run.");
   AddListCommand(*app, action);
   AddRunCommand(*app, action);
   AddMergeCommand(*app, action);
@@ -29,8 +30,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(std::function<int()>& action) {
   return app;
 }
 
-ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, std::ostream& out,
-                              std::ostream& err) {
+ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   // A first word that is neither a flag nor a subcommand gets a message
   // that names it (CLI11 would only say a subcommand is required).
   if (argc > 1 && argv[1][0] != '-' &&

@@ -26,8 +26,7 @@ struct ParseOutcome {
 
 // Parses argv into `app`. Help goes to `out`; a refusal is explained on `err`
 // (naming the flag or word at fault) and gives exit code 2.
-ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, std::ostream& out,
-                              std::ostream& err);
+ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
 // Parses argv and runs the chosen subcommand; returns the exit code.
 int RunDepthbench(int argc, const char* const* argv);

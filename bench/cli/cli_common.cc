@@ -14,8 +14,7 @@
 namespace depthbench::cli {
 
 void DomainFlags::Add(CLI::App& app) {
-  app.add_option("--near", near, "near plane: VALUE or MIN:MAX (default 1e-4:10, log-uniform)")
-      ->group("Domain");
+  app.add_option("--near", near, "near plane: VALUE or MIN:MAX (default 1e-4:10, log-uniform)")->group("Domain");
   app.add_option("--far", far, "far plane: VALUE or MIN:MAX, instead of --ratio")->group("Domain");
   app.add_option("--ratio", ratio,
                  "far/near ratio: VALUE, MIN:MAX, inf, or MIN:MAX,inf (default 1e1:1e8,inf). Infinite-far "
@@ -23,14 +22,12 @@ void DomainFlags::Add(CLI::App& app) {
       ->group("Domain");
   app.add_option("--fov", fov, "vertical field of view in degrees: VALUE or MIN:MAX, in (0, 180) (default 1:179)")
       ->group("Domain");
-  app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (default 0.1:10)")
-      ->group("Domain");
+  app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (default 0.1:10)")->group("Domain");
   app.add_option("--camera-distance", camera_distance,
                  "camera distance from the world origin: VALUE or MIN:MAX (default 0:1e6; 0 puts the camera at "
                  "the origin)")
       ->group("Domain");
-  app.add_option("--depth", eye_depth, "eye-depth range of interest in world units: VALUE or MIN:MAX")
-      ->group("Domain");
+  app.add_option("--depth", eye_depth, "eye-depth range of interest in world units: VALUE or MIN:MAX")->group("Domain");
   app.add_option("--resolution", resolution, "render target WIDTHxHEIGHT (default: a mix of common sizes)")
       ->group("Domain");
 }
@@ -48,8 +45,8 @@ Expected<Domain> DomainFlags::Apply(Domain d) const {
   if (!fov.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(fov, "--fov", kFovLimits), d.fov_degrees));
   if (!aspect.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(aspect, "--aspect", kAspectLimits), d.aspect));
   if (!camera_distance.empty()) {
-    DB_RETURN_IF_ERROR(StoreInto(ParseRange(camera_distance, "--camera-distance", kCameraDistanceLimits),
-                                 d.camera_distance));
+    DB_RETURN_IF_ERROR(
+        StoreInto(ParseRange(camera_distance, "--camera-distance", kCameraDistanceLimits), d.camera_distance));
   }
   if (!eye_depth.empty()) {
     DB_ASSIGN_OR_RETURN(Range z, ParseRange(eye_depth, "--depth", kEyeDepthLimits));
@@ -72,9 +69,7 @@ void CellFlags::Add(CLI::App& app) {
   app.add_option("--variant", variants, "variants to run (several, or comma-separated; default all)")
       ->delimiter(',')
       ->group("Cells");
-  app.add_option("--convention", conventions, "depth conventions to run (default all)")
-      ->delimiter(',')
-      ->group("Cells");
+  app.add_option("--convention", conventions, "depth conventions to run (default all)")->delimiter(',')->group("Cells");
   app.add_option("--format", formats, "storage formats to run (default all)")->delimiter(',')->group("Cells");
 }
 
@@ -99,9 +94,9 @@ Expected<std::vector<Cell>> CellFlags::Select() const {
 }
 
 void BackendFlags::Add(CLI::App& app, bool allow_several) {
-  auto* option = app.add_option("--backend", backends,
-                                allow_several ? "backends to run: cpu, vulkan (default both)"
-                                              : "backend to run: cpu or vulkan");
+  auto* option =
+      app.add_option("--backend", backends,
+                     allow_several ? "backends to run: cpu, vulkan (default both)" : "backend to run: cpu or vulkan");
   option->delimiter(',')->group("Backends");
   if (!allow_several) option->expected(1);
   app.add_option("--device", device,

@@ -9,9 +9,9 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
-#include "bench/base/status.h"
 
 namespace depthbench::cli {
 

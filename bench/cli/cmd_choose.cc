@@ -4,11 +4,11 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
 #include "bench/choose/choose.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/files.h"
-#include "bench/base/progress.h"
 
 namespace depthbench::cli {
 namespace {
@@ -61,8 +61,8 @@ int RunChoose(const ChooseFlags& f) {
 
 void AddChooseCommand(CLI::App& app, std::function<int()>& action) {
   auto flags = std::make_shared<ChooseFlags>();
-  CLI::App* cmd =
-      app.add_subcommand("choose", "Rank the reconstructions a scene can use: the cheapest that meets its requirement first");
+  CLI::App* cmd = app.add_subcommand(
+      "choose", "Rank the reconstructions a scene can use: the cheapest that meets its requirement first");
   cmd->footer(
       "Measures every (variant, convention, format) the scene's engine allows, inside the scene's ranges (and at "
       "the requirement's depth), models its error over eye depth to predict the scene's far end, costs it (GPU "

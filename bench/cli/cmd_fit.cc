@@ -4,11 +4,11 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/files.h"
 #include "bench/fit/precision_fit.h"
-#include "bench/base/progress.h"
 
 namespace depthbench::cli {
 namespace {
@@ -51,7 +51,8 @@ int Fit(const FitFlags& f) {
   for (auto& b : *made) backends.push_back(b.get());
 
   Progress progress("fit", StderrIsTerminal());
-  auto sweeps = RunFitSweeps(plan, backends, [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); });
+  auto sweeps =
+      RunFitSweeps(plan, backends, [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); });
   if (!sweeps.ok()) return ReportError(sweeps.status());
   const Metric metrics[] = {Metric::kTotal, Metric::kStorage, Metric::kArith};
   const std::vector<PrecisionFit> fits = FitPrecision(*sweeps, plan, metrics, kAllLevels);

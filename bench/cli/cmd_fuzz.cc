@@ -4,14 +4,14 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/progress.h"
+#include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/fuzz/campaign.h"
 #include "bench/fuzz/worst_case.h"
-#include "bench/base/progress.h"
 #include "bench/pipeline/stats.h"
 #include "bench/sweep/sweep.h"
-#include "bench/base/text_table.h"
 
 namespace depthbench::cli {
 namespace {
@@ -32,15 +32,16 @@ struct FuzzFlags {
 
 std::string DescribeCase(const FuzzCase& c) {
   const Frame& f = c.frame;
-  std::string depth = c.sample.pick == DepthPick::kEyeDepth ? fmt::format("eye depth {:.6g}", c.sample.eye_depth)
-                      : c.sample.pick == DepthPick::kStoredZero    ? "stored 0"
-                      : c.sample.pick == DepthPick::kStoredOne     ? "stored 1"
+  std::string depth = c.sample.pick == DepthPick::kEyeDepth     ? fmt::format("eye depth {:.6g}", c.sample.eye_depth)
+                      : c.sample.pick == DepthPick::kStoredZero ? "stored 0"
+                      : c.sample.pick == DepthPick::kStoredOne  ? "stored 1"
                       : c.sample.pick == DepthPick::kStoredAfterZero ? "first stored value above 0"
                                                                      : "last stored value below 1";
-  return fmt::format("fov {:.4g}, aspect {:.4g}, near {:.4g}, far/near {:.3g}, camera at {:.3g}, pixel ({}, {}) of "
-                     "{}x{}, {}",
-                     f.fov_y_degrees, f.aspect, f.near, f.ratio(), f.camera_distance(), c.sample.x, c.sample.y,
-                     f.width, f.height, depth);
+  return fmt::format(
+      "fov {:.4g}, aspect {:.4g}, near {:.4g}, far/near {:.3g}, camera at {:.3g}, pixel ({}, {}) of "
+      "{}x{}, {}",
+      f.fov_y_degrees, f.aspect, f.near, f.ratio(), f.camera_distance(), c.sample.x, c.sample.y, f.width, f.height,
+      depth);
 }
 
 int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backend*>& backends) {
@@ -73,9 +74,10 @@ int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Bac
       result->from_random * kSamplesPerFrame, result->from_mutation * kSamplesPerFrame, options.cells.size(),
       backends.size() == 1 ? backends[0]->name() : "cpu and vulkan", result->checks, result->seconds,
       result->cases / std::max(result->seconds, 1e-9));
-  std::cout << fmt::format("invariants: finite output where the reference is finite; arithmetic error within "
-                           "{}x2^-24 x (depth + ray + world condition numbers)\n",
-                           kRoundings);
+  std::cout << fmt::format(
+      "invariants: finite output where the reference is finite; arithmetic error within "
+      "{}x2^-24 x (depth + ray + world condition numbers)\n",
+      kRoundings);
   if (result->findings.empty()) {
     std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result->closest_cell,
                              result->closest);
@@ -84,7 +86,11 @@ int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Bac
   std::cout << fmt::format("{} findings (deduplicated by cell, backend and kind; each shrunk):\n",
                            result->findings.size());
   using Align = TextTable::Align;
-  TextTable table({{"finding", Align::kLeft}, {"hits"}, {"arith bits lost"}, {"bound"}, {"shrunk case", Align::kLeft},
+  TextTable table({{"finding", Align::kLeft},
+                   {"hits"},
+                   {"arith bits lost"},
+                   {"bound"},
+                   {"shrunk case", Align::kLeft},
                    {"reproducer", Align::kLeft}});
   for (const CampaignFinding& finding : result->findings) {
     const Judgement& j = finding.judgement;
@@ -107,8 +113,14 @@ int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backe
     random_samples = *n;
   }
   Backend& backend = *backends.front();
-  TextTable table({{"cell", TextTable::Align::kLeft}, {"search: worst bits lost"}, {"evaluations"}, {"seconds"},
-                   {"random: worst bits lost"}, {"samples"}, {"seconds"}, {"search >= random"}});
+  TextTable table({{"cell", TextTable::Align::kLeft},
+                   {"search: worst bits lost"},
+                   {"evaluations"},
+                   {"seconds"},
+                   {"random: worst bits lost"},
+                   {"samples"},
+                   {"seconds"},
+                   {"search >= random"}});
   bool all_found = true;
   for (const Cell& cell : CellsForDomain(cells, *domain)) {
     SearchOptions options;
@@ -138,8 +150,9 @@ int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backe
       const double random_worst = results->cells.front().stats.All()[Metric::kTotal].max();
       const bool ok = found->worst >= random_worst;
       all_found = all_found && ok;
-      row.insert(row.end(), {fmt::format("{:.3f}", BitsLost(random_worst)), ShortCount(static_cast<double>(random_samples)),
-                             fmt::format("{:.1f}", results->run.seconds), ok ? "yes" : "NO"});
+      row.insert(row.end(),
+                 {fmt::format("{:.3f}", BitsLost(random_worst)), ShortCount(static_cast<double>(random_samples)),
+                  fmt::format("{:.1f}", results->run.seconds), ok ? "yes" : "NO"});
     } else {
       row.insert(row.end(), {"-", "-", "-", "-"});
     }
@@ -153,7 +166,8 @@ int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backe
 }
 
 int Fuzz(const FuzzFlags& f) {
-  if (!(f.seconds > 0)) return ReportError(InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds)));
+  if (!(f.seconds > 0))
+    return ReportError(InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds)));
   auto cells = f.cells.Select();
   if (!cells.ok()) return ReportError(cells.status());
   if (!f.search && !f.out.empty()) {
@@ -191,8 +205,7 @@ void AddFuzzCommand(CLI::App& app, std::function<int()>& action) {
       "  depthbench fuzz --seconds 60 --out findings/\n"
       "  depthbench run --repro findings/divide_standard_d32_sfloat_cpu_beyond_bound.json\n"
       "  depthbench fuzz --search --seconds 2 --against-random 1e8 --variant divide --convention standard");
-  cmd->add_option("--seconds", flags->seconds,
-                  "how long to fuzz (default 30); with --search, the time per cell");
+  cmd->add_option("--seconds", flags->seconds, "how long to fuzz (default 30); with --search, the time per cell");
   cmd->add_option("--cases", flags->cases, "stop after this many inputs instead of a time");
   cmd->add_option("--seed", flags->seed, "random seed of the mutations and of the search (default 1)");
   cmd->add_option("--corpus", flags->corpus, "files or folders of inputs to run first (default fuzz/corpus/formulas)");

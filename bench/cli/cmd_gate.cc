@@ -5,11 +5,11 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/files.h"
 #include "bench/gate/gate_report.h"
-#include "bench/base/progress.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench::cli {
@@ -91,9 +91,7 @@ int Gate(const GateFlags& f) {
   options.domain = plan.domain;
   options.threads = f.threads;
   Progress progress("gate", StderrIsTerminal());
-  options.progress = [&](const SweepProgress& p) {
-    progress.Update(p.fraction(), p.Describe());
-  };
+  options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
   auto results = RunSweep(options, backends);
   if (!results.ok()) return ReportError(results.status());
   progress.Finish(fmt::format("{} cells on {} backend(s)", results->cells.size(), backends.size()));
@@ -159,8 +157,7 @@ void AddGateCommand(CLI::App& app, std::function<int()>& action) {
       "  depthbench gate --baseline reports/baselines/lavapipe.json --shaders my_edited_copy/shaders --junit gate.xml\n"
       "  depthbench gate --update --baseline reports/baselines/cpu.json",
       plan.seed, plan.samples));
-  cmd->add_option("--baseline", flags->baselines, "baseline file, one per backend (repeat for several)")
-      ->required();
+  cmd->add_option("--baseline", flags->baselines, "baseline file, one per backend (repeat for several)")->required();
   cmd->add_option("--backend", flags->new_backends,
                   "with --update, the backend of each baseline file that does not exist yet, in order");
   cmd->add_option("--shaders", flags->shaders, "shader directory to test (an edited copy of shaders/)");

@@ -4,10 +4,10 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/text_table.h"
-#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench::cli {
 namespace {
@@ -23,7 +23,8 @@ const char* InputName(DepthInput input) {
 
 int List() {
   using Align = TextTable::Align;
-  TextTable variants({{"variant", Align::kLeft}, {"seed", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
+  TextTable variants(
+      {{"variant", Align::kLeft}, {"seed", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
   for (const auto& v : AllVariants()) {
     variants.AddRow({std::string(v.name), std::string(v.seed), InputName(v.input), std::string(v.idea)});
   }
@@ -35,7 +36,8 @@ int List() {
   std::cout << "\nDepth conventions\n";
   conventions.Print(std::cout);
 
-  TextTable formats({{"format", Align::kLeft}, {"short", Align::kLeft}, {"Vulkan", Align::kLeft}, {"stores", Align::kLeft}});
+  TextTable formats(
+      {{"format", Align::kLeft}, {"short", Align::kLeft}, {"Vulkan", Align::kLeft}, {"stores", Align::kLeft}});
   for (const auto& f : AllFormats()) {
     formats.AddRow({std::string(f.name), std::string(f.short_name), std::string(f.vulkan_name), InputName(f.stores)});
   }
@@ -59,7 +61,8 @@ int List() {
 }  // namespace
 
 void AddListCommand(CLI::App& app, std::function<int()>& action) {
-  CLI::App* cmd = app.add_subcommand("list", "List variants (with their seeds), conventions, formats and Vulkan devices");
+  CLI::App* cmd =
+      app.add_subcommand("list", "List variants (with their seeds), conventions, formats and Vulkan devices");
   cmd->callback([&action] { action = [] { return List(); }; });
 }
 

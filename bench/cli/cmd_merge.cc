@@ -43,9 +43,10 @@ int Merge(const MergeFlags& f) {
 void AddMergeCommand(CLI::App& app, std::function<int()>& action) {
   auto flags = std::make_shared<MergeFlags>();
   CLI::App* cmd = app.add_subcommand("merge", "Add up the results of the shards of one sweep (run --shard K/N)");
-  cmd->footer("Shards of one sweep share seed, sample count and domain; their histograms add up exactly to "
-              "the results of running the whole sweep at once.\n\n"
-              "Example:\n  depthbench merge part1.json part2.json --json all.json");
+  cmd->footer(
+      "Shards of one sweep share seed, sample count and domain; their histograms add up exactly to "
+      "the results of running the whole sweep at once.\n\n"
+      "Example:\n  depthbench merge part1.json part2.json --json all.json");
   cmd->add_option("inputs", flags->inputs, "results files of shards (depthbench run --shard K/N --json FILE)")
       ->required()
       ->check(CLI::ExistingFile);

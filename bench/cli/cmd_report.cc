@@ -6,11 +6,11 @@
 
 #include <fmt/format.h>
 
-#include "bench/cli/cli_common.h"
-#include "bench/cli/commands.h"
 #include "bench/base/environment.h"
 #include "bench/base/files.h"
 #include "bench/base/progress.h"
+#include "bench/cli/cli_common.h"
+#include "bench/cli/commands.h"
 #include "bench/report/report.h"
 #include "bench/report/report_render.h"
 
@@ -73,7 +73,8 @@ int Report(const ReportFlags& f) {
   if (cells->size() != AllCells().size()) plan.cells = *cells;
   plan.speed_files = SpeedFiles(f);
   for (const fs::path& file : plan.speed_files) {
-    if (!fs::is_regular_file(file)) return ReportError(NotFound(fmt::format("--speed: {} does not exist", file.string())));
+    if (!fs::is_regular_file(file))
+      return ReportError(NotFound(fmt::format("--speed: {} does not exist", file.string())));
   }
 
   // Everything that can be refused is refused before the sweeps run.
@@ -175,8 +176,7 @@ void AddReportCommand(CLI::App& app, std::function<int()>& action) {
       ->required();
   cmd->add_flag("--quick", flags->quick,
                 "fewer samples (4e4 per far/near ratio, 1e5 default-domain), same page: seconds, not minutes");
-  cmd->add_option("--history", flags->history, "SQLite history database (created if missing)")
-      ->capture_default_str();
+  cmd->add_option("--history", flags->history, "SQLite history database (created if missing)")->capture_default_str();
   cmd->add_flag("--no-history", flags->no_history, "neither read nor record history");
   cmd->add_option("--samples", flags->samples, "samples per far/near ratio (default 3e5; quick 4e4)");
   cmd->add_option("--default-samples", flags->default_samples,

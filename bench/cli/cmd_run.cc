@@ -4,17 +4,17 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
+#include "bench/base/progress.h"
+#include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/progress.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
-#include "bench/sweep/repro.h"
 #include "bench/pipeline/stats.h"
 #include "bench/results/results_table.h"
-#include "bench/base/files.h"
+#include "bench/sweep/repro.h"
 #include "bench/sweep/sweep.h"
-#include "bench/base/text_table.h"
 
 namespace depthbench::cli {
 namespace {
@@ -54,14 +54,15 @@ int ReplayReproFile(const RunFlags& f, std::vector<Backend*>& backends) {
   for (std::size_t c = 0; c < file->cells.size(); ++c) {
     for (std::size_t b = 0; b < backends.size(); ++b) {
       const Judgement& j = checker->At(c, b, 0);
-      std::string verdict = !j.checked ? "not checked (the reference is degenerate)"
-                            : j.nan    ? "FINDING: NaN where the reference is finite"
-                            : j.inf    ? "FINDING: Inf where the reference is finite"
-                            : j.arith > j.bound
-                                ? fmt::format("FINDING: arithmetic error {:.3g} ({:.1f} bits lost) beyond the bound "
-                                              "{:.3g} ({:.1f} bits)",
-                                              j.arith, BitsLost(j.arith), j.bound, BitsLost(j.bound))
-                                : fmt::format("holds: arithmetic error {:.3g} within the bound {:.3g}", j.arith, j.bound);
+      std::string verdict =
+          !j.checked          ? "not checked (the reference is degenerate)"
+          : j.nan             ? "FINDING: NaN where the reference is finite"
+          : j.inf             ? "FINDING: Inf where the reference is finite"
+          : j.arith > j.bound ? fmt::format(
+                                    "FINDING: arithmetic error {:.3g} ({:.1f} bits lost) beyond the bound "
+                                    "{:.3g} ({:.1f} bits)",
+                                    j.arith, BitsLost(j.arith), j.bound, BitsLost(j.bound))
+                              : fmt::format("holds: arithmetic error {:.3g} within the bound {:.3g}", j.arith, j.bound);
       failures += j.violates();
       std::cout << fmt::format("{} on {}: {}\n", file->cells[c].Name(), backends[b]->name(), verdict);
     }
@@ -94,10 +95,14 @@ int Run(const RunFlags& f) {
   options.cells = *cells;
   std::vector<BandFamily> splits;
   for (const std::string& s : f.split) {
-    if (s == "ratio") splits.push_back(BandFamily::kRatio);
-    else if (s == "depth") splits.push_back(BandFamily::kDepth);
-    else if (s == "distance") splits.push_back(BandFamily::kDistance);
-    else return ReportError(InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s)));
+    if (s == "ratio")
+      splits.push_back(BandFamily::kRatio);
+    else if (s == "depth")
+      splits.push_back(BandFamily::kDepth);
+    else if (s == "distance")
+      splits.push_back(BandFamily::kDistance);
+    else
+      return ReportError(InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s)));
   }
   if (!f.json.empty()) {
     Status writable = CheckWritable(f.json, "--json");
@@ -115,7 +120,8 @@ int Run(const RunFlags& f) {
     if (f.index.empty() || *end != '\0' || f.index[0] == '-') {
       return ReportError(InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ...)", f.index)));
     }
-    auto repro = Reproduce(options.seed, index, options.domain, CellsForDomain(options.cells, options.domain), backends);
+    auto repro =
+        Reproduce(options.seed, index, options.domain, CellsForDomain(options.cells, options.domain), backends);
     if (!repro.ok()) return ReportError(repro.status());
     PrintRepro(*repro, std::cout);
     if (!f.json.empty()) {
@@ -126,14 +132,12 @@ int Run(const RunFlags& f) {
   }
 
   Progress progress("run", StderrIsTerminal() && !f.quiet);
-  options.progress = [&](const SweepProgress& p) {
-    progress.Update(p.fraction(), p.Describe());
-  };
+  options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
   auto results = RunSweep(options, backends);
   if (!results.ok()) return ReportError(results.status());
   if (!f.quiet) {
-    progress.Finish(fmt::format("{} reconstructions in {} cells", ShortCount(static_cast<double>(results->run.reconstructions)),
-                                results->cells.size()));
+    progress.Finish(fmt::format("{} reconstructions in {} cells",
+                                ShortCount(static_cast<double>(results->run.reconstructions)), results->cells.size()));
   }
 
   PrintRunHeader(*results, std::cout);

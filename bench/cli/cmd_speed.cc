@@ -6,14 +6,14 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/vulkan_backend.h"
+#include "bench/base/progress.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
-#include "bench/base/progress.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_run.h"
 #include "bench/speed/speed_table.h"
 #include "bench/sweep/sweep.h"
-#include "bench/backends/vulkan/vulkan_backend.h"
 
 namespace depthbench::cli {
 namespace {
@@ -77,9 +77,10 @@ int Speed(const SpeedFlags& f) {
   if (!valid.ok()) {
     // Name the flags, not the struct.
     if (options.alu_taps < 2 || options.alu_taps > GpuPassTimer::kMaxTaps) {
-      return ReportError(InvalidArgument(fmt::format("--taps: {} is out of range; allowed 2 to {} (the ALU-bound "
-                                                     "regime; 1 tap is the memory-bound one, always measured)",
-                                                     options.alu_taps, GpuPassTimer::kMaxTaps)));
+      return ReportError(
+          InvalidArgument(fmt::format("--taps: {} is out of range; allowed 2 to {} (the ALU-bound "
+                                      "regime; 1 tap is the memory-bound one, always measured)",
+                                      options.alu_taps, GpuPassTimer::kMaxTaps)));
     }
     if (options.repetitions < 3) {
       return ReportError(InvalidArgument(
@@ -129,9 +130,9 @@ int Speed(const SpeedFlags& f) {
   if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results->gpu.size(), results->run.seconds));
 
   std::string source;
-  Expected<Results> accuracy =
-      given_accuracy ? Expected<Results>(*given_accuracy)
-                     : AccuracyFor(f, options.cells, shared_context, *accuracy_samples, source);
+  Expected<Results> accuracy = given_accuracy
+                                   ? Expected<Results>(*given_accuracy)
+                                   : AccuracyFor(f, options.cells, shared_context, *accuracy_samples, source);
   if (given_accuracy) source = f.results;
   if (!accuracy.ok()) return ReportError(accuracy.status().WithContext("accuracy results for the trade"));
   Status traded = AddTrade(*results, *accuracy, source);

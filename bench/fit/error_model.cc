@@ -15,9 +15,12 @@ const ModelInfo kModels[] = {
     {ModelKind::kConstant, "constant", 1, false, false, {"a"}},
     {ModelKind::kDepth, "depth", 2, false, true, {"a", "c (bits per doubling of z/n)"}},
     {ModelKind::kRatio, "ratio", 2, true, false, {"a", "s (bits per doubling of f/n)"}},
-    {ModelKind::kFull, "full", 3, true, true,
-     {"a", "s (bits per doubling of f/n)", "c (bits per doubling of z/n)"}},
-    {ModelKind::kPhysical, "physical", 4, true, true,
+    {ModelKind::kFull, "full", 3, true, true, {"a", "s (bits per doubling of f/n)", "c (bits per doubling of z/n)"}},
+    {ModelKind::kPhysical,
+     "physical",
+     4,
+     true,
+     true,
      {"log2 alpha (arithmetic floor)", "log2(beta u_fmt / u)", "gamma (power of z/n)", "delta (power of f/n)"}},
 };
 
@@ -128,8 +131,7 @@ const ModelInfo& Info(ModelKind kind) { return kModels[static_cast<int>(kind)]; 
 Expected<ModelKind> ParseModelKind(const std::string& name) {
   for (const ModelInfo& m : kModels)
     if (name == m.name) return m.kind;
-  return InvalidArgument(
-      fmt::format("unknown model '{}'; allowed: constant, depth, ratio, full, physical", name));
+  return InvalidArgument(fmt::format("unknown model '{}'; allowed: constant, depth, ratio, full, physical", name));
 }
 
 double FittedModel::Predict(double x, double y) const {
@@ -174,8 +176,8 @@ Expected<FittedModel> FitModel(std::span<const FitPoint> points, ModelKind kind)
   const ModelInfo& info = Info(kind);
   const int n = static_cast<int>(points.size());
   if (n < info.parameters + 1) {
-    return InvalidArgument(fmt::format("{} points are too few for the {} model ({} parameters)", n, info.name,
-                                       info.parameters));
+    return InvalidArgument(
+        fmt::format("{} points are too few for the {} model ({} parameters)", n, info.name, info.parameters));
   }
   FittedModel fit;
   fit.kind = kind;

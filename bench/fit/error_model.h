@@ -30,8 +30,8 @@
 namespace depthbench {
 
 enum class ModelKind { kConstant, kDepth, kRatio, kFull, kPhysical };
-inline constexpr ModelKind kAllModels[] = {ModelKind::kConstant, ModelKind::kDepth, ModelKind::kRatio,
-                                           ModelKind::kFull, ModelKind::kPhysical};
+inline constexpr ModelKind kAllModels[] = {ModelKind::kConstant, ModelKind::kDepth, ModelKind::kRatio, ModelKind::kFull,
+                                           ModelKind::kPhysical};
 
 struct ModelInfo {
   ModelKind kind;
@@ -57,8 +57,8 @@ struct FittedModel {
   std::vector<double> parameters;
   std::vector<double> covariance;  // row-major, parameters x parameters (empty if not computable)
   int points = 0;
-  double rss = 0.0;           // sum of squared residuals, bits^2 (outliers capped by the robust loss)
-  double sigma = 0.0;         // residual standard deviation, bits
+  double rss = 0.0;    // sum of squared residuals, bits^2 (outliers capped by the robust loss)
+  double sigma = 0.0;  // residual standard deviation, bits
   double bic = 0.0;
   bool converged = false;
 

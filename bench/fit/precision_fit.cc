@@ -8,8 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/pipeline/bands.h"
 #include "bench/base/text_table.h"
+#include "bench/pipeline/bands.h"
 
 namespace depthbench {
 namespace {
@@ -119,10 +119,10 @@ std::vector<BandPoint> CollectBandPoints(const FitSweeps& sweeps, const Cell& ce
       const double lo = std::max(1.0, DepthBandLow(d)), hi = std::min(DepthBandLow(d) * 10.0, span);
       if (!(hi > lo)) continue;
       // A share of NaN/Inf above 1 - q puts the quantile at infinity.
-      const double q = static_cast<double>(band.nan + band.inf) >
-                               (1.0 - LevelQuantile(level)) * static_cast<double>(band.judged())
-                           ? INFINITY
-                           : band[metric].AtLevel(level, metric);
+      const double q =
+          static_cast<double>(band.nan + band.inf) > (1.0 - LevelQuantile(level)) * static_cast<double>(band.judged())
+              ? INFINITY
+              : band[metric].AtLevel(level, metric);
       BandPoint p;
       p.ratio = ratio;
       p.depth_band = d;
@@ -251,21 +251,21 @@ nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const 
     for (const auto& [name, ratio] : f.budget_ratio) {
       budgets[name] = ratio ? JsonNumber(*ratio) : nlohmann::json("met throughout");
     }
-    out.push_back({{"cell", f.cell.Name()},
-                   {"backend", f.backend},
-                   {"metric", MetricName(f.metric)},
-                   {"level", LevelName(f.level)},
-                   {"infinite_far", f.infinite_far},
-                   {"points", f.points},
-                   {"model", Info(f.model.kind).name},
-                   {"slope_bits_per_doubling", f.slope},
-                   {"slope_interval_95", {f.slope_low, f.slope_high}},
-                   {"predicted_bits_lost", f.predicted},
-                   {"last_ratio_meeting_budget", budgets},
-                   {"holdout", {{"points", f.holdout_points},
-                                {"max_miss_bits", f.holdout_max_miss},
-                                {"rms_miss_bits", f.holdout_rms_miss}}},
-                   {"models", ranking}});
+    out.push_back(
+        {{"cell", f.cell.Name()},
+         {"backend", f.backend},
+         {"metric", MetricName(f.metric)},
+         {"level", LevelName(f.level)},
+         {"infinite_far", f.infinite_far},
+         {"points", f.points},
+         {"model", Info(f.model.kind).name},
+         {"slope_bits_per_doubling", f.slope},
+         {"slope_interval_95", {f.slope_low, f.slope_high}},
+         {"predicted_bits_lost", f.predicted},
+         {"last_ratio_meeting_budget", budgets},
+         {"holdout",
+          {{"points", f.holdout_points}, {"max_miss_bits", f.holdout_max_miss}, {"rms_miss_bits", f.holdout_rms_miss}}},
+         {"models", ranking}});
   }
   nlohmann::json ratios = nlohmann::json::array();
   for (double r : plan.ratios) ratios.push_back(r);

@@ -31,10 +31,10 @@ std::uint64_t MinimumSamples(Level level);
 struct FitPlan {
   std::uint64_t seed = 7;
   std::uint64_t samples_per_ratio = 100000;
-  std::vector<double> ratios;  // finite far/near ratios swept; empty: 10^1 .. 10^8 in half decades
-  bool infinite = true;        // also sweep an infinite far plane
-  Domain domain;               // everything but the ratio (the camera defaults to the origin)
-  std::vector<Cell> cells;     // empty: all
+  std::vector<double> ratios;    // finite far/near ratios swept; empty: 10^1 .. 10^8 in half decades
+  bool infinite = true;          // also sweep an infinite far plane
+  Domain domain;                 // everything but the ratio (the camera defaults to the origin)
+  std::vector<Cell> cells;       // empty: all
   std::vector<double> held_out;  // ratios kept out of the hold-out fit; empty: 10^3.5 and 10^6.5
   FitPlan();
 };
@@ -54,7 +54,7 @@ Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> 
 struct BandPoint {
   double ratio = 0.0;  // +infinity for the infinite sweep
   int depth_band = 0;
-  FitPoint point;      // b = +infinity when the quantile is not finite
+  FitPoint point;  // b = +infinity when the quantile is not finite
   // A point the models are fitted to: finite, and above the lowest kept
   // bin (a quantile in the underflow bin only says "tiny").
   bool modelled = false;
@@ -92,8 +92,8 @@ struct PrecisionFit {
 };
 
 // `progress` is told (cells fitted, cells to fit) after each (cell, backend).
-std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan,
-                                       std::span<const Metric> metrics, std::span<const Level> levels,
+std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan, std::span<const Metric> metrics,
+                                       std::span<const Level> levels,
                                        const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const FitPlan& plan);

@@ -88,8 +88,14 @@ Expected<FuzzCase> Shrink(CaseChecker& checker, FuzzCase c, FindingKind kind, co
   const std::vector<Edit> edits = {
       [](FuzzCase& t) { t.frame.camera_position = glm::dvec3(0.0); },
       [](FuzzCase& t) { t.frame.rotation = glm::dmat3(1.0); },
-      [](FuzzCase& t) { t.sample.x = t.frame.width / 2; t.sample.y = t.frame.height / 2; },
-      [](FuzzCase& t) { t.sample.x = 0; t.sample.y = 0; },
+      [](FuzzCase& t) {
+        t.sample.x = t.frame.width / 2;
+        t.sample.y = t.frame.height / 2;
+      },
+      [](FuzzCase& t) {
+        t.sample.x = 0;
+        t.sample.y = 0;
+      },
       [](FuzzCase& t) {
         t.sample.x = static_cast<std::uint32_t>(std::uint64_t{t.sample.x} * 64 / t.frame.width);
         t.sample.y = static_cast<std::uint32_t>(std::uint64_t{t.sample.y} * 64 / t.frame.height);
@@ -119,8 +125,8 @@ Expected<FuzzCase> Shrink(CaseChecker& checker, FuzzCase c, FindingKind kind, co
       if (n >= 5) *x = static_cast<float>(*x);  // camera components stay float32 values
       if (!(candidate.frame.far > candidate.frame.near)) continue;
       CompleteFrame(candidate.frame, std::nullopt);
-      candidate.frame.volume_depth = std::clamp(candidate.frame.volume_depth, candidate.frame.near,
-                                                candidate.frame.depth_limit);
+      candidate.frame.volume_depth =
+          std::clamp(candidate.frame.volume_depth, candidate.frame.near, candidate.frame.depth_limit);
       DB_ASSIGN_OR_RETURN(bool fails, still_fails(candidate));
       if (fails) {
         c = candidate;
@@ -158,7 +164,8 @@ Expected<std::vector<FuzzPoint>> ReadCorpus(const std::vector<std::filesystem::p
 
 Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(options.domain.Validate());
-  if (options.seconds <= 0 && options.cases == 0) return InvalidArgument("give a time (--seconds) or a count (--cases)");
+  if (options.seconds <= 0 && options.cases == 0)
+    return InvalidArgument("give a time (--seconds) or a count (--cases)");
   DB_ASSIGN_OR_RETURN(std::vector<FuzzPoint> corpus, ReadCorpus(options.corpus));
   std::vector<Backend*> backend_list(backends.begin(), backends.end());
   DB_ASSIGN_OR_RETURN(CaseChecker checker, CaseChecker::Make(options.cells, backend_list));
@@ -233,8 +240,8 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
             }
             continue;
           }
-          const std::string signature = fmt::format("{} {} {}", checker.cells()[c].Name(),
-                                                    backend_list[b]->name(), FindingKindName(j.kind()));
+          const std::string signature =
+              fmt::format("{} {} {}", checker.cells()[c].Name(), backend_list[b]->name(), FindingKindName(j.kind()));
           auto [it, fresh] = by_signature.try_emplace(signature, result.findings.size());
           if (!fresh) {
             ++result.findings[it->second].hits;

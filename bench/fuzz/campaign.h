@@ -21,12 +21,12 @@
 namespace depthbench {
 
 struct CampaignOptions {
-  double seconds = 10.0;        // stop after this long (0: no limit)
-  std::uint64_t cases = 0;      // or after this many cases (0: no limit)
+  double seconds = 10.0;    // stop after this long (0: no limit)
+  std::uint64_t cases = 0;  // or after this many cases (0: no limit)
   std::uint64_t seed = 1;
   std::vector<Cell> cells;
   std::vector<std::filesystem::path> corpus;  // files of FuzzPoint bytes, or folders of them
-  std::filesystem::path out;    // where reproducer files go ("" = none written)
+  std::filesystem::path out;                  // where reproducer files go ("" = none written)
   Domain domain = FuzzDomain();
   std::uint32_t frames_per_batch = 64;  // x 64 samples
   // Units held at a value in every input (index into the 18 units of a
@@ -48,11 +48,11 @@ struct CampaignFinding {
 };
 
 struct CampaignResult {
-  std::uint64_t cases = 0;          // inputs run (each through every cell and backend)
-  std::uint64_t checks = 0;         // (cell, backend, input) triples checked
+  std::uint64_t cases = 0;   // inputs run (each through every cell and backend)
+  std::uint64_t checks = 0;  // (cell, backend, input) triples checked
   std::uint64_t from_corpus = 0, from_extremes = 0, from_random = 0, from_mutation = 0;
   double seconds = 0.0;
-  double closest = 0.0;             // the largest arithmetic error / bound seen that was no finding
+  double closest = 0.0;  // the largest arithmetic error / bound seen that was no finding
   std::string closest_cell;
   std::vector<CampaignFinding> findings;
 };

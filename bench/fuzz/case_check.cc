@@ -34,14 +34,15 @@ double ArithmeticBound(const Cell& cell, const Frame& frame, const f32::DepthPar
   // inverse_vp carries the camera's translation through the homogeneous
   // divide: the rounding of w scales the whole translated point, so the
   // depth and world conditions multiply instead of adding.
-  const double conditions = cell.variant == Variant::kInverseVp
-                                ? depth_condition * world_condition + ray_condition
-                                : depth_condition + ray_condition + world_condition;
+  const double conditions = cell.variant == Variant::kInverseVp ? depth_condition * world_condition + ray_condition
+                                                                : depth_condition + ray_condition + world_condition;
   return kRoundings * 0x1.0p-24 * conditions;
 }
 
 CaseChecker::CaseChecker(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads)
-    : cells_(std::move(cells)), backends_(std::move(backends)), layout_(MakeRunLayout(cells_)),
+    : cells_(std::move(cells)),
+      backends_(std::move(backends)),
+      layout_(MakeRunLayout(cells_)),
       pool_(std::make_unique<ThreadPool>(threads)) {}
 
 Expected<CaseChecker> CaseChecker::Make(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads) {
@@ -83,7 +84,8 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
             const double distance = r.denoted_depth * glm::length(ray);
             // The judge measures errors relative to the true point's
             // distance; the bound is about the point the texel denotes.
-            j.bound = ArithmeticBound(plan.cell, frame, batch_.depth_params[f * kHardwareConventionCount + plan.convention_slot],
+            j.bound = ArithmeticBound(plan.cell, frame,
+                                      batch_.depth_params[f * kHardwareConventionCount + plan.convention_slot],
                                       batch_.depths[at], distance) *
                       (r.denoted_depth / r.true_depth);
             if (r.denoted_depth == DBL_MAX) {

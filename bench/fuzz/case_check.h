@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "bench/backends/backend.h"
+#include "bench/base/status.h"
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/sampler.h"
-#include "bench/base/status.h"
-#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 
@@ -48,9 +48,9 @@ double ArithmeticBound(const Cell& cell, const Frame& frame, const f32::DepthPar
                        double distance_from_camera);
 
 struct Judgement {
-  double total = 0.0;   // relative errors (NaN when the output is not finite)
+  double total = 0.0;  // relative errors (NaN when the output is not finite)
   double arith = 0.0;
-  double bound = 0.0;   // ArithmeticBound
+  double bound = 0.0;    // ArithmeticBound
   bool checked = false;  // the reference is finite and the cell runs on the frame
   bool judged = false;   // and the point lies inside the frustum (errors count, as in a sweep)
   bool nan = false, inf = false;

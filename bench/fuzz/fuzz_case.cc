@@ -12,7 +12,6 @@
 namespace depthbench {
 namespace {
 
-
 const char* PickName(DepthPick p) {
   switch (p) {
     case DepthPick::kEyeDepth: return "eye_depth";
@@ -26,13 +25,14 @@ const char* PickName(DepthPick p) {
 
 Expected<DepthPick> ParsePick(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(std::string name, r.String());
-  for (DepthPick p : {DepthPick::kEyeDepth, DepthPick::kStoredZero, DepthPick::kStoredOne,
-                      DepthPick::kStoredAfterZero, DepthPick::kStoredBeforeOne}) {
+  for (DepthPick p : {DepthPick::kEyeDepth, DepthPick::kStoredZero, DepthPick::kStoredOne, DepthPick::kStoredAfterZero,
+                      DepthPick::kStoredBeforeOne}) {
     if (name == PickName(p)) return p;
   }
-  return r.Error(fmt::format("unknown depth pick '{}'; allowed: eye_depth, stored_zero, stored_one, "
-                             "stored_after_zero, stored_before_one",
-                             name));
+  return r.Error(
+      fmt::format("unknown depth pick '{}'; allowed: eye_depth, stored_zero, stored_one, "
+                  "stored_after_zero, stored_before_one",
+                  name));
 }
 
 // Reads a number that must lie in (lo, hi] or [lo, hi].
@@ -203,8 +203,7 @@ FuzzCase CaseAt(const Domain& domain, const FuzzPoint& point) {
 CaseSource::CaseSource(std::vector<Frame> frames, std::vector<PixelSample> samples)
     : frames_(std::move(frames)), samples_(std::move(samples)) {}
 
-CaseSource::CaseSource(const FuzzCase& single)
-    : frames_{single.frame}, samples_(kSamplesPerFrame, single.sample) {}
+CaseSource::CaseSource(const FuzzCase& single) : frames_{single.frame}, samples_(kSamplesPerFrame, single.sample) {}
 
 Frame CaseSource::FrameAt(std::uint64_t frame_index) const {
   Frame f = frames_.at(frame_index);
@@ -231,16 +230,19 @@ void PointBatch::AddFrame(const FuzzPoint& base, const std::function<FuzzPoint(s
 
 bool CellRunsOn(const Cell& cell, const Frame& frame) {
   const ConventionInfo& c = Info(cell.convention);
-  const bool needs_finite = (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) ||
-                            Info(cell.format).stores == DepthInput::kLinear;
+  const bool needs_finite =
+      (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) || Info(cell.format).stores == DepthInput::kLinear;
   return frame.finite() || !needs_finite;
 }
 
 nlohmann::json ReproFileToJson(const ReproFile& file) {
   nlohmann::json cells = nlohmann::json::array();
   for (const Cell& c : file.cells) cells.push_back(c.Name());
-  nlohmann::json out = {{"schema", "depthbench.repro"}, {"schema_version", 1}, {"cells", cells},
-                        {"backends", file.backends}, {"case", CaseToJson(file.fuzz_case)}};
+  nlohmann::json out = {{"schema", "depthbench.repro"},
+                        {"schema_version", 1},
+                        {"cells", cells},
+                        {"backends", file.backends},
+                        {"case", CaseToJson(file.fuzz_case)}};
   if (!file.finding.is_null()) out["finding"] = file.finding;
   return out;
 }
@@ -249,8 +251,8 @@ Expected<ReproFile> ReproFileFromJson(const nlohmann::json& json, const std::str
   const JsonReader r(json, source);
   DB_ASSIGN_OR_RETURN(std::string schema, r.String("schema"));
   if (schema != "depthbench.repro") {
-    return r.Error(fmt::format("schema is '{}', not 'depthbench.repro' (a reproducer file of depthbench fuzz)",
-                               schema));
+    return r.Error(
+        fmt::format("schema is '{}', not 'depthbench.repro' (a reproducer file of depthbench fuzz)", schema));
   }
   DB_ASSIGN_OR_RETURN(std::uint64_t version, r.Unsigned("schema_version"));
   if (version != 1) return r.Error(fmt::format("schema_version {} is not supported (this build reads 1)", version));

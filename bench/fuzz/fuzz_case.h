@@ -17,11 +17,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/base/json_reader.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
-#include "bench/base/json_reader.h"
 #include "bench/pipeline/sampler.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 

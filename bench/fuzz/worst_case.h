@@ -23,15 +23,15 @@ struct SearchOptions {
   Cell cell;
   Domain domain;
   std::uint64_t seed = 1;
-  double seconds = 1.0;               // time budget
+  double seconds = 1.0;                      // time budget
   std::uint32_t frames_per_generation = 32;  // x 64 samples
-  std::uint32_t elite = 16;          // best inputs kept
+  std::uint32_t elite = 16;                  // best inputs kept
   std::function<void(double fraction, double best_bits)> progress;
 };
 
 struct SearchResult {
-  double worst = 0.0;        // largest total relative error found (NaN/Inf outputs are not counted)
-  FuzzPoint point;           // where
+  double worst = 0.0;  // largest total relative error found (NaN/Inf outputs are not counted)
+  FuzzPoint point;     // where
   FuzzCase worst_case;
   std::uint64_t evaluations = 0;
   double seconds = 0.0;

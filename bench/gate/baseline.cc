@@ -80,10 +80,14 @@ json BaselineToJson(const Baseline& b) {
   for (const auto& [name, figures] : b.cells) {
     json bands = json::object();
     for (const auto& [band, f] : figures) {
-      bands[band] = {{"total_p999_bits", f.total_p999}, {"total_max_bits", JsonNumber(f.total_max)},
-                     {"arith_p999_bits", f.arith_p999}, {"arith_max_bits", JsonNumber(f.arith_max)},
-                     {"judged", f.judged},              {"nan", f.nan},
-                     {"inf", f.inf},                    {"worst_index", JsonIndex(f.worst_index)},
+      bands[band] = {{"total_p999_bits", f.total_p999},
+                     {"total_max_bits", JsonNumber(f.total_max)},
+                     {"arith_p999_bits", f.arith_p999},
+                     {"arith_max_bits", JsonNumber(f.arith_max)},
+                     {"judged", f.judged},
+                     {"nan", f.nan},
+                     {"inf", f.inf},
+                     {"worst_index", JsonIndex(f.worst_index)},
                      {"first_nonfinite_index", JsonIndex(f.first_nonfinite_index)}};
     }
     cells[name] = bands;

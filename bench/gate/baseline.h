@@ -12,11 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/json_reader.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
-#include "bench/base/json_reader.h"
 #include "bench/results/results.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
@@ -29,7 +29,7 @@ struct BandFigures {
   double total_p999 = 0, total_max = 0;
   double arith_p999 = 0, arith_max = 0;
   std::uint64_t judged = 0, nan = 0, inf = 0;
-  std::uint64_t worst_index = 0;           // the sample with the largest total error
+  std::uint64_t worst_index = 0;            // the sample with the largest total error
   std::uint64_t first_nonfinite_index = 0;  // UINT64_MAX when there is none
   friend bool operator==(const BandFigures&, const BandFigures&) = default;
 };

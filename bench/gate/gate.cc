@@ -54,8 +54,8 @@ void CompareCount(const char* what, std::uint64_t before, std::uint64_t after, s
 Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Baseline& run,
                                              const GateTolerance& tolerance) {
   if (baseline.backend != run.backend) {
-    return InvalidArgument(fmt::format("the baseline was made on the {} backend, not {}", baseline.backend,
-                                       run.backend));
+    return InvalidArgument(
+        fmt::format("the baseline was made on the {} backend, not {}", baseline.backend, run.backend));
   }
   if (baseline.device.name != run.device.name) {
     return InvalidArgument(fmt::format("the baseline was made on device '{}'; this run is on '{}'",
@@ -71,8 +71,7 @@ Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Bas
   GateComparison comparison;
   comparison.backend = run.backend;
   if (baseline.device.driver != run.device.driver) {
-    comparison.notes.push_back(
-        fmt::format("driver changed: '{}' -> '{}'", baseline.device.driver, run.device.driver));
+    comparison.notes.push_back(fmt::format("driver changed: '{}' -> '{}'", baseline.device.driver, run.device.driver));
   }
   if (baseline.device.compiler != run.device.compiler) {
     comparison.notes.push_back(

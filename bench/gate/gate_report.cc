@@ -91,7 +91,8 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
       for (std::size_t k = 0; k < bands.size() && k < kShown; ++k) {
         out << fmt::format("  {}: {}\n", bands[k].band, Join(bands[k].reasons, ", "));
       }
-      if (bands.size() > kShown) out << fmt::format("  ... and {} more bands (--json has them all)\n", bands.size() - kShown);
+      if (bands.size() > kShown)
+        out << fmt::format("  ... and {} more bands (--json has them all)\n", bands.size() - kShown);
       // One reproducer, for the band that changed most.
       const std::string repro = ReproFor(r, v.cell, v.worse.front());
       if (!repro.empty()) out << "  reproduce: " << repro << "\n";
@@ -139,14 +140,18 @@ std::string GateJUnit(const std::vector<GateRun>& runs) {
 
 nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
   auto figures = [](const BandFigures& f) {
-    return nlohmann::json{{"total_p999_bits", f.total_p999}, {"total_max_bits", f.total_max},
-                          {"arith_p999_bits", f.arith_p999}, {"arith_max_bits", f.arith_max},
-                          {"nan", f.nan},                    {"inf", f.inf}};
+    return nlohmann::json{{"total_p999_bits", f.total_p999},
+                          {"total_max_bits", f.total_max},
+                          {"arith_p999_bits", f.arith_p999},
+                          {"arith_max_bits", f.arith_max},
+                          {"nan", f.nan},
+                          {"inf", f.inf}};
   };
   auto changes = [&](const std::vector<BandChange>& list) {
     nlohmann::json out = nlohmann::json::array();
     for (const BandChange& c : list) {
-      out.push_back({{"band", c.band}, {"reasons", c.reasons}, {"before", figures(c.before)}, {"after", figures(c.after)}});
+      out.push_back(
+          {{"band", c.band}, {"reasons", c.reasons}, {"before", figures(c.before)}, {"after", figures(c.after)}});
     }
     return out;
   };
@@ -156,7 +161,9 @@ nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& t
     nlohmann::json cells = nlohmann::json::array();
     for (const CellVerdict& v : r.comparison.cells) {
       nlohmann::json cell = {{"cell", v.cell},
-                             {"verdict", v.failed() ? "worse" : v.better.empty() ? "same" : "better"},
+                             {"verdict", v.failed()         ? "worse"
+                                         : v.better.empty() ? "same"
+                                                            : "better"},
                              {"disappeared", v.disappeared},
                              {"appeared", v.appeared},
                              {"worse", changes(v.worse)},

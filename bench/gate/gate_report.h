@@ -14,8 +14,8 @@ namespace depthbench {
 
 struct GateRun {
   GateComparison comparison;
-  Baseline baseline;  // what the run was compared with
-  Baseline current;   // what the run measured
+  Baseline baseline;       // what the run was compared with
+  Baseline current;        // what the run measured
   std::string shader_dir;  // "" when the built-in shaders ran
 };
 

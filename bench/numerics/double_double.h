@@ -39,8 +39,8 @@ namespace dd_detail {
 inline double Fma(double a, double b, double c) { return std::fma(a, b, c); }
 inline Double4 Fma(Double4 a, Double4 b, Double4 c) {
 #if defined(__FMA__)
-  return reinterpret_cast<Double4>(_mm256_fmadd_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b),
-                                                   reinterpret_cast<__m256d>(c)));
+  return reinterpret_cast<Double4>(
+      _mm256_fmadd_pd(reinterpret_cast<__m256d>(a), reinterpret_cast<__m256d>(b), reinterpret_cast<__m256d>(c)));
 #else
   Double4 r;
   for (int k = 0; k < 4; ++k) r[k] = std::fma(a[k], b[k], c[k]);
@@ -180,7 +180,6 @@ inline bool operator<(DoubleDouble a, DoubleDouble b) {
 inline bool operator>(DoubleDouble a, DoubleDouble b) { return b < a; }
 inline bool operator<=(DoubleDouble a, DoubleDouble b) { return !(b < a); }
 inline bool operator>=(DoubleDouble a, DoubleDouble b) { return !(a < b); }
-
 
 // The float next to the finite float f: above it when `up`, else below
 // (what std::nextafter gives, without the library call, which the

@@ -20,8 +20,8 @@
 
 #include <glm/glm.hpp>
 
-#include "bench/numerics/double_double.h"
 #include "bench/base/simd.h"
+#include "bench/numerics/double_double.h"
 #include "shared/compat.h"
 
 // Formulas take parameters they do not all use (one signature for all
@@ -76,8 +76,11 @@ using vec2 = glm::vec<2, DoubleDouble4>;
 using vec3 = glm::vec<3, DoubleDouble4>;
 using vec4 = glm::vec<4, DoubleDouble4>;
 using mat4 = glm::mat<4, 4, DoubleDouble4>;
+// The depth mapping needs the parameter blocks first.
+// clang-format off
 #include "shared/params.h"
 #include "shared/depth_mapping.h"
+// clang-format on
 }  // namespace depthbench::hp4
 
 #pragma GCC diagnostic pop

@@ -27,6 +27,9 @@ struct vec4 {
 struct mat4 {
   vec4 columns[4];
 };
+// The depth mapping needs the parameter blocks first.
+// clang-format off
 #include "shared/params.h"
 #include "shared/depth_mapping.h"
+// clang-format on
 }  // namespace depthbench::mp

@@ -16,9 +16,18 @@ class MpfrReal {
   // Precision of every MpfrReal, in bits.
   static constexpr mpfr_prec_t kPrecision = 400;
 
-  MpfrReal() { mpfr_init2(v_, kPrecision); mpfr_set_zero(v_, 1); }
-  MpfrReal(double x) { mpfr_init2(v_, kPrecision); mpfr_set_d(v_, x, MPFR_RNDN); }  // NOLINT: exact
-  MpfrReal(const MpfrReal& o) { mpfr_init2(v_, kPrecision); mpfr_set(v_, o.v_, MPFR_RNDN); }
+  MpfrReal() {
+    mpfr_init2(v_, kPrecision);
+    mpfr_set_zero(v_, 1);
+  }
+  MpfrReal(double x) {
+    mpfr_init2(v_, kPrecision);
+    mpfr_set_d(v_, x, MPFR_RNDN);
+  }  // NOLINT: exact
+  MpfrReal(const MpfrReal& o) {
+    mpfr_init2(v_, kPrecision);
+    mpfr_set(v_, o.v_, MPFR_RNDN);
+  }
   MpfrReal& operator=(const MpfrReal& o) {
     if (this != &o) mpfr_set(v_, o.v_, MPFR_RNDN);
     return *this;

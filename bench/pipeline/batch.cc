@@ -15,8 +15,7 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
     auto it = std::find(layout.encodings.begin(), layout.encodings.end(), cell.encoding());
     auto slot = static_cast<std::uint32_t>(it - layout.encodings.begin());
     if (it == layout.encodings.end()) layout.encodings.push_back(cell.encoding());
-    std::uint32_t convention_slot =
-        Info(cell.convention).hardware ? static_cast<std::uint32_t>(cell.convention) : 0u;
+    std::uint32_t convention_slot = Info(cell.convention).hardware ? static_cast<std::uint32_t>(cell.convention) : 0u;
     layout.cells.push_back({cell, slot, convention_slot});
   }
   return layout;

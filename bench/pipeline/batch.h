@@ -10,11 +10,11 @@
 
 #include <glm/glm.hpp>
 
-#include "bench/pipeline/cells.h"
+#include "bench/base/thread_pool.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/cells.h"
 #include "bench/pipeline/reference.h"
 #include "bench/pipeline/sampler.h"
-#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 
@@ -31,18 +31,16 @@ struct Batch {
 
   // Judge inputs, as arrays of components so that the judge reads them in
   // SIMD lanes.
-  std::vector<Frame> frames;                   // [frame]: exact parameters
-  std::vector<std::uint8_t> distance_bands;    // [frame]: DistanceBand of the camera
-  std::vector<double> ray_x, ray_y, ray_z;     // [sample]: world-space ray at unit eye depth
-  SampleArrays samples;                        // [sample]: the depth pick and what the reference needs
-  ReferenceArrays reference;                   // [depth slot * count + sample]
-  std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: stored texel bits
+  std::vector<Frame> frames;                 // [frame]: exact parameters
+  std::vector<std::uint8_t> distance_bands;  // [frame]: DistanceBand of the camera
+  std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
+  SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
+  ReferenceArrays reference;                 // [depth slot * count + sample]
+  std::vector<std::uint32_t> codes;          // [depth slot * count + sample]: stored texel bits
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 
-  std::uint32_t FrameOf(std::uint32_t sample) const {
-    return (sample + first_offset) / kSamplesPerFrame;
-  }
+  std::uint32_t FrameOf(std::uint32_t sample) const { return (sample + first_offset) / kSamplesPerFrame; }
   std::size_t frame_count() const { return frames.size(); }
 };
 

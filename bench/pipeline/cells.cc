@@ -35,7 +35,6 @@ std::string JoinNames(const Table& table, NameOf name_of) {
 
 }  // namespace
 
-
 bool Reads(Variant v, Convention c, Format f) {
   DepthInput input = Info(v).input;
   return Info(f).stores == input && Info(c).hardware == (input == DepthInput::kHardware);
@@ -70,16 +69,16 @@ Expected<Variant> ParseVariant(std::string_view name) {
   std::string key = Lower(name);
   for (const auto& v : kVariants)
     if (v.name == key) return v.id;
-  return InvalidArgument("unknown variant '" + std::string(name) + "'; allowed: " +
-                         JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }));
+  return InvalidArgument("unknown variant '" + std::string(name) +
+                         "'; allowed: " + JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }));
 }
 
 Expected<Convention> ParseConvention(std::string_view name) {
   std::string key = Lower(name);
   for (const auto& c : kConventions)
     if (c.name == key) return c.id;
-  return InvalidArgument("unknown convention '" + std::string(name) + "'; allowed: " +
-                         JoinNames(kConventions, [](const ConventionInfo& c) { return c.name; }));
+  return InvalidArgument("unknown convention '" + std::string(name) +
+                         "'; allowed: " + JoinNames(kConventions, [](const ConventionInfo& c) { return c.name; }));
 }
 
 Expected<Format> ParseFormat(std::string_view name) {
@@ -89,8 +88,8 @@ Expected<Format> ParseFormat(std::string_view name) {
   // VK_FORMAT_R32_SFLOAT names two of our formats; it means the linear one.
   for (const auto& f : kFormats)
     if (Lower(f.vulkan_name) == key) return f.id;
-  return InvalidArgument("unknown format '" + std::string(name) + "'; allowed: " +
-                         JoinNames(kFormats, [](const FormatInfo& f) {
+  return InvalidArgument("unknown format '" + std::string(name) +
+                         "'; allowed: " + JoinNames(kFormats, [](const FormatInfo& f) {
                            return std::string(f.name) + " (" + std::string(f.short_name) + ")";
                          }));
 }
@@ -99,17 +98,15 @@ Expected<Cell> ParseCell(std::string_view name) {
   auto first = name.find('/');
   auto second = first == std::string_view::npos ? first : name.find('/', first + 1);
   if (second == std::string_view::npos) {
-    return InvalidArgument("cell '" + std::string(name) +
-                           "' is not of the form variant/convention/format");
+    return InvalidArgument("cell '" + std::string(name) + "' is not of the form variant/convention/format");
   }
   DB_ASSIGN_OR_RETURN(Variant v, ParseVariant(name.substr(0, first)));
   DB_ASSIGN_OR_RETURN(Convention c, ParseConvention(name.substr(first + 1, second - first - 1)));
   DB_ASSIGN_OR_RETURN(Format f, ParseFormat(name.substr(second + 1)));
   if (!Reads(v, c, f)) {
-    return InvalidArgument("cell '" + std::string(name) + "' does not exist: " +
-                           std::string(Info(v).name) + " does not read " +
-                           std::string(Info(f).name) + " under the " +
-                           std::string(Info(c).name) + " convention");
+    return InvalidArgument("cell '" + std::string(name) + "' does not exist: " + std::string(Info(v).name) +
+                           " does not read " + std::string(Info(f).name) + " under the " + std::string(Info(c).name) +
+                           " convention");
   }
   return Cell{v, c, f};
 }
@@ -118,8 +115,7 @@ bool CellFilter::Keeps(const Cell& cell) const {
   auto keeps = [](const auto& list, auto value) {
     return list.empty() || std::find(list.begin(), list.end(), value) != list.end();
   };
-  return keeps(variants, cell.variant) && keeps(conventions, cell.convention) &&
-         keeps(formats, cell.format);
+  return keeps(variants, cell.variant) && keeps(conventions, cell.convention) && keeps(formats, cell.format);
 }
 
 }  // namespace depthbench

@@ -101,12 +101,10 @@ inline constexpr std::array<VariantInfo, kVariantCount> kVariants = {{
      "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside"},
     {Variant::kInverseVp, "inverse_vp", "002", DepthInput::kHardware,
      "inverse view-projection times (ndc, depth, 1), divide by w"},
-    {Variant::kDivide, "divide", "004", DepthInput::kHardware,
-     "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
+    {Variant::kDivide, "divide", "004", DepthInput::kHardware, "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
     {Variant::kReciprocal, "reciprocal", "004", DepthInput::kHardware,
      "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW"},
-    {Variant::kPq, "pq", "004", DepthInput::kHardware,
-     "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
+    {Variant::kPq, "pq", "004", DepthInput::kHardware, "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
 }};
 
 // The DB_CONVENTION_* bits of shared/params.h (cells.cc checks they agree).
@@ -115,36 +113,27 @@ inline constexpr std::uint32_t kRev = 1, kInf = 2, kGl = 4;
 inline constexpr std::array<ConventionInfo, kConventionCount> kConventions = {{
     {Convention::kStandard, "standard", 0, true, "near -> 0, far -> 1, clip depth [0,1]"},
     {Convention::kReversed, "reversed", kRev, true, "near -> 1, far -> 0, clip depth [0,1]"},
-    {Convention::kStandardInf, "standard-inf", kInf, true,
-     "near -> 0, infinite far -> 1, clip depth [0,1]"},
-    {Convention::kReversedInf, "reversed-inf", kRev | kInf, true,
-     "near -> 1, infinite far -> 0, clip depth [0,1]"},
+    {Convention::kStandardInf, "standard-inf", kInf, true, "near -> 0, infinite far -> 1, clip depth [0,1]"},
+    {Convention::kReversedInf, "reversed-inf", kRev | kInf, true, "near -> 1, infinite far -> 0, clip depth [0,1]"},
     {Convention::kStandardGl, "standard-gl", kGl, true, "near -> -1, far -> 1, clip depth [-1,1]"},
-    {Convention::kReversedGl, "reversed-gl", kRev | kGl, true,
-     "near -> 1, far -> -1, clip depth [-1,1]"},
+    {Convention::kReversedGl, "reversed-gl", kRev | kGl, true, "near -> 1, far -> -1, clip depth [-1,1]"},
     {Convention::kStandardInfGl, "standard-inf-gl", kInf | kGl, true,
      "near -> -1, infinite far -> 1, clip depth [-1,1]"},
     {Convention::kReversedInfGl, "reversed-inf-gl", kRev | kInf | kGl, true,
      "near -> 1, infinite far -> -1, clip depth [-1,1]"},
-    {Convention::kLinear, "linear", 0, false,
-     "no projective mapping: the stored value is linear in eye depth"},
+    {Convention::kLinear, "linear", 0, false, "no projective mapping: the stored value is linear in eye depth"},
 }};
 
 inline constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
-    {Format::kD16Unorm, "d16_unorm", "d16", "VK_FORMAT_D16_UNORM", DepthInput::kHardware,
-     TexelKind::kUnorm, 16},
-    {Format::kX8D24Unorm, "x8_d24_unorm", "d24", "VK_FORMAT_X8_D24_UNORM_PACK32",
-     DepthInput::kHardware, TexelKind::kUnorm, 24},
-    {Format::kD32Sfloat, "d32_sfloat", "d32f", "VK_FORMAT_D32_SFLOAT", DepthInput::kHardware,
+    {Format::kD16Unorm, "d16_unorm", "d16", "VK_FORMAT_D16_UNORM", DepthInput::kHardware, TexelKind::kUnorm, 16},
+    {Format::kX8D24Unorm, "x8_d24_unorm", "d24", "VK_FORMAT_X8_D24_UNORM_PACK32", DepthInput::kHardware,
+     TexelKind::kUnorm, 24},
+    {Format::kD32Sfloat, "d32_sfloat", "d32f", "VK_FORMAT_D32_SFLOAT", DepthInput::kHardware, TexelKind::kFloat32, 32},
+    {Format::kR32Sfloat, "r32_sfloat", "r32f", "VK_FORMAT_R32_SFLOAT", DepthInput::kLinear, TexelKind::kFloat32, 32},
+    {Format::kR16Sfloat, "r16_sfloat", "r16f", "VK_FORMAT_R16_SFLOAT", DepthInput::kLinear, TexelKind::kFloat16, 16},
+    {Format::kR16Unorm, "r16_unorm", "r16", "VK_FORMAT_R16_UNORM", DepthInput::kLinear, TexelKind::kUnorm, 16},
+    {Format::kR32SfloatViewZ, "r32_sfloat_viewz", "viewz", "VK_FORMAT_R32_SFLOAT", DepthInput::kViewZ,
      TexelKind::kFloat32, 32},
-    {Format::kR32Sfloat, "r32_sfloat", "r32f", "VK_FORMAT_R32_SFLOAT", DepthInput::kLinear,
-     TexelKind::kFloat32, 32},
-    {Format::kR16Sfloat, "r16_sfloat", "r16f", "VK_FORMAT_R16_SFLOAT", DepthInput::kLinear,
-     TexelKind::kFloat16, 16},
-    {Format::kR16Unorm, "r16_unorm", "r16", "VK_FORMAT_R16_UNORM", DepthInput::kLinear,
-     TexelKind::kUnorm, 16},
-    {Format::kR32SfloatViewZ, "r32_sfloat_viewz", "viewz", "VK_FORMAT_R32_SFLOAT",
-     DepthInput::kViewZ, TexelKind::kFloat32, 32},
 }};
 }  // namespace catalog
 
@@ -186,7 +175,7 @@ std::vector<Encoding> AllEncodings();
 Expected<Variant> ParseVariant(std::string_view name);
 Expected<Convention> ParseConvention(std::string_view name);
 Expected<Format> ParseFormat(std::string_view name);  // canonical, short or VK_FORMAT_ name
-Expected<Cell> ParseCell(std::string_view name);       // "variant/convention/format"
+Expected<Cell> ParseCell(std::string_view name);      // "variant/convention/format"
 
 // Which cells a filter keeps: empty lists keep everything.
 struct CellFilter {

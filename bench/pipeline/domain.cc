@@ -31,16 +31,13 @@ Expected<double> ParseNumber(std::string_view text, std::string_view what) {
 }
 
 std::string DescribeLimits(const RangeLimits& limits) {
-  return fmt::format("{}{:g}, {:g}{}{}{}", limits.lowest_exclusive ? "(" : "[", limits.lowest,
-                     limits.highest, limits.highest_exclusive ? ")" : "]",
-                     limits.unit.empty() ? "" : " ", limits.unit);
+  return fmt::format("{}{:g}, {:g}{}{}{}", limits.lowest_exclusive ? "(" : "[", limits.lowest, limits.highest,
+                     limits.highest_exclusive ? ")" : "]", limits.unit.empty() ? "" : " ", limits.unit);
 }
 
 }  // namespace
 
-std::string Range::ToString() const {
-  return fixed() ? fmt::format("{:g}", min) : fmt::format("{:g}:{:g}", min, max);
-}
+std::string Range::ToString() const { return fixed() ? fmt::format("{:g}", min) : fmt::format("{:g}:{:g}", min, max); }
 
 Status CheckRange(const Range& range, std::string_view what, const RangeLimits& limits) {
   auto outside = [&](double x) {
@@ -48,12 +45,11 @@ Status CheckRange(const Range& range, std::string_view what, const RangeLimits& 
            (limits.highest_exclusive ? x >= limits.highest : x > limits.highest);
   };
   if (range.min > range.max) {
-    return InvalidArgument(
-        fmt::format("{}: minimum {:g} is above maximum {:g}", what, range.min, range.max));
+    return InvalidArgument(fmt::format("{}: minimum {:g} is above maximum {:g}", what, range.min, range.max));
   }
   if (outside(range.min) || outside(range.max)) {
-    return InvalidArgument(fmt::format("{}: {} is out of range; allowed {}", what,
-                                       range.ToString(), DescribeLimits(limits)));
+    return InvalidArgument(
+        fmt::format("{}: {} is out of range; allowed {}", what, range.ToString(), DescribeLimits(limits)));
   }
   return Status::Ok();
 }
@@ -85,8 +81,8 @@ Status ParseRatioInto(std::string_view text, Domain& domain) {
   if (comma != std::string_view::npos) {
     std::string_view rest = text.substr(comma + 1);
     if (rest != "inf" && rest != "infinite") {
-      return InvalidArgument(fmt::format(
-          "--ratio: '{}' is not understood; use VALUE, MIN:MAX, inf, or MIN:MAX,inf", text));
+      return InvalidArgument(
+          fmt::format("--ratio: '{}' is not understood; use VALUE, MIN:MAX, inf, or MIN:MAX,inf", text));
     }
     infinite = true;
     finite_part = text.substr(0, comma);
@@ -110,9 +106,8 @@ Status Domain::Validate() const {
     if (far) {
       DB_RETURN_IF_ERROR(CheckRange(*far, "far", kFarLimits));
       if (far->min <= near.max) {
-        return InvalidArgument(fmt::format(
-            "far must be greater than near: far {} does not exceed near {} everywhere",
-            far->ToString(), near.ToString()));
+        return InvalidArgument(fmt::format("far must be greater than near: far {} does not exceed near {} everywhere",
+                                           far->ToString(), near.ToString()));
       }
     } else {
       DB_RETURN_IF_ERROR(CheckRange(ratio, "ratio", kRatioLimits));
@@ -123,17 +118,14 @@ Status Domain::Validate() const {
   for (const auto& r : resolutions) {
     if (r.width == 0 || r.height == 0 || r.width > 65535 || r.height > 65535) {
       return InvalidArgument(
-          fmt::format("resolution {}x{} is out of range; allowed 1 to 65535 pixels a side",
-                      r.width, r.height));
+          fmt::format("resolution {}x{} is out of range; allowed 1 to 65535 pixels a side", r.width, r.height));
     }
   }
   return Status::Ok();
 }
 
 std::string Domain::ToFlags() const {
-  auto range = [](const Range& r) {
-    return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max);
-  };
+  auto range = [](const Range& r) { return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max); };
   std::string flags = fmt::format("--fov {} --aspect {} --near {}", range(fov_degrees), range(aspect), range(near));
   if (!finite_far) {
     flags += " --ratio inf";
@@ -158,9 +150,8 @@ std::string Domain::Describe() const {
   } else {
     far_text = "infinite far";
   }
-  std::string text = fmt::format("fov {} deg, aspect {}, near {}, {}, camera distance {}",
-                                 fov_degrees.ToString(), aspect.ToString(), near.ToString(),
-                                 far_text, camera_distance.ToString());
+  std::string text = fmt::format("fov {} deg, aspect {}, near {}, {}, camera distance {}", fov_degrees.ToString(),
+                                 aspect.ToString(), near.ToString(), far_text, camera_distance.ToString());
   if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
   return text;
 }

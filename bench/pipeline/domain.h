@@ -52,14 +52,13 @@ struct Domain {
   Range ratio{10.0, 1e8};
   bool finite_far = true;
   bool infinite_far = true;
-  std::optional<Range> far;       // absolute far plane; the ratio then follows from near
+  std::optional<Range> far;  // absolute far plane; the ratio then follows from near
   // Camera distance from the world origin. With min 0 and max > 0, a quarter
   // of the frames sit exactly at the origin and the rest are log-uniform in
   // [max * 1e-6, max]; otherwise log-uniform in [min, max] (or fixed).
   Range camera_distance{0.0, 1e6};
   std::optional<Range> eye_depth;  // absolute eye-depth range of interest (clipped to the frustum)
-  std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160},
-                                      {1366, 768}, {800, 600}};
+  std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}, {1366, 768}, {800, 600}};
 
   // Far/near span used by frames whose far plane is infinite only.
   static constexpr double kInfiniteDepthSpan = 1e8;

@@ -85,19 +85,20 @@ Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, 
     case DepthInput::kHardware: {
       const DoubleDouble4 window = hp4::window_depth_from_eye_depth(wide(n), wide(f), bits, wide(depth));
       if ((bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) {
-        return RoundToFloat4(window, lanes, [&](int k, DoubleDouble x) { return SettleLane(x, [&] { return exact_window(k); }); });
+        return RoundToFloat4(window, lanes,
+                             [&](int k, DoubleDouble x) { return SettleLane(x, [&] { return exact_window(k); }); });
       }
-      const Float4 ndc = RoundToFloat4(window * DoubleDouble4(2.0) - DoubleDouble4(1.0), lanes, [&](int k, DoubleDouble x) {
-        return SettleLane(x, [&] { return exact_window(k) * mp::real(2.0) - mp::real(1.0); });
-      });
+      const Float4 ndc =
+          RoundToFloat4(window * DoubleDouble4(2.0) - DoubleDouble4(1.0), lanes, [&](int k, DoubleDouble x) {
+            return SettleLane(x, [&] { return exact_window(k) * mp::real(2.0) - mp::real(1.0); });
+          });
       return __builtin_convertvector(0.5 * __builtin_convertvector(ndc, Double4) + 0.5, Float4);
     }
     case DepthInput::kLinear:
       return RoundToFloat4(wide(depth) / wide(f), lanes, [&](int k, DoubleDouble x) {
         return SettleLane(x, [&] { return mp::real(z[k]) / mp::real(far[k]); });
       });
-    case DepthInput::kViewZ:
-      return __builtin_convertvector(-depth, Float4);
+    case DepthInput::kViewZ: return __builtin_convertvector(-depth, Float4);
   }
   return Float4{};
 }
@@ -106,8 +107,8 @@ Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, 
 
 EncodeFallbacks EncodeFallbackCounts() { return {tie_fallbacks.load(), mpfr_fallbacks.load()}; }
 
-void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth,
-                    std::size_t n, float* out) {
+void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth, std::size_t n,
+                    float* out) {
   for (std::size_t i = 0; i < n; i += 4) {
     double lanes[3][4];
     for (std::size_t k = 0; k < 4; ++k) {
@@ -116,7 +117,8 @@ void PipelineFloats(Encoding encoding, const double* near, const double* far, co
       lanes[1][k] = far[at];
       lanes[2][k] = eye_depth[at];
     }
-    const Float4 f = PipelineFloat4(encoding, lanes[0], lanes[1], lanes[2], static_cast<int>(std::min<std::size_t>(4, n - i)));
+    const Float4 f =
+        PipelineFloat4(encoding, lanes[0], lanes[1], lanes[2], static_cast<int>(std::min<std::size_t>(4, n - i)));
     for (std::size_t k = 0; k < 4 && i + k < n; ++k) out[i + k] = f[k];
   }
 }
@@ -138,7 +140,7 @@ std::uint16_t FloatToHalf(float value) {
   double v = std::fabs(static_cast<double>(value));
   if (std::isnan(value)) return 0x7e00;
   if (v >= 65520.0) return sign | 0x7c00;  // rounds to infinity
-  if (v < 0x1p-14) {                        // subnormal half: multiples of 2^-24
+  if (v < 0x1p-14) {                       // subnormal half: multiples of 2^-24
     return sign | static_cast<std::uint16_t>(std::nearbyint(v * 0x1p24));
   }
   int exponent;
@@ -168,12 +170,9 @@ float HalfToFloat(std::uint16_t half) {
 float FetchTexel(Format format, std::uint32_t code) {
   const FormatInfo& info = Info(format);
   switch (info.texel) {
-    case TexelKind::kFloat32:
-      return std::bit_cast<float>(code);
-    case TexelKind::kFloat16:
-      return HalfToFloat(static_cast<std::uint16_t>(code));
-    case TexelKind::kUnorm:
-      break;
+    case TexelKind::kFloat32: return std::bit_cast<float>(code);
+    case TexelKind::kFloat16: return HalfToFloat(static_cast<std::uint16_t>(code));
+    case TexelKind::kUnorm: break;
   }
   // code / (2^b - 1) rounded to double and then to float is correctly
   // rounded for b <= 24: the exact quotient's binary expansion repeats with
@@ -301,22 +300,20 @@ namespace {
   switch (info.stores) {
     case DepthInput::kHardware:
       return hp4::eye_depth_from_window_depth(near, far, Info(encoding.convention).bits, value, complement);
-    case DepthInput::kLinear:
-      return value * far;
-    case DepthInput::kViewZ:
-      return -value;
+    case DepthInput::kLinear: return value * far;
+    case DepthInput::kViewZ: return -value;
   }
   return DD(NAN);
 }
 
 [[gnu::always_inline]] inline void DecodeEyeDepthsBody(Encoding encoding, const double* near, const double* far,
-                                                       const std::uint32_t* codes, const float* fetched,
-                                                       std::size_t n, double* hi, double* lo) {
+                                                       const std::uint32_t* codes, const float* fetched, std::size_t n,
+                                                       double* hi, double* lo) {
   const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
   // Two groups of four per step: their dependency chains interleave.
   constexpr std::size_t kStep = 8;
-  const auto decode = [&](const Double4 (&n4)[2], const Double4 (&f4)[2], const Double4 (&texel)[2])
-                          __attribute__((always_inline)) {
+  const auto decode = [&](const Double4(&n4)[2], const Double4(&f4)[2], const Double4(&texel)[2])
+      __attribute__((always_inline)) {
     std::array<DoubleDouble4, 2> z;
     for (int g = 0; g < 2; ++g) {
       z[g] = DecodeTexel(encoding, DoubleDouble4::FromParts(n4[g], Double4{}),
@@ -370,9 +367,9 @@ namespace {
 
 void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
                      const float* fetched, std::size_t n, double* hi, double* lo, Isa isa) {
-  RunWith(isa, [&](auto) __attribute__((always_inline)) {
-    DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo);
-  });
+  RunWith(
+      isa, [&](auto)
+               __attribute__((always_inline)) { DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo); });
 }
 
 DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored) {

@@ -21,9 +21,9 @@
 
 #include <cstdint>
 
-#include "bench/pipeline/cells.h"
-#include "bench/numerics/double_double.h"
 #include "bench/base/isa.h"
+#include "bench/numerics/double_double.h"
+#include "bench/pipeline/cells.h"
 #include "bench/pipeline/sampler.h"
 
 namespace depthbench {
@@ -39,8 +39,8 @@ struct StoredDepth {
 float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth);
 // The same for n samples, four lanes at a time (far is 0 for an infinite
 // far plane); every lane computes exactly what the scalar form does.
-void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth,
-                    std::size_t n, float* out);
+void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth, std::size_t n,
+                    float* out);
 // Step 3 and the fetch, for one value and for n.
 StoredDepth StoreFloat(Format format, float value);
 void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_t* codes, float* fetched);
@@ -65,7 +65,7 @@ void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, c
 // Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);
 std::uint32_t FloatToUnorm(float value, int bits);  // clamps to [0, 1] first
-std::uint16_t FloatToHalf(float value);              // round to nearest even
+std::uint16_t FloatToHalf(float value);             // round to nearest even
 float HalfToFloat(std::uint16_t half);
 
 // How often a value fell exactly on a tie between two floats, and how often

@@ -18,9 +18,9 @@ struct ErrorLanes {
   Real total_sq, arith_sq, absolute_sq;
 };
 template <class Real>
-[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera,
-                                                      Real ray_x, Real ray_y, Real ray_z, Real true_depth,
-                                                      Real denoted_depth, Real inverse_distance_sq) {
+[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera, Real ray_x,
+                                                      Real ray_y, Real ray_z, Real true_depth, Real denoted_depth,
+                                                      Real inverse_distance_sq) {
   const Real qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
   const Real tx = qx - true_depth * ray_x, ty = qy - true_depth * ray_y, tz = qz - true_depth * ray_z;
   const Real ax = qx - denoted_depth * ray_x, ay = qy - denoted_depth * ray_y, az = qz - denoted_depth * ray_z;
@@ -47,7 +47,7 @@ constexpr int kAbsolute = static_cast<int>(Metric::kAbsolute);
 
 // Where one run of samples lives in the batch's arrays.
 struct RunInputs {
-  const float *x, *y, *z;                 // the cell's output components
+  const float *x, *y, *z;  // the cell's output components
   const double *ray_x, *ray_y, *ray_z;
   const double *true_depth, *denoted_depth, *inverse_distance_sq;
   const std::uint8_t* joint_band;
@@ -88,9 +88,9 @@ template <int N>
     store(&s.absolute_bin[i], bins(e.absolute_sq, kAbsolute));
   }
   for (; i < n; ++i) {  // the tail of a batch that ends inside a frame
-    const ErrorLanes<double> e = Errors<double>(in.x[i], in.y[i], in.z[i], camera, in.ray_x[i], in.ray_y[i],
-                                                in.ray_z[i], in.true_depth[i], in.denoted_depth[i],
-                                                in.inverse_distance_sq[i]);
+    const ErrorLanes<double> e =
+        Errors<double>(in.x[i], in.y[i], in.z[i], camera, in.ray_x[i], in.ray_y[i], in.ray_z[i], in.true_depth[i],
+                       in.denoted_depth[i], in.inverse_distance_sq[i]);
     s.total[i] = e.total_sq;
     s.arith[i] = e.arith_sq;
     s.absolute[i] = e.absolute_sq;
@@ -142,8 +142,7 @@ template <class Run>
 [[gnu::always_inline]] inline void ForEachFrameRun(const Batch& batch, Run run) {
   for (std::uint32_t begin = 0; begin < batch.count;) {
     const std::uint32_t frame = batch.FrameOf(begin);
-    const std::uint32_t end =
-        std::min<std::uint32_t>(batch.count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
+    const std::uint32_t end = std::min<std::uint32_t>(batch.count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
     run(frame, begin, end);
     begin = end;
   }
@@ -169,22 +168,29 @@ template <int N>
   RunScratch scratch;
   // Frame by frame: a frame's reference stays in cache while every cell
   // reads it.
-  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end)
-                             __attribute__((always_inline)) {
-    const std::uint32_t n = end - begin;
-    const glm::dvec3 camera = batch.frames[frame].camera_position;
-    const std::size_t at = offset + begin;
-    for (const JudgedCell& cell : cells) {
-      const float* p = cell.positions.data();
-      const RunInputs in{p + begin, p + count + begin, p + 2 * std::size_t{count} + begin,
-                         batch.ray_x.data() + begin, batch.ray_y.data() + begin, batch.ray_z.data() + begin,
-                         ref.true_depth.data() + at, ref.denoted_depth.data() + at,
-                         ref.inverse_distance_sq.data() + at, ref.joint_band.data() + at, ref.status.data() + at};
-      Measure<N>(in, camera, n, scratch);
-      Record(in.status, in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
-             cell.accumulator->Distance(batch.distance_bands[frame]));
-    }
-  });
+  ForEachFrameRun(
+      batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
+        const std::uint32_t n = end - begin;
+        const glm::dvec3 camera = batch.frames[frame].camera_position;
+        const std::size_t at = offset + begin;
+        for (const JudgedCell& cell : cells) {
+          const float* p = cell.positions.data();
+          const RunInputs in{p + begin,
+                             p + count + begin,
+                             p + 2 * std::size_t{count} + begin,
+                             batch.ray_x.data() + begin,
+                             batch.ray_y.data() + begin,
+                             batch.ray_z.data() + begin,
+                             ref.true_depth.data() + at,
+                             ref.denoted_depth.data() + at,
+                             ref.inverse_distance_sq.data() + at,
+                             ref.joint_band.data() + at,
+                             ref.status.data() + at};
+          Measure<N>(in, camera, n, scratch);
+          Record(in.status, in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
+                 cell.accumulator->Distance(batch.distance_bands[frame]));
+        }
+      });
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 
@@ -197,41 +203,42 @@ template <int N>
   const double* storage = batch.reference.storage_square.data() + offset;
   constexpr int kStorage = static_cast<int>(Metric::kStorage);
   std::array<std::int64_t, kMaxRun> bins;
-  ForEachFrameRun(batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end)
-                             __attribute__((always_inline)) {
-    // The bins N at a time (as the judge's Measure does), then the counts.
-    std::uint32_t i = begin;
-    for (; i + N <= end; i += N) {
-      typename Lanes<N>::Double squares;
-      std::memcpy(&squares, storage + i, sizeof(squares));
-      const auto lanes = DenseBinsOfSquares<typename Lanes<N>::Int>(squares, kLowestOctave[kStorage]);
-      std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
-    }
-    for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
-    CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
-    for (i = begin; i < end; ++i) {
-      if (status[i] != ReferenceStatus::kJudged) continue;
-      const std::uint64_t index = batch.first_index + i;
-      const int bin = static_cast<int>(bins[i - begin]);
-      accumulator.Joint(joint_band[i]).Record(Metric::kStorage, bin, storage[i], index);
-      distance.Record(Metric::kStorage, bin, storage[i], index);
-    }
-  });
+  ForEachFrameRun(
+      batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
+        // The bins N at a time (as the judge's Measure does), then the counts.
+        std::uint32_t i = begin;
+        for (; i + N <= end; i += N) {
+          typename Lanes<N>::Double squares;
+          std::memcpy(&squares, storage + i, sizeof(squares));
+          const auto lanes = DenseBinsOfSquares<typename Lanes<N>::Int>(squares, kLowestOctave[kStorage]);
+          std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
+        }
+        for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
+        CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
+        for (i = begin; i < end; ++i) {
+          if (status[i] != ReferenceStatus::kJudged) continue;
+          const std::uint64_t index = batch.first_index + i;
+          const int bin = static_cast<int>(bins[i - begin]);
+          accumulator.Joint(joint_band[i]).Record(Metric::kStorage, bin, storage[i], index);
+          distance.Record(Metric::kStorage, bin, storage[i], index);
+        }
+      });
   accumulator.Count(batch.count);
 }
 
 }  // namespace
 
 void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa) {
-  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
-    JudgeSlotBody<decltype(lanes)::value>(batch, depth_slot, cells);
-  });
+  RunWith(
+      isa, [&](auto lanes)
+               __attribute__((always_inline)) { JudgeSlotBody<decltype(lanes)::value>(batch, depth_slot, cells); });
 }
 
 void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
-  RunWith(isa, [&](auto lanes) __attribute__((always_inline)) {
-    RecordStorageBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
-  });
+  RunWith(
+      isa, [&](auto lanes) __attribute__((always_inline)) {
+        RecordStorageBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
+      });
 }
 
 }  // namespace depthbench

@@ -6,8 +6,8 @@
 #include <span>
 #include <vector>
 
-#include "bench/pipeline/batch.h"
 #include "bench/base/isa.h"
+#include "bench/pipeline/batch.h"
 #include "bench/pipeline/stats.h"
 
 namespace depthbench {
@@ -23,12 +23,10 @@ struct JudgedCell {
 // the slot's reference, read once). Records total, arithmetic and absolute
 // errors; storage errors belong to the encoding (RecordStorage). `isa` must
 // be one the processor runs.
-void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells,
-               Isa isa = Isa::kWidest);
+void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa = Isa::kWidest);
 
 // Records the storage error of one depth slot's samples.
-void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator,
-                   Isa isa = Isa::kWidest);
+void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa = Isa::kWidest);
 
 // The squared errors of one output (for reproducers and tests): relative
 // total, relative arithmetic, absolute total.

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "bench/pipeline/bands.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/bands.h"
 
 namespace depthbench {
 namespace {
@@ -30,8 +30,8 @@ ReferenceSample ReferenceArrays::Get(std::size_t at) const {
 
 void SampleArrays::Resize(std::size_t n) {
   pick.resize(n);
-  for (auto* v : {&eye_depth, &near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq,
-                  &inverse_distance_sq}) {
+  for (auto* v :
+       {&eye_depth, &near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq, &inverse_distance_sq}) {
     v->resize(n);
   }
   depth_band.resize(n);
@@ -81,10 +81,10 @@ struct ReferenceLanes {
   I status;  // ReferenceStatus
 };
 template <class D, class I>
-[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi,
-                                                                D denoted_lo, D near, D depth_limit,
-                                                                D interest_min, D interest_max, D ray_length_sq,
-                                                                D eye_inverse_distance_sq, bool infinite_far) {
+[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo,
+                                                               D near, D depth_limit, D interest_min, D interest_max,
+                                                               D ray_length_sq, D eye_inverse_distance_sq,
+                                                               bool infinite_far) {
   using DD = BasicDoubleDouble<D>;
   const auto eye = eye_pick != 0.0;
   // Stored-value picks have no scene point of their own: the truth is what
@@ -101,7 +101,7 @@ template <class D, class I>
   // infinity.
   const auto holdable = (t > 0.0) & (t * t * ray_length_sq < kLargestFloatSquared);
   const D limit = infinite_far ? zero + INFINITY : depth_limit;
-  const D far = interest_max < limit ? interest_max : limit;     // std::min(limit, interest_max)
+  const D far = interest_max < limit ? interest_max : limit;    // std::min(limit, interest_max)
   const D nearest = near < interest_min ? interest_min : near;  // std::max(near, interest_min)
   const auto outside = (t < nearest * (1.0 - kPlaneSlack)) | (t > far * (1.0 + kPlaneSlack));
   const I judged = I{} + static_cast<std::int64_t>(ReferenceStatus::kJudged);
@@ -128,8 +128,7 @@ template <class D, class I>
   // changes to the vectors' own pointers.
   const DepthPick* pick = samples.pick.data() + first;
   const double *eye_depth = samples.eye_depth.data() + first, *near = samples.near.data() + first,
-               *depth_limit = samples.depth_limit.data() + first,
-               *interest_min = samples.interest_min.data() + first,
+               *depth_limit = samples.depth_limit.data() + first, *interest_min = samples.interest_min.data() + first,
                *interest_max = samples.interest_max.data() + first,
                *ray_length_sq = samples.ray_length_sq.data() + first,
                *eye_inverse_distance_sq = samples.inverse_distance_sq.data() + first;
@@ -180,9 +179,10 @@ template <class D, class I>
 void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
                 const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
                 Isa isa) {
-  RunWith(isa, [&](auto) __attribute__((always_inline)) {
-    ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
-  });
+  RunWith(
+      isa, [&](auto) __attribute__((always_inline)) {
+        ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
+      });
 }
 
 }  // namespace depthbench

@@ -18,9 +18,9 @@
 
 #include <glm/glm.hpp>
 
-#include "bench/pipeline/cells.h"
-#include "bench/numerics/double_double.h"
 #include "bench/base/isa.h"
+#include "bench/numerics/double_double.h"
+#include "bench/pipeline/cells.h"
 #include "bench/pipeline/sampler.h"
 
 namespace depthbench {
@@ -36,8 +36,8 @@ enum class ReferenceStatus : std::uint8_t {
 
 // The reference of one (encoding, sample).
 struct ReferenceSample {
-  double true_depth = 0.0;     // eye depth of the true point
-  double denoted_depth = 0.0;  // eye depth the stored value denotes (DBL_MAX for infinity)
+  double true_depth = 0.0;           // eye depth of the true point
+  double denoted_depth = 0.0;        // eye depth the stored value denotes (DBL_MAX for infinity)
   double inverse_distance_sq = 0.0;  // 1 / |true point - camera|^2 (0 unless judged)
   std::uint8_t joint_band = 0;
   ReferenceStatus status = ReferenceStatus::kDegenerate;
@@ -57,14 +57,14 @@ struct ReferenceArrays {
 // What the reference needs of each sample, whatever the encoding.
 struct SampleArrays {
   std::vector<DepthPick> pick;
-  std::vector<double> eye_depth;            // for eye-depth picks (near for the others)
-  std::vector<double> near, far;            // the frame's planes (far 0 when infinite)
-  std::vector<double> depth_limit;          // the frame's largest eye depth
+  std::vector<double> eye_depth;                   // for eye-depth picks (near for the others)
+  std::vector<double> near, far;                   // the frame's planes (far 0 when infinite)
+  std::vector<double> depth_limit;                 // the frame's largest eye depth
   std::vector<double> interest_min, interest_max;  // eye depths the domain is about (near..inf when unrestricted)
-  std::vector<double> ray_length_sq;        // |PixelRay|^2
-  std::vector<double> inverse_distance_sq;  // 1 / (eye depth * |ray|)^2, for eye-depth picks
-  std::vector<std::uint8_t> depth_band;     // of the eye depth, for eye-depth picks
-  std::vector<std::uint8_t> ratio_band;     // the frame's far/near band
+  std::vector<double> ray_length_sq;               // |PixelRay|^2
+  std::vector<double> inverse_distance_sq;         // 1 / (eye depth * |ray|)^2, for eye-depth picks
+  std::vector<std::uint8_t> depth_band;            // of the eye depth, for eye-depth picks
+  std::vector<std::uint8_t> ratio_band;            // the frame's far/near band
 
   void Resize(std::size_t n);
   // Fills entry i for a sample of `frame` whose ray is `ray`.

@@ -23,7 +23,7 @@ enum Stream : std::uint32_t {
   kFrameAspect = 1002,
   kFrameNear = 1004,
   kFrameFar = 1006,
-  kFrameRotation = 1008,  // three uniforms: 1008..1013
+  kFrameRotation = 1008,   // three uniforms: 1008..1013
   kFrameDirection = 1014,  // two uniforms: 1014..1017
   kFrameDistance = 1018,   // and 1020 (origin or not)
   kFrameResolution = 1022,
@@ -153,8 +153,8 @@ Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_i
     f.camera_position[k] = RoundToFloat32(direction[k] * distance);
   }
 
-  const std::size_t pick = std::min(d.resolutions.size() - 1,
-                                    static_cast<std::size_t>(std::floor(u.resolution * d.resolutions.size())));
+  const std::size_t pick =
+      std::min(d.resolutions.size() - 1, static_cast<std::size_t>(std::floor(u.resolution * d.resolutions.size())));
   f.width = d.resolutions[pick].width;
   f.height = d.resolutions[pick].height;
   f.volume_depth = LogUniform(u.volume, f.near, f.depth_limit);
@@ -170,8 +170,8 @@ PixelSample SampleFromUnits(const SampleUnits& u, const Frame& frame, std::uint6
   const double pick = u.pick;
   const double lo = frame.eye_depth_min, hi = frame.eye_depth_max;
   if (pick < 0.05) {
-    static constexpr DepthPick kEdges[4] = {DepthPick::kStoredZero, DepthPick::kStoredOne,
-                                            DepthPick::kStoredAfterZero, DepthPick::kStoredBeforeOne};
+    static constexpr DepthPick kEdges[4] = {DepthPick::kStoredZero, DepthPick::kStoredOne, DepthPick::kStoredAfterZero,
+                                            DepthPick::kStoredBeforeOne};
     s.pick = kEdges[std::min(3, static_cast<int>(pick / 0.05 * 4.0))];
   } else if (pick < 0.15) {  // near band: the first doubling of depth
     s.eye_depth = std::min(hi, lo * std::exp2(u.depth));

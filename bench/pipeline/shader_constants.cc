@@ -29,9 +29,7 @@ void ScreenAttribute(At at, hp::vec4& origin, hp::vec4& du, hp::vec4& dv) {
 
 float Round(DD x) { return RoundToFloat(x); }
 glm::vec4 Round(const hp::vec4& v) { return {Round(v.x), Round(v.y), Round(v.z), Round(v.w)}; }
-glm::mat4 Round(const hp::mat4& m) {
-  return glm::mat4(Round(m[0]), Round(m[1]), Round(m[2]), Round(m[3]));
-}
+glm::mat4 Round(const hp::mat4& m) { return glm::mat4(Round(m[0]), Round(m[1]), Round(m[2]), Round(m[3])); }
 
 }  // namespace
 
@@ -49,30 +47,26 @@ hp::FrameParams BuildFrameParams(const Frame& frame) {
   p.camera_world[3] = hp::vec4(DD(c.x), DD(c.y), DD(c.z), DD(1.0));
   p.camera_position = hp::vec4(DD(c.x), DD(c.y), DD(c.z), far);
   p.lens = hp::vec4(tan_x, tan_y, DD(1.0) / tan_x, DD(1.0) / tan_y);
-  p.resolution = hp::vec4(DD(frame.width), DD(frame.height), DD(1.0) / DD(frame.width),
-                          DD(1.0) / DD(frame.height));
+  p.resolution = hp::vec4(DD(frame.width), DD(frame.height), DD(1.0) / DD(frame.width), DD(1.0) / DD(frame.height));
 
   // View-space point of the pixel ray at eye depth `depth`.
   auto view_at = [&](DD depth) {
-    return [=](DD ndc_x, DD ndc_y) {
-      return hp::vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth);
-    };
+    return [=](DD ndc_x, DD ndc_y) { return hp::vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth); };
   };
   // Seed 000: far-plane corners rotated to world space.
-  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin,
-                  p.frustum_ray_du, p.frustum_ray_dv);
+  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin, p.frustum_ray_du,
+                  p.frustum_ray_dv);
   // Seed 000, light volume: the surface's view-space position.
   ScreenAttribute(view_at(DD(frame.volume_depth)), p.volume_position_origin, p.volume_position_du,
                   p.volume_position_dv);
   // Seed 003: the eye ray at w = 1 in view space and rotated to world space.
   ScreenAttribute(view_at(DD(1.0)), p.eye_ray_view_origin, p.eye_ray_view_du, p.eye_ray_view_dv);
-  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(DD(1.0))(x, y)); },
-                  p.eye_ray_world_origin, p.eye_ray_world_du, p.eye_ray_world_dv);
+  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(DD(1.0))(x, y)); }, p.eye_ray_world_origin,
+                  p.eye_ray_world_du, p.eye_ray_world_dv);
   return p;
 }
 
-hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f,
-                                 Convention convention) {
+hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
   const ConventionInfo& info = Info(convention);
   const DD near(frame.near);
   const DD far = frame.finite() ? DD(frame.far) : DD(0.0);

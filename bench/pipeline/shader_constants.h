@@ -5,8 +5,8 @@
 // itself, not of a sloppy host-side matrix inverse.
 #pragma once
 
-#include "bench/pipeline/cells.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/cells.h"
 #include "bench/pipeline/sampler.h"
 
 namespace depthbench {
@@ -14,8 +14,7 @@ namespace depthbench {
 hp::FrameParams BuildFrameParams(const Frame& frame);
 // Only for the projective conventions (Info(c).hardware); `frame_params` is
 // BuildFrameParams(frame).
-hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& frame_params,
-                                 Convention convention);
+hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& frame_params, Convention convention);
 
 f32::FrameParams RoundToFloat(const hp::FrameParams& params);
 f32::DepthParams RoundToFloat(const hp::DepthParams& params);

@@ -32,8 +32,7 @@ std::string DepthBandName(int band) {
 }
 std::string DistanceBandName(int band) {
   if (band == 0) return "<1";
-  return band == kDistanceBands - 1 ? fmt::format("1e{}+", 2 * band - 2)
-                                    : fmt::format("1e{}", 2 * band - 2);
+  return band == kDistanceBands - 1 ? fmt::format("1e{}+", 2 * band - 2) : fmt::format("1e{}", 2 * band - 2);
 }
 double RatioBandLow(int band) { return band == kInfiniteRatioBand ? INFINITY : std::pow(10.0, band); }
 double DepthBandLow(int band) { return std::pow(10.0, band); }

@@ -27,9 +27,9 @@
 #include <string>
 #include <vector>
 
-#include "bench/pipeline/bands.h"
 #include "bench/base/simd.h"
 #include "bench/base/status.h"
+#include "bench/pipeline/bands.h"
 
 namespace depthbench {
 

@@ -92,11 +92,11 @@ class Statement {
   std::int64_t Int(int c) const { return sqlite3_column_int64(stmt_, c); }
   double Real(int c) const {
     return sqlite3_column_type(stmt_, c) == SQLITE_NULL ? std::numeric_limits<double>::quiet_NaN()
-                                                         : sqlite3_column_double(stmt_, c);
+                                                        : sqlite3_column_double(stmt_, c);
   }
   std::uint64_t Index(int c) const {
     return sqlite3_column_type(stmt_, c) == SQLITE_NULL ? kNoIndex
-                                                         : static_cast<std::uint64_t>(sqlite3_column_int64(stmt_, c));
+                                                        : static_cast<std::uint64_t>(sqlite3_column_int64(stmt_, c));
   }
 
  private:
@@ -124,9 +124,10 @@ Expected<History> History::Open(const std::filesystem::path& path) {
   History history(db, path);
   sqlite3_busy_timeout(db, 10000);  // two reports at once: the second waits for the first's write
   // Reading the header fails here when the file is not SQLite at all.
-  Statement probe(db, "SELECT (SELECT application_id FROM pragma_application_id),"
-                      " (SELECT user_version FROM pragma_user_version),"
-                      " (SELECT count(*) FROM sqlite_schema)");
+  Statement probe(db,
+                  "SELECT (SELECT application_id FROM pragma_application_id),"
+                  " (SELECT user_version FROM pragma_user_version),"
+                  " (SELECT count(*) FROM sqlite_schema)");
   if (!probe.ok() || probe.Step() != SQLITE_ROW) {
     return DbError(db, path, "not a SQLite database (give --history another file)");
   }
@@ -141,8 +142,8 @@ Expected<History> History::Open(const std::filesystem::path& path) {
     return InvalidArgument(fmt::format(
         "{}: a SQLite database, but not a depthbench history (give --history another file)", path.string()));
   } else if (version != kSchemaVersion) {
-    return InvalidArgument(fmt::format("{}: history schema version {}; this depthbench reads version {}",
-                                       path.string(), version, kSchemaVersion));
+    return InvalidArgument(fmt::format("{}: history schema version {}; this depthbench reads version {}", path.string(),
+                                       version, kSchemaVersion));
   }
   return history;
 }
@@ -178,8 +179,7 @@ Expected<std::int64_t> History::Record(HistoryRun run, std::span<const Baseline>
     (void)Exec("ROLLBACK");  // the first error is the one to report
     return error;
   };
-  Statement insert_run(db_,
-                       "INSERT INTO runs(made_at, commit_id, host, version, quick, seconds) VALUES(?,?,?,?,?,?)");
+  Statement insert_run(db_, "INSERT INTO runs(made_at, commit_id, host, version, quick, seconds) VALUES(?,?,?,?,?,?)");
   if (!insert_run.ok()) return fail("cannot record the run");
   insert_run.Bind(1, run.made_at).Bind(2, run.commit).Bind(3, run.host).Bind(4, run.version);
   insert_run.Bind(5, std::int64_t{run.quick}).BindReal(6, run.seconds);
@@ -215,8 +215,7 @@ Expected<std::int64_t> History::Record(HistoryRun run, std::span<const Baseline>
   return run.id;
 }
 
-Expected<std::optional<std::pair<HistoryRun, Baseline>>> History::Previous(std::int64_t run_id,
-                                                                           const Baseline& like) {
+Expected<std::optional<std::pair<HistoryRun, Baseline>>> History::Previous(std::int64_t run_id, const Baseline& like) {
   Statement find(db_,
                  "SELECT r.id, r.made_at, r.commit_id, r.host, r.version, r.quick, r.seconds, b.device"
                  " FROM runs r JOIN run_backends b ON b.run_id = r.id"
@@ -228,8 +227,7 @@ Expected<std::optional<std::pair<HistoryRun, Baseline>>> History::Previous(std::
   if (step == SQLITE_DONE) return std::optional<std::pair<HistoryRun, Baseline>>();
   if (step != SQLITE_ROW) return DbError(db_, path_, "cannot read the history");
 
-  HistoryRun run{find.Int(0), find.Text(1), find.Text(2), find.Text(3), find.Text(4), find.Int(5) != 0,
-                 find.Real(6)};
+  HistoryRun run{find.Int(0), find.Text(1), find.Text(2), find.Text(3), find.Text(4), find.Int(5) != 0, find.Real(6)};
   Baseline b;
   b.backend = like.backend;
   b.plan = like.plan;

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "bench/gate/baseline.h"
 #include "bench/base/status.h"
+#include "bench/gate/baseline.h"
 
 struct sqlite3;
 

@@ -8,12 +8,12 @@
 
 #include <fmt/format.h>
 
-#include "bench/pipeline/bands.h"
-#include "bench/choose/choose.h"
 #include "bench/base/environment.h"
+#include "bench/choose/choose.h"
 #include "bench/gate/gate.h"
-#include "bench/sweep/repro.h"
+#include "bench/pipeline/bands.h"
 #include "bench/speed/trade.h"
+#include "bench/sweep/repro.h"
 
 namespace depthbench {
 namespace {
@@ -58,9 +58,7 @@ json CellRow(const Cell& cell, const std::string& backend) {
           {"backend", backend}};
 }
 
-double P999Bits(const BandStats& band, Metric metric) {
-  return BitsLost(band[metric].AtLevel(Level::kP999, metric));
-}
+double P999Bits(const BandStats& band, Metric metric) { return BitsLost(band[metric].AtLevel(Level::kP999, metric)); }
 
 // What a model says at (x, y), with its 95% interval.
 Estimate ModelAt(const FittedModel& model, double x, double y) {
@@ -86,8 +84,7 @@ json ModelAlongPoints(const PrecisionFit& fit, const FitSweeps& sweeps, const Fi
   for (const BandPoint& band : bands) {
     if (deepest_only && band.depth_band != deepest[band.ratio]) continue;
     if (!ratios.empty() && std::none_of(ratios.begin(), ratios.end(), [&](double r) {
-          return std::isinf(r) ? std::isinf(band.ratio)
-                               : std::fabs(std::log10(r) - std::log10(band.ratio)) < 1e-6;
+          return std::isinf(r) ? std::isinf(band.ratio) : std::fabs(std::log10(r) - std::log10(band.ratio)) < 1e-6;
         })) {
       continue;
     }
@@ -485,10 +482,9 @@ nlohmann::json ReportJson(const ReportPlan& plan, const ReportMeasurements& m) {
                  {"backend_differences", BackendDifferences(m.sweeps, backends)},
                  {"findings", Findings(m)}};
   Expected<json> speed = SpeedSection(plan, m);
-  report["speed"] = speed.ok() ? *speed
-                               : json{{"sources", json::array()},
-                                      {"rows", json::array()},
-                                      {"error", speed.status().message()}};
+  report["speed"] =
+      speed.ok() ? *speed
+                 : json{{"sources", json::array()}, {"rows", json::array()}, {"error", speed.status().message()}};
   report["history"] = nullptr;
   return report;
 }
@@ -499,8 +495,8 @@ std::vector<Baseline> HistoryFigures(const ReportMeasurements& m) {
   return figures;
 }
 
-Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run,
-                  std::span<const Baseline> figures, int trend_runs) {
+Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
+                  int trend_runs) {
   DB_ASSIGN_OR_RETURN(std::int64_t id, history.Record(run, figures));
   DB_ASSIGN_OR_RETURN(std::int64_t runs, history.RunCount());
   json trend = json::array(), changes = json::array(), previous = json::array(), notes = json::array();

@@ -26,12 +26,12 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
-#include "bench/gate/baseline.h"
+#include "bench/base/status.h"
 #include "bench/fit/precision_fit.h"
+#include "bench/gate/baseline.h"
 #include "bench/report/history.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
-#include "bench/base/status.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
@@ -84,7 +84,7 @@ std::vector<Baseline> HistoryFigures(const ReportMeasurements& measured);
 // Records the run in the history and adds the "history" part to the
 // document: the trend of every cell, the previous comparable run, and what
 // got worse (or better) since it, by the gate's tolerances.
-Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run,
-                  std::span<const Baseline> figures, int trend_runs);
+Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
+                  int trend_runs);
 
 }  // namespace depthbench

@@ -51,9 +51,12 @@ std::string CellName(const json& row) {
 std::string Escape(std::string s) {
   std::string out;
   for (char c : s) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n') out += ' ';
-    else out += c;
+    if (c == '|')
+      out += "\\|";
+    else if (c == '\n')
+      out += ' ';
+    else
+      out += c;
   }
   return out;
 }
@@ -75,9 +78,8 @@ void Changes(const json& report, std::string& out) {
     return;
   }
   if (h["previous"].empty()) {
-    out += fmt::format(
-        "First run of this sample plan on this device in `{}`: nothing to compare with yet.\n\n",
-        h.value("database", ""));
+    out += fmt::format("First run of this sample plan on this device in `{}`: nothing to compare with yet.\n\n",
+                       h.value("database", ""));
     return;
   }
   std::vector<std::string> previous;
@@ -112,8 +114,9 @@ void Changes(const json& report, std::string& out) {
       }
       const std::size_t kBandsShown = 3;
       std::vector<std::string> first(bands.begin(), bands.begin() + std::min(bands.size(), kBandsShown));
-      out += fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
-                         bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
+      out +=
+          fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
+                      bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
     }
   }
   if (!better.empty()) out += fmt::format("\n{} cell(s) got better.", better.size());
@@ -136,24 +139,27 @@ void Headline(const json& report, std::string& out) {
     if (row.value("backend", "") != backend) continue;
     const std::pair<std::string, std::string> key{row.value("convention", ""), row.value("format", "")};
     auto [it, added] = best.try_emplace(key, &row);
-    if (added) order.push_back(key);
-    else if (far_bits(row) < far_bits(*it->second)) it->second = &row;
+    if (added)
+      order.push_back(key);
+    else if (far_bits(row) < far_bits(*it->second))
+      it->second = &row;
   }
   out += fmt::format(
       "## Headline ({})\n\nPer convention and format, the variant that keeps the most bits at the far plane; "
       "bits lost at p99.9 of the relative error, from the fitted model.\n\n",
       backend);
-  out += "| convention | format | best variant | bits lost per doubling of f/n | at 1e4 | at 1e8 | at inf | f/n for 1e-3 | f/n for 1e-6 |\n";
+  out +=
+      "| convention | format | best variant | bits lost per doubling of f/n | at 1e4 | at 1e8 | at inf | f/n for 1e-3 "
+      "| f/n for 1e-6 |\n";
   out += "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& key : order) {
     const json& row = *best[key];
     const json& p = row["predicted_bits"];
     auto predicted = [&](const char* at) { return p.contains(at) ? Bits(p, at) : std::string("-"); };
-    const std::string slope =
-        row["slope"].is_null()
-            ? "-"
-            : fmt::format("{:.2f} [{:.2f}, {:.2f}]", NumberOr(row, "slope", 0), NumberOr(row, "slope_low", NAN),
-                          NumberOr(row, "slope_high", NAN));
+    const std::string slope = row["slope"].is_null()
+                                  ? "-"
+                                  : fmt::format("{:.2f} [{:.2f}, {:.2f}]", NumberOr(row, "slope", 0),
+                                                NumberOr(row, "slope_low", NAN), NumberOr(row, "slope_high", NAN));
     out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", key.first, key.second,
                        row.value("variant", ""), slope, predicted("1e4"), predicted("1e8"), predicted("inf"),
                        Text(row, "ratio_for_1e-3"), Text(row, "ratio_for_1e-6"));
@@ -162,8 +168,9 @@ void Headline(const json& report, std::string& out) {
 }
 
 void Worst(const json& report, std::string& out) {
-  out += "## Worst cells\n\nHighest p99.9 bits lost over the default domain (every projection, pose and depth the "
-         "sampler draws).\n\n";
+  out +=
+      "## Worst cells\n\nHighest p99.9 bits lost over the default domain (every projection, pose and depth the "
+      "sampler draws).\n\n";
   out += "| cell | backend | p99.9 bits lost | max bits lost | NaN | Inf |\n|---|---|---:|---:|---:|---:|\n";
   std::vector<std::string> worst = WorstCells(report, kWorstInSummary);
   for (const std::string& name : worst) {
@@ -190,9 +197,9 @@ void Findings(const json& report, std::string& out) {
       out += fmt::format("- ... and {} more (see report.html)\n", rows.size() - kFindingsInSummary);
       break;
     }
-    out += fmt::format("- `{}` on {}, {}: {} NaN, {} Inf of {}; first: `{}`\n", CellName(row),
-                       row.value("backend", ""), row.value("sweep", ""), Text(row, "nan"), Text(row, "inf"),
-                       Text(row, "judged"), row.value("command", ""));
+    out += fmt::format("- `{}` on {}, {}: {} NaN, {} Inf of {}; first: `{}`\n", CellName(row), row.value("backend", ""),
+                       row.value("sweep", ""), Text(row, "nan"), Text(row, "inf"), Text(row, "judged"),
+                       row.value("command", ""));
   }
   out += "\n";
 }
@@ -254,10 +261,11 @@ std::string RenderMarkdown(const json& report) {
   for (const json& b : env["backends"]) {
     devices.push_back(fmt::format("{} ({})", b.value("name", ""), b["device"].value("name", "")));
   }
-  out += fmt::format("{} · commit `{}` · {} · {} samples per far/near ratio, {} default-domain samples{} · {:.0f} s\n\n",
-                     env.value("started_at", ""), env.value("commit", "").substr(0, 12), fmt::join(devices, ", "),
-                     env["fit_sweeps"].value("samples_per_ratio", 0), env["default_sweep"].value("samples", 0),
-                     env.value("quick", false) ? " (quick)" : "", NumberOr(env, "seconds", 0.0));
+  out +=
+      fmt::format("{} · commit `{}` · {} · {} samples per far/near ratio, {} default-domain samples{} · {:.0f} s\n\n",
+                  env.value("started_at", ""), env.value("commit", "").substr(0, 12), fmt::join(devices, ", "),
+                  env["fit_sweeps"].value("samples_per_ratio", 0), env["default_sweep"].value("samples", 0),
+                  env.value("quick", false) ? " (quick)" : "", NumberOr(env, "seconds", 0.0));
   Changes(report, out);
   Headline(report, out);
   Worst(report, out);
@@ -277,9 +285,8 @@ std::vector<std::string> WorstCells(const json& report, std::size_t count) {
     rows.push_back({NumberOr(row, "p999_bits", INFINITY), NumberOr(row, "max_bits", INFINITY),
                     CellName(row) + " on " + row.value("backend", "")});
   }
-  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
-    return a.p999 != b.p999 ? a.p999 > b.p999 : a.max > b.max;
-  });
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const Row& a, const Row& b) { return a.p999 != b.p999 ? a.p999 > b.p999 : a.max > b.max; });
   std::vector<std::string> names;
   for (std::size_t i = 0; i < rows.size() && i < count; ++i) names.push_back(rows[i].name);
   return names;

@@ -31,8 +31,7 @@ Expected<Shard> ParseShard(std::string_view text) {
   if (slash == std::string_view::npos || !parse(text.substr(0, slash), shard.index) ||
       !parse(text.substr(slash + 1), shard.count) || shard.count == 0 || shard.index == 0 ||
       shard.index > shard.count) {
-    return InvalidArgument(fmt::format(
-        "--shard: '{}' is not K/N with 1 <= K <= N (shard K of N, e.g. 2/4)", text));
+    return InvalidArgument(fmt::format("--shard: '{}' is not K/N with 1 <= K <= N (shard K of N, e.g. 2/4)", text));
   }
   return shard;
 }
@@ -61,12 +60,9 @@ json MetricToJson(const MetricStats& m) {
 json BandToJson(const BandStats& b) {
   json metrics = json::object();
   for (int m = 0; m < kMetricCount; ++m) metrics[MetricName(static_cast<Metric>(m))] = MetricToJson(b.metrics[m]);
-  return {{"finite", b.finite},
-          {"nan", b.nan},
-          {"inf", b.inf},
-          {"degenerate", b.degenerate},
-          {"outside", b.outside},
-          {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
+  return {{"finite", b.finite},   {"nan", b.nan},
+          {"inf", b.inf},         {"degenerate", b.degenerate},
+          {"outside", b.outside}, {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
           {"metrics", metrics}};
 }
 
@@ -241,7 +237,6 @@ Expected<int> BandIndex(const JsonReader& r, const std::string& key, int count) 
   return static_cast<int>(v);
 }
 
-
 }  // namespace
 
 Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
@@ -291,8 +286,8 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   }
   DB_ASSIGN_OR_RETURN(std::int64_t version, top.Integer("schema_version"));
   if (version != kResultsSchemaVersion) {
-    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})",
-                                 version, kResultsSchemaVersion));
+    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})", version,
+                                 kResultsSchemaVersion));
   }
   Results results;
   RunInfo& run = results.run;
@@ -394,9 +389,8 @@ Expected<Results> MergeResults(const std::vector<Results>& parts) {
     merged.run.seconds += b.seconds;
     merged.run.reconstructions += b.reconstructions;
     for (const CellResult& c : part.cells) {
-      auto it = std::find_if(merged.cells.begin(), merged.cells.end(), [&](const CellResult& m) {
-        return m.cell == c.cell && m.backend == c.backend;
-      });
+      auto it = std::find_if(merged.cells.begin(), merged.cells.end(),
+                             [&](const CellResult& m) { return m.cell == c.cell && m.backend == c.backend; });
       if (it == merged.cells.end()) {
         merged.cells.push_back(c);
       } else {

@@ -12,11 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/json_reader.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
-#include "bench/base/json_reader.h"
 #include "bench/pipeline/stats.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
@@ -52,8 +52,8 @@ struct RunInfo {
   std::vector<Shard> shards;  // the shards these results hold
   Domain domain;
   std::vector<BackendRecord> backends;
-  double seconds = 0.0;                   // wall time (summed over merged shards)
-  std::uint64_t reconstructions = 0;      // cell evaluations judged against the reference
+  double seconds = 0.0;               // wall time (summed over merged shards)
+  std::uint64_t reconstructions = 0;  // cell evaluations judged against the reference
 };
 
 struct CellResult {

@@ -23,8 +23,7 @@ std::string SiCount(double x) {
 
 void PrintRunHeader(const Results& results, std::ostream& out) {
   const RunInfo& run = results.run;
-  out << fmt::format("depthbench {} (commit {}), seed {}, {} samples", run.version, run.commit, run.seed,
-                     run.samples);
+  out << fmt::format("depthbench {} (commit {}), seed {}, {} samples", run.version, run.commit, run.seed, run.samples);
   if (!(run.shards.size() == 1 && run.shards[0].count == 1)) {
     std::string shards;
     for (const Shard& s : run.shards) shards += (shards.empty() ? "" : ",") + s.ToString();
@@ -39,8 +38,8 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     out << "\n";
   }
   if (run.seconds > 0) {
-    out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions),
-                       run.seconds, SiCount(run.reconstructions / run.seconds));
+    out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions), run.seconds,
+                       SiCount(run.reconstructions / run.seconds));
   }
   out << "bits lost = max(0, log2(relative error / 2^-24)); relative to the distance from the camera\n\n";
 }
@@ -65,8 +64,8 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
     const BandStats all = c.stats.All();
     const Summary total = Summarize(all, Metric::kTotal);
     const Summary absolute = Summarize(all, Metric::kAbsolute);
-    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99),
-                  Bits(total.p999), Bits(total.max), Bits(Summarize(all, Metric::kArith).p999),
+    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99), Bits(total.p999),
+                  Bits(total.max), Bits(Summarize(all, Metric::kArith).p999),
                   Bits(Summarize(all, Metric::kStorage).p999), fmt::format("{:.2g}", absolute.p999),
                   fmt::format("{:.2g}", absolute.max), Count(all.nan), Count(all.inf), Count(all.degenerate)});
   }

@@ -7,10 +7,10 @@
 #include <fmt/format.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/encode.h"
 #include "bench/pipeline/shader_constants.h"
 #include "bench/speed/depth_image.h"
-#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 namespace {
@@ -76,8 +76,7 @@ Expected<std::vector<CpuCost>> MeasureCpuCosts(std::span<const Cell> cells, cons
   for (const Cell& cell : cells) {
     if (!Reads(cell.variant, cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention; no CPU path to time",
-                                         Info(cell.variant).name, Info(cell.format).name,
-                                         Info(cell.convention).name));
+                                         Info(cell.variant).name, Info(cell.format).name, Info(cell.convention).name));
     }
   }
   const CpuCostInput input = MakeCpuCostInput(cells, options.samples);
@@ -89,8 +88,8 @@ Expected<std::vector<CpuCost>> MeasureCpuCosts(std::span<const Cell> cells, cons
     // Warm-up and calibration: one run, then as many per repetition as
     // make it last min_repetition_ns.
     DB_ASSIGN_OR_RETURN(const double once, TimeRuns(*backend, input.batch, k, 1, scratch));
-    const auto runs = static_cast<std::uint32_t>(
-        std::clamp(std::ceil(options.min_repetition_ns / std::max(once, 1.0)), 1.0, 1e6));
+    const auto runs =
+        static_cast<std::uint32_t>(std::clamp(std::ceil(options.min_repetition_ns / std::max(once, 1.0)), 1.0, 1e6));
     std::vector<double> per_reconstruction;
     for (std::uint32_t r = 0; r < options.repetitions; ++r) {
       DB_ASSIGN_OR_RETURN(const double ns, TimeRuns(*backend, input.batch, k, runs, scratch));

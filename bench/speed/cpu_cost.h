@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "bench/backends/backend.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/cells.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
@@ -36,9 +36,9 @@ struct CpuCost {
 };
 
 struct CpuCostOptions {
-  std::uint32_t samples = 4096;      // per backend run: fits in L1/L2 with its outputs
+  std::uint32_t samples = 4096;  // per backend run: fits in L1/L2 with its outputs
   std::uint32_t repetitions = 15;
-  double min_repetition_ns = 2e6;    // each repetition runs the cell at least this long
+  double min_repetition_ns = 2e6;  // each repetition runs the cell at least this long
 };
 
 // One CpuCost per cell, in the order given. InvalidArgument when a cell

@@ -92,10 +92,9 @@ Expected<DepthImage> MakeDepthImage(Encoding encoding, Resolution resolution, Th
     return InvalidArgument(fmt::format("no variant reads {} under the {} convention, so there is no pass to time",
                                        Info(encoding.format).name, Info(encoding.convention).name));
   }
-  if (resolution.width == 0 || resolution.height == 0 || resolution.width > kMaxSide ||
-      resolution.height > kMaxSide) {
-    return InvalidArgument(fmt::format("resolution {}x{} is outside 1x1 to {}x{}", resolution.width,
-                                       resolution.height, kMaxSide, kMaxSide));
+  if (resolution.width == 0 || resolution.height == 0 || resolution.width > kMaxSide || resolution.height > kMaxSide) {
+    return InvalidArgument(fmt::format("resolution {}x{} is outside 1x1 to {}x{}", resolution.width, resolution.height,
+                                       kMaxSide, kMaxSide));
   }
   DepthImage image;
   image.encoding = encoding;
@@ -110,19 +109,22 @@ Expected<DepthImage> MakeDepthImage(Encoding encoding, Resolution resolution, Th
 
   const std::uint32_t width = resolution.width;
   image.texels.resize(static_cast<std::size_t>(width) * resolution.height * image.texel_bytes);
-  pool.ParallelFor(resolution.height, [&](std::size_t begin, std::size_t end, unsigned) {
-    const std::vector<std::uint32_t> codes = EncodeDepthRows(encoding, image.frame, static_cast<std::uint32_t>(begin),
-                                                             static_cast<std::uint32_t>(end - begin));
-    std::uint8_t* out = image.texels.data() + begin * width * image.texel_bytes;
-    for (std::size_t k = 0; k < codes.size(); ++k) {
-      if (image.texel_bytes == 2) {
-        const auto code = static_cast<std::uint16_t>(codes[k]);
-        std::memcpy(out + k * 2, &code, 2);
-      } else {
-        std::memcpy(out + k * 4, &codes[k], 4);
-      }
-    }
-  }, 16);
+  pool.ParallelFor(
+      resolution.height,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        const std::vector<std::uint32_t> codes = EncodeDepthRows(
+            encoding, image.frame, static_cast<std::uint32_t>(begin), static_cast<std::uint32_t>(end - begin));
+        std::uint8_t* out = image.texels.data() + begin * width * image.texel_bytes;
+        for (std::size_t k = 0; k < codes.size(); ++k) {
+          if (image.texel_bytes == 2) {
+            const auto code = static_cast<std::uint16_t>(codes[k]);
+            std::memcpy(out + k * 2, &code, 2);
+          } else {
+            std::memcpy(out + k * 4, &codes[k], 4);
+          }
+        }
+      },
+      16);
   return image;
 }
 

@@ -10,23 +10,23 @@
 #include <span>
 #include <vector>
 
-#include "bench/pipeline/cells.h"
-#include "bench/pipeline/domain.h"
-#include "bench/numerics/formulas.h"
-#include "bench/pipeline/sampler.h"
 #include "bench/base/status.h"
 #include "bench/base/thread_pool.h"
+#include "bench/numerics/formulas.h"
+#include "bench/pipeline/cells.h"
+#include "bench/pipeline/domain.h"
+#include "bench/pipeline/sampler.h"
 
 namespace depthbench {
 
 struct DepthImage {
   Encoding encoding{};
   Resolution resolution{0, 0};
-  std::uint32_t texel_bytes = 0;       // 2 or 4
-  std::vector<std::uint8_t> texels;    // row-major, tightly packed, as vkCmdCopyBufferToImage reads them
-  Frame frame;                         // the exact frame
-  f32::FrameParams frame_params{};     // what the pass's uniform buffer holds
-  f32::DepthParams depth_params{};     // zero for the linear convention (no projection is read)
+  std::uint32_t texel_bytes = 0;     // 2 or 4
+  std::vector<std::uint8_t> texels;  // row-major, tightly packed, as vkCmdCopyBufferToImage reads them
+  Frame frame;                       // the exact frame
+  f32::FrameParams frame_params{};   // what the pass's uniform buffer holds
+  f32::DepthParams depth_params{};   // zero for the linear convention (no projection is read)
 
   std::uint32_t Code(std::uint32_t x, std::uint32_t y) const;  // the texel's bits
 };

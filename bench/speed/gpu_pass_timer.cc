@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/speed/timing_stats.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/speed/timing_stats.h"
 
 namespace depthbench {
 namespace {
@@ -66,9 +66,10 @@ Status CheckFormatFeatures(Format format, VkFormatFeatureFlags features, const s
     missing += std::string(missing.empty() ? "" : " and ") + "transfers into images";
   }
   if (missing.empty()) return Status::Ok();
-  return Unavailable(fmt::format("{} ({}) is not supported by Vulkan device '{}': its optimal-tiling features "
-                                 "lack {}, so no pass can read a real image of it",
-                                 Info(format).name, Info(format).vulkan_name, device_name, missing));
+  return Unavailable(
+      fmt::format("{} ({}) is not supported by Vulkan device '{}': its optimal-tiling features "
+                  "lack {}, so no pass can read a real image of it",
+                  Info(format).name, Info(format).vulkan_name, device_name, missing));
 }
 
 GpuPassTimer::GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir)
@@ -79,9 +80,10 @@ Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<Vul
   if (context == nullptr) return InvalidArgument("the GPU pass timer needs a Vulkan context");
   const VulkanDeviceProperties& properties = context->properties();
   if (properties.queue_timestamp_valid_bits == 0) {
-    return Unavailable(fmt::format("Vulkan device '{}': its compute queue cannot write timestamps "
-                                   "(timestampValidBits 0), so passes cannot be timed on it",
-                                   properties.name));
+    return Unavailable(
+        fmt::format("Vulkan device '{}': its compute queue cannot write timestamps "
+                    "(timestampValidBits 0), so passes cannot be timed on it",
+                    properties.name));
   }
   if (!(properties.limits.timestampPeriod > 0.0f)) {
     return Unavailable(fmt::format("Vulkan device '{}' reports timestampPeriod {}", properties.name,
@@ -156,8 +158,8 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
       {kTapsConstant, 0, sizeof(std::uint32_t)},
       {kConventionConstant, sizeof(std::uint32_t), sizeof(std::uint32_t)},
   }};
-  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
-                                            sizeof(values), values.data()};
+  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(values),
+                                            values.data()};
   DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
                       context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
                                                       fmt::format("the {} speed pass", Info(variant).name)));
@@ -212,8 +214,8 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
   image_info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkImage handle = VK_NULL_HANDLE;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateImage(vk_device(), &image_info, nullptr, &handle),
-                             fmt::format("vkCreateImage of {} {}x{}", Info(format).vulkan_name,
-                                         image.resolution.width, image.resolution.height)));
+                             fmt::format("vkCreateImage of {} {}x{}", Info(format).vulkan_name, image.resolution.width,
+                                         image.resolution.height)));
   DeviceObject<VkImage> new_image(vk_device(), handle, vkDestroyImage);
   VkMemoryRequirements requirements{};
   vkGetImageMemoryRequirements(vk_device(), handle, &requirements);
@@ -232,9 +234,9 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
   DeviceObject<VkImageView> new_view(vk_device(), view, vkDestroyImageView);
 
   // The texels travel through a staging buffer, as an engine uploads.
-  DB_ASSIGN_OR_RETURN(VulkanBuffer staging, context_->CreateHostBuffer(image.texels.size(),
-                                                                        VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                                                        HostAccess::kUpload));
+  DB_ASSIGN_OR_RETURN(
+      VulkanBuffer staging,
+      context_->CreateHostBuffer(image.texels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, HostAccess::kUpload));
   std::memcpy(staging.mapped(), image.texels.data(), image.texels.size());
   DB_RETURN_IF_ERROR(staging.FlushHostWrites());
   DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
@@ -248,8 +250,8 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
     to_transfer.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     to_transfer.image = handle;
     to_transfer.subresourceRange = {aspect, 0, 1, 0, 1};
-    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
-                         0, nullptr, 1, &to_transfer);
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &to_transfer);
     VkBufferImageCopy region{};
     region.imageSubresource = {aspect, 0, 0, 1};
     region.imageExtent = {image.resolution.width, image.resolution.height, 1};
@@ -259,8 +261,8 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
     to_shader.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
     to_shader.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
     to_shader.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &to_shader);
+    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr,
+                         0, nullptr, 1, &to_shader);
   }));
   image_view_.Reset();
   image_.Reset();
@@ -274,10 +276,10 @@ Status GpuPassTimer::CreateResultBuffer(VkDeviceSize bytes) {
   if (bytes == result_bytes_) return Status::Ok();
   const VkPhysicalDeviceLimits& limits = device().limits;
   if (bytes > limits.maxStorageBufferRange) {
-    return InvalidArgument(fmt::format("a pass over {}x{} pixels writes {} bytes; Vulkan device '{}' binds at "
-                                       "most {} bytes of storage buffer",
-                                       resolution_.width, resolution_.height, bytes, device().name,
-                                       limits.maxStorageBufferRange));
+    return InvalidArgument(
+        fmt::format("a pass over {}x{} pixels writes {} bytes; Vulkan device '{}' binds at "
+                    "most {} bytes of storage buffer",
+                    resolution_.width, resolution_.height, bytes, device().name, limits.maxStorageBufferRange));
   }
   result_buffer_.Reset();
   result_memory_.Reset();
@@ -329,16 +331,16 @@ Status GpuPassTimer::LoadImage(const DepthImage& image) {
       static_cast<std::size_t>(image.resolution.width) * image.resolution.height * TexelBytes(image.encoding.format);
   if (image.texels.size() != expected || image.texel_bytes != TexelBytes(image.encoding.format)) {
     return InvalidArgument(fmt::format("depth image of {}x{} {} holds {} bytes; it needs {}", image.resolution.width,
-                                       image.resolution.height, Info(image.encoding.format).name,
-                                       image.texels.size(), expected));
+                                       image.resolution.height, Info(image.encoding.format).name, image.texels.size(),
+                                       expected));
   }
   DB_RETURN_IF_ERROR(CreateImage(image));
-  DB_RETURN_IF_ERROR(CreateResultBuffer(static_cast<VkDeviceSize>(image.resolution.width) * image.resolution.height *
-                                        sizeof(float)));
+  DB_RETURN_IF_ERROR(
+      CreateResultBuffer(static_cast<VkDeviceSize>(image.resolution.width) * image.resolution.height * sizeof(float)));
   if (constants_.handle() == VK_NULL_HANDLE) {
-    DB_ASSIGN_OR_RETURN(constants_, context_->CreateHostBuffer(sizeof(PassConstants),
-                                                               VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                                                               HostAccess::kUpload));
+    DB_ASSIGN_OR_RETURN(
+        constants_,
+        context_->CreateHostBuffer(sizeof(PassConstants), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, HostAccess::kUpload));
   }
   const PassConstants constants{image.frame_params, image.depth_params};
   std::memcpy(constants_.mapped(), &constants, sizeof(constants));
@@ -389,10 +391,10 @@ Expected<std::vector<double>> GpuPassTimer::TimeGroups(std::span<const Group> gr
     }
   }));
   std::vector<std::uint64_t> stamps(queries);
-  DB_RETURN_IF_ERROR(CheckVk(vkGetQueryPoolResults(vk_device(), pool, 0, queries, stamps.size() * sizeof(std::uint64_t),
-                                                   stamps.data(), sizeof(std::uint64_t),
-                                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                             "vkGetQueryPoolResults"));
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkGetQueryPoolResults(vk_device(), pool, 0, queries, stamps.size() * sizeof(std::uint64_t), stamps.data(),
+                                    sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+              "vkGetQueryPoolResults"));
   std::vector<double> ns_per_pass(groups.size());
   for (std::uint32_t g = 0; g < groups.size(); ++g) {
     DB_ASSIGN_OR_RETURN(const double ns,
@@ -416,10 +418,10 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   if (variants.empty()) return InvalidArgument("no variant to time");
   for (const Variant variant : variants) {
     if (!Reads(variant, encoding_.convention, encoding_.format)) {
-      return InvalidArgument(fmt::format("{} does not read {} under the {} convention (see 'depthbench list'); "
-                                         "such a pass is not timed",
-                                         Info(variant).name, Info(encoding_.format).name,
-                                         Info(encoding_.convention).name));
+      return InvalidArgument(
+          fmt::format("{} does not read {} under the {} convention (see 'depthbench list'); "
+                      "such a pass is not timed",
+                      Info(variant).name, Info(encoding_.format).name, Info(encoding_.convention).name));
     }
   }
   if (taps == 0 || taps > kMaxTaps) {
@@ -485,9 +487,8 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
 
 Expected<std::vector<float>> GpuPassTimer::ReadResults() {
   if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
-  DB_ASSIGN_OR_RETURN(VulkanBuffer readback,
-                      context_->CreateHostBuffer(result_bytes_, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                 HostAccess::kReadback));
+  DB_ASSIGN_OR_RETURN(VulkanBuffer readback, context_->CreateHostBuffer(result_bytes_, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                                        HostAccess::kReadback));
   DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
     VkMemoryBarrier to_transfer{};
     to_transfer.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
@@ -514,8 +515,8 @@ Status GpuPassTimer::CheckValidation(std::uint64_t errors_before, const std::str
   const std::shared_ptr<ValidationLog> log = context_->validation_log();
   const std::uint64_t errors = log->error_count() - errors_before;
   if (errors == 0) return Status::Ok();
-  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) while {}; the last: {}", errors,
-                              during, log->last_error()));
+  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) while {}; the last: {}", errors, during,
+                              log->last_error()));
 }
 
 }  // namespace depthbench

@@ -38,10 +38,10 @@
 
 #include <vulkan/vulkan.h>
 
+#include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/speed/depth_image.h"
-#include "bench/base/status.h"
-#include "bench/backends/vulkan/vulkan_context.h"
 
 namespace depthbench {
 
@@ -87,8 +87,7 @@ class GpuPassTimer {
   Expected<std::vector<PassTiming>> TimePasses(std::span<const Variant> variants, std::uint32_t taps,
                                                std::uint32_t warmup, std::uint32_t repetitions);
   // The same for one variant.
-  Expected<PassTiming> TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup,
-                                std::uint32_t repetitions);
+  Expected<PassTiming> TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup, std::uint32_t repetitions);
   // The values the last pass wrote, one per pixel (for tests).
   Expected<std::vector<float>> ReadResults();
 

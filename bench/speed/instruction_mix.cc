@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 #include <glslang/SPIRV/GLSL.std.450.h>
-#include <glslang/SPIRV/spirv.hpp>
 #include <spirv-tools/libspirv.h>
+#include <glslang/SPIRV/spirv.hpp>
 
 namespace depthbench {
 namespace {
@@ -21,11 +21,11 @@ struct FunctionBody {
 
 // Everything the counter needs from one pass over the module.
 struct ModuleScan {
-  std::unordered_map<std::uint32_t, std::string> names;          // id -> OpName
-  std::unordered_map<std::uint32_t, std::uint32_t> type_lanes;   // type id -> scalar lanes
+  std::unordered_map<std::uint32_t, std::string> names;             // id -> OpName
+  std::unordered_map<std::uint32_t, std::uint32_t> type_lanes;      // type id -> scalar lanes
   std::unordered_map<std::uint32_t, std::uint32_t> matrix_columns;  // matrix type id -> columns
-  std::unordered_map<std::uint32_t, std::uint32_t> value_types;  // result id -> type id
-  std::unordered_map<std::uint32_t, bool> glsl_std_450_sets;     // ext inst import ids
+  std::unordered_map<std::uint32_t, std::uint32_t> value_types;     // result id -> type id
+  std::unordered_map<std::uint32_t, bool> glsl_std_450_sets;        // ext inst import ids
   std::unordered_map<std::uint32_t, FunctionBody> functions;
   std::uint32_t current_function = 0;  // 0 outside functions
 };
@@ -64,20 +64,14 @@ spv_result_t ScanInstruction(void* user_data, const spv_parsed_instruction_t* in
   const std::uint32_t* w = inst->words;
   if (inst->result_id != 0 && inst->type_id != 0) scan.value_types[inst->result_id] = inst->type_id;
   switch (static_cast<spv::Op>(inst->opcode)) {
-    case spv::OpName:
-      scan.names[w[1]] = DecodeString(w + 2, inst->num_words - 2u);
-      return SPV_SUCCESS;
+    case spv::OpName: scan.names[w[1]] = DecodeString(w + 2, inst->num_words - 2u); return SPV_SUCCESS;
     case spv::OpExtInstImport:
       scan.glsl_std_450_sets[w[1]] = DecodeString(w + 2, inst->num_words - 2u) == "GLSL.std.450";
       return SPV_SUCCESS;
     case spv::OpTypeFloat:
     case spv::OpTypeInt:
-    case spv::OpTypeBool:
-      scan.type_lanes[w[1]] = 1;
-      return SPV_SUCCESS;
-    case spv::OpTypeVector:
-      scan.type_lanes[w[1]] = LanesOf(scan, w[2]) * w[3];
-      return SPV_SUCCESS;
+    case spv::OpTypeBool: scan.type_lanes[w[1]] = 1; return SPV_SUCCESS;
+    case spv::OpTypeVector: scan.type_lanes[w[1]] = LanesOf(scan, w[2]) * w[3]; return SPV_SUCCESS;
     case spv::OpTypeMatrix:
       scan.type_lanes[w[1]] = LanesOf(scan, w[2]) * w[3];
       scan.matrix_columns[w[1]] = w[3];
@@ -86,11 +80,8 @@ spv_result_t ScanInstruction(void* user_data, const spv_parsed_instruction_t* in
       scan.current_function = inst->result_id;
       scan.functions[inst->result_id];
       return SPV_SUCCESS;
-    case spv::OpFunctionEnd:
-      scan.current_function = 0;
-      return SPV_SUCCESS;
-    default:
-      break;
+    case spv::OpFunctionEnd: scan.current_function = 0; return SPV_SUCCESS;
+    default: break;
   }
   if (scan.current_function == 0) return SPV_SUCCESS;
 
@@ -235,9 +226,10 @@ Expected<InstructionMix> CountInstructionMix(std::span<const std::uint32_t> spir
     }
   }
   if (root == 0) {
-    return InvalidArgument(fmt::format("the SPIR-V module has no function named '{}' (is it called, and "
-                                       "was the module compiled with debug names?)",
-                                       function_name));
+    return InvalidArgument(
+        fmt::format("the SPIR-V module has no function named '{}' (is it called, and "
+                    "was the module compiled with debug names?)",
+                    function_name));
   }
 
   // Inclusive mixes, memoized; GLSL forbids recursion, and a cycle here

@@ -23,9 +23,7 @@ Expected<Regime> ParseRegime(std::string_view name) {
   return InvalidArgument(fmt::format("unknown regime '{}'; allowed: memory, alu", name));
 }
 
-std::string ResolutionName(Resolution resolution) {
-  return fmt::format("{}x{}", resolution.width, resolution.height);
-}
+std::string ResolutionName(Resolution resolution) { return fmt::format("{}x{}", resolution.width, resolution.height); }
 
 Expected<Resolution> ParseResolution(std::string_view text, std::string_view what) {
   const auto x = text.find_first_of("xX");
@@ -36,15 +34,15 @@ Expected<Resolution> ParseResolution(std::string_view text, std::string_view wha
   };
   if (x == std::string_view::npos || !parse(text.substr(0, x), r.width) || !parse(text.substr(x + 1), r.height) ||
       r.width == 0 || r.height == 0) {
-    return InvalidArgument(fmt::format("{}: '{}' is not WIDTHxHEIGHT with both at least 1 (e.g. 1920x1080)", what,
-                                       text));
+    return InvalidArgument(
+        fmt::format("{}: '{}' is not WIDTHxHEIGHT with both at least 1 (e.g. 1920x1080)", what, text));
   }
   return r;
 }
 
 bool SameGroup(const GpuTiming& a, const GpuTiming& b) {
-  return a.cell.convention == b.cell.convention && a.cell.format == b.cell.format &&
-         a.resolution == b.resolution && a.regime == b.regime && a.taps == b.taps;
+  return a.cell.convention == b.cell.convention && a.cell.format == b.cell.format && a.resolution == b.resolution &&
+         a.regime == b.regime && a.taps == b.taps;
 }
 
 void RankGpuTimings(std::vector<GpuTiming>& timings) {
@@ -92,8 +90,8 @@ const CpuCost* SpeedResults::FindCpu(const Cell& cell) const {
 namespace {
 
 json SummaryToJson(const TimingSummary& s) {
-  return {{"count", s.count}, {"median", s.median}, {"q1", s.q1}, {"q3", s.q3},
-          {"spread", s.spread()}, {"min", s.min},  {"max", s.max}};
+  return {{"count", s.count},     {"median", s.median}, {"q1", s.q1},  {"q3", s.q3},
+          {"spread", s.spread()}, {"min", s.min},       {"max", s.max}};
 }
 
 json CountToJson(const OpCount& c) { return {{"instructions", c.instructions}, {"lanes", c.lanes}}; }
@@ -194,14 +192,17 @@ json ToJson(const SpeedResults& results) {
                         {"on_gpu_front", p.on_gpu_front},
                         {"on_cpu_front", p.on_cpu_front}});
     }
-    trade.push_back({{"convention", Info(front.convention).name},
-                     {"format", Info(front.format).name},
-                     {"points", points}});
+    trade.push_back(
+        {{"convention", Info(front.convention).name}, {"format", Info(front.format).name}, {"points", points}});
   }
-  return {{"schema", kSpeedSchema}, {"schema_version", kSpeedSchemaVersion},
-          {"run", RunToJson(results.run)}, {"gpu", gpu},
-          {"static", static_costs},        {"cpu", cpu},
-          {"trade", trade},                {"skipped", results.skipped}};
+  return {{"schema", kSpeedSchema},
+          {"schema_version", kSpeedSchemaVersion},
+          {"run", RunToJson(results.run)},
+          {"gpu", gpu},
+          {"static", static_costs},
+          {"cpu", cpu},
+          {"trade", trade},
+          {"skipped", results.skipped}};
 }
 
 Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results) {
@@ -468,10 +469,10 @@ Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path) {
 
 Expected<RankingComparison> CompareRankings(const SpeedResults& first, const SpeedResults& second) {
   if (first.run.device.name != second.run.device.name || first.run.device.driver != second.run.device.driver) {
-    return InvalidArgument(fmt::format("rankings are kept per device: one run is of '{}' ({}), the other of '{}' "
-                                       "({})",
-                                       first.run.device.name, first.run.device.driver, second.run.device.name,
-                                       second.run.device.driver));
+    return InvalidArgument(
+        fmt::format("rankings are kept per device: one run is of '{}' ({}), the other of '{}' "
+                    "({})",
+                    first.run.device.name, first.run.device.driver, second.run.device.name, second.run.device.driver));
   }
   RankingComparison comparison;
   for (std::size_t i = 0; i < first.gpu.size(); ++i) {

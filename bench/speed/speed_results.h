@@ -13,12 +13,12 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 #include "bench/speed/cpu_cost.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/timing_stats.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
@@ -39,8 +39,8 @@ struct GpuTiming {
   Resolution resolution{0, 0};
   Regime regime = Regime::kMemory;
   std::uint32_t taps = 1;
-  TimingSummary ns_per_pass;            // over the repetitions
-  std::vector<double> repetitions_ns;   // each repetition's time per pass
+  TimingSummary ns_per_pass;           // over the repetitions
+  std::vector<double> repetitions_ns;  // each repetition's time per pass
   std::uint32_t passes_per_repetition = 1;
   std::uint32_t warmup_passes = 0;
   std::uint32_t rank = 0;  // among the variants of its group (RankGpuTimings); 0 before ranking
@@ -96,7 +96,7 @@ struct SpeedRunInfo {
   std::string device_type;           // "cpu", "discrete gpu", ...
   double timestamp_period_ns = 0.0;  // VkPhysicalDeviceLimits::timestampPeriod
   std::uint32_t timestamp_valid_bits = 0;
-  std::string note;                  // what the figures mean on this device
+  std::string note;  // what the figures mean on this device
   std::uint32_t warmup = 0;
   std::uint32_t repetitions = 0;
   std::uint32_t alu_taps = 0;
@@ -105,7 +105,7 @@ struct SpeedRunInfo {
   std::string accuracy_source;   // the results file, or "internal run of N samples"
   std::string accuracy_backend;  // which backend's errors the trade uses
   std::string accuracy_device;
-  std::string cpu_compiler;      // the CPU backend's compiler
+  std::string cpu_compiler;  // the CPU backend's compiler
   double seconds = 0.0;
 };
 
@@ -136,10 +136,10 @@ Expected<Resolution> ParseResolution(std::string_view text, std::string_view wha
 // How two runs on one device rank the variants, pair by pair within each
 // group present in both.
 struct RankingComparison {
-  std::uint32_t pairs = 0;          // pairs of variants compared
-  std::uint32_t agree = 0;          // the same order in both runs, both distinguishable
-  std::uint32_t both_ties = 0;      // indistinguishable in both runs
-  std::uint32_t one_sided = 0;      // distinguishable in one run, a tie in the other
+  std::uint32_t pairs = 0;                  // pairs of variants compared
+  std::uint32_t agree = 0;                  // the same order in both runs, both distinguishable
+  std::uint32_t both_ties = 0;              // indistinguishable in both runs
+  std::uint32_t one_sided = 0;              // distinguishable in one run, a tie in the other
   std::vector<std::string> contradictions;  // opposite distinguishable orders, described
 };
 // InvalidArgument when the runs are of different devices: rankings are

@@ -6,11 +6,11 @@
 #include <fmt/format.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
+#include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/base/environment.h"
+#include "bench/base/thread_pool.h"
 #include "bench/speed/depth_image.h"
 #include "bench/speed/trade.h"
-#include "bench/base/thread_pool.h"
-#include "bench/backends/vulkan/shader_compiler.h"
 
 namespace depthbench {
 
@@ -18,28 +18,28 @@ Status ValidateSpeedOptions(const SpeedOptions& o) {
   if (o.cells.empty()) return InvalidArgument("Violated constraint: SpeedOptions::cells is not empty");
   if (o.resolutions.empty()) return InvalidArgument("Violated constraint: SpeedOptions::resolutions is not empty");
   if (o.alu_taps < 2 || o.alu_taps > GpuPassTimer::kMaxTaps) {
-    return InvalidArgument(fmt::format("Violated constraint: 2 <= SpeedOptions::alu_taps <= {} (it is {}; one tap "
-                                       "is the memory-bound regime)",
-                                       GpuPassTimer::kMaxTaps, o.alu_taps));
+    return InvalidArgument(
+        fmt::format("Violated constraint: 2 <= SpeedOptions::alu_taps <= {} (it is {}; one tap "
+                    "is the memory-bound regime)",
+                    GpuPassTimer::kMaxTaps, o.alu_taps));
   }
   if (o.warmup < 1) return InvalidArgument("Violated constraint: SpeedOptions::warmup >= 1");
   // Quartiles of fewer than three values are the values themselves.
   if (o.repetitions < 3) {
-    return InvalidArgument(fmt::format("Violated constraint: SpeedOptions::repetitions >= 3 (it is {}); a spread "
-                                       "needs at least three",
-                                       o.repetitions));
+    return InvalidArgument(
+        fmt::format("Violated constraint: SpeedOptions::repetitions >= 3 (it is {}); a spread "
+                    "needs at least three",
+                    o.repetitions));
   }
   if (o.cpu.repetitions < 3) return InvalidArgument("Violated constraint: CpuCostOptions::repetitions >= 3");
   for (const Cell& cell : o.cells) {
     if (!Reads(cell.variant, cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention: no such pass to time",
-                                         Info(cell.variant).name, Info(cell.format).name,
-                                         Info(cell.convention).name));
+                                         Info(cell.variant).name, Info(cell.format).name, Info(cell.convention).name));
     }
   }
   return Status::Ok();
 }
-
 
 std::string DeviceNote(const VulkanDeviceProperties& device) {
   if (device.type == VK_PHYSICAL_DEVICE_TYPE_CPU) {

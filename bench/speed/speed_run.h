@@ -10,21 +10,21 @@
 #include <string>
 #include <vector>
 
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 #include "bench/results/results.h"
 #include "bench/speed/cpu_cost.h"
 #include "bench/speed/gpu_pass_timer.h"
 #include "bench/speed/speed_results.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
 struct SpeedOptions {
   std::vector<Cell> cells;
   std::vector<Resolution> resolutions{{1920, 1080}, {3840, 2160}};
-  std::uint32_t alu_taps = 16;    // reconstructions per pixel in the ALU-bound regime
-  std::uint32_t warmup = 2;       // warm-up passes per measurement (at least; see gpu_pass_timer.h)
+  std::uint32_t alu_taps = 16;  // reconstructions per pixel in the ALU-bound regime
+  std::uint32_t warmup = 2;     // warm-up passes per measurement (at least; see gpu_pass_timer.h)
   std::uint32_t repetitions = 10;
   // A cell whose format the device cannot sample: refused (true), or left
   // out and listed in SpeedResults::skipped (false).

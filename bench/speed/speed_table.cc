@@ -34,11 +34,12 @@ std::string Count(const OpCount& c) {
 
 void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
   const SpeedRunInfo& run = results.run;
-  out << fmt::format("depthbench {} speed (commit {}) on {} [{}; {}; {}]\n", run.version, run.commit,
-                     run.device.name, run.device_type, run.device.driver, run.device.api);
-  out << fmt::format("timestamps: period {} ns, {} valid bits; {} warm-up passes (and more up to 20 ms), {} "
-                     "repetitions; ALU-bound regime: {} taps per pixel\n",
-                     run.timestamp_period_ns, run.timestamp_valid_bits, run.warmup, run.repetitions, run.alu_taps);
+  out << fmt::format("depthbench {} speed (commit {}) on {} [{}; {}; {}]\n", run.version, run.commit, run.device.name,
+                     run.device_type, run.device.driver, run.device.api);
+  out << fmt::format(
+      "timestamps: period {} ns, {} valid bits; {} warm-up passes (and more up to 20 ms), {} "
+      "repetitions; ALU-bound regime: {} taps per pixel\n",
+      run.timestamp_period_ns, run.timestamp_valid_bits, run.warmup, run.repetitions, run.alu_taps);
   out << "note: " << run.note << "\n";
   out << "figures are medians ±spread (interquartile range); a rank is 1 + the variants of the same convention, "
          "format, resolution and regime that are faster by more than the spread; '=' marks a rank shared with "
@@ -46,8 +47,8 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
 }
 
 void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
-  std::vector<TextTable::Column> columns = {{"variant", Align::kLeft}, {"convention", Align::kLeft},
-                                            {"format", Align::kLeft}};
+  std::vector<TextTable::Column> columns = {
+      {"variant", Align::kLeft}, {"convention", Align::kLeft}, {"format", Align::kLeft}};
   for (const Resolution& r : results.run.resolutions) {
     columns.push_back({fmt::format("{} mem ns/px", ResolutionName(r))});
     columns.push_back({"rank"});
@@ -148,11 +149,11 @@ void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
                     fmt::format("{}", p.nonfinite)});
     }
   }
-  out << fmt::format("The trade at {} (ALU-bound GPU cost) and on the CPU: cost against p99.9 bits lost ({} "
-                     "backend, {}); * = on the Pareto front (no variant is as cheap, to the spread, and as "
-                     "accurate, to 1/4 bit, and better in one)\n",
-                     ResolutionName(results.run.trade_resolution), results.run.accuracy_backend,
-                     results.run.accuracy_source);
+  out << fmt::format(
+      "The trade at {} (ALU-bound GPU cost) and on the CPU: cost against p99.9 bits lost ({} "
+      "backend, {}); * = on the Pareto front (no variant is as cheap, to the spread, and as "
+      "accurate, to 1/4 bit, and better in one)\n",
+      ResolutionName(results.run.trade_resolution), results.run.accuracy_backend, results.run.accuracy_source);
   table.Print(out);
   out << "\n";
 }

@@ -64,9 +64,7 @@ const char* OrderingName(Ordering ordering) {
   return "?";
 }
 
-double ComparisonSpread(const TimingSummary& a, const TimingSummary& b) {
-  return std::max(a.spread(), b.spread());
-}
+double ComparisonSpread(const TimingSummary& a, const TimingSummary& b) { return std::max(a.spread(), b.spread()); }
 
 Ordering Compare(const TimingSummary& a, const TimingSummary& b) {
   const double difference = a.median - b.median;

@@ -61,9 +61,9 @@ std::vector<TradeFront> BuildTrade(const SpeedResults& speed, const Results& acc
     const CellResult* errors = accuracy.Find(cell, backend);
     const CpuCost* cpu = speed.FindCpu(cell);
     if (errors == nullptr || cpu == nullptr) {
-      left_out.push_back(fmt::format("{}: no {} in the trade", cell.Name(),
-                                     errors == nullptr ? "accuracy result of the " + backend + " backend"
-                                                       : std::string("CPU cost")));
+      left_out.push_back(
+          fmt::format("{}: no {} in the trade", cell.Name(),
+                      errors == nullptr ? "accuracy result of the " + backend + " backend" : std::string("CPU cost")));
       continue;
     }
     TradePoint point;

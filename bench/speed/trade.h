@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "bench/base/status.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 

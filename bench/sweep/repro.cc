@@ -4,10 +4,10 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/stats.h"
-#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 namespace {
@@ -34,8 +34,8 @@ const char* PickName(DepthPick p) {
 
 }  // namespace
 
-Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain,
-                          std::span<const Cell> cells, std::span<Backend* const> backends) {
+Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain, std::span<const Cell> cells,
+                          std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(domain.Validate());
   const Sampler sampler(seed, domain);
   DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(sampler, index, cells, backends));
@@ -107,9 +107,10 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
 void PrintRepro(const Repro& repro, std::ostream& out) {
   out << fmt::format("{}\n{}\n{}\n", repro.origin, repro.frame, repro.sample);
   for (const ReproCell& c : repro.cells) {
-    out << fmt::format("\n{}: stored 0x{:08x} (fetched as {:.9g}); true eye depth {:.17g}, stored value denotes "
-                       "{:.17g} (storage error {:.3g}); {}\n",
-                       c.cell.Name(), c.code, c.fetched, c.true_depth, c.denoted_depth, c.storage, c.status);
+    out << fmt::format(
+        "\n{}: stored 0x{:08x} (fetched as {:.9g}); true eye depth {:.17g}, stored value denotes "
+        "{:.17g} (storage error {:.3g}); {}\n",
+        c.cell.Name(), c.code, c.fetched, c.true_depth, c.denoted_depth, c.storage, c.status);
     for (const ReproCellOutput& o : c.outputs) {
       out << fmt::format("  {:>6}: ({:.9g}, {:.9g}, {:.9g})", o.backend, o.position[0], o.position[1], o.position[2]);
       if (o.nan || o.inf) {
@@ -145,15 +146,15 @@ nlohmann::json ReproToJson(const Repro& repro) {
                      {"status", c.status},
                      {"outputs", outputs}});
   }
-  return {{"seed", repro.seed}, {"index", repro.index}, {"frame", repro.frame}, {"sample", repro.sample},
-          {"cells", cells}};
+  return {
+      {"seed", repro.seed}, {"index", repro.index}, {"frame", repro.frame}, {"sample", repro.sample}, {"cells", cells}};
 }
 
 std::string ReproCommand(std::uint64_t seed, std::uint64_t index, const Domain& domain, const Cell& cell,
                          const std::string& backend) {
   return fmt::format("depthbench run --seed {} --index {} --backend {} --variant {} --convention {} --format {} {}",
-                     seed, index, backend, Info(cell.variant).name, Info(cell.convention).name,
-                     Info(cell.format).name, domain.ToFlags());
+                     seed, index, backend, Info(cell.variant).name, Info(cell.convention).name, Info(cell.format).name,
+                     domain.ToFlags());
 }
 
 }  // namespace depthbench

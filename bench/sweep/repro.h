@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 #include "bench/pipeline/sampler.h"
-#include "bench/base/status.h"
 
 namespace depthbench {
 
@@ -47,8 +47,8 @@ struct Repro {
   std::vector<ReproCell> cells;
 };
 
-Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain,
-                          std::span<const Cell> cells, std::span<Backend* const> backends);
+Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain, std::span<const Cell> cells,
+                          std::span<Backend* const> backends);
 // The same for sample `index` of any source (a reproducer file's case).
 Expected<Repro> ReproduceFrom(const SampleSource& source, std::uint64_t index, std::span<const Cell> cells,
                               std::span<Backend* const> backends);

@@ -8,12 +8,12 @@
 
 #include <fmt/format.h>
 
-#include "bench/pipeline/batch.h"
 #include "bench/base/environment.h"
-#include "bench/pipeline/judge.h"
-#include "bench/pipeline/sampler.h"
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
+#include "bench/pipeline/batch.h"
+#include "bench/pipeline/judge.h"
+#include "bench/pipeline/sampler.h"
 
 namespace depthbench {
 
@@ -62,8 +62,7 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
   for (const Cell& cell : cells) {
     const ConventionInfo& c = Info(cell.convention);
     const DepthInput stores = Info(cell.format).stores;
-    bool needs_finite = (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) ||
-                        stores == DepthInput::kLinear;
+    bool needs_finite = (c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) == 0u) || stores == DepthInput::kLinear;
     bool needs_infinite = c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) != 0u;
     if (needs_finite && !domain.finite_far) continue;
     if (needs_infinite && !domain.infinite_far) continue;
@@ -78,9 +77,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
   if (!ProcessorRuns(options.isa)) return Unavailable("this processor does not run the requested instruction set");
   const std::vector<Cell> all = AllCells();
-  const std::vector<Cell> cells =
-      CellsForDomain(options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells),
-                     options.domain);
+  const std::vector<Cell> cells = CellsForDomain(
+      options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells), options.domain);
   if (cells.empty()) {
     return InvalidArgument(
         "none of the selected cells can run in this domain (finite-far conventions and linear formats need "
@@ -123,9 +121,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // this order, and the small ones at the end even out the finish.
   std::vector<std::uint32_t> slot_order(slot_count);
   std::iota(slot_order.begin(), slot_order.end(), 0u);
-  std::stable_sort(slot_order.begin(), slot_order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return cells_of_slot[a].size() > cells_of_slot[b].size();
-  });
+  std::stable_sort(slot_order.begin(), slot_order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return cells_of_slot[a].size() > cells_of_slot[b].size(); });
   std::vector<std::uint32_t> every_cell(cell_count);
   std::iota(every_cell.begin(), every_cell.end(), 0u);
 

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "bench/backends/backend.h"
+#include "bench/base/isa.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
-#include "bench/base/isa.h"
 #include "bench/results/results.h"
 
 namespace depthbench {
@@ -33,10 +33,10 @@ struct SweepOptions {
   std::uint64_t samples = 1'000'000;  // of the whole sweep (all shards)
   Shard shard;
   Domain domain;
-  std::vector<Cell> cells;            // empty: every cell the domain allows
+  std::vector<Cell> cells;  // empty: every cell the domain allows
   std::uint32_t batch_size = 16384;
-  unsigned threads = 0;               // 0: one per hardware thread
-  Isa isa = Isa::kWidest;             // of the hot loops (bench/base/isa.h): the same results whatever it is
+  unsigned threads = 0;    // 0: one per hardware thread
+  Isa isa = Isa::kWidest;  // of the hot loops (bench/base/isa.h): the same results whatever it is
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

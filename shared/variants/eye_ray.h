@@ -11,9 +11,9 @@
 // general form and makes the signs come out right in our space.
 // No include guard: see compat.h. Needs params.h, screen.h.
 DB_FN vec3 eye_ray_world_position(FrameParams frame, DepthParams depth, vec2 uv, real stored) {
-  vec3 ray_view = interpolate_screen_attribute(frame.eye_ray_view_origin, frame.eye_ray_view_du,
-                                               frame.eye_ray_view_dv, uv);
-  vec3 ray_world = interpolate_screen_attribute(frame.eye_ray_world_origin, frame.eye_ray_world_du,
-                                                frame.eye_ray_world_dv, uv);
+  vec3 ray_view =
+      interpolate_screen_attribute(frame.eye_ray_view_origin, frame.eye_ray_view_du, frame.eye_ray_view_dv, uv);
+  vec3 ray_world =
+      interpolate_screen_attribute(frame.eye_ray_world_origin, frame.eye_ray_world_du, frame.eye_ray_world_dv, uv);
   return ray_world * (stored / ray_view.z) + db_xyz(frame.camera_position);
 }

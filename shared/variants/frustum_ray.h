@@ -9,7 +9,6 @@
 // add to the camera position rounds in world space.
 // No include guard: see compat.h. Needs params.h, screen.h.
 DB_FN vec3 frustum_ray_world_position(FrameParams frame, DepthParams depth, vec2 uv, real stored) {
-  vec3 ray = interpolate_screen_attribute(frame.frustum_ray_origin, frame.frustum_ray_du,
-                                          frame.frustum_ray_dv, uv);
+  vec3 ray = interpolate_screen_attribute(frame.frustum_ray_origin, frame.frustum_ray_du, frame.frustum_ray_dv, uv);
   return db_xyz(frame.camera_position) + stored * ray;
 }

@@ -65,8 +65,7 @@ void RunCell(const Batch& batch, const CellPlan& plan, float* out) {
       }
       const Float8::Lanes x = __builtin_convertvector(pixels & 0xffffu, Float8::Lanes);
       const Float8::Lanes y = __builtin_convertvector(pixels >> 16, Float8::Lanes);
-      const f32x8::vec2 uv =
-          f32x8::uv_from_pixel(Float8::FromLanes(x), Float8::FromLanes(y), frame.resolution);
+      const f32x8::vec2 uv = f32x8::uv_from_pixel(Float8::FromLanes(x), Float8::FromLanes(y), frame.resolution);
       const f32x8::vec3 p = Reconstruct(frame, depth, uv, Float8::FromLanes(stored));
       const std::size_t count = batch.count;
       if (n == kLanes) {

@@ -12,8 +12,8 @@
 
 #include <fmt/format.h>
 
-#include "bench/numerics/formulas.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/numerics/formulas.h"
 
 namespace depthbench {
 namespace {
@@ -42,10 +42,12 @@ static_assert(kSamplesPerFrame % kCpuSamplesPerInvocation == 0);
 // `options` may request either number (0: by device type).
 Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, const BackendOptions& options) {
   const bool cpu = type == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const std::uint32_t per_invocation =
-      options.samples_per_invocation != 0 ? options.samples_per_invocation : cpu ? kCpuSamplesPerInvocation : 1;
-  const std::uint32_t frames =
-      options.frames_per_workgroup != 0 ? options.frames_per_workgroup : cpu ? kCpuFramesPerWorkgroup : 1;
+  const std::uint32_t per_invocation = options.samples_per_invocation != 0 ? options.samples_per_invocation
+                                       : cpu                               ? kCpuSamplesPerInvocation
+                                                                           : 1;
+  const std::uint32_t frames = options.frames_per_workgroup != 0 ? options.frames_per_workgroup
+                               : cpu                             ? kCpuFramesPerWorkgroup
+                                                                 : 1;
   if (kSamplesPerFrame % per_invocation != 0) {
     return InvalidArgument(fmt::format("{} samples per invocation do not divide the {} samples of a frame",
                                        per_invocation, kSamplesPerFrame));
@@ -92,9 +94,11 @@ std::size_t DepthSlotsOf(const Batch& batch) { return batch.depths.size() / batc
 
 // Bytes each binding holds for a batch of `cells` cells.
 BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t cells) {
-  return {batch.frame_params.size() * sizeof(f32::FrameParams), batch.depth_params.size() * sizeof(f32::DepthParams),
+  return {batch.frame_params.size() * sizeof(f32::FrameParams),
+          batch.depth_params.size() * sizeof(f32::DepthParams),
           std::size_t{slices.length} * sizeof(std::uint32_t),
-          DepthSlotsOf(batch) * slices.length * sizeof(float), cells * sizeof(f32::CellSlice),
+          DepthSlotsOf(batch) * slices.length * sizeof(float),
+          cells * sizeof(f32::CellSlice),
           cells * 3 * slices.length * sizeof(float)};
 }
 
@@ -187,7 +191,7 @@ class VulkanBackend final : public Backend {
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
-  BackendOptions options_;                // the requested pass shape (PassShapeFor)
+  BackendOptions options_;                   // the requested pass shape (PassShapeFor)
   PassShape shape_{kSamplesPerFrame, 1, 1};  // of the prepared pipelines
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
@@ -221,8 +225,7 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
   std::filesystem::path shader_dir = options.shader_dir.empty()
                                          ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
                                          : std::filesystem::path(options.shader_dir);
-  std::unique_ptr<VulkanBackend> backend(
-      new VulkanBackend(std::move(context), std::move(shader_dir), options));
+  std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir), options));
   const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
   Status status = backend->CreateDescriptorObjects();
   if (status.ok()) status = backend->CreateCommandObjects();
@@ -289,8 +292,8 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant,
                                sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kFramesPerWorkgroupConstant, offsetof(PassShape, frames_per_workgroup),
                                sizeof(std::uint32_t)}};
-  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(),
-                                            sizeof(shape), &shape};
+  const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(shape),
+                                            &shape};
   return context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
                                          fmt::format("'{}'", path.string()));
 }

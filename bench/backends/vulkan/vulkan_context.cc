@@ -35,7 +35,6 @@ bool ValidationRequestedByEnvironment() {
   return value != nullptr && std::string_view(value) == "1";
 }
 
-
 VKAPI_ATTR VkBool32 VKAPI_CALL RecordValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                        VkDebugUtilsMessageTypeFlagsEXT,
                                                        const VkDebugUtilsMessengerCallbackDataEXT* data,
@@ -550,8 +549,8 @@ Expected<DeviceObject<VkPipeline>> VulkanContext::CreateComputePipeline(std::spa
   module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
   module_info.pCode = spirv.data();
   VkShaderModule module = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateShaderModule(device_, &module_info, nullptr, &module),
-                             "vkCreateShaderModule for " + what));
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateShaderModule(device_, &module_info, nullptr, &module), "vkCreateShaderModule for " + what));
   // The pipeline keeps what it needs; the module goes when this returns.
   const DeviceObject<VkShaderModule> module_owner(device_, module, vkDestroyShaderModule);
 
