@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backends/backend.h"
+#include "bench/backends/factory.h"
 #include "bench/choose/choose.h"
 #include "bench/fit/precision_fit.h"
 #include "tests/command_runner.h"

@@ -84,7 +84,7 @@ class NonFinitePatternBackend final : public Backend {
   const DeviceInfo& device() const override { return device_; }
   bool concurrent() const override { return true; }
   Status Prepare(std::span<const CellPlan>, PassKind) override { return Status::Ok(); }
-  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+  Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override {
     constexpr float kInf = std::numeric_limits<float>::infinity(), kNan = std::numeric_limits<float>::quiet_NaN();
     constexpr float kPatterns[4][3] = {{kInf, -kInf, 1}, {kNan, 1, 1}, {-kInf, kNan, kInf}, {1, 2, 3}};

@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backends/backend.h"
+#include "bench/backends/factory.h"
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"

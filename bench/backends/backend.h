@@ -2,7 +2,7 @@
 // never judges (the judge and the reference know nothing of backends).
 //
 // Lifecycle:
-//   1. create it for a device (MakeBackend below, or a backend's own
+//   1. create it for a device (MakeBackend in factory.h, or a backend's own
 //      factory that accepts an existing device);
 //   2. Prepare(cells) once: whatever running those cells needs (the Vulkan
 //      backend compiles the shaders and builds pipelines here);
@@ -20,18 +20,11 @@
 #include <string>
 #include <vector>
 
+#include "bench/backends/device_info.h"
 #include "bench/base/status.h"
-#include "bench/pipeline/batch.h"
+#include "bench/pipeline/shader_inputs.h"
 
 namespace depthbench {
-
-struct DeviceInfo {
-  std::string name;      // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
-  std::string driver;    // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
-  std::string api;       // "Vulkan 1.3.230"
-  std::string kind;      // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
-  std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
-};
 
 enum class PassKind { kCompute };
 
@@ -49,7 +42,7 @@ class Backend {
   // element ((k * 3 + c) * batch.count + i) is component c (x, y, z) of
   // sample i for the k-th listed cell. The storage is `scratch` or the
   // backend's own, valid until the next Run on the same thread.
-  virtual Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+  virtual Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch) = 0;
 
   // Whether Run may be called from several threads at once (with disjoint
@@ -68,8 +61,5 @@ struct BackendOptions {
   std::uint32_t samples_per_invocation = 0;
   std::uint32_t frames_per_workgroup = 0;
 };
-
-// "cpu" or "vulkan".
-Expected<std::unique_ptr<Backend>> MakeBackend(const std::string& name, const BackendOptions& options);
 
 }  // namespace depthbench

@@ -1,5 +1,5 @@
-// MakeBackend: the one place that maps a backend's name to its factory.
-#include "bench/backends/backend.h"
+#include "bench/backends/factory.h"
+
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 

@@ -13,11 +13,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backends/backend.h"
 #include "bench/choose/scene.h"
 #include "bench/fit/error_model.h"
 
 namespace depthbench {
+
+class Backend;  // bench/backends/backend.h
 
 // The cost of a candidate, in one unit for the whole ranking.
 struct CandidateCost {

@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/factory.h"
+
 namespace depthbench::cli {
 
 void DomainFlags::Add(CLI::App& app) {

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/factory.h"
+
 #include "bench/base/files.h"
 #include "bench/base/progress.h"
 #include "bench/choose/choose.h"

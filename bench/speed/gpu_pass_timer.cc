@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/speed/timing_stats.h"
 
@@ -94,32 +95,19 @@ Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<Vul
     return NotFound(fmt::format("speed shader directory '{}' does not exist", (shader_dir / "speed").string()));
   }
   std::unique_ptr<GpuPassTimer> timer(new GpuPassTimer(std::move(context), std::move(shader_dir)));
-  const std::uint64_t errors_before = timer->context_->validation_log()->error_count();
-  DB_RETURN_IF_ERROR(timer->CreateLayouts());
-  DB_RETURN_IF_ERROR(timer->CreateCommandObjects());
-  DB_RETURN_IF_ERROR(timer->CheckValidation(errors_before, "creating the GPU pass timer"));
-  return timer;
-}
-
-GpuPassTimer::~GpuPassTimer() {
-  if (context_->queue() != VK_NULL_HANDLE) vkQueueWaitIdle(context_->queue());
-  if (command_buffer_ != VK_NULL_HANDLE) {
-    vkFreeCommandBuffers(vk_device(), context_->command_pool(), 1, &command_buffer_);
-  }
-}
-
-Status GpuPassTimer::CreateLayouts() {
+  const ValidationScope validation(*timer->context_);
   const std::array<VkDescriptorSetLayoutBinding, 3> bindings = {{
       {kConstantsBinding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
       {kImageBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
       {kResultsBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
   }};
-  DB_ASSIGN_OR_RETURN(ComputeLayout layout, context_->CreateComputeLayout(bindings, sizeof(PassSize)));
-  set_layout_ = std::move(layout.set_layout);
-  pipeline_layout_ = std::move(layout.pipeline_layout);
-  descriptor_pool_ = std::move(layout.pool);
-  descriptor_set_ = layout.set;
+  DB_ASSIGN_OR_RETURN(timer->pass_, ComputePass::Create(timer->context_, bindings, sizeof(PassSize)));
+  DB_RETURN_IF_ERROR(timer->CreateSampler());
+  DB_RETURN_IF_ERROR(validation.Check("the creation of the GPU pass timer"));
+  return timer;
+}
 
+Status GpuPassTimer::CreateSampler() {
   // texelFetch ignores filtering and addressing; the sampler only has to exist.
   VkSamplerCreateInfo sampler_info{};
   sampler_info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
@@ -134,8 +122,6 @@ Status GpuPassTimer::CreateLayouts() {
   sampler_ = DeviceObject<VkSampler>(vk_device(), sampler, vkDestroySampler);
   return Status::Ok();
 }
-
-Status GpuPassTimer::CreateCommandObjects() { return context_->CreateCommandObjects(command_buffer_, fence_); }
 
 Status GpuPassTimer::CheckFormat(Format format) const {
   VkFormatProperties properties{};
@@ -160,9 +146,9 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
   }};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(values),
                                             values.data()};
-  DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
-                      context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
-                                                      fmt::format("the {} speed pass", Info(variant).name)));
+  DB_ASSIGN_OR_RETURN(
+      DeviceObject<VkPipeline> pipeline,
+      pass_->CreatePipeline(spirv, specialization, fmt::format("the {} speed pass", Info(variant).name)));
   auto& stored = pipelines_[key];
   stored = std::move(pipeline);
   return stored.get();
@@ -183,17 +169,6 @@ Expected<DeviceObject<VkDeviceMemory>> GpuPassTimer::AllocateDeviceLocal(
   DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(vk_device(), &allocate_info, nullptr, &memory),
                              fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
   return DeviceObject<VkDeviceMemory>(vk_device(), memory, vkFreeMemory);
-}
-
-template <class Record>
-Status GpuPassTimer::Submit(Record record) {
-  VkCommandBufferBeginInfo begin_info{};
-  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
-  record(command_buffer_);
-  DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer"));
-  return context_->SubmitAndWait(command_buffer_, fence_);
 }
 
 Status GpuPassTimer::CreateImage(const DepthImage& image) {
@@ -239,7 +214,7 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
       context_->CreateHostBuffer(image.texels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, HostAccess::kUpload));
   std::memcpy(staging.mapped(), image.texels.data(), image.texels.size());
   DB_RETURN_IF_ERROR(staging.FlushHostWrites());
-  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
     VkImageMemoryBarrier to_transfer{};
     to_transfer.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
     to_transfer.srcAccessMask = 0;
@@ -306,11 +281,6 @@ void GpuPassTimer::WriteDescriptors() {
   const VkDescriptorImageInfo image_info{sampler_.get(), image_view_.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   const VkDescriptorBufferInfo results_info{result_buffer_.get(), 0, result_bytes_};
   std::array<VkWriteDescriptorSet, 3> writes{};
-  for (VkWriteDescriptorSet& write : writes) {
-    write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    write.dstSet = descriptor_set_;
-    write.descriptorCount = 1;
-  }
   writes[0].dstBinding = kConstantsBinding;
   writes[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   writes[0].pBufferInfo = &constants_info;
@@ -320,11 +290,11 @@ void GpuPassTimer::WriteDescriptors() {
   writes[2].dstBinding = kResultsBinding;
   writes[2].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   writes[2].pBufferInfo = &results_info;
-  vkUpdateDescriptorSets(vk_device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  pass_->WriteDescriptors(writes);
 }
 
 Status GpuPassTimer::LoadImage(const DepthImage& image) {
-  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const ValidationScope validation(*context_);
   loaded_ = false;
   resolution_ = image.resolution;
   const std::size_t expected =
@@ -346,23 +316,21 @@ Status GpuPassTimer::LoadImage(const DepthImage& image) {
   std::memcpy(constants_.mapped(), &constants, sizeof(constants));
   DB_RETURN_IF_ERROR(constants_.FlushHostWrites());
   WriteDescriptors();
-  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "loading the depth image"));
+  DB_RETURN_IF_ERROR(validation.Check("the loading of the depth image"));
   encoding_ = image.encoding;
   loaded_ = true;
   return Status::Ok();
 }
 
-void GpuPassTimer::RecordPasses(VkPipeline pipeline, std::uint32_t passes) {
-  vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
-                          &descriptor_set_, 0, nullptr);
+void GpuPassTimer::RecordPasses(VkCommandBuffer commands, VkPipeline pipeline, std::uint32_t passes) const {
+  pass_->Bind(commands, pipeline);
   const PassSize size{resolution_.width, resolution_.height};
-  vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(size), &size);
+  pass_->PushConstants(commands, &size, sizeof(size));
   for (std::uint32_t pass = 0; pass < passes; ++pass) {
-    vkCmdDispatch(command_buffer_, GroupsFor(resolution_.width), GroupsFor(resolution_.height), 1);
+    vkCmdDispatch(commands, GroupsFor(resolution_.width), GroupsFor(resolution_.height), 1);
     // Each pass waits for the one before, and the next submission's passes
     // for the last: they all write the same results.
-    ComputeToComputeBarrier(command_buffer_);
+    ComputeToComputeBarrier(commands);
   }
 }
 
@@ -381,12 +349,12 @@ Expected<std::vector<double>> GpuPassTimer::TimeGroups(std::span<const Group> gr
     query_capacity_ = queries;
   }
   const VkQueryPool pool = query_pool_.get();
-  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
     vkCmdResetQueryPool(commands, pool, 0, queries);
     for (std::uint32_t g = 0; g < groups.size(); ++g) {
       // Bottom of pipe: written once everything recorded before has finished.
       vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g);
-      RecordPasses(groups[g].pipeline, groups[g].passes);
+      RecordPasses(commands, groups[g].pipeline, groups[g].passes);
       vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g + 1);
     }
   }));
@@ -430,7 +398,7 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   if (warmup == 0 || repetitions == 0) {
     return InvalidArgument("a timed pass needs at least one warm-up pass and one repetition");
   }
-  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const ValidationScope validation(*context_);
   const std::size_t count = variants.size();
   std::vector<VkPipeline> pipelines;
   for (const Variant variant : variants) {
@@ -461,9 +429,9 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   if (warmed_ns < kMinWarmupNs) {
     const auto rounds = static_cast<std::uint32_t>(std::min<double>(
         std::ceil((kMinWarmupNs - warmed_ns) / round_ns), static_cast<double>(kMaxExtraWarmupPasses / count)));
-    DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer) {
+    DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
       for (std::uint32_t round = 0; round < rounds; ++round) {
-        for (const VkPipeline pipeline : pipelines) RecordPasses(pipeline, 1);
+        for (const VkPipeline pipeline : pipelines) RecordPasses(commands, pipeline, 1);
       }
     }));
     for (PassTiming& timing : timings) timing.warmup_passes += rounds;
@@ -481,7 +449,7 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   for (std::uint32_t round = 0; round < repetitions; ++round) {
     for (std::size_t v = 0; v < count; ++v) timings[v].ns_per_pass.push_back(timed[round * count + v]);
   }
-  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "timing passes"));
+  DB_RETURN_IF_ERROR(validation.Check("the timing of passes"));
   return timings;
 }
 
@@ -489,7 +457,7 @@ Expected<std::vector<float>> GpuPassTimer::ReadResults() {
   if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
   DB_ASSIGN_OR_RETURN(VulkanBuffer readback, context_->CreateHostBuffer(result_bytes_, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                                                         HostAccess::kReadback));
-  DB_RETURN_IF_ERROR(Submit([&](VkCommandBuffer commands) {
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
     VkMemoryBarrier to_transfer{};
     to_transfer.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
     to_transfer.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -509,14 +477,6 @@ Expected<std::vector<float>> GpuPassTimer::ReadResults() {
   std::vector<float> values(result_bytes_ / sizeof(float));
   std::memcpy(values.data(), readback.mapped(), result_bytes_);
   return values;
-}
-
-Status GpuPassTimer::CheckValidation(std::uint64_t errors_before, const std::string& during) const {
-  const std::shared_ptr<ValidationLog> log = context_->validation_log();
-  const std::uint64_t errors = log->error_count() - errors_before;
-  if (errors == 0) return Status::Ok();
-  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) while {}; the last: {}", errors, during,
-                              log->last_error()));
 }
 
 }  // namespace depthbench

@@ -38,6 +38,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
@@ -69,7 +70,6 @@ class GpuPassTimer {
 
   static Expected<std::unique_ptr<GpuPassTimer>> Create(std::shared_ptr<VulkanContext> context,
                                                         std::filesystem::path shader_dir);
-  ~GpuPassTimer();
   GpuPassTimer(const GpuPassTimer&) = delete;
   GpuPassTimer& operator=(const GpuPassTimer&) = delete;
 
@@ -95,18 +95,14 @@ class GpuPassTimer {
   explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
   VkDevice vk_device() const { return context_->device(); }
 
-  Status CreateLayouts();
-  Status CreateCommandObjects();
+  Status CreateSampler();
   Expected<VkPipeline> Pipeline(Variant variant, Convention convention, std::uint32_t taps);
   Expected<DeviceObject<VkDeviceMemory>> AllocateDeviceLocal(const VkMemoryRequirements& requirements) const;
   Status CreateImage(const DepthImage& image);
   Status CreateResultBuffer(VkDeviceSize bytes);
   void WriteDescriptors();
-  // Records `record` into the command buffer, submits it and waits.
-  template <class Record>
-  Status Submit(Record record);
   // `passes` passes of `pipeline` with barriers between them.
-  void RecordPasses(VkPipeline pipeline, std::uint32_t passes);
+  void RecordPasses(VkCommandBuffer commands, VkPipeline pipeline, std::uint32_t passes) const;
   // A group: `passes` back-to-back passes of one pipeline.
   struct Group {
     VkPipeline pipeline;
@@ -114,18 +110,14 @@ class GpuPassTimer {
   };
   // Times the groups in order, in one submission; ns per pass per group.
   Expected<std::vector<double>> TimeGroups(std::span<const Group> groups);
-  Status CheckValidation(std::uint64_t errors_before, const std::string& during) const;
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
 
-  DeviceObject<VkDescriptorSetLayout> set_layout_;
-  DeviceObject<VkPipelineLayout> pipeline_layout_;
-  DeviceObject<VkDescriptorPool> descriptor_pool_;
-  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;  // freed with the pool
+  // The constants, the image and the results of speed_pass.glsl; the pass
+  // size pushed.
+  std::unique_ptr<ComputePass> pass_;
   DeviceObject<VkSampler> sampler_;
-  DeviceObject<VkFence> fence_;
-  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // from the context's pool; the destructor frees it
   DeviceObject<VkQueryPool> query_pool_;
   std::uint32_t query_capacity_ = 0;
 

@@ -140,11 +140,7 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
   run.started_at = CurrentTimeUtc();
   run.host = HostName();
   const VulkanDeviceProperties& device = timer.device();
-  run.device.name = device.name;
-  run.device.driver = device.DriverString();
-  run.device.api = "Vulkan " + VulkanVersionString(device.api_version);
-  run.device.kind = device.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu";
-  run.device.compiler = GlslangVersion();
+  run.device = DeviceInfoOf(device);
   run.device_type = DeviceTypeName(device.type);
   run.timestamp_period_ns = device.limits.timestampPeriod;
   run.timestamp_valid_bits = device.queue_timestamp_valid_bits;

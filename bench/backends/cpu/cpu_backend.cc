@@ -38,7 +38,7 @@ f32x8::DepthParams Widen(const f32::DepthParams& narrow) {
 // Frame by frame (the frame's constants are uniform), eight samples at a
 // time in the lanes of the f32x8 instantiation.
 template <f32x8::WorldPositionFn Reconstruct>
-void RunCell(const Batch& batch, const CellPlan& plan, float* out) {
+void RunCell(const ShaderInputs& batch, const CellPlan& plan, float* out) {
   constexpr int kLanes = Float8::kLanes;
   const float* depths = batch.depths.data() + static_cast<std::size_t>(plan.depth_slot) * batch.count;
   for (std::uint32_t begin = 0; begin < batch.count;) {
@@ -84,7 +84,7 @@ void RunCell(const Batch& batch, const CellPlan& plan, float* out) {
   }
 }
 
-using CellRunner = void (*)(const Batch&, const CellPlan&, float*);
+using CellRunner = void (*)(const ShaderInputs&, const CellPlan&, float*);
 
 CellRunner RunnerFor(Variant v) {
   switch (v) {
@@ -123,7 +123,7 @@ class CpuBackend final : public Backend {
     return Status::Ok();
   }
 
-  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+  Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override {
     const std::size_t per_cell = static_cast<std::size_t>(batch.count) * 3;
     scratch.resize(per_cell * which.size());

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/numerics/formulas.h"
 
@@ -55,7 +56,7 @@ Expected<PassShape> PassShapeFor(VkPhysicalDeviceType type, const BackendOptions
   return PassShape{kSamplesPerFrame / per_invocation, per_invocation, frames};
 }
 
-std::uint32_t WorkgroupsFor(const Batch& batch, const PassShape& shape) {
+std::uint32_t WorkgroupsFor(const ShaderInputs& batch, const PassShape& shape) {
   return static_cast<std::uint32_t>((batch.frame_count() + shape.frames_per_workgroup - 1) /
                                     shape.frames_per_workgroup);
 }
@@ -70,9 +71,9 @@ std::uint32_t WorkgroupsFor(const Batch& batch, const PassShape& shape) {
 struct SliceLayout {
   std::uint32_t lead = 0;
   std::uint32_t length = 0;
-  bool compact(const Batch& batch) const { return lead == 0 && length == batch.count; }
+  bool compact(const ShaderInputs& batch) const { return lead == 0 && length == batch.count; }
 };
-SliceLayout SliceLayoutFor(const Batch& batch, const PassShape& shape) {
+SliceLayout SliceLayoutFor(const ShaderInputs& batch, const PassShape& shape) {
   if (shape.samples_per_invocation % 4 != 0) return {0, batch.count};
   const std::uint32_t lead = batch.first_offset % 4;
   return {lead, (lead + batch.count + 3) / 4 * 4};
@@ -90,10 +91,10 @@ enum Binding : std::uint32_t {
 };
 using BindingBytes = std::array<VkDeviceSize, kBindingCount>;
 
-std::size_t DepthSlotsOf(const Batch& batch) { return batch.depths.size() / batch.count; }
+std::size_t DepthSlotsOf(const ShaderInputs& batch) { return batch.depths.size() / batch.count; }
 
 // Bytes each binding holds for a batch of `cells` cells.
-BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t cells) {
+BindingBytes BytesFor(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) {
   return {batch.frame_params.size() * sizeof(f32::FrameParams),
           batch.depth_params.size() * sizeof(f32::DepthParams),
           std::size_t{slices.length} * sizeof(std::uint32_t),
@@ -104,7 +105,7 @@ BindingBytes BytesFor(const Batch& batch, const SliceLayout& slices, std::size_t
 
 // The push constants of a dispatch whose cells start at CellSlice entry
 // `first_cell`.
-f32::PassConstants PassConstantsFor(const Batch& batch, const SliceLayout& slices, std::uint32_t first_cell) {
+f32::PassConstants PassConstantsFor(const ShaderInputs& batch, const SliceLayout& slices, std::uint32_t first_cell) {
   return {.slice_length = slices.length,
           .samples_per_frame = kSamplesPerFrame,
           .conventions_per_frame = kHardwareConventionCount,
@@ -152,7 +153,6 @@ class VulkanBackend final : public Backend {
  public:
   static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
                                                    const BackendOptions& options);
-  ~VulkanBackend() override;
 
   std::string name() const override { return "vulkan"; }
   const DeviceInfo& device() const override { return device_; }
@@ -160,34 +160,27 @@ class VulkanBackend final : public Backend {
   bool concurrent() const override { return false; }
 
   Status Prepare(std::span<const CellPlan> cells, PassKind pass) override;
-  Expected<std::span<const float>> Run(const Batch& batch, std::span<const std::uint32_t> which,
+  Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override;
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
                 const BackendOptions& options);
 
-  VkDevice vk_device() const { return context_->device(); }
   std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
-
-  // The objects every run uses, whatever the cells.
-  Status CreateDescriptorObjects();
-  Status CreateCommandObjects();
 
   Status PrepareOnDevice(std::span<const CellPlan> cells);
   Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape) const;
 
-  Expected<std::span<const float>> RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+  Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
-  Status CheckRun(const Batch& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
+  Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
-  Status Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+  Status Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
                 std::span<const f32::CellSlice> cell_slices);
   void BindBuffers(const BindingBytes& bytes);
-  Status Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan);
-  Status SubmitAndWait();
-  // Internal when the validation layer reported errors since `errors_before`.
-  Status CheckValidation(std::uint64_t errors_before, std::string_view during) const;
+  void Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
+              const DispatchPlan& plan) const;
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
@@ -196,13 +189,7 @@ class VulkanBackend final : public Backend {
   DeviceInfo device_;
   std::vector<CellPlan> cells_;
 
-  DeviceObject<VkDescriptorSetLayout> set_layout_;
-  DeviceObject<VkPipelineLayout> pipeline_layout_;
-  DeviceObject<VkDescriptorPool> descriptor_pool_;
-  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;  // freed with the pool
-  DeviceObject<VkFence> fence_;
-  // From the context's pool; the destructor frees it.
-  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  std::unique_ptr<ComputePass> pass_;  // the storage buffers of compute_pass.glsl, PassConstants pushed
   // Indexed by Variant; null for variants no prepared cell uses.
   std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines_;
   std::array<VulkanBuffer, kBindingCount> buffers_;
@@ -210,14 +197,10 @@ class VulkanBackend final : public Backend {
 
 VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
                              const BackendOptions& options)
-    : context_(std::move(context)), shader_dir_(std::move(shader_dir)), options_(options) {
-  const VulkanDeviceProperties& properties = context_->properties();
-  device_.name = properties.name;
-  device_.driver = properties.DriverString();
-  device_.api = "Vulkan " + VulkanVersionString(properties.api_version);
-  device_.kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu";
-  device_.compiler = GlslangVersion();
-}
+    : context_(std::move(context)),
+      shader_dir_(std::move(shader_dir)),
+      options_(options),
+      device_(DeviceInfoOf(context_->properties())) {}
 
 Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanContext> context,
                                                          const BackendOptions& options) {
@@ -226,41 +209,22 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
                                          ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
                                          : std::filesystem::path(options.shader_dir);
   std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir), options));
-  const std::uint64_t errors_before = backend->context_->validation_log()->error_count();
-  Status status = backend->CreateDescriptorObjects();
-  if (status.ok()) status = backend->CreateCommandObjects();
-  if (status.ok()) status = backend->CheckValidation(errors_before, "backend creation");
-  if (!status.ok()) return status.WithContext(backend->DeviceContext());
-  return std::unique_ptr<Backend>(std::move(backend));
-}
-
-VulkanBackend::~VulkanBackend() {
-  // A run that failed after submitting may still be executing.
-  if (context_->queue() != VK_NULL_HANDLE) vkQueueWaitIdle(context_->queue());
-  if (command_buffer_ != VK_NULL_HANDLE) {
-    vkFreeCommandBuffers(vk_device(), context_->command_pool(), 1, &command_buffer_);
-  }
-}
-
-Status VulkanBackend::CreateDescriptorObjects() {
+  const ValidationScope validation(*backend->context_);
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   }
-  DB_ASSIGN_OR_RETURN(ComputeLayout layout, context_->CreateComputeLayout(bindings, sizeof(f32::PassConstants)));
-  set_layout_ = std::move(layout.set_layout);
-  pipeline_layout_ = std::move(layout.pipeline_layout);
-  descriptor_pool_ = std::move(layout.pool);
-  descriptor_set_ = layout.set;
-  return Status::Ok();
+  Status status =
+      StoreInto(ComputePass::Create(backend->context_, bindings, sizeof(f32::PassConstants)), backend->pass_);
+  if (status.ok()) status = validation.Check("backend creation");
+  if (!status.ok()) return status.WithContext(backend->DeviceContext());
+  return std::unique_ptr<Backend>(std::move(backend));
 }
 
-Status VulkanBackend::CreateCommandObjects() { return context_->CreateCommandObjects(command_buffer_, fence_); }
-
 Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
-  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const ValidationScope validation(*context_);
   Status status = PrepareOnDevice(cells);
-  if (status.ok()) status = CheckValidation(errors_before, "Prepare");
+  if (status.ok()) status = validation.Check("Prepare");
   return status.WithContext(DeviceContext());
 }
 
@@ -294,32 +258,32 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant,
                                sizeof(std::uint32_t)}};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(shape),
                                             &shape};
-  return context_->CreateComputePipeline(spirv, pipeline_layout_.get(), specialization,
-                                         fmt::format("'{}'", path.string()));
+  return pass_->CreatePipeline(spirv, specialization, fmt::format("'{}'", path.string()));
 }
 
 // The positions stay in the mapped readback buffer when their slices are
 // compact; otherwise they are gathered into `scratch`.
-Expected<std::span<const float>> VulkanBackend::Run(const Batch& batch, std::span<const std::uint32_t> which,
+Expected<std::span<const float>> VulkanBackend::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                     std::vector<float>& scratch) {
   Expected<std::span<const float>> positions = RunOnDevice(batch, which, scratch);
   if (!positions.ok()) return positions.status().WithContext(DeviceContext());
   return positions;
 }
 
-Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, std::span<const std::uint32_t> which,
+Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& batch,
+                                                            std::span<const std::uint32_t> which,
                                                             std::vector<float>& scratch) {
   const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
   if (output_floats == 0) return std::span<const float>();
   const SliceLayout slices = SliceLayoutFor(batch, shape_);
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
-  const std::uint64_t errors_before = context_->validation_log()->error_count();
+  const ValidationScope validation(*context_);
   const DispatchPlan plan = PlanDispatches(cells_, which, slices);
   DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
-  DB_RETURN_IF_ERROR(Record(batch, slices, plan));
-  DB_RETURN_IF_ERROR(SubmitAndWait());
-  DB_RETURN_IF_ERROR(CheckValidation(errors_before, "Run"));
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); }));
+  DB_RETURN_IF_ERROR(buffers_[kPositions].InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(validation.Check("Run"));
   const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
   if (slices.compact(batch)) return std::span<const float>(device_positions, output_floats);
   // Every slice's samples, without the lead and the padding.
@@ -333,7 +297,7 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const Batch& batch, 
 
 // What the shaders would otherwise read or write out of bounds, and what
 // the device cannot address or dispatch.
-Status VulkanBackend::CheckRun(const Batch& batch, std::span<const std::uint32_t> which,
+Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                const BindingBytes& bytes) const {
   const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
   if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
@@ -389,7 +353,7 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
   return Status::Ok();
 }
 
-Status VulkanBackend::Upload(const Batch& batch, const SliceLayout& slices, const BindingBytes& bytes,
+Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
                              std::span<const f32::CellSlice> cell_slices) {
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
@@ -425,54 +389,30 @@ void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     infos[binding] = {buffers_[binding].handle(), 0, bytes[binding]};
-    writes[binding].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[binding].dstSet = descriptor_set_;
     writes[binding].dstBinding = binding;
-    writes[binding].descriptorCount = 1;
     writes[binding].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[binding].pBufferInfo = &infos[binding];
   }
-  vkUpdateDescriptorSets(vk_device(), kBindingCount, writes.data(), 0, nullptr);
+  pass_->WriteDescriptors(writes);
 }
 
-Status VulkanBackend::Record(const Batch& batch, const SliceLayout& slices, const DispatchPlan& plan) {
-  VkCommandBufferBeginInfo begin_info{};
-  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
-  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1,
-                          &descriptor_set_, 0, nullptr);
+void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
+                           const DispatchPlan& plan) const {
   const std::uint32_t groups = WorkgroupsFor(batch, shape_);
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
   for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
-    const VkPipeline pipeline = pipelines_[VariantIndex(dispatch.variant)].get();
-    vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    pass_->Bind(commands, pipelines_[VariantIndex(dispatch.variant)].get());
     const f32::PassConstants constants = PassConstantsFor(batch, slices, dispatch.first_cell);
-    vkCmdPushConstants(command_buffer_, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(constants),
-                       &constants);
-    vkCmdDispatch(command_buffer_, groups, dispatch.cells, 1);
+    pass_->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, groups, dispatch.cells, 1);
   }
   // The host reads the positions once the fence signals.
   VkMemoryBarrier to_host{};
   to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                       &to_host, 0, nullptr, 0, nullptr);
-  return CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer");
-}
-
-Status VulkanBackend::SubmitAndWait() {
-  DB_RETURN_IF_ERROR(context_->SubmitAndWait(command_buffer_, fence_));
-  return buffers_[kPositions].InvalidateForHostReads();
-}
-
-Status VulkanBackend::CheckValidation(std::uint64_t errors_before, std::string_view during) const {
-  const std::shared_ptr<ValidationLog> log = context_->validation_log();
-  const std::uint64_t errors = log->error_count() - errors_before;
-  if (errors == 0) return Status::Ok();
-  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) during {}; the last: {}", errors,
-                              during, log->last_error()));
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                       nullptr, 0, nullptr);
 }
 
 }  // namespace

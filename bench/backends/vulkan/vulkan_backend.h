@@ -1,6 +1,7 @@
 // The Vulkan backend: the shaders/ compute shaders, compiled with glslang at
-// Prepare time and dispatched once per cell over a batch. Inputs go up and
-// positions come back through host-visible buffers; Run waits for the device.
+// Prepare time; a Run dispatches once per variant, each of the variant's
+// cells in a row of workgroups. Inputs go up and positions come back
+// through host-visible buffers; Run waits for the device.
 #pragma once
 
 #include <memory>

@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/shader_compiler.h"
+
 namespace depthbench {
 namespace {
 
@@ -460,112 +462,22 @@ Expected<VulkanBuffer> VulkanContext::CreateHostBuffer(VkDeviceSize size, VkBuff
   return buffer;
 }
 
-Expected<ComputeLayout> VulkanContext::CreateComputeLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                                           std::uint32_t push_constant_bytes) const {
-  ComputeLayout out;
-  VkDescriptorSetLayoutCreateInfo set_layout_info{};
-  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_layout_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
-  set_layout_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(device_, &set_layout_info, nullptr, &set_layout),
-                             "vkCreateDescriptorSetLayout"));
-  out.set_layout = DeviceObject<VkDescriptorSetLayout>(device_, set_layout, vkDestroyDescriptorSetLayout);
-
-  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
-  VkPipelineLayoutCreateInfo pipeline_layout_info{};
-  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-  pipeline_layout_info.setLayoutCount = 1;
-  pipeline_layout_info.pSetLayouts = &set_layout;
-  pipeline_layout_info.pushConstantRangeCount = push_constant_bytes > 0 ? 1 : 0;
-  pipeline_layout_info.pPushConstantRanges = &push_constants;
-  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(device_, &pipeline_layout_info, nullptr, &pipeline_layout),
-                             "vkCreatePipelineLayout"));
-  out.pipeline_layout = DeviceObject<VkPipelineLayout>(device_, pipeline_layout, vkDestroyPipelineLayout);
-
-  // The pool holds exactly what the one set needs, type by type.
-  std::vector<VkDescriptorPoolSize> sizes;
-  for (const VkDescriptorSetLayoutBinding& b : bindings) {
-    auto it = std::find_if(sizes.begin(), sizes.end(), [&](const auto& s) { return s.type == b.descriptorType; });
-    if (it == sizes.end()) {
-      sizes.push_back({b.descriptorType, b.descriptorCount});
-    } else {
-      it->descriptorCount += b.descriptorCount;
-    }
-  }
-  VkDescriptorPoolCreateInfo pool_info{};
-  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
-  pool_info.pPoolSizes = sizes.data();
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorPool(device_, &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
-  out.pool = DeviceObject<VkDescriptorPool>(device_, pool, vkDestroyDescriptorPool);
-
-  VkDescriptorSetAllocateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  set_info.descriptorPool = pool;
-  set_info.descriptorSetCount = 1;
-  set_info.pSetLayouts = &set_layout;
-  DB_RETURN_IF_ERROR(CheckVk(vkAllocateDescriptorSets(device_, &set_info, &out.set), "vkAllocateDescriptorSets"));
-  return out;
+DeviceInfo DeviceInfoOf(const VulkanDeviceProperties& properties) {
+  return {.name = properties.name,
+          .driver = properties.DriverString(),
+          .api = "Vulkan " + VulkanVersionString(properties.api_version),
+          .kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu",
+          .compiler = GlslangVersion()};
 }
 
-Status VulkanContext::CreateCommandObjects(VkCommandBuffer& command_buffer, DeviceObject<VkFence>& fence) const {
-  VkCommandBufferAllocateInfo command_info{};
-  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-  command_info.commandPool = command_pool_;
-  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  command_info.commandBufferCount = 1;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkAllocateCommandBuffers(device_, &command_info, &command_buffer), "vkAllocateCommandBuffers"));
-  VkFenceCreateInfo fence_info{};
-  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VkFence handle = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device_, &fence_info, nullptr, &handle), "vkCreateFence"));
-  fence = DeviceObject<VkFence>(device_, handle, vkDestroyFence);
-  return Status::Ok();
-}
+ValidationScope::ValidationScope(const VulkanContext& context)
+    : log_(context.validation_log()), errors_before_(log_->error_count()) {}
 
-Status VulkanContext::SubmitAndWait(VkCommandBuffer command_buffer, const DeviceObject<VkFence>& fence_object) const {
-  const VkFence fence = fence_object.get();
-  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(device_, 1, &fence), "vkResetFences"));
-  VkSubmitInfo submit{};
-  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &command_buffer;
-  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(queue_, 1, &submit, fence), "vkQueueSubmit"));
-  return CheckVk(vkWaitForFences(device_, 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()),
-                 "vkWaitForFences");
-}
-
-Expected<DeviceObject<VkPipeline>> VulkanContext::CreateComputePipeline(std::span<const std::uint32_t> spirv,
-                                                                        VkPipelineLayout layout,
-                                                                        const VkSpecializationInfo& specialization,
-                                                                        const std::string& what) const {
-  VkShaderModuleCreateInfo module_info{};
-  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
-  module_info.pCode = spirv.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateShaderModule(device_, &module_info, nullptr, &module), "vkCreateShaderModule for " + what));
-  // The pipeline keeps what it needs; the module goes when this returns.
-  const DeviceObject<VkShaderModule> module_owner(device_, module, vkDestroyShaderModule);
-
-  VkComputePipelineCreateInfo pipeline_info{};
-  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pipeline_info.stage.module = module;
-  pipeline_info.stage.pName = "main";
-  pipeline_info.stage.pSpecializationInfo = &specialization;
-  pipeline_info.layout = layout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
-                             "vkCreateComputePipelines for " + what));
-  return DeviceObject<VkPipeline>(device_, pipeline, vkDestroyPipeline);
+Status ValidationScope::Check(std::string_view operation) const {
+  const std::uint64_t errors = log_->error_count() - errors_before_;
+  if (errors == 0) return Status::Ok();
+  return Internal(fmt::format("the Vulkan validation layer reported {} error(s) during {}; the last: {}", errors,
+                              operation, log_->last_error()));
 }
 
 }  // namespace depthbench

@@ -10,11 +10,13 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include <vulkan/vulkan.h>
 
+#include "bench/backends/device_info.h"
 #include "bench/base/status.h"
 
 namespace depthbench {
@@ -65,6 +67,10 @@ struct VulkanDeviceProperties {
   // does not report its driver.
   std::string DriverString() const;
 };
+
+// What results record about a Vulkan device (the backend's and the speed
+// run's), with glslang as the shaders' compiler.
+DeviceInfo DeviceInfoOf(const VulkanDeviceProperties& properties);
 
 // Warnings and errors the validation layer reported. Shared between the
 // context and its observers so that what the layer says while the context
@@ -156,15 +162,6 @@ enum class HostAccess {
   kReadback,  // written by shaders, read by the host: cached memory is much faster to read
 };
 
-// One descriptor set's layout, the pipeline layout around it, a pool
-// holding that one set, and the set (freed with the pool).
-struct ComputeLayout {
-  DeviceObject<VkDescriptorSetLayout> set_layout;
-  DeviceObject<VkPipelineLayout> pipeline_layout;
-  DeviceObject<VkDescriptorPool> pool;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-};
-
 class VulkanContext {
  public:
   static Expected<std::unique_ptr<VulkanContext>> Create(const VulkanContextOptions& options);
@@ -191,21 +188,6 @@ class VulkanContext {
   // A mapped buffer of `size` bytes (> 0) in memory suited to `access`.
   Expected<VulkanBuffer> CreateHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage, HostAccess access) const;
 
-  // What every compute pass of this project builds the same way (the
-  // backend's and the speed timer's): the descriptor objects of one set of
-  // `bindings` with `push_constant_bytes` of push constants; a primary
-  // command buffer of the context's pool with an unsignalled fence; a
-  // compute pipeline running `main` of `spirv` (`what` names it in errors).
-  Expected<ComputeLayout> CreateComputeLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                              std::uint32_t push_constant_bytes) const;
-  Status CreateCommandObjects(VkCommandBuffer& command_buffer, DeviceObject<VkFence>& fence) const;
-  // Submits a recorded command buffer to the queue and waits on `fence`.
-  Status SubmitAndWait(VkCommandBuffer command_buffer, const DeviceObject<VkFence>& fence) const;
-  Expected<DeviceObject<VkPipeline>> CreateComputePipeline(std::span<const std::uint32_t> spirv,
-                                                           VkPipelineLayout layout,
-                                                           const VkSpecializationInfo& specialization,
-                                                           const std::string& what) const;
-
  private:
   VulkanContext() = default;
 
@@ -223,6 +205,19 @@ class VulkanContext {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
+};
+
+// Watches the validation layer over one operation: Check fails with
+// Internal, naming how many errors it reported and the last, when any
+// arrived since the scope was made.
+class ValidationScope {
+ public:
+  explicit ValidationScope(const VulkanContext& context);
+  Status Check(std::string_view operation) const;
+
+ private:
+  std::shared_ptr<ValidationLog> log_;
+  std::uint64_t errors_before_;
 };
 
 }  // namespace depthbench

@@ -1,0 +1,17 @@
+// DeviceInfo: what results record about the device a backend ran on. A
+// plain record, so that readers of results need nothing of the backends.
+#pragma once
+
+#include <string>
+
+namespace depthbench {
+
+struct DeviceInfo {
+  std::string name;      // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
+  std::string driver;    // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
+  std::string api;       // "Vulkan 1.3.230"
+  std::string kind;      // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
+  std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
+};
+
+}  // namespace depthbench

@@ -1,0 +1,161 @@
+#include "bench/backends/vulkan/compute_pass.h"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace depthbench {
+
+Expected<std::unique_ptr<ComputePass>> ComputePass::Create(std::shared_ptr<VulkanContext> context,
+                                                           std::span<const VkDescriptorSetLayoutBinding> bindings,
+                                                           std::uint32_t push_constant_bytes) {
+  if (context == nullptr) return InvalidArgument("a compute pass needs a Vulkan context");
+  std::unique_ptr<ComputePass> pass(new ComputePass(std::move(context)));
+  DB_RETURN_IF_ERROR(pass->CreateLayout(bindings, push_constant_bytes));
+  DB_RETURN_IF_ERROR(pass->CreateCommandObjects());
+  return pass;
+}
+
+ComputePass::~ComputePass() {
+  // Submit leaves nothing in flight, so the command buffer is not pending.
+  if (command_buffer_ != VK_NULL_HANDLE) vkFreeCommandBuffers(device(), context_->command_pool(), 1, &command_buffer_);
+}
+
+Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
+                                 std::uint32_t push_constant_bytes) {
+  push_constant_bytes_ = push_constant_bytes;
+  VkDescriptorSetLayoutCreateInfo set_layout_info{};
+  set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  set_layout_info.bindingCount = static_cast<std::uint32_t>(bindings.size());
+  set_layout_info.pBindings = bindings.data();
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorSetLayout(device(), &set_layout_info, nullptr, &set_layout),
+                             "vkCreateDescriptorSetLayout"));
+  set_layout_ = DeviceObject<VkDescriptorSetLayout>(device(), set_layout, vkDestroyDescriptorSetLayout);
+
+  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
+  VkPipelineLayoutCreateInfo pipeline_layout_info{};
+  pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pipeline_layout_info.setLayoutCount = 1;
+  pipeline_layout_info.pSetLayouts = &set_layout;
+  pipeline_layout_info.pushConstantRangeCount = push_constant_bytes > 0 ? 1 : 0;
+  pipeline_layout_info.pPushConstantRanges = &push_constants;
+  VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreatePipelineLayout(device(), &pipeline_layout_info, nullptr, &pipeline_layout),
+                             "vkCreatePipelineLayout"));
+  pipeline_layout_ = DeviceObject<VkPipelineLayout>(device(), pipeline_layout, vkDestroyPipelineLayout);
+
+  // The pool holds exactly what the one set needs, type by type.
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (const VkDescriptorSetLayoutBinding& b : bindings) {
+    auto it = std::find_if(sizes.begin(), sizes.end(), [&](const auto& s) { return s.type == b.descriptorType; });
+    if (it == sizes.end()) {
+      sizes.push_back({b.descriptorType, b.descriptorCount});
+    } else {
+      it->descriptorCount += b.descriptorCount;
+    }
+  }
+  VkDescriptorPoolCreateInfo pool_info{};
+  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+  pool_info.pPoolSizes = sizes.data();
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorPool(device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
+  pool_ = DeviceObject<VkDescriptorPool>(device(), pool, vkDestroyDescriptorPool);
+
+  VkDescriptorSetAllocateInfo set_info{};
+  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  set_info.descriptorPool = pool;
+  set_info.descriptorSetCount = 1;
+  set_info.pSetLayouts = &set_layout;
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateDescriptorSets(device(), &set_info, &set_), "vkAllocateDescriptorSets"));
+  return Status::Ok();
+}
+
+Status ComputePass::CreateCommandObjects() {
+  VkCommandBufferAllocateInfo command_info{};
+  command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  command_info.commandPool = context_->command_pool();
+  command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  command_info.commandBufferCount = 1;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkAllocateCommandBuffers(device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
+  VkFenceCreateInfo fence_info{};
+  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  VkFence handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device(), &fence_info, nullptr, &handle), "vkCreateFence"));
+  fence_ = DeviceObject<VkFence>(device(), handle, vkDestroyFence);
+  return Status::Ok();
+}
+
+Expected<DeviceObject<VkPipeline>> ComputePass::CreatePipeline(std::span<const std::uint32_t> spirv,
+                                                               const VkSpecializationInfo& specialization,
+                                                               const std::string& what) const {
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+  module_info.pCode = spirv.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateShaderModule(device(), &module_info, nullptr, &module), "vkCreateShaderModule for " + what));
+  // The pipeline keeps what it needs; the module goes when this returns.
+  const DeviceObject<VkShaderModule> module_owner(device(), module, vkDestroyShaderModule);
+
+  VkComputePipelineCreateInfo pipeline_info{};
+  pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeline_info.stage.module = module;
+  pipeline_info.stage.pName = "main";
+  pipeline_info.stage.pSpecializationInfo = &specialization;
+  pipeline_info.layout = pipeline_layout_.get();
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateComputePipelines(device(), VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline),
+                             "vkCreateComputePipelines for " + what));
+  return DeviceObject<VkPipeline>(device(), pipeline, vkDestroyPipeline);
+}
+
+void ComputePass::WriteDescriptors(std::span<VkWriteDescriptorSet> writes) const {
+  for (VkWriteDescriptorSet& write : writes) {
+    write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    write.dstSet = set_;
+    if (write.descriptorCount == 0) write.descriptorCount = 1;
+  }
+  vkUpdateDescriptorSets(device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
+
+void ComputePass::Bind(VkCommandBuffer commands, VkPipeline pipeline) const {
+  if (pipeline != VK_NULL_HANDLE) vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+  vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1, &set_, 0, nullptr);
+}
+
+void ComputePass::PushConstants(VkCommandBuffer commands, const void* data, std::uint32_t bytes) const {
+  vkCmdPushConstants(commands, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                     std::min(bytes, push_constant_bytes_), data);
+}
+
+Status ComputePass::Submit(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBufferBeginInfo begin_info{};
+  begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
+  record(command_buffer_);
+  DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer"));
+  const VkFence fence = fence_.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkResetFences(device(), 1, &fence), "vkResetFences"));
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer_;
+  DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
+  const Status waited = CheckVk(
+      vkWaitForFences(device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()), "vkWaitForFences");
+  // A wait that failed may leave the work running: drain the queue, so that
+  // nothing it uses is destroyed under it.
+  if (!waited.ok()) vkQueueWaitIdle(context_->queue());
+  return waited;
+}
+
+}  // namespace depthbench
