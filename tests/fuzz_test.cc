@@ -88,7 +88,7 @@ TEST(ReproFileTest, BadFilesNameTheField) {
     std::string message;
   };
   for (const Case& c : std::vector<Case>{
-           {"/schema", "depthbench.results", "not 'depthbench.repro'"},
+           {"/schema", "depthbench.results", "expected 'depthbench.repro'"},
            {"/case/frame/near", -1.0, "case.frame.near: -1 is out of range"},
            {"/case/frame/far", 1e-9, "must be greater than near"},
            {"/case/frame/rotation/0", 2.0, "not an orthonormal matrix"},
@@ -318,7 +318,7 @@ TEST(FuzzCommandTest, FindsShrinksWritesAndReplaysOnBothBackends) {
   const testing::CommandResult bad =
       testing::RunDepthbench({"run", "--repro", std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/baselines/cpu.json"});
   EXPECT_EQ(bad.exit_code, 2);
-  EXPECT_NE(bad.err.find("schema is 'depthbench.baseline', not 'depthbench.repro'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("schema is 'depthbench.baseline', expected 'depthbench.repro'"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
+
 namespace depthbench {
 namespace {
 
@@ -53,6 +55,44 @@ Expected<nlohmann::json> JsonReader::Parse(const std::string& text, const std::s
     }
   }
   return InvalidArgument(fmt::format("{}:{}:{}: not valid JSON", source, line, column));
+}
+
+Expected<nlohmann::json> ReadJsonFile(const std::filesystem::path& path) {
+  DB_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
+  return JsonReader::Parse(text, path.string());
+}
+
+nlohmann::json WithSchema(const JsonSchema& schema, nlohmann::json body) {
+  body["schema"] = schema.name;
+  body["schema_version"] = schema.version;
+  return body;
+}
+
+Status JsonReader::CheckSchema(const JsonSchema& schema) const {
+  DB_ASSIGN_OR_RETURN(const std::string name, String("schema"));
+  if (name != schema.name) {
+    return Error(fmt::format("schema is '{}', expected '{}' ({})", name, schema.name, schema.what));
+  }
+  DB_ASSIGN_OR_RETURN(const std::int64_t version, Integer("schema_version"));
+  if (version != schema.version) {
+    return Error(
+        fmt::format("schema_version {} is not supported (this depthbench reads version {})", version, schema.version));
+  }
+  return Status::Ok();
+}
+
+Status JsonReader::ForEach(const ElementReader& read) const {
+  DB_ASSIGN_OR_RETURN(const std::size_t count, ArraySize());
+  for (std::size_t i = 0; i < count; ++i) {
+    DB_ASSIGN_OR_RETURN(const JsonReader element, Element(i));
+    DB_RETURN_IF_ERROR(read(element));
+  }
+  return Status::Ok();
+}
+
+Status JsonReader::ForEach(const std::string& key, const ElementReader& read) const {
+  DB_ASSIGN_OR_RETURN(const JsonReader array, Field(key));
+  return array.ForEach(read);
 }
 
 Status JsonReader::Error(const std::string& message) const {

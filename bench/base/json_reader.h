@@ -5,13 +5,24 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
 #include "bench/base/status.h"
 
 namespace depthbench {
+
+// What every depthbench JSON file starts with: "schema" (its kind) and
+// "schema_version". A reader accepts one version.
+struct JsonSchema {
+  const char* name;  // "depthbench.results"
+  int version;       // 1
+  const char* what;  // "a results file (depthbench run --json)", for errors
+};
 
 class JsonReader {
  public:
@@ -39,6 +50,15 @@ class JsonReader {
   Expected<std::int64_t> Integer(const std::string& key) const;
   Expected<bool> Bool(const std::string& key) const;
 
+  // Calls `read` on every element of this array, or of the array `key`.
+  using ElementReader = std::function<Status(const JsonReader&)>;
+  Status ForEach(const ElementReader& read) const;
+  Status ForEach(const std::string& key, const ElementReader& read) const;
+
+  // Ok when this object's "schema" and "schema_version" are `schema`'s;
+  // otherwise an error that says what the file is and what was expected.
+  Status CheckSchema(const JsonSchema& schema) const;
+
   Status Error(const std::string& message) const;
   const nlohmann::json& json() const { return json_; }
   const std::string& path() const { return path_; }
@@ -49,6 +69,14 @@ class JsonReader {
   std::string source_;
   std::string path_;
 };
+
+// The parsed content of a JSON file; errors name the file (and the line and
+// column of a syntax error).
+Expected<nlohmann::json> ReadJsonFile(const std::filesystem::path& path);
+
+// `body` (an object) with the header of a file of `schema` added:
+// "schema": its name, "schema_version": its version.
+nlohmann::json WithSchema(const JsonSchema& schema, nlohmann::json body);
 
 // A double as JSON: a number, or "inf"/"-inf"/"nan" (JSON has no such numbers).
 nlohmann::json JsonNumber(double x);

@@ -281,17 +281,16 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                          : nlohmann::json(nullptr)},
          {"reason", v.reason}});
   }
-  return {{"schema", "depthbench.choose"},
-          {"schema_version", 1},
-          {"scene", r.scene},
-          {"requirement", r.requirement},
-          {"backend", r.backend},
-          {"device", r.device},
-          {"seconds", r.seconds},
-          {"choice", r.ranked.empty() || !r.ranked.front().meets ? nlohmann::json(nullptr)
-                                                                 : nlohmann::json(r.ranked.front().cell.Name())},
-          {"suggestions", r.suggestions},
-          {"ranked", ranked}};
+  return WithSchema(kChooseSchema, {{"scene", r.scene},
+                                    {"requirement", r.requirement},
+                                    {"backend", r.backend},
+                                    {"device", r.device},
+                                    {"seconds", r.seconds},
+                                    {"choice", r.ranked.empty() || !r.ranked.front().meets
+                                                   ? nlohmann::json(nullptr)
+                                                   : nlohmann::json(r.ranked.front().cell.Name())},
+                                    {"suggestions", r.suggestions},
+                                    {"ranked", ranked}});
 }
 
 }  // namespace depthbench

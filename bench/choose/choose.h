@@ -13,10 +13,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/base/json_reader.h"
 #include "bench/choose/scene.h"
 #include "bench/fit/error_model.h"
 
 namespace depthbench {
+
+inline constexpr JsonSchema kChooseSchema{"depthbench.choose", 1, "a choice of depthbench choose --json"};
 
 class Backend;  // bench/backends/backend.h
 

@@ -269,16 +269,14 @@ nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const 
   }
   nlohmann::json ratios = nlohmann::json::array();
   for (double r : plan.ratios) ratios.push_back(r);
-  return {{"schema", "depthbench.fit"},
-          {"schema_version", 1},
-          {"plan",
-           {{"seed", plan.seed},
-            {"samples_per_ratio", plan.samples_per_ratio},
-            {"ratios", ratios},
-            {"infinite", plan.infinite},
-            {"held_out", plan.held_out},
-            {"domain", DomainToJson(plan.domain)}}},
-          {"fits", out}};
+  return WithSchema(kFitSchema, {{"plan",
+                                  {{"seed", plan.seed},
+                                   {"samples_per_ratio", plan.samples_per_ratio},
+                                   {"ratios", ratios},
+                                   {"infinite", plan.infinite},
+                                   {"held_out", plan.held_out},
+                                   {"domain", DomainToJson(plan.domain)}}},
+                                 {"fits", out}});
 }
 
 void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std::ostream& out) {

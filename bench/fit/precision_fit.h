@@ -19,11 +19,14 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/json_reader.h"
 #include "bench/fit/error_model.h"
 #include "bench/results/results.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
+
+inline constexpr JsonSchema kFitSchema{"depthbench.fit", 1, "the models of depthbench fit --json"};
 
 // Samples a band needs for a quantile at this level to mean something.
 std::uint64_t MinimumSamples(Level level);

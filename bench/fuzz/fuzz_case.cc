@@ -238,43 +238,33 @@ bool CellRunsOn(const Cell& cell, const Frame& frame) {
 nlohmann::json ReproFileToJson(const ReproFile& file) {
   nlohmann::json cells = nlohmann::json::array();
   for (const Cell& c : file.cells) cells.push_back(c.Name());
-  nlohmann::json out = {{"schema", "depthbench.repro"},
-                        {"schema_version", 1},
-                        {"cells", cells},
-                        {"backends", file.backends},
-                        {"case", CaseToJson(file.fuzz_case)}};
+  nlohmann::json out =
+      WithSchema(kReproSchema, {{"cells", cells}, {"backends", file.backends}, {"case", CaseToJson(file.fuzz_case)}});
   if (!file.finding.is_null()) out["finding"] = file.finding;
   return out;
 }
 
 Expected<ReproFile> ReproFileFromJson(const nlohmann::json& json, const std::string& source) {
   const JsonReader r(json, source);
-  DB_ASSIGN_OR_RETURN(std::string schema, r.String("schema"));
-  if (schema != "depthbench.repro") {
-    return r.Error(
-        fmt::format("schema is '{}', not 'depthbench.repro' (a reproducer file of depthbench fuzz)", schema));
-  }
-  DB_ASSIGN_OR_RETURN(std::uint64_t version, r.Unsigned("schema_version"));
-  if (version != 1) return r.Error(fmt::format("schema_version {} is not supported (this build reads 1)", version));
+  DB_RETURN_IF_ERROR(r.CheckSchema(kReproSchema));
   ReproFile file;
-  DB_ASSIGN_OR_RETURN(JsonReader cells, r.Field("cells"));
-  DB_ASSIGN_OR_RETURN(std::size_t n, cells.ArraySize());
-  for (std::size_t i = 0; i < n; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader e, cells.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("cells", [&](const JsonReader& e) -> Status {
     DB_ASSIGN_OR_RETURN(std::string name, e.String());
     auto cell = ParseCell(name);
     if (!cell.ok()) return e.Error(cell.status().message());
     file.cells.push_back(*cell);
+    return Status::Ok();
+  }));
+  if (file.cells.empty()) {
+    DB_ASSIGN_OR_RETURN(const JsonReader cells, r.Field("cells"));
+    return cells.Error("names no cell");
   }
-  if (file.cells.empty()) return cells.Error("names no cell");
   if (r.Has("backends")) {
-    DB_ASSIGN_OR_RETURN(JsonReader backends, r.Field("backends"));
-    DB_ASSIGN_OR_RETURN(std::size_t m, backends.ArraySize());
-    for (std::size_t i = 0; i < m; ++i) {
-      DB_ASSIGN_OR_RETURN(JsonReader e, backends.Element(i));
+    DB_RETURN_IF_ERROR(r.ForEach("backends", [&](const JsonReader& e) -> Status {
       DB_ASSIGN_OR_RETURN(std::string name, e.String());
       file.backends.push_back(name);
-    }
+      return Status::Ok();
+    }));
   }
   DB_ASSIGN_OR_RETURN(JsonReader fuzz_case, r.Field("case"));
   DB_ASSIGN_OR_RETURN(file.fuzz_case, CaseFromJson(fuzz_case));
@@ -288,8 +278,7 @@ Expected<ReproFile> ReproFileFromJson(const nlohmann::json& json, const std::str
 }
 
 Expected<ReproFile> ReadReproFile(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
-  DB_ASSIGN_OR_RETURN(nlohmann::json json, JsonReader::Parse(text, path.string()));
+  DB_ASSIGN_OR_RETURN(const nlohmann::json json, ReadJsonFile(path));
   return ReproFileFromJson(json, path.string());
 }
 

@@ -90,8 +90,9 @@ class PointBatch {
 // formats need a finite far plane).
 bool CellRunsOn(const Cell& cell, const Frame& frame);
 
-// Reproducer files (schema depthbench.repro, version 1): the case's exact
-// inputs, the cells it concerns, and what was found.
+// Reproducer files: the case's exact inputs, the cells it concerns, and
+// what was found.
+inline constexpr JsonSchema kReproSchema{"depthbench.repro", 1, "a reproducer file of depthbench fuzz"};
 struct ReproFile {
   FuzzCase fuzz_case;
   std::vector<Cell> cells;

@@ -92,28 +92,18 @@ json BaselineToJson(const Baseline& b) {
     }
     cells[name] = bands;
   }
-  return {{"schema", kBaselineSchema},
-          {"schema_version", kBaselineSchemaVersion},
-          {"backend", b.backend},
-          {"device", DeviceToJson(b.device)},
-          {"version", b.version},
-          {"commit", b.commit},
-          {"made_at", b.made_at},
-          {"plan", SamplePlanToJson(b.plan)},
-          {"cells", cells}};
+  return WithSchema(kBaselineSchema, {{"backend", b.backend},
+                                      {"device", DeviceToJson(b.device)},
+                                      {"version", b.version},
+                                      {"commit", b.commit},
+                                      {"made_at", b.made_at},
+                                      {"plan", SamplePlanToJson(b.plan)},
+                                      {"cells", cells}});
 }
 
 Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
   JsonReader top(j, source);
-  DB_ASSIGN_OR_RETURN(std::string schema, top.String("schema"));
-  if (schema != kBaselineSchema) {
-    return top.Error(fmt::format("schema is '{}', expected '{}'", schema, kBaselineSchema));
-  }
-  DB_ASSIGN_OR_RETURN(std::int64_t version, top.Integer("schema_version"));
-  if (version != kBaselineSchemaVersion) {
-    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})", version,
-                                 kBaselineSchemaVersion));
-  }
+  DB_RETURN_IF_ERROR(top.CheckSchema(kBaselineSchema));
   Baseline b;
   DB_ASSIGN_OR_RETURN(b.backend, top.String("backend"));
   DB_ASSIGN_OR_RETURN(JsonReader device, top.Field("device"));
@@ -155,8 +145,7 @@ Status WriteBaseline(const std::filesystem::path& path, const Baseline& baseline
 }
 
 Expected<Baseline> ReadBaseline(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
-  DB_ASSIGN_OR_RETURN(nlohmann::json j, JsonReader::Parse(text, path.string()));
+  DB_ASSIGN_OR_RETURN(const nlohmann::json j, ReadJsonFile(path));
   return BaselineFromJson(j, path.string());
 }
 

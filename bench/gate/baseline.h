@@ -20,8 +20,7 @@
 
 namespace depthbench {
 
-inline constexpr const char* kBaselineSchema = "depthbench.baseline";
-inline constexpr int kBaselineSchemaVersion = 1;
+inline constexpr JsonSchema kBaselineSchema{"depthbench.baseline", 1, "a gate baseline (reports/baselines/)"};
 
 // What a gate compares in one band of one cell: bits lost of the total and
 // of the arithmetic error, and the NaN/Inf counts.

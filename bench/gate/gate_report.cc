@@ -180,11 +180,9 @@ nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& t
                         {"improvements", r.comparison.improvements()},
                         {"cells", cells}});
   }
-  return {{"schema", "depthbench.gate"},
-          {"schema_version", 1},
-          {"verdict", pass ? "pass" : "fail"},
-          {"tolerance", {{"p999_bits", tolerance.p999_bits}, {"max_bits", tolerance.max_bits}}},
-          {"backends", backends}};
+  return WithSchema(kGateSchema, {{"verdict", pass ? "pass" : "fail"},
+                                  {"tolerance", {{"p999_bits", tolerance.p999_bits}, {"max_bits", tolerance.max_bits}}},
+                                  {"backends", backends}});
 }
 
 }  // namespace depthbench

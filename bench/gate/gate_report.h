@@ -8,9 +8,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/base/json_reader.h"
 #include "bench/gate/gate.h"
 
 namespace depthbench {
+
+inline constexpr JsonSchema kGateSchema{"depthbench.gate", 1, "a gate verdict of depthbench gate --json"};
 
 struct GateRun {
   GateComparison comparison;

@@ -161,22 +161,20 @@ json ToJson(const Results& results) {
                      {"bands", {{"joint", joint}, {"distance", distance}}}});
   }
 
-  return {{"schema", kResultsSchema},
-          {"schema_version", kResultsSchemaVersion},
-          {"run",
-           {{"version", run.version},
-            {"commit", run.commit},
-            {"started_at", run.started_at},
-            {"host", run.host},
-            {"seed", run.seed},
-            {"samples", run.samples},
-            {"samples_per_frame", run.samples_per_frame},
-            {"shards", shards},
-            {"domain", DomainToJson(run.domain)},
-            {"backends", backends},
-            {"seconds", run.seconds},
-            {"reconstructions", run.reconstructions}}},
-          {"cells", cells}};
+  return WithSchema(kResultsSchema, {{"run",
+                                      {{"version", run.version},
+                                       {"commit", run.commit},
+                                       {"started_at", run.started_at},
+                                       {"host", run.host},
+                                       {"seed", run.seed},
+                                       {"samples", run.samples},
+                                       {"samples_per_frame", run.samples_per_frame},
+                                       {"shards", shards},
+                                       {"domain", DomainToJson(run.domain)},
+                                       {"backends", backends},
+                                       {"seconds", run.seconds},
+                                       {"reconstructions", run.reconstructions}}},
+                                     {"cells", cells}});
 }
 
 Status WriteResults(const std::filesystem::path& path, const Results& results) {
@@ -201,17 +199,15 @@ Expected<MetricStats> MetricFrom(const JsonReader& r) {
   MetricStats m;
   DB_ASSIGN_OR_RETURN(m.max_square, r.Number("max_square"));
   DB_ASSIGN_OR_RETURN(m.worst_index, r.Unsigned("worst_index"));
-  DB_ASSIGN_OR_RETURN(JsonReader bins, r.Field("bins"));
-  DB_ASSIGN_OR_RETURN(std::size_t n, bins.ArraySize());
-  for (std::size_t i = 0; i < n; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader pair, bins.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("bins", [&](const JsonReader& pair) -> Status {
     DB_ASSIGN_OR_RETURN(JsonReader slot, pair.Element(0));
     DB_ASSIGN_OR_RETURN(JsonReader count, pair.Element(1));
     DB_ASSIGN_OR_RETURN(std::int64_t s, slot.Integer());
     DB_ASSIGN_OR_RETURN(std::uint64_t c, count.Unsigned());
     if (s < 0 || s >= kDenseBins) return slot.Error(fmt::format("bin {} outside [0, {})", s, kDenseBins));
     m.bins[static_cast<int>(s)] += c;
-  }
+    return Status::Ok();
+  }));
   return m;
 }
 
@@ -262,17 +258,15 @@ Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
   DB_RETURN_IF_ERROR(optional_range("far", d.far));
   DB_ASSIGN_OR_RETURN(d.camera_distance, range("camera_distance"));
   DB_RETURN_IF_ERROR(optional_range("eye_depth", d.eye_depth));
-  DB_ASSIGN_OR_RETURN(JsonReader res, r.Field("resolutions"));
-  DB_ASSIGN_OR_RETURN(std::size_t n, res.ArraySize());
   d.resolutions.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader pair, res.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("resolutions", [&](const JsonReader& pair) -> Status {
     DB_ASSIGN_OR_RETURN(JsonReader w, pair.Element(0));
     DB_ASSIGN_OR_RETURN(JsonReader h, pair.Element(1));
     DB_ASSIGN_OR_RETURN(std::uint64_t width, w.Unsigned());
     DB_ASSIGN_OR_RETURN(std::uint64_t height, h.Unsigned());
     d.resolutions.push_back({static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
-  }
+    return Status::Ok();
+  }));
   Status valid = d.Validate();
   if (!valid.ok()) return r.Error(valid.message());
   return d;
@@ -280,15 +274,7 @@ Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
 
 Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   JsonReader top(j, source);
-  DB_ASSIGN_OR_RETURN(std::string schema, top.String("schema"));
-  if (schema != kResultsSchema) {
-    return top.Error(fmt::format("schema is '{}', expected '{}'", schema, kResultsSchema));
-  }
-  DB_ASSIGN_OR_RETURN(std::int64_t version, top.Integer("schema_version"));
-  if (version != kResultsSchemaVersion) {
-    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})", version,
-                                 kResultsSchemaVersion));
-  }
+  DB_RETURN_IF_ERROR(top.CheckSchema(kResultsSchema));
   Results results;
   RunInfo& run = results.run;
   DB_ASSIGN_OR_RETURN(JsonReader r, top.Field("run"));
@@ -302,32 +288,25 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   run.samples_per_frame = static_cast<std::uint32_t>(per_frame);
   DB_ASSIGN_OR_RETURN(run.seconds, r.Number("seconds"));
   DB_ASSIGN_OR_RETURN(run.reconstructions, r.Unsigned("reconstructions"));
-  DB_ASSIGN_OR_RETURN(JsonReader shards, r.Field("shards"));
-  DB_ASSIGN_OR_RETURN(std::size_t shard_count, shards.ArraySize());
-  for (std::size_t i = 0; i < shard_count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader s, shards.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("shards", [&](const JsonReader& s) -> Status {
     DB_ASSIGN_OR_RETURN(std::string text, s.String());
     Expected<Shard> shard = ParseShard(text);
     if (!shard.ok()) return s.Error(shard.status().message());
     run.shards.push_back(*shard);
-  }
+    return Status::Ok();
+  }));
   DB_ASSIGN_OR_RETURN(JsonReader domain, r.Field("domain"));
   DB_ASSIGN_OR_RETURN(run.domain, DomainFromJson(domain.json(), source));
-  DB_ASSIGN_OR_RETURN(JsonReader backends, r.Field("backends"));
-  DB_ASSIGN_OR_RETURN(std::size_t backend_count, backends.ArraySize());
-  for (std::size_t i = 0; i < backend_count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader b, backends.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("backends", [&](const JsonReader& b) -> Status {
     BackendRecord record;
     DB_ASSIGN_OR_RETURN(record.name, b.String("name"));
     DB_ASSIGN_OR_RETURN(JsonReader device, b.Field("device"));
     DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
     run.backends.push_back(record);
-  }
+    return Status::Ok();
+  }));
 
-  DB_ASSIGN_OR_RETURN(JsonReader cells, top.Field("cells"));
-  DB_ASSIGN_OR_RETURN(std::size_t cell_count, cells.ArraySize());
-  for (std::size_t i = 0; i < cell_count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader c, cells.Element(i));
+  DB_RETURN_IF_ERROR(top.ForEach("cells", [&](const JsonReader& c) -> Status {
     CellResult result;
     DB_ASSIGN_OR_RETURN(std::string name, c.String("cell"));
     Expected<Cell> cell = ParseCell(name);
@@ -335,31 +314,27 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     result.cell = *cell;
     DB_ASSIGN_OR_RETURN(result.backend, c.String("backend"));
     DB_ASSIGN_OR_RETURN(JsonReader bands, c.Field("bands"));
-    DB_ASSIGN_OR_RETURN(JsonReader joint, bands.Field("joint"));
-    DB_ASSIGN_OR_RETURN(std::size_t joint_count, joint.ArraySize());
-    for (std::size_t k = 0; k < joint_count; ++k) {
-      DB_ASSIGN_OR_RETURN(JsonReader b, joint.Element(k));
+    DB_RETURN_IF_ERROR(bands.ForEach("joint", [&](const JsonReader& b) -> Status {
       DB_ASSIGN_OR_RETURN(int ratio, BandIndex(b, "ratio_band", kRatioBands));
       DB_ASSIGN_OR_RETURN(int depth, BandIndex(b, "depth_band", kDepthBands));
       DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
       result.stats.joint[JointBand(ratio, depth)].Merge(stats);
-    }
-    DB_ASSIGN_OR_RETURN(JsonReader distance, bands.Field("distance"));
-    DB_ASSIGN_OR_RETURN(std::size_t distance_count, distance.ArraySize());
-    for (std::size_t k = 0; k < distance_count; ++k) {
-      DB_ASSIGN_OR_RETURN(JsonReader b, distance.Element(k));
+      return Status::Ok();
+    }));
+    DB_RETURN_IF_ERROR(bands.ForEach("distance", [&](const JsonReader& b) -> Status {
       DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "distance_band", kDistanceBands));
       DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
       result.stats.distance[band].Merge(stats);
-    }
+      return Status::Ok();
+    }));
     results.cells.push_back(std::move(result));
-  }
+    return Status::Ok();
+  }));
   return results;
 }
 
 Expected<Results> ReadResults(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
-  DB_ASSIGN_OR_RETURN(json j, JsonReader::Parse(text, path.string()));
+  DB_ASSIGN_OR_RETURN(const json j, ReadJsonFile(path));
   return ResultsFromJson(j, path.string());
 }
 

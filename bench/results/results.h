@@ -1,7 +1,8 @@
 // Results: what a run measured, per cell and backend, with how it was made.
-// Saved as versioned JSON (schema "depthbench.results", version 1; see
-// reports/results.schema.json). The JSON keeps the full histograms, so
-// results of shards merge exactly into the results of the whole sweep.
+// Saved as versioned JSON (kResultsSchema; ToJson below is its definition,
+// ResultsFromJson checks every field it reads). The JSON keeps the full
+// histograms, so results of shards merge exactly into the results of the
+// whole sweep.
 #pragma once
 
 #include <cstdint>
@@ -20,8 +21,7 @@
 
 namespace depthbench {
 
-inline constexpr const char* kResultsSchema = "depthbench.results";
-inline constexpr int kResultsSchemaVersion = 1;
+inline constexpr JsonSchema kResultsSchema{"depthbench.results", 1, "a results file of depthbench run --json"};
 
 // Shard K of N (1-based, as "--shard K/N" spells it): samples
 // [total * (K-1) / N, total * K / N) of the sweep.

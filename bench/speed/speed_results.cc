@@ -10,6 +10,7 @@
 
 #include "bench/base/files.h"
 #include "bench/base/json_reader.h"
+#include "bench/results/results.h"
 
 namespace depthbench {
 
@@ -119,10 +120,6 @@ json VariantNames(const std::vector<Variant>& variants) {
   return names;
 }
 
-json DeviceToJson(const DeviceInfo& d) {
-  return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", d.kind}, {"compiler", d.compiler}};
-}
-
 json RunToJson(const SpeedRunInfo& run) {
   json resolutions = json::array();
   for (const Resolution& r : run.resolutions) resolutions.push_back(ResolutionName(r));
@@ -195,14 +192,12 @@ json ToJson(const SpeedResults& results) {
     trade.push_back(
         {{"convention", Info(front.convention).name}, {"format", Info(front.format).name}, {"points", points}});
   }
-  return {{"schema", kSpeedSchema},
-          {"schema_version", kSpeedSchemaVersion},
-          {"run", RunToJson(results.run)},
-          {"gpu", gpu},
-          {"static", static_costs},
-          {"cpu", cpu},
-          {"trade", trade},
-          {"skipped", results.skipped}};
+  return WithSchema(kSpeedSchema, {{"run", RunToJson(results.run)},
+                                   {"gpu", gpu},
+                                   {"static", static_costs},
+                                   {"cpu", cpu},
+                                   {"trade", trade},
+                                   {"skipped", results.skipped}});
 }
 
 Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results) {
@@ -294,12 +289,8 @@ Expected<SpeedRunInfo> ReadRun(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(run.commit, r.String("commit"));
   DB_ASSIGN_OR_RETURN(run.started_at, r.String("started_at"));
   DB_ASSIGN_OR_RETURN(run.host, r.String("host"));
-  DB_ASSIGN_OR_RETURN(JsonReader device, r.Field("device"));
-  DB_ASSIGN_OR_RETURN(run.device.name, device.String("name"));
-  DB_ASSIGN_OR_RETURN(run.device.driver, device.String("driver"));
-  DB_ASSIGN_OR_RETURN(run.device.api, device.String("api"));
-  DB_ASSIGN_OR_RETURN(run.device.kind, device.String("kind"));
-  DB_ASSIGN_OR_RETURN(run.device.compiler, device.String("compiler"));
+  DB_ASSIGN_OR_RETURN(const JsonReader device, r.Field("device"));
+  DB_ASSIGN_OR_RETURN(run.device, DeviceFromJson(device));
   DB_ASSIGN_OR_RETURN(run.device_type, r.String("device_type"));
   DB_ASSIGN_OR_RETURN(run.timestamp_period_ns, r.Number("timestamp_period_ns"));
   DB_ASSIGN_OR_RETURN(run.timestamp_valid_bits, ReadU32(r, "timestamp_valid_bits"));
@@ -307,13 +298,11 @@ Expected<SpeedRunInfo> ReadRun(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(run.warmup, ReadU32(r, "warmup"));
   DB_ASSIGN_OR_RETURN(run.repetitions, ReadU32(r, "repetitions"));
   DB_ASSIGN_OR_RETURN(run.alu_taps, ReadU32(r, "alu_taps"));
-  DB_ASSIGN_OR_RETURN(JsonReader resolutions, r.Field("resolutions"));
-  DB_ASSIGN_OR_RETURN(const std::size_t count, resolutions.ArraySize());
-  for (std::size_t i = 0; i < count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader element, resolutions.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("resolutions", [&](const JsonReader& element) -> Status {
     DB_ASSIGN_OR_RETURN(Resolution resolution, ReadResolution(element));
     run.resolutions.push_back(resolution);
-  }
+    return Status::Ok();
+  }));
   DB_ASSIGN_OR_RETURN(JsonReader trade_resolution, r.Field("trade_resolution"));
   DB_ASSIGN_OR_RETURN(run.trade_resolution, ReadResolution(trade_resolution));
   DB_ASSIGN_OR_RETURN(run.accuracy_source, r.String("accuracy_source"));
@@ -338,25 +327,21 @@ Expected<GpuTiming> ReadGpuTiming(const JsonReader& r) {
   if (t.taps == 0) return r.Error("taps must be at least 1");
   DB_ASSIGN_OR_RETURN(JsonReader summary, r.Field("ns_per_pass"));
   DB_ASSIGN_OR_RETURN(t.ns_per_pass, ReadSummary(summary));
-  DB_ASSIGN_OR_RETURN(JsonReader repetitions, r.Field("repetitions_ns"));
-  DB_ASSIGN_OR_RETURN(const std::size_t count, repetitions.ArraySize());
-  for (std::size_t i = 0; i < count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader element, repetitions.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("repetitions_ns", [&](const JsonReader& element) -> Status {
     DB_ASSIGN_OR_RETURN(const double ns, element.Number());
     t.repetitions_ns.push_back(ns);
-  }
+    return Status::Ok();
+  }));
   DB_ASSIGN_OR_RETURN(t.passes_per_repetition, ReadU32(r, "passes_per_repetition"));
   DB_ASSIGN_OR_RETURN(t.warmup_passes, ReadU32(r, "warmup_passes"));
   DB_ASSIGN_OR_RETURN(t.rank, ReadU32(r, "rank"));
-  DB_ASSIGN_OR_RETURN(JsonReader tied, r.Field("indistinguishable_from"));
-  DB_ASSIGN_OR_RETURN(const std::size_t ties, tied.ArraySize());
-  for (std::size_t i = 0; i < ties; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader element, tied.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("indistinguishable_from", [&](const JsonReader& element) -> Status {
     DB_ASSIGN_OR_RETURN(const std::string name, element.String());
     Expected<Variant> variant = ParseVariant(name);
     if (!variant.ok()) return element.Error(variant.status().message());
     t.indistinguishable_from.push_back(*variant);
-  }
+    return Status::Ok();
+  }));
   return t;
 }
 
@@ -372,10 +357,7 @@ Expected<TradeFront> ReadFront(const JsonReader& r) {
   if (!f.ok()) return format_field.Error(f.status().message());
   front.convention = *c;
   front.format = *f;
-  DB_ASSIGN_OR_RETURN(JsonReader points, r.Field("points"));
-  DB_ASSIGN_OR_RETURN(const std::size_t count, points.ArraySize());
-  for (std::size_t i = 0; i < count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader p, points.Element(i));
+  DB_RETURN_IF_ERROR(r.ForEach("points", [&](const JsonReader& p) -> Status {
     TradePoint point;
     DB_ASSIGN_OR_RETURN(point.variant, ReadVariant(p, "variant"));
     if (!Reads(point.variant, front.convention, front.format)) {
@@ -392,42 +374,25 @@ Expected<TradeFront> ReadFront(const JsonReader& r) {
     DB_ASSIGN_OR_RETURN(point.on_gpu_front, p.Bool("on_gpu_front"));
     DB_ASSIGN_OR_RETURN(point.on_cpu_front, p.Bool("on_cpu_front"));
     front.points.push_back(point);
-  }
+    return Status::Ok();
+  }));
   return front;
-}
-
-// Calls read(element) for each element of array `key`.
-template <class Read>
-Status ForEach(const JsonReader& top, const std::string& key, Read read) {
-  DB_ASSIGN_OR_RETURN(JsonReader array, top.Field(key));
-  DB_ASSIGN_OR_RETURN(const std::size_t count, array.ArraySize());
-  for (std::size_t i = 0; i < count; ++i) {
-    DB_ASSIGN_OR_RETURN(JsonReader element, array.Element(i));
-    DB_RETURN_IF_ERROR(read(element));
-  }
-  return Status::Ok();
 }
 
 }  // namespace
 
 Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& source) {
   const JsonReader top(j, source);
-  DB_ASSIGN_OR_RETURN(const std::string schema, top.String("schema"));
-  if (schema != kSpeedSchema) return top.Error(fmt::format("schema is '{}', expected '{}'", schema, kSpeedSchema));
-  DB_ASSIGN_OR_RETURN(const std::int64_t version, top.Integer("schema_version"));
-  if (version != kSpeedSchemaVersion) {
-    return top.Error(fmt::format("schema_version {} is not supported (this depthbench reads version {})", version,
-                                 kSpeedSchemaVersion));
-  }
+  DB_RETURN_IF_ERROR(top.CheckSchema(kSpeedSchema));
   SpeedResults results;
   DB_ASSIGN_OR_RETURN(JsonReader run, top.Field("run"));
   DB_ASSIGN_OR_RETURN(results.run, ReadRun(run));
-  DB_RETURN_IF_ERROR(ForEach(top, "gpu", [&](const JsonReader& r) -> Status {
+  DB_RETURN_IF_ERROR(top.ForEach("gpu", [&](const JsonReader& r) -> Status {
     DB_ASSIGN_OR_RETURN(GpuTiming timing, ReadGpuTiming(r));
     results.gpu.push_back(std::move(timing));
     return Status::Ok();
   }));
-  DB_RETURN_IF_ERROR(ForEach(top, "static", [&](const JsonReader& r) -> Status {
+  DB_RETURN_IF_ERROR(top.ForEach("static", [&](const JsonReader& r) -> Status {
     StaticCost cost;
     DB_ASSIGN_OR_RETURN(cost.variant, ReadVariant(r, "variant"));
     DB_ASSIGN_OR_RETURN(cost.function, r.String("function"));
@@ -436,7 +401,7 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
     results.static_costs.push_back(std::move(cost));
     return Status::Ok();
   }));
-  DB_RETURN_IF_ERROR(ForEach(top, "cpu", [&](const JsonReader& r) -> Status {
+  DB_RETURN_IF_ERROR(top.ForEach("cpu", [&](const JsonReader& r) -> Status {
     CpuCost cost;
     DB_ASSIGN_OR_RETURN(cost.cell, ReadCell(r, "cell"));
     DB_ASSIGN_OR_RETURN(JsonReader summary, r.Field("ns_per_reconstruction"));
@@ -446,12 +411,12 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
     results.cpu.push_back(cost);
     return Status::Ok();
   }));
-  DB_RETURN_IF_ERROR(ForEach(top, "trade", [&](const JsonReader& r) -> Status {
+  DB_RETURN_IF_ERROR(top.ForEach("trade", [&](const JsonReader& r) -> Status {
     DB_ASSIGN_OR_RETURN(TradeFront front, ReadFront(r));
     results.trade.push_back(std::move(front));
     return Status::Ok();
   }));
-  DB_RETURN_IF_ERROR(ForEach(top, "skipped", [&](const JsonReader& r) -> Status {
+  DB_RETURN_IF_ERROR(top.ForEach("skipped", [&](const JsonReader& r) -> Status {
     DB_ASSIGN_OR_RETURN(std::string text, r.String());
     results.skipped.push_back(std::move(text));
     return Status::Ok();
@@ -460,8 +425,7 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
 }
 
 Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
-  DB_ASSIGN_OR_RETURN(const json j, JsonReader::Parse(text, path.string()));
+  DB_ASSIGN_OR_RETURN(const json j, ReadJsonFile(path));
   return SpeedResultsFromJson(j, path.string());
 }
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/backends/device_info.h"
+#include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
@@ -22,8 +23,7 @@
 
 namespace depthbench {
 
-inline constexpr const char* kSpeedSchema = "depthbench.speed";
-inline constexpr int kSpeedSchemaVersion = 1;
+inline constexpr JsonSchema kSpeedSchema{"depthbench.speed", 1, "a speed file of depthbench speed --json"};
 
 // The two regimes of a timed pass.
 enum class Regime : std::uint8_t {
