@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const std::string& w : words) argv.push_back(w.c_str());
   argv.push_back(nullptr);  // as the C runtime passes it
 
-  std::function<int()> action;
+  depthbench::cli::CommandAction action;
   const std::unique_ptr<CLI::App> app = depthbench::cli::MakeDepthbenchApp(action);
   std::ostringstream out, err;  // keeps the fuzzer's own output readable
   const depthbench::cli::ParseOutcome parsed =

@@ -1,4 +1,5 @@
 #include "bench/choose/choose.h"
+#include "bench/base/resources.h"
 
 #include <algorithm>
 #include <chrono>
@@ -76,8 +77,8 @@ std::pair<double, std::string> PredictAtFarEnd(const Scene& scene, const CellRes
 }  // namespace
 
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
-  const std::filesystem::path dir =
-      shader_dir.empty() ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders" : std::filesystem::path(shader_dir);
+  std::filesystem::path dir = shader_dir;
+  if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
   std::map<Variant, CandidateCost> by_variant;
   for (const VariantInfo& v : AllVariants()) {
     DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileComputeShader(dir / (std::string(v.name) + ".comp")));

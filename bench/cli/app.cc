@@ -3,18 +3,35 @@
 #include <iostream>
 #include <string>
 
+#include <fmt/format.h>
+
+#include "bench/base/build_info.h"
+#include "bench/base/resources.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 
 namespace depthbench::cli {
+namespace {
 
-std::unique_ptr<CLI::App> MakeDepthbenchApp(std::function<int()>& action) {
+// The one place where a command that could not run becomes a message
+// ("depthbench: error: ...") and exit code 2.
+int ExitCode(const Expected<int>& ran) { return ran.ok() ? *ran : ReportError(ran.status()); }
+
+}  // namespace
+
+std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   auto app = std::make_unique<CLI::App>(
       "depthbench: measures how precisely shader code reconstructs view- and world-space position "
       "from a depth buffer, for every variant, depth convention and storage format, on the GPU "
       "(Vulkan) and the CPU",
       "depthbench");
   app->require_subcommand(1);
+  app->set_version_flag("--version", [] {
+    const Expected<DataFolder> data = FindDataFolder();
+    return fmt::format(
+        "depthbench {} (commit {})\ndata folder: {}", BuildVersion(), BuildCommit(),
+        data.ok() ? fmt::format("{} ({})", data->root.string(), data->found_by) : data.status().message());
+  });
   app->footer(
       "Run 'depthbench SUBCOMMAND --help' for a subcommand's flags.\n"
       "Exit codes: 0 success, 1 a finding (a gate that fails, a fuzz finding), 2 could not run.");
@@ -51,11 +68,11 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
 }
 
 int RunDepthbench(int argc, const char* const* argv) {
-  std::function<int()> action;
+  CommandAction action;
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
-  return action ? action() : kExitCannotRun;
+  return action ? ExitCode(action()) : kExitCannotRun;
 }
 
 }  // namespace depthbench::cli

@@ -9,11 +9,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/cli/commands.h"
+
 namespace depthbench::cli {
 
 // The program's CLI11 app. When a parse chooses a subcommand, `action` is set
 // to the function that runs it; `action` must outlive the app.
-std::unique_ptr<CLI::App> MakeDepthbenchApp(std::function<int()>& action);
+std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action);
 
 // What a parse decided.
 struct ParseOutcome {

@@ -113,7 +113,11 @@ void BackendFlags::Add(CLI::App& app, bool allow_several) {
       ->group("Backends");
 }
 
-Expected<std::vector<std::unique_ptr<Backend>>> BackendFlags::Make() const {
+BackendSet::BackendSet(std::vector<std::unique_ptr<Backend>> owned) : owned_(std::move(owned)) {
+  for (const auto& backend : owned_) pointers_.push_back(backend.get());
+}
+
+Expected<BackendSet> BackendFlags::Make() const {
   std::vector<std::unique_ptr<Backend>> out;
   BackendOptions options{device, shaders, validate};
   for (const std::string& name : backends) {
@@ -124,7 +128,7 @@ Expected<std::vector<std::unique_ptr<Backend>>> BackendFlags::Make() const {
     out.push_back(std::move(backend));
   }
   if (out.empty()) return InvalidArgument("--backend: no backend given; allowed: cpu, vulkan");
-  return out;
+  return BackendSet(std::move(out));
 }
 
 Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what) {

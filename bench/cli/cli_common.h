@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -33,13 +34,25 @@ struct CellFlags {
   Expected<std::vector<Cell>> Select() const;  // the catalog's cells the filters keep
 };
 
+// The backends a command runs: owns them, and lists them, in the order the
+// flags name them, as the pointers the sweeps take.
+class BackendSet {
+ public:
+  explicit BackendSet(std::vector<std::unique_ptr<Backend>> owned);
+  std::span<Backend* const> view() const { return pointers_; }
+
+ private:
+  std::vector<std::unique_ptr<Backend>> owned_;
+  std::vector<Backend*> pointers_;  // owned_'s, which moves do not invalidate
+};
+
 struct BackendFlags {
   std::vector<std::string> backends{"cpu", "vulkan"};
   std::string device;
   std::string shaders;
   bool validate = false;
   void Add(CLI::App& app, bool allow_several = true);
-  Expected<std::vector<std::unique_ptr<Backend>>> Make() const;
+  Expected<BackendSet> Make() const;
 };
 
 // "1e6", "1000000" -> a positive count.
@@ -53,6 +66,7 @@ Status CheckWritable(const std::string& path, const std::string& what);
 bool StderrIsTerminal();
 
 // Prints a Status as "depthbench: error: ..." and returns its exit code.
+// Commands return their Status; app.cc alone reports it with this.
 int ReportError(const Status& status);
 
 }  // namespace depthbench::cli

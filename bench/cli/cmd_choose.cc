@@ -25,43 +25,28 @@ struct ChooseFlags {
   std::string device, shaders;
 };
 
-int RunChoose(const ChooseFlags& f) {
-  auto scene = LoadScene(f.scene);
-  if (!scene.ok()) return ReportError(scene.status());
+Expected<int> RunChoose(const ChooseFlags& f) {
+  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(f.scene));
   ChooseOptions options;
-  auto samples = ParseCount(f.samples, "--samples");
-  if (!samples.ok()) return ReportError(samples.status());
-  options.samples = *samples;
+  DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
-  if (!f.json.empty()) {
-    Status writable = CheckWritable(f.json, "--json");
-    if (!writable.ok()) return ReportError(writable);
-  }
-  auto costs = StaticCostLookup(f.shaders);
-  if (!costs.ok()) return ReportError(costs.status());
-  CostLookup lookup = *costs;
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
+  DB_ASSIGN_OR_RETURN(CostLookup lookup, StaticCostLookup(f.shaders));
   if (!f.speed.empty()) {
-    auto measured = SpeedCostLookup(f.speed, lookup);
-    if (!measured.ok()) return ReportError(measured.status());
-    lookup = *measured;
+    DB_ASSIGN_OR_RETURN(lookup, SpeedCostLookup(f.speed, lookup));
   }
-  auto backend = MakeBackend(f.backend, {f.device, f.shaders, false});
-  if (!backend.ok()) return ReportError(backend.status());
+  DB_ASSIGN_OR_RETURN(const std::unique_ptr<Backend> backend, MakeBackend(f.backend, {f.device, f.shaders, false}));
   Progress progress("choose", StderrIsTerminal());
-  auto choice = Choose(*scene, **backend, lookup, options);
-  if (!choice.ok()) return ReportError(choice.status());
-  progress.Finish(fmt::format("{} candidates", choice->ranked.size()));
-  PrintChoice(*choice, std::cout);
-  if (!f.json.empty()) {
-    Status written = WriteFileAtomically(f.json, ChoiceToJson(*choice).dump(1) + "\n");
-    if (!written.ok()) return ReportError(written);
-  }
+  DB_ASSIGN_OR_RETURN(const ChooseResult choice, Choose(scene, *backend, lookup, options));
+  progress.Finish(fmt::format("{} candidates", choice.ranked.size()));
+  PrintChoice(choice, std::cout);
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ChoiceToJson(choice).dump(1) + "\n"));
   return kExitOk;
 }
 
 }  // namespace
 
-void AddChooseCommand(CLI::App& app, std::function<int()>& action) {
+void AddChooseCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<ChooseFlags>();
   CLI::App* cmd = app.add_subcommand(
       "choose", "Rank the reconstructions a scene can use: the cheapest that meets its requirement first");

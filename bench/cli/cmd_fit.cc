@@ -23,52 +23,36 @@ struct FitFlags {
   BackendFlags backends;
 };
 
-int Fit(const FitFlags& f) {
+Expected<int> Fit(const FitFlags& f) {
   FitPlan plan;
-  auto samples = ParseCount(f.samples, "--samples");
-  if (!samples.ok()) return ReportError(samples.status());
-  plan.samples_per_ratio = *samples;
+  DB_ASSIGN_OR_RETURN(plan.samples_per_ratio, ParseCount(f.samples, "--samples"));
   plan.seed = f.seed;
   if (!f.domain.ratio.empty() || !f.domain.far.empty()) {
-    return ReportError(InvalidArgument(
-        "--ratio and --far do not apply to fit: it sweeps far/near from 1e1 to 1e8 and infinity itself"));
+    return InvalidArgument(
+        "--ratio and --far do not apply to fit: it sweeps far/near from 1e1 to 1e8 and infinity itself");
   }
-  auto domain = f.domain.Apply(plan.domain);
-  if (!domain.ok()) return ReportError(domain.status());
-  plan.domain = *domain;
-  auto cells = f.cells.Select();
-  if (!cells.ok()) return ReportError(cells.status());
-  plan.cells = *cells;
-  auto level = ParseLevel(f.level);
-  if (!level.ok()) return ReportError(level.status());
-  if (!f.json.empty()) {
-    Status writable = CheckWritable(f.json, "--json");
-    if (!writable.ok()) return ReportError(writable);
-  }
-  auto made = f.backends.Make();
-  if (!made.ok()) return ReportError(made.status());
-  std::vector<Backend*> backends;
-  for (auto& b : *made) backends.push_back(b.get());
+  DB_ASSIGN_OR_RETURN(plan.domain, f.domain.Apply(plan.domain));
+  DB_ASSIGN_OR_RETURN(plan.cells, f.cells.Select());
+  DB_ASSIGN_OR_RETURN(const Level level, ParseLevel(f.level));
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
+  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
+  const std::span<Backend* const> backends = made.view();
 
   Progress progress("fit", StderrIsTerminal());
-  auto sweeps =
-      RunFitSweeps(plan, backends, [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); });
-  if (!sweeps.ok()) return ReportError(sweeps.status());
+  const auto on_progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
+  DB_ASSIGN_OR_RETURN(const FitSweeps sweeps, RunFitSweeps(plan, backends, on_progress));
   const Metric metrics[] = {Metric::kTotal, Metric::kStorage, Metric::kArith};
-  const std::vector<PrecisionFit> fits = FitPrecision(*sweeps, plan, metrics, kAllLevels);
+  const std::vector<PrecisionFit> fits = FitPrecision(sweeps, plan, metrics, kAllLevels);
   progress.Finish(fmt::format("{} fits", fits.size()));
 
-  PrintPrecisionFits(fits, *level, std::cout);
-  if (!f.json.empty()) {
-    Status written = WriteFileAtomically(f.json, PrecisionFitsToJson(fits, plan).dump(1) + "\n");
-    if (!written.ok()) return ReportError(written);
-  }
+  PrintPrecisionFits(fits, level, std::cout);
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, PrecisionFitsToJson(fits, plan).dump(1) + "\n"));
   return kExitOk;
 }
 
 }  // namespace
 
-void AddFitCommand(CLI::App& app, std::function<int()>& action) {
+void AddFitCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<FitFlags>();
   CLI::App* cmd = app.add_subcommand(
       "fit", "Fit error models per cell (Ceres) and report the precision lost as the far/near ratio grows");

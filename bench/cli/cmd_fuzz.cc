@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/progress.h"
+#include "bench/base/resources.h"
 #include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
@@ -20,7 +21,7 @@ struct FuzzFlags {
   double seconds = 30;
   std::string cases;
   std::uint64_t seed = 1;
-  std::vector<std::string> corpus{std::string(DEPTHBENCH_SOURCE_DIR) + "/fuzz/corpus/formulas"};
+  std::vector<std::string> corpus;  // default: the data folder's fuzz/corpus/formulas
   std::string out = "fuzz-findings";
   bool search = false;
   std::string against_random;
@@ -44,47 +45,45 @@ std::string DescribeCase(const FuzzCase& c) {
       depth);
 }
 
-int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backend*>& backends) {
+Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
   CampaignOptions options;
   options.seconds = f.seconds;
   if (!f.cases.empty()) {
-    auto cases = ParseCount(f.cases, "--cases");
-    if (!cases.ok()) return ReportError(cases.status());
-    options.cases = *cases;
+    DB_ASSIGN_OR_RETURN(options.cases, ParseCount(f.cases, "--cases"));
     options.seconds = 0;
   }
   options.seed = f.seed;
   options.cells = cells;
   for (const std::string& c : f.corpus) options.corpus.emplace_back(c);
+  if (f.corpus.empty()) {
+    DB_ASSIGN_OR_RETURN(std::filesystem::path seeds, DataPath("fuzz/corpus/formulas"));
+    options.corpus.push_back(std::move(seeds));
+  }
   options.out = f.out;
-  auto domain = f.domain.Apply(FuzzDomain());
-  if (!domain.ok()) return ReportError(domain.status());
-  options.domain = *domain;
+  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(FuzzDomain()));
   options.cells = CellsForDomain(cells, options.domain);
   Progress progress("fuzz", StderrIsTerminal() && !f.quiet);
   options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
-  auto result = RunCampaign(options, backends);
-  if (!result.ok()) return ReportError(result.status());
-  if (!f.quiet) progress.Finish(fmt::format("{} inputs", result->cases));
+  DB_ASSIGN_OR_RETURN(const CampaignResult result, RunCampaign(options, backends));
+  if (!f.quiet) progress.Finish(fmt::format("{} inputs", result.cases));
 
   std::cout << fmt::format(
       "fuzz: {} inputs ({} from the corpus, {} at the domain's extremes, {} random, {} mutated) through {} cells on "
       "{}: {} checks in {:.1f} s ({:.0f} inputs/s)\n",
-      result->cases, result->from_corpus * kSamplesPerFrame, result->from_extremes * kSamplesPerFrame,
-      result->from_random * kSamplesPerFrame, result->from_mutation * kSamplesPerFrame, options.cells.size(),
-      backends.size() == 1 ? backends[0]->name() : "cpu and vulkan", result->checks, result->seconds,
-      result->cases / std::max(result->seconds, 1e-9));
+      result.cases, result.from_corpus * kSamplesPerFrame, result.from_extremes * kSamplesPerFrame,
+      result.from_random * kSamplesPerFrame, result.from_mutation * kSamplesPerFrame, options.cells.size(),
+      backends.size() == 1 ? backends[0]->name() : "cpu and vulkan", result.checks, result.seconds,
+      result.cases / std::max(result.seconds, 1e-9));
   std::cout << fmt::format(
       "invariants: finite output where the reference is finite; arithmetic error within "
       "{}x2^-24 x (depth + ray + world condition numbers)\n",
       kRoundings);
-  if (result->findings.empty()) {
-    std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result->closest_cell,
-                             result->closest);
+  if (result.findings.empty()) {
+    std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;
   }
   std::cout << fmt::format("{} findings (deduplicated by cell, backend and kind; each shrunk):\n",
-                           result->findings.size());
+                           result.findings.size());
   using Align = TextTable::Align;
   TextTable table({{"finding", Align::kLeft},
                    {"hits"},
@@ -92,7 +91,7 @@ int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Bac
                    {"bound"},
                    {"shrunk case", Align::kLeft},
                    {"reproducer", Align::kLeft}});
-  for (const CampaignFinding& finding : result->findings) {
+  for (const CampaignFinding& finding : result.findings) {
     const Judgement& j = finding.judgement;
     table.AddRow({finding.signature, std::to_string(finding.hits),
                   std::isfinite(j.arith) ? fmt::format("{:.1f}", BitsLost(j.arith)) : (j.nan ? "NaN" : "Inf"),
@@ -103,14 +102,11 @@ int Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Bac
   return kExitFinding;
 }
 
-int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backend*>& backends) {
-  auto domain = f.domain.Apply(Domain{});
-  if (!domain.ok()) return ReportError(domain.status());
+Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
+  DB_ASSIGN_OR_RETURN(const Domain domain, f.domain.Apply(Domain{}));
   std::uint64_t random_samples = 0;
   if (!f.against_random.empty()) {
-    auto n = ParseCount(f.against_random, "--against-random");
-    if (!n.ok()) return ReportError(n.status());
-    random_samples = *n;
+    DB_ASSIGN_OR_RETURN(random_samples, ParseCount(f.against_random, "--against-random"));
   }
   Backend& backend = *backends.front();
   TextTable table({{"cell", TextTable::Align::kLeft},
@@ -122,72 +118,64 @@ int Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::vector<Backe
                    {"seconds"},
                    {"search >= random"}});
   bool all_found = true;
-  for (const Cell& cell : CellsForDomain(cells, *domain)) {
+  for (const Cell& cell : CellsForDomain(cells, domain)) {
     SearchOptions options;
     options.cell = cell;
-    options.domain = *domain;
+    options.domain = domain;
     options.seed = f.seed;
     options.seconds = f.seconds;
     Progress progress(cell.Name(), StderrIsTerminal() && !f.quiet);
     options.progress = [&](double fraction, double worst) {
       progress.Update(fraction, fmt::format("worst {:.2f} bits lost", BitsLost(worst)));
     };
-    auto found = SearchWorstCase(options, backend);
-    if (!found.ok()) return ReportError(found.status());
-    if (!f.quiet) progress.Finish(fmt::format("{:.2f} bits lost", BitsLost(found->worst)));
-    std::vector<std::string> row = {cell.Name(), fmt::format("{:.3f}", BitsLost(found->worst)),
-                                    ShortCount(static_cast<double>(found->evaluations)),
-                                    fmt::format("{:.1f}", found->seconds)};
+    DB_ASSIGN_OR_RETURN(const SearchResult found, SearchWorstCase(options, backend));
+    if (!f.quiet) progress.Finish(fmt::format("{:.2f} bits lost", BitsLost(found.worst)));
+    std::vector<std::string> row = {cell.Name(), fmt::format("{:.3f}", BitsLost(found.worst)),
+                                    ShortCount(static_cast<double>(found.evaluations)),
+                                    fmt::format("{:.1f}", found.seconds)};
     if (random_samples > 0) {
       SweepOptions sweep;
       sweep.samples = random_samples;
       sweep.seed = f.seed;
-      sweep.domain = *domain;
+      sweep.domain = domain;
       sweep.cells = {cell};
       Backend* only[] = {&backend};
-      auto results = RunSweep(sweep, only);
-      if (!results.ok()) return ReportError(results.status());
-      const double random_worst = results->cells.front().stats.All()[Metric::kTotal].max();
-      const bool ok = found->worst >= random_worst;
+      DB_ASSIGN_OR_RETURN(const Results results, RunSweep(sweep, only));
+      const double random_worst = results.cells.front().stats.All()[Metric::kTotal].max();
+      const bool ok = found.worst >= random_worst;
       all_found = all_found && ok;
       row.insert(row.end(),
                  {fmt::format("{:.3f}", BitsLost(random_worst)), ShortCount(static_cast<double>(random_samples)),
-                  fmt::format("{:.1f}", results->run.seconds), ok ? "yes" : "NO"});
+                  fmt::format("{:.1f}", results.run.seconds), ok ? "yes" : "NO"});
     } else {
       row.insert(row.end(), {"-", "-", "-", "-"});
     }
     table.AddRow(row);
-    if (!f.quiet) std::cerr << "  worst input of " << cell.Name() << ": " << DescribeCase(found->worst_case) << "\n";
+    if (!f.quiet) std::cerr << "  worst input of " << cell.Name() << ": " << DescribeCase(found.worst_case) << "\n";
   }
   std::cout << fmt::format("worst-case search on {} ({}), {:.1f} s per cell, domain {}\n", backend.name(),
-                           backend.device().name, f.seconds, domain->Describe());
+                           backend.device().name, f.seconds, domain.Describe());
   table.Print(std::cout);
   return all_found ? kExitOk : kExitFinding;
 }
 
-int Fuzz(const FuzzFlags& f) {
-  if (!(f.seconds > 0))
-    return ReportError(InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds)));
-  auto cells = f.cells.Select();
-  if (!cells.ok()) return ReportError(cells.status());
+Expected<int> Fuzz(const FuzzFlags& f) {
+  if (!(f.seconds > 0)) return InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds));
+  DB_ASSIGN_OR_RETURN(const std::vector<Cell> cells, f.cells.Select());
   if (!f.search && !f.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(f.out, ec);
-    Status writable = CheckWritable(f.out + "/.probe", "--out");
-    if (!writable.ok()) return ReportError(writable);
+    DB_RETURN_IF_ERROR(CheckWritable(f.out + "/.probe", "--out"));
   }
   BackendFlags backend_flags = f.backends;
   if (f.search && backend_flags.backends.size() > 1) backend_flags.backends = {"cpu"};
-  auto made = backend_flags.Make();
-  if (!made.ok()) return ReportError(made.status());
-  std::vector<Backend*> backends;
-  for (auto& b : *made) backends.push_back(b.get());
-  return f.search ? Search(f, *cells, backends) : Campaign(f, *cells, backends);
+  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make());
+  return f.search ? Search(f, cells, made.view()) : Campaign(f, cells, made.view());
 }
 
 }  // namespace
 
-void AddFuzzCommand(CLI::App& app, std::function<int()>& action) {
+void AddFuzzCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<FuzzFlags>();
   CLI::App* cmd = app.add_subcommand(
       "fuzz",
@@ -208,7 +196,9 @@ void AddFuzzCommand(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--seconds", flags->seconds, "how long to fuzz (default 30); with --search, the time per cell");
   cmd->add_option("--cases", flags->cases, "stop after this many inputs instead of a time");
   cmd->add_option("--seed", flags->seed, "random seed of the mutations and of the search (default 1)");
-  cmd->add_option("--corpus", flags->corpus, "files or folders of inputs to run first (default fuzz/corpus/formulas)");
+  cmd->add_option(
+      "--corpus", flags->corpus,
+      "files or folders of inputs to run first (default: the seed corpus, fuzz/corpus/formulas of the data folder)");
   cmd->add_option("--out", flags->out, "folder for the reproducer files (default fuzz-findings)");
   cmd->add_flag("--search", flags->search,
                 "search each cell's worst case (largest total error) in the default domain, narrowed by the domain "

@@ -29,11 +29,10 @@ struct BaselineSlot {
   Baseline baseline;
 };
 
-int Gate(const GateFlags& f) {
+Expected<int> Gate(const GateFlags& f) {
   for (const auto& [path, what] : {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}}) {
     if (path.empty()) continue;
-    Status writable = CheckWritable(path, what);
-    if (!writable.ok()) return ReportError(writable);
+    DB_RETURN_IF_ERROR(CheckWritable(path, what));
   }
   // The baselines, and the backends they name.
   std::vector<BaselineSlot> slots;
@@ -42,28 +41,24 @@ int Gate(const GateFlags& f) {
     BaselineSlot slot;
     slot.path = path;
     if (f.update) {  // refused now, not after the sweep
-      Status writable = CheckWritable(path, "--baseline");
-      if (!writable.ok()) return ReportError(writable.WithContext("--update"));
+      DB_RETURN_IF_ERROR(CheckWritable(path, "--baseline").WithContext("--update"));
     }
     slot.exists = std::filesystem::exists(path);
     if (slot.exists) {
-      auto baseline = ReadBaseline(path);
-      if (!baseline.ok()) return ReportError(baseline.status().WithContext("the baseline does not parse"));
-      slot.baseline = std::move(*baseline);
+      DB_RETURN_IF_ERROR(StoreInto(ReadBaseline(path), slot.baseline).WithContext("the baseline does not parse"));
     } else if (!f.update) {
-      return ReportError(NotFound(fmt::format(
+      return NotFound(fmt::format(
           "baseline '{}' does not exist; make one with: depthbench gate --update --baseline {} --backend cpu|vulkan",
-          path, path)));
+          path, path));
     } else if (next_new < f.new_backends.size()) {
       slot.baseline.backend = f.new_backends[next_new++];
     } else {
-      return ReportError(InvalidArgument(fmt::format(
-          "baseline '{}' does not exist yet: say which backend it is for with --backend (one per new baseline)",
-          path)));
+      return InvalidArgument(fmt::format(
+          "baseline '{}' does not exist yet: say which backend it is for with --backend (one per new baseline)", path));
     }
     if (slot.baseline.backend != "cpu" && slot.baseline.backend != "vulkan") {
-      return ReportError(InvalidArgument(
-          fmt::format("baseline '{}' is for backend '{}'; allowed: cpu, vulkan", path, slot.baseline.backend)));
+      return InvalidArgument(
+          fmt::format("baseline '{}' is for backend '{}'; allowed: cpu, vulkan", path, slot.baseline.backend));
     }
     slots.push_back(std::move(slot));
   }
@@ -78,10 +73,8 @@ int Gate(const GateFlags& f) {
   backend_flags.device = f.device;
   backend_flags.shaders = f.shaders;
   backend_flags.validate = f.validate;
-  auto made = backend_flags.Make();
-  if (!made.ok()) return ReportError(made.status());
-  std::vector<Backend*> backends;
-  for (auto& b : *made) backends.push_back(b.get());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make());
+  const std::span<Backend* const> backends = made.view();
 
   // The gate's own sweep.
   const SamplePlan plan = GatePlan();
@@ -92,22 +85,18 @@ int Gate(const GateFlags& f) {
   options.threads = f.threads;
   Progress progress("gate", StderrIsTerminal());
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
-  auto results = RunSweep(options, backends);
-  if (!results.ok()) return ReportError(results.status());
-  progress.Finish(fmt::format("{} cells on {} backend(s)", results->cells.size(), backends.size()));
+  DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
+  progress.Finish(fmt::format("{} cells on {} backend(s)", results.cells.size(), backends.size()));
 
   const GateTolerance tolerance;
   std::vector<GateRun> runs;
   for (const BaselineSlot& s : slots) {
     GateRun run;
-    run.current = BaselineFromResults(*results, s.baseline.backend);
+    run.current = BaselineFromResults(results, s.baseline.backend);
     run.shader_dir = f.shaders;
     if (s.exists) {
-      auto comparison = CompareWithBaseline(s.baseline, run.current, tolerance);
-      if (!comparison.ok()) {
-        return ReportError(comparison.status().WithContext(fmt::format("cannot judge against '{}'", s.path)));
-      }
-      run.comparison = std::move(*comparison);
+      DB_RETURN_IF_ERROR(StoreInto(CompareWithBaseline(s.baseline, run.current, tolerance), run.comparison)
+                             .WithContext(fmt::format("cannot judge against '{}'", s.path)));
       run.baseline = s.baseline;
     } else {
       run.comparison.backend = s.baseline.backend;
@@ -116,18 +105,11 @@ int Gate(const GateFlags& f) {
   }
 
   PrintGateVerdict(runs, tolerance, std::cout);
-  if (!f.junit.empty()) {
-    Status written = WriteFileAtomically(f.junit, GateJUnit(runs));
-    if (!written.ok()) return ReportError(written);
-  }
-  if (!f.json.empty()) {
-    Status written = WriteFileAtomically(f.json, GateJson(runs, tolerance).dump(1) + "\n");
-    if (!written.ok()) return ReportError(written);
-  }
+  if (!f.junit.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.junit, GateJUnit(runs)));
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, GateJson(runs, tolerance).dump(1) + "\n"));
   if (f.update) {
     for (std::size_t k = 0; k < slots.size(); ++k) {
-      Status written = WriteBaseline(slots[k].path, runs[k].current);
-      if (!written.ok()) return ReportError(written);
+      DB_RETURN_IF_ERROR(WriteBaseline(slots[k].path, runs[k].current));
       std::cout << fmt::format("baseline written: {} ({} cells on {})\n", slots[k].path, runs[k].current.cells.size(),
                                runs[k].current.device.name);
     }
@@ -140,7 +122,7 @@ int Gate(const GateFlags& f) {
 
 }  // namespace
 
-void AddGateCommand(CLI::App& app, std::function<int()>& action) {
+void AddGateCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<GateFlags>();
   CLI::App* cmd = app.add_subcommand(
       "gate", "Fail when a shader edit loses precision: a fixed-seed sweep of every cell against baselines");

@@ -21,7 +21,7 @@ const char* InputName(DepthInput input) {
   return "?";
 }
 
-int List() {
+Expected<int> List() {
   using Align = TextTable::Align;
   TextTable variants(
       {{"variant", Align::kLeft}, {"seed", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
@@ -60,7 +60,7 @@ int List() {
 
 }  // namespace
 
-void AddListCommand(CLI::App& app, std::function<int()>& action) {
+void AddListCommand(CLI::App& app, CommandAction& action) {
   CLI::App* cmd =
       app.add_subcommand("list", "List variants (with their seeds), conventions, formats and Vulkan devices");
   cmd->callback([&action] { action = [] { return List(); }; });

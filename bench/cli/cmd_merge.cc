@@ -15,32 +15,29 @@ struct MergeFlags {
   std::string output;
 };
 
-int Merge(const MergeFlags& f) {
-  Status writable = CheckWritable(f.output, "--json");
-  if (!writable.ok()) return ReportError(writable);
+Expected<int> Merge(const MergeFlags& f) {
+  DB_RETURN_IF_ERROR(CheckWritable(f.output, "--json"));
   std::vector<Results> parts;
   for (const std::string& path : f.inputs) {
-    auto part = ReadResults(path);
-    if (!part.ok()) return ReportError(part.status());
-    parts.push_back(std::move(*part));
+    DB_ASSIGN_OR_RETURN(Results part, ReadResults(path));
+    parts.push_back(std::move(part));
   }
-  auto merged = MergeResults(parts);
-  if (!merged.ok()) return ReportError(merged.status());
+  DB_ASSIGN_OR_RETURN(const Results merged, MergeResults(parts));
   std::uint64_t covered = 0;
-  for (const Shard& s : merged->run.shards) covered += s.End(merged->run.samples) - s.Begin(merged->run.samples);
-  PrintRunHeader(*merged, std::cout);
-  PrintResultsTable(*merged, std::cout);
-  if (covered != merged->run.samples) {
+  for (const Shard& s : merged.run.shards) covered += s.End(merged.run.samples) - s.Begin(merged.run.samples);
+  PrintRunHeader(merged, std::cout);
+  PrintResultsTable(merged, std::cout);
+  if (covered != merged.run.samples) {
     std::cout << fmt::format("\nnote: the merged shards cover {} of the sweep's {} samples\n", covered,
-                             merged->run.samples);
+                             merged.run.samples);
   }
-  Status written = WriteResults(f.output, *merged);
-  return written.ok() ? kExitOk : ReportError(written);
+  DB_RETURN_IF_ERROR(WriteResults(f.output, merged));
+  return kExitOk;
 }
 
 }  // namespace
 
-void AddMergeCommand(CLI::App& app, std::function<int()>& action) {
+void AddMergeCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<MergeFlags>();
   CLI::App* cmd = app.add_subcommand("merge", "Add up the results of the shards of one sweep (run --shard K/N)");
   cmd->footer(

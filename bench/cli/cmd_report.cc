@@ -9,9 +9,11 @@
 #include "bench/base/environment.h"
 #include "bench/base/files.h"
 #include "bench/base/progress.h"
+#include "bench/base/resources.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/report/report.h"
+#include "bench/report/report_json.h"
 #include "bench/report/report_render.h"
 
 namespace depthbench::cli {
@@ -19,31 +21,31 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSourceDir = DEPTHBENCH_SOURCE_DIR;
-
 struct ReportFlags {
   std::string out;
   bool quick = false;
-  std::string history = (kSourceDir / "reports" / "history.sqlite").string();
+  std::string history;  // default: history.sqlite in the user's data folder
   bool no_history = false;
   std::string samples, default_samples;
   std::uint64_t seed = 7;
   std::vector<std::string> speed;
   bool no_speed = false;
-  std::string plot_library = (kSourceDir / "reports" / "node_modules").string();
-  std::string page_template = (kSourceDir / "reports" / "report_template.html").string();
+  std::string plot_library;   // default: the data folder's
+  std::string page_template;  // default: the data folder's
   bool fail_on_regression = false;
   CellFlags cells;
   BackendFlags backends;
 };
 
-// The speed files: those named, or every one committed under reports/speed.
-std::vector<fs::path> SpeedFiles(const ReportFlags& f) {
+// The speed files: those named, or every one of the data folder's
+// reports/speed (committed under reports/speed in the source tree).
+Expected<std::vector<fs::path>> SpeedFiles(const ReportFlags& f) {
   std::vector<fs::path> files;
   if (f.no_speed) return files;
-  if (!f.speed.empty()) return {f.speed.begin(), f.speed.end()};
+  if (!f.speed.empty()) return std::vector<fs::path>(f.speed.begin(), f.speed.end());
+  DB_ASSIGN_OR_RETURN(const fs::path folder, DataPath("reports/speed"));
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(kSourceDir / "reports" / "speed", ec)) {
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
     // "x.repeat.json" files repeat "x.json" (a repeatability check): one is enough.
     if (entry.path().extension() == ".json" && name.find(".repeat.") == std::string::npos) {
@@ -54,54 +56,47 @@ std::vector<fs::path> SpeedFiles(const ReportFlags& f) {
   return files;
 }
 
-int Report(const ReportFlags& f) {
+Expected<int> RunReport(const ReportFlags& f) {
   ReportPlan plan = f.quick ? ReportPlan::Quick() : ReportPlan::Nightly();
   if (!f.samples.empty()) {
-    auto samples = ParseCount(f.samples, "--samples");
-    if (!samples.ok()) return ReportError(samples.status());
-    plan.fit.samples_per_ratio = *samples;
+    DB_ASSIGN_OR_RETURN(plan.fit.samples_per_ratio, ParseCount(f.samples, "--samples"));
   }
   if (!f.default_samples.empty()) {
-    auto samples = ParseCount(f.default_samples, "--default-samples");
-    if (!samples.ok()) return ReportError(samples.status());
-    plan.main_samples = *samples;
+    DB_ASSIGN_OR_RETURN(plan.main_samples, ParseCount(f.default_samples, "--default-samples"));
   }
   plan.fit.seed = f.seed;
   plan.shader_dir = f.backends.shaders;
-  auto cells = f.cells.Select();
-  if (!cells.ok()) return ReportError(cells.status());
-  if (cells->size() != AllCells().size()) plan.cells = *cells;
-  plan.speed_files = SpeedFiles(f);
+  DB_ASSIGN_OR_RETURN(std::vector<Cell> cells, f.cells.Select());
+  if (cells.size() != AllCells().size()) plan.cells = std::move(cells);
+  DB_ASSIGN_OR_RETURN(plan.speed_files, SpeedFiles(f));
   for (const fs::path& file : plan.speed_files) {
-    if (!fs::is_regular_file(file))
-      return ReportError(NotFound(fmt::format("--speed: {} does not exist", file.string())));
+    if (!fs::is_regular_file(file)) return NotFound(fmt::format("--speed: {} does not exist", file.string()));
   }
 
   // Everything that can be refused is refused before the sweeps run.
-  if (f.out.empty()) return ReportError(InvalidArgument("--out: give the folder to write the report into"));
+  if (f.out.empty()) return InvalidArgument("--out: give the folder to write the report into");
   std::error_code ec;
   fs::create_directories(f.out, ec);
   if (ec || !fs::is_directory(f.out)) {
-    return ReportError(IoError(fmt::format("--out: cannot create folder '{}': {}", f.out, ec.message())));
+    return IoError(fmt::format("--out: cannot create folder '{}': {}", f.out, ec.message()));
   }
-  Status writable = CheckWritable((fs::path(f.out) / "results.json").string(), "--out");
-  if (!writable.ok()) return ReportError(writable);
-  const PlotLibrary library{f.plot_library};
-  Status library_ok = library.Check();
-  if (!library_ok.ok()) return ReportError(library_ok);
-  if (!fs::is_regular_file(f.page_template)) {
-    return ReportError(NotFound(fmt::format("--template: {} does not exist", f.page_template)));
+  DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / "results.json").string(), "--out"));
+  PlotLibrary library{f.plot_library};
+  if (library.node_modules.empty())
+    DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));
+  fs::path page_template = f.page_template;
+  if (page_template.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/report_template.html"), page_template));
+  DB_RETURN_IF_ERROR(library.Check());
+  if (!fs::is_regular_file(page_template)) {
+    return NotFound(fmt::format("--template: {} does not exist", page_template.string()));
   }
   std::optional<History> history;
   if (!f.no_history) {
-    auto opened = History::Open(f.history);
-    if (!opened.ok()) return ReportError(opened.status().WithContext("--history"));
-    history = std::move(*opened);
+    const fs::path path = f.history.empty() ? UserDataFolder() / "history.sqlite" : fs::path(f.history);
+    DB_RETURN_IF_ERROR(StoreInto(History::Open(path), history).WithContext("--history"));
   }
-  auto made = f.backends.Make();
-  if (!made.ok()) return ReportError(made.status());
-  std::vector<Backend*> backends;
-  for (auto& b : *made) backends.push_back(b.get());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
+  const std::span<Backend* const> backends = made.view();
 
   const bool terminal = StderrIsTerminal();
   std::unique_ptr<Progress> stage;
@@ -116,11 +111,10 @@ int Report(const ReportFlags& f) {
 
   const std::string started_at = CurrentTimeUtc();
   auto measured = MeasureReport(plan, backends, progress);
-  if (!measured.ok()) return ReportError(measured.status());
+  if (!measured.ok()) return measured.status();
 
   progress.begin("write");
-  nlohmann::json report = ReportJson(plan, *measured);
-  int worse = 0;
+  Report report = BuildReport(plan, *measured);
   if (history) {
     HistoryRun run;
     run.made_at = started_at;
@@ -128,20 +122,19 @@ int Report(const ReportFlags& f) {
     run.host = measured->main.run.host;
     run.version = measured->main.run.version;
     run.quick = plan.quick;
-    run.seconds = report["environment"].value("seconds", 0.0);
-    Status added = AddHistory(report, *history, run, HistoryFigures(*measured), plan.trend_runs);
-    if (!added.ok()) return ReportError(added.WithContext("--history"));
-    for (const auto& change : report["history"]["changes"]) worse += change.value("direction", "") == "worse";
+    run.seconds = report.environment.seconds.value_or(0.0);
+    DB_RETURN_IF_ERROR(
+        AddHistory(report, *history, run, HistoryFigures(*measured), plan.trend_runs).WithContext("--history"));
   }
-  auto page = RenderHtml(report, f.page_template, library);
-  if (!page.ok()) return ReportError(page.status());
+  const std::size_t worse = report.history ? report.history->worse() : 0;
+  DB_ASSIGN_OR_RETURN(const std::string page, RenderHtml(report, page_template, library));
   const std::string markdown = RenderMarkdown(report);
   const fs::path out(f.out);
-  for (const auto& [name, text] : {std::pair<const char*, std::string>{"results.json", report.dump(1) + "\n"},
-                                   {"report.md", markdown},
-                                   {"report.html", *page}}) {
-    Status written = WriteFileAtomically(out / name, text);
-    if (!written.ok()) return ReportError(written);
+  for (const auto& [name, text] :
+       {std::pair<const char*, std::string>{"results.json", ReportToJson(report).dump(1) + "\n"},
+        {"report.md", markdown},
+        {"report.html", page}}) {
+    DB_RETURN_IF_ERROR(WriteFileAtomically(out / name, text));
   }
   progress.end(fmt::format("{} (report.html, report.md, results.json)", out.string()));
 
@@ -151,7 +144,7 @@ int Report(const ReportFlags& f) {
 
 }  // namespace
 
-void AddReportCommand(CLI::App& app, std::function<int()>& action) {
+void AddReportCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<ReportFlags>();
   CLI::App* cmd = app.add_subcommand(
       "report", "The nightly precision report: HTML page with plots, Markdown summary, JSON, and history");
@@ -176,7 +169,9 @@ void AddReportCommand(CLI::App& app, std::function<int()>& action) {
       ->required();
   cmd->add_flag("--quick", flags->quick,
                 "fewer samples (4e4 per far/near ratio, 1e5 default-domain), same page: seconds, not minutes");
-  cmd->add_option("--history", flags->history, "SQLite history database (created if missing)")->capture_default_str();
+  cmd->add_option("--history", flags->history,
+                  "SQLite history database, created if missing (default: history.sqlite in $XDG_DATA_HOME/depthbench, "
+                  "else ~/.local/share/depthbench)");
   cmd->add_flag("--no-history", flags->no_history, "neither read nor record history");
   cmd->add_option("--samples", flags->samples, "samples per far/near ratio (default 3e5; quick 4e4)");
   cmd->add_option("--default-samples", flags->default_samples,
@@ -184,17 +179,18 @@ void AddReportCommand(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--seed", flags->seed, "seed of the far/near sweeps (default 7)");
   cmd->add_option("--speed", flags->speed,
                   "speed files (depthbench speed --json) for the speed/accuracy front (default: every "
-                  "reports/speed/*.json)");
+                  "reports/speed/*.json of the data folder: those committed with depthbench)");
   cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses instruction counts only");
   cmd->add_option("--plot-library", flags->plot_library,
-                  "node_modules folder holding vega, vega-lite and vega-embed (npm ci --prefix reports)")
-      ->capture_default_str();
-  cmd->add_option("--template", flags->page_template, "the page's HTML template")->capture_default_str();
+                  "node_modules folder holding vega, vega-lite and vega-embed (default: the data folder's "
+                  "reports/node_modules, which ./setup.sh installs with npm ci --prefix reports)");
+  cmd->add_option("--template", flags->page_template,
+                  "the page's HTML template (default: the data folder's reports/report_template.html)");
   cmd->add_flag("--fail-on-regression", flags->fail_on_regression,
                 "exit 1 when a cell got worse since the previous comparable run");
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
-  cmd->callback([flags, &action] { action = [flags] { return Report(*flags); }; });
+  cmd->callback([flags, &action] { action = [flags] { return RunReport(*flags); }; });
 }
 
 }  // namespace depthbench::cli

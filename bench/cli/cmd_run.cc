@@ -37,23 +37,20 @@ struct RunFlags {
 
 // Replays a reproducer file of depthbench fuzz: the same output, and
 // whether the finding still holds (exit 1) or is gone (exit 0).
-int ReplayReproFile(const RunFlags& f, std::vector<Backend*>& backends) {
-  auto file = ReadReproFile(f.repro);
-  if (!file.ok()) return ReportError(file.status());
-  const CaseSource source(file->fuzz_case);
-  auto repro = ReproduceFrom(source, 0, file->cells, backends);
-  if (!repro.ok()) return ReportError(repro.status());
-  repro->origin = fmt::format("the case of {}", f.repro);
-  PrintRepro(*repro, std::cout);
-  auto checker = CaseChecker::Make(file->cells, backends, 1);
-  if (!checker.ok()) return ReportError(checker.status());
-  Status evaluated = checker->Evaluate(source, 0, 1);
-  if (!evaluated.ok()) return ReportError(evaluated);
+Expected<int> ReplayReproFile(const RunFlags& f, std::span<Backend* const> backends) {
+  DB_ASSIGN_OR_RETURN(const ReproFile file, ReadReproFile(f.repro));
+  const CaseSource source(file.fuzz_case);
+  DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(source, 0, file.cells, backends));
+  repro.origin = fmt::format("the case of {}", f.repro);
+  PrintRepro(repro, std::cout);
+  DB_ASSIGN_OR_RETURN(CaseChecker checker,
+                      CaseChecker::Make(file.cells, std::vector<Backend*>(backends.begin(), backends.end()), 1));
+  DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, 1));
   int failures = 0;
   std::cout << "\n";
-  for (std::size_t c = 0; c < file->cells.size(); ++c) {
+  for (std::size_t c = 0; c < file.cells.size(); ++c) {
     for (std::size_t b = 0; b < backends.size(); ++b) {
-      const Judgement& j = checker->At(c, b, 0);
+      const Judgement& j = checker.At(c, b, 0);
       std::string verdict =
           !j.checked          ? "not checked (the reference is degenerate)"
           : j.nan             ? "FINDING: NaN where the reference is finite"
@@ -64,35 +61,24 @@ int ReplayReproFile(const RunFlags& f, std::vector<Backend*>& backends) {
                                     j.arith, BitsLost(j.arith), j.bound, BitsLost(j.bound))
                               : fmt::format("holds: arithmetic error {:.3g} within the bound {:.3g}", j.arith, j.bound);
       failures += j.violates();
-      std::cout << fmt::format("{} on {}: {}\n", file->cells[c].Name(), backends[b]->name(), verdict);
+      std::cout << fmt::format("{} on {}: {}\n", file.cells[c].Name(), backends[b]->name(), verdict);
     }
   }
-  if (!f.json.empty()) {
-    Status written = WriteFileAtomically(f.json, ReproToJson(*repro).dump(1) + "\n");
-    if (!written.ok()) return ReportError(written);
-  }
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ReproToJson(repro).dump(1) + "\n"));
   return failures > 0 ? kExitFinding : kExitOk;
 }
 
-int Run(const RunFlags& f) {
+Expected<int> Run(const RunFlags& f) {
   SweepOptions options;
-  auto samples = ParseCount(f.samples, "--samples");
-  if (!samples.ok()) return ReportError(samples.status());
-  options.samples = *samples;
+  DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
   options.threads = f.threads;
   options.batch_size = f.batch;
   if (!f.shard.empty()) {
-    auto shard = ParseShard(f.shard);
-    if (!shard.ok()) return ReportError(shard.status());
-    options.shard = *shard;
+    DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
-  auto domain = f.domain.Apply(Domain{});
-  if (!domain.ok()) return ReportError(domain.status());
-  options.domain = *domain;
-  auto cells = f.cells.Select();
-  if (!cells.ok()) return ReportError(cells.status());
-  options.cells = *cells;
+  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}));
+  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select());
   std::vector<BandFamily> splits;
   for (const std::string& s : f.split) {
     if (s == "ratio")
@@ -102,57 +88,44 @@ int Run(const RunFlags& f) {
     else if (s == "distance")
       splits.push_back(BandFamily::kDistance);
     else
-      return ReportError(InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s)));
+      return InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s));
   }
-  if (!f.json.empty()) {
-    Status writable = CheckWritable(f.json, "--json");
-    if (!writable.ok()) return ReportError(writable);
-  }
-  auto made = f.backends.Make();
-  if (!made.ok()) return ReportError(made.status());
-  std::vector<Backend*> backends;
-  for (auto& b : *made) backends.push_back(b.get());
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
+  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
+  const std::span<Backend* const> backends = made.view();
 
   if (!f.repro.empty()) return ReplayReproFile(f, backends);
   if (!f.index.empty()) {  // one sample, in full
     char* end = nullptr;
     const unsigned long long index = std::strtoull(f.index.c_str(), &end, 10);
     if (f.index.empty() || *end != '\0' || f.index[0] == '-') {
-      return ReportError(InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ...)", f.index)));
+      return InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ...)", f.index));
     }
-    auto repro =
-        Reproduce(options.seed, index, options.domain, CellsForDomain(options.cells, options.domain), backends);
-    if (!repro.ok()) return ReportError(repro.status());
-    PrintRepro(*repro, std::cout);
-    if (!f.json.empty()) {
-      Status written = WriteFileAtomically(f.json, ReproToJson(*repro).dump(1) + "\n");
-      if (!written.ok()) return ReportError(written);
-    }
+    DB_ASSIGN_OR_RETURN(const Repro repro, Reproduce(options.seed, index, options.domain,
+                                                     CellsForDomain(options.cells, options.domain), backends));
+    PrintRepro(repro, std::cout);
+    if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ReproToJson(repro).dump(1) + "\n"));
     return kExitOk;
   }
 
   Progress progress("run", StderrIsTerminal() && !f.quiet);
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
-  auto results = RunSweep(options, backends);
-  if (!results.ok()) return ReportError(results.status());
+  DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
   if (!f.quiet) {
     progress.Finish(fmt::format("{} reconstructions in {} cells",
-                                ShortCount(static_cast<double>(results->run.reconstructions)), results->cells.size()));
+                                ShortCount(static_cast<double>(results.run.reconstructions)), results.cells.size()));
   }
 
-  PrintRunHeader(*results, std::cout);
-  PrintResultsTable(*results, std::cout);
-  for (BandFamily family : splits) PrintBandTable(*results, family, std::cout);
-  if (!f.json.empty()) {
-    Status written = WriteResults(f.json, *results);
-    if (!written.ok()) return ReportError(written);
-  }
+  PrintRunHeader(results, std::cout);
+  PrintResultsTable(results, std::cout);
+  for (BandFamily family : splits) PrintBandTable(results, family, std::cout);
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteResults(f.json, results));
   return kExitOk;
 }
 
 }  // namespace
 
-void AddRunCommand(CLI::App& app, std::function<int()>& action) {
+void AddRunCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<RunFlags>();
   CLI::App* cmd = app.add_subcommand(
       "run",

@@ -8,6 +8,7 @@
 
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/base/progress.h"
+#include "bench/base/resources.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/results/results.h"
@@ -55,16 +56,13 @@ Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cell
   return RunSweep(sweep, backends);
 }
 
-int Speed(const SpeedFlags& f) {
+Expected<int> Speed(const SpeedFlags& f) {
   SpeedOptions options;
-  auto cells = f.cells.Select();
-  if (!cells.ok()) return ReportError(cells.status());
-  options.cells = *cells;
+  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select());
   options.resolutions.clear();
   for (const std::string& text : f.resolutions) {
-    auto resolution = ParseResolution(text, "--resolution");
-    if (!resolution.ok()) return ReportError(resolution.status());
-    options.resolutions.push_back(*resolution);
+    DB_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(text, "--resolution"));
+    options.resolutions.push_back(resolution);
   }
   options.alu_taps = f.taps;
   options.warmup = f.quick && !f.warmup_given ? 1 : f.warmup;
@@ -77,89 +75,72 @@ int Speed(const SpeedFlags& f) {
   if (!valid.ok()) {
     // Name the flags, not the struct.
     if (options.alu_taps < 2 || options.alu_taps > GpuPassTimer::kMaxTaps) {
-      return ReportError(
-          InvalidArgument(fmt::format("--taps: {} is out of range; allowed 2 to {} (the ALU-bound "
-                                      "regime; 1 tap is the memory-bound one, always measured)",
-                                      options.alu_taps, GpuPassTimer::kMaxTaps)));
+      return InvalidArgument(
+          fmt::format("--taps: {} is out of range; allowed 2 to {} (the ALU-bound "
+                      "regime; 1 tap is the memory-bound one, always measured)",
+                      options.alu_taps, GpuPassTimer::kMaxTaps));
     }
     if (options.repetitions < 3) {
-      return ReportError(InvalidArgument(
-          fmt::format("--repetitions: {} is too few; at least 3 (a spread needs three values)", options.repetitions)));
+      return InvalidArgument(
+          fmt::format("--repetitions: {} is too few; at least 3 (a spread needs three values)", options.repetitions));
     }
-    if (options.warmup < 1) return ReportError(InvalidArgument("--warmup: at least 1 warm-up pass is needed"));
-    return ReportError(valid);
+    if (options.warmup < 1) return InvalidArgument("--warmup: at least 1 warm-up pass is needed");
+    return valid;
   }
   const std::string accuracy_samples_text = f.quick && !f.accuracy_samples_given ? "1e4" : f.accuracy_samples;
-  auto accuracy_samples = ParseCount(accuracy_samples_text, "--accuracy-samples");
-  if (!accuracy_samples.ok()) return ReportError(accuracy_samples.status());
-  if (!f.json.empty()) {
-    Status writable = CheckWritable(f.json, "--json");
-    if (!writable.ok()) return ReportError(writable);
-  }
+  DB_ASSIGN_OR_RETURN(const std::uint64_t accuracy_samples, ParseCount(accuracy_samples_text, "--accuracy-samples"));
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
   // Files given are read before the long work starts.
   std::optional<SpeedResults> previous;
   if (!f.compare.empty()) {
-    auto read = ReadSpeedResults(f.compare);
-    if (!read.ok()) return ReportError(read.status().WithContext("--compare"));
-    previous = std::move(read).value();
+    DB_RETURN_IF_ERROR(StoreInto(ReadSpeedResults(f.compare), previous).WithContext("--compare"));
   }
   std::optional<Results> given_accuracy;
   if (!f.results.empty()) {
-    auto read = ReadResults(f.results);
-    if (!read.ok()) return ReportError(read.status().WithContext("--results"));
-    given_accuracy = std::move(read).value();
+    DB_RETURN_IF_ERROR(StoreInto(ReadResults(f.results), given_accuracy).WithContext("--results"));
   }
 
   VulkanContextOptions context_options;
   context_options.device = f.device;
   context_options.validation = f.validate;
-  auto context = VulkanContext::Create(context_options);
-  if (!context.ok()) return ReportError(context.status());
-  std::shared_ptr<VulkanContext> shared_context = std::move(context).value();
-  const std::filesystem::path shader_dir =
-      f.shaders.empty() ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders" : std::filesystem::path(f.shaders);
-  auto timer = GpuPassTimer::Create(shared_context, shader_dir);
-  if (!timer.ok()) return ReportError(timer.status());
+  DB_ASSIGN_OR_RETURN(const std::shared_ptr<VulkanContext> shared_context, VulkanContext::Create(context_options));
+  std::filesystem::path shader_dir = f.shaders;
+  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
+  DB_ASSIGN_OR_RETURN(const std::unique_ptr<GpuPassTimer> timer, GpuPassTimer::Create(shared_context, shader_dir));
 
   Progress progress("speed", StderrIsTerminal() && !f.quiet);
   options.progress = [&](std::size_t done, std::size_t total, const std::string& what) {
     progress.Update(static_cast<double>(done) / static_cast<double>(total), what);
   };
-  auto results = RunSpeed(**timer, shader_dir, options);
-  if (!results.ok()) return ReportError(results.status());
-  if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results->gpu.size(), results->run.seconds));
+  DB_ASSIGN_OR_RETURN(SpeedResults results, RunSpeed(*timer, shader_dir, options));
+  if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results.gpu.size(), results.run.seconds));
 
   std::string source;
-  Expected<Results> accuracy = given_accuracy
-                                   ? Expected<Results>(*given_accuracy)
-                                   : AccuracyFor(f, options.cells, shared_context, *accuracy_samples, source);
+  Expected<Results> accuracy = given_accuracy ? Expected<Results>(*given_accuracy)
+                                              : AccuracyFor(f, options.cells, shared_context, accuracy_samples, source);
   if (given_accuracy) source = f.results;
-  if (!accuracy.ok()) return ReportError(accuracy.status().WithContext("accuracy results for the trade"));
-  Status traded = AddTrade(*results, *accuracy, source);
-  if (!traded.ok()) return ReportError(traded.WithContext("accuracy results for the trade"));
+  if (!accuracy.ok()) return accuracy.status().WithContext("accuracy results for the trade");
+  DB_RETURN_IF_ERROR(AddTrade(results, *accuracy, source).WithContext("accuracy results for the trade"));
 
-  PrintSpeedHeader(*results, std::cout);
-  PrintGpuTable(*results, std::cout);
-  PrintStaticTable(*results, std::cout);
-  PrintCpuTable(*results, std::cout);
-  PrintTradeTable(*results, std::cout);
-  PrintSkipped(*results, std::cout);
-  if (!f.json.empty()) {
-    Status written = WriteSpeedResults(f.json, *results);
-    if (!written.ok()) return ReportError(written);
-  }
+  PrintSpeedHeader(results, std::cout);
+  PrintGpuTable(results, std::cout);
+  PrintStaticTable(results, std::cout);
+  PrintCpuTable(results, std::cout);
+  PrintTradeTable(results, std::cout);
+  PrintSkipped(results, std::cout);
+  if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteSpeedResults(f.json, results));
   if (previous) {
-    auto comparison = CompareRankings(*previous, *results);
-    if (!comparison.ok()) return ReportError(comparison.status().WithContext("--compare"));
-    PrintRankingComparison(*comparison, std::cout);
-    if (!comparison->contradictions.empty()) return kExitFinding;
+    RankingComparison comparison;
+    DB_RETURN_IF_ERROR(StoreInto(CompareRankings(*previous, results), comparison).WithContext("--compare"));
+    PrintRankingComparison(comparison, std::cout);
+    if (!comparison.contradictions.empty()) return kExitFinding;
   }
   return kExitOk;
 }
 
 }  // namespace
 
-void AddSpeedCommand(CLI::App& app, std::function<int()>& action) {
+void AddSpeedCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<SpeedFlags>();
   CLI::App* cmd = app.add_subcommand(
       "speed",

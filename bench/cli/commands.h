@@ -1,22 +1,28 @@
 // The subcommands of depthbench. Each Add*Command registers its flags and,
-// when chosen, sets `action` to the function that runs it and returns the
-// exit code.
+// when chosen, sets `action` to the function that runs it.
 #pragma once
 
 #include <functional>
 
 #include <CLI/CLI.hpp>
 
+#include "bench/base/status.h"
+
 namespace depthbench::cli {
 
-void AddListCommand(CLI::App& app, std::function<int()>& action);
-void AddRunCommand(CLI::App& app, std::function<int()>& action);
-void AddMergeCommand(CLI::App& app, std::function<int()>& action);
-void AddSpeedCommand(CLI::App& app, std::function<int()>& action);
-void AddGateCommand(CLI::App& app, std::function<int()>& action);
-void AddFitCommand(CLI::App& app, std::function<int()>& action);
-void AddChooseCommand(CLI::App& app, std::function<int()>& action);
-void AddFuzzCommand(CLI::App& app, std::function<int()>& action);
-void AddReportCommand(CLI::App& app, std::function<int()>& action);
+// Runs a chosen subcommand: the exit code of a command that ran (kExitOk, or
+// kExitFinding for a finding), or the Status that says why it could not run,
+// which RunDepthbench reports (exit kExitCannotRun).
+using CommandAction = std::function<Expected<int>()>;
+
+void AddListCommand(CLI::App& app, CommandAction& action);
+void AddRunCommand(CLI::App& app, CommandAction& action);
+void AddMergeCommand(CLI::App& app, CommandAction& action);
+void AddSpeedCommand(CLI::App& app, CommandAction& action);
+void AddGateCommand(CLI::App& app, CommandAction& action);
+void AddFitCommand(CLI::App& app, CommandAction& action);
+void AddChooseCommand(CLI::App& app, CommandAction& action);
+void AddFuzzCommand(CLI::App& app, CommandAction& action);
+void AddReportCommand(CLI::App& app, CommandAction& action);
 
 }  // namespace depthbench::cli

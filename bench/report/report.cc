@@ -18,8 +18,6 @@
 namespace depthbench {
 namespace {
 
-using json = nlohmann::json;
-
 // The far/near ratios whose error-versus-depth curves the page draws (the
 // infinite sweep too): the decades the depth-precision literature plots.
 const double kDepthCurveRatios[] = {1e2, 1e4, 1e6, 1e8, INFINITY};
@@ -34,28 +32,17 @@ constexpr double kNotableDifferenceBits = kBitsResolution;
 constexpr std::size_t kMostWorstSamples = 40;
 constexpr std::size_t kMostDifferences = 40;
 
-// A number for the page: four significant digits (the statistics hold no
-// more), null when not finite (JSON has no infinity; the schema says what
-// null means where it may appear).
-json Num(double x) {
-  if (!std::isfinite(x)) return nullptr;
-  return std::stod(fmt::format("{:.4g}", x));
-}
-
 // "1e4", "1e3.5", "inf".
 std::string RatioLabel(double ratio) {
   if (std::isinf(ratio)) return "inf";
   return fmt::format("1e{:g}", std::round(std::log10(ratio) * 100.0) / 100.0);
 }
 
-json Log10Ratio(double ratio) { return std::isinf(ratio) ? json(nullptr) : Num(std::log10(ratio)); }
+Figure Log10Ratio(double ratio) { return std::isinf(ratio) ? Figure() : Shown(std::log10(ratio)); }
 
-// The columns every row about a cell starts with.
-json CellRow(const Cell& cell, const std::string& backend) {
-  return {{"variant", Info(cell.variant).name},
-          {"convention", Info(cell.convention).name},
-          {"format", Info(cell.format).name},
-          {"backend", backend}};
+CellColumns Columns(const Cell& cell, const std::string& backend = "") {
+  return {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
+          std::string(Info(cell.format).name), backend};
 }
 
 double P999Bits(const BandStats& band, Metric metric) { return BitsLost(band[metric].AtLevel(Level::kP999, metric)); }
@@ -70,8 +57,8 @@ Estimate ModelAt(const FittedModel& model, double x, double y) {
 // of each ratio (the one the far plane lies in). A band whose quantile is
 // not finite (NaN/Inf outputs past the level) or below the statistics'
 // resolution has no measured value, and says which.
-json ModelAlongPoints(const PrecisionFit& fit, const FitSweeps& sweeps, const FitPlan& plan, bool deepest_only,
-                      std::span<const double> ratios, bool relative) {
+std::vector<ModelPointRow> ModelAlongPoints(const PrecisionFit& fit, const FitSweeps& sweeps, const FitPlan& plan,
+                                            bool deepest_only, std::span<const double> ratios, bool relative) {
   const std::vector<BandPoint> bands = CollectBandPoints(sweeps, fit.cell, fit.backend, fit.metric, fit.level);
   std::map<double, int> deepest;  // ratio -> deepest depth band
   for (const BandPoint& p : bands) {
@@ -79,8 +66,8 @@ json ModelAlongPoints(const PrecisionFit& fit, const FitSweeps& sweeps, const Fi
     if (!added) it->second = std::max(it->second, p.depth_band);
   }
   // Bits, or the relative error they stand for.
-  auto value = [relative](double b) { return Num(relative ? std::ldexp(std::exp2(b), -24) : b); };
-  json rows = json::array();
+  auto value = [relative](double b) { return Shown(relative ? std::ldexp(std::exp2(b), -24) : b); };
+  std::vector<ModelPointRow> rows;
   for (const BandPoint& band : bands) {
     if (deepest_only && band.depth_band != deepest[band.ratio]) continue;
     if (!ratios.empty() && std::none_of(ratios.begin(), ratios.end(), [&](double r) {
@@ -92,28 +79,29 @@ json ModelAlongPoints(const PrecisionFit& fit, const FitSweeps& sweeps, const Fi
     const Estimate model = ModelAt(fit.model, p.x, p.y);
     const bool held_out = std::any_of(plan.held_out.begin(), plan.held_out.end(),
                                       [&](double r) { return std::fabs(std::log2(r) - p.x) < 1e-9; });
-    json row = CellRow(fit.cell, fit.backend);
-    row["level"] = LevelName(fit.level);
-    row["ratio"] = RatioLabel(band.ratio);
-    row["log10_ratio"] = Log10Ratio(band.ratio);
-    row["depth"] = Num(std::exp2(p.y));
-    row["measured"] = band.modelled ? value(p.b) : json(nullptr);
-    row["state"] = band.modelled ? "measured" : std::isinf(p.b) ? "not finite" : "below resolution";
-    row["model"] = value(model.value);
-    row["low"] = value(model.low);
-    row["high"] = value(model.high);
-    row["held_out"] = !fit.infinite_far && held_out;
+    ModelPointRow row;
+    row.cell = Columns(fit.cell, fit.backend);
+    row.level = LevelName(fit.level);
+    row.ratio = RatioLabel(band.ratio);
+    row.log10_ratio = Log10Ratio(band.ratio);
+    row.depth = Shown(std::exp2(p.y));
+    row.measured = band.modelled ? value(p.b) : Figure();
+    row.state = band.modelled ? "measured" : std::isinf(p.b) ? "not finite" : "below resolution";
+    row.model = value(model.value);
+    row.low = value(model.low);
+    row.high = value(model.high);
+    row.held_out = !fit.infinite_far && held_out;
     rows.push_back(std::move(row));
   }
   return rows;
 }
 
-json BudgetJson(const PrecisionFit& fit, const char* budget) {
+BudgetRatio Budget(const PrecisionFit& fit, const char* budget) {
   auto it = fit.budget_ratio.find(budget);
-  if (it == fit.budget_ratio.end()) return nullptr;  // infinite far: no ratio to speak of
-  if (!it->second) return "always";
-  if (*it->second == 0.0) return "never";
-  return Num(*it->second);
+  if (it == fit.budget_ratio.end()) return {};  // infinite far: no ratio to speak of
+  if (!it->second) return {BudgetRatio::Kind::kAlways, {}};
+  if (*it->second == 0.0) return {BudgetRatio::Kind::kNever, {}};
+  return {BudgetRatio::Kind::kRatio, Shown(*it->second)};
 }
 
 // The sweep a result came from, in words, and its repro command.
@@ -125,68 +113,59 @@ std::string SweepName(const Results& r) {
   return "default domain";
 }
 
-json HeadlineRows(const ReportMeasurements& m) {
-  json rows = json::array();
+std::vector<HeadlineRow> HeadlineRows(const ReportMeasurements& m) {
+  std::vector<HeadlineRow> rows;
   for (const PrecisionFit& f : m.fits) {
     if (f.metric != Metric::kTotal || f.level != Level::kP999) continue;
-    json row = CellRow(f.cell, f.backend);
-    row["cell"] = f.cell.Name();
-    row["infinite_far"] = f.infinite_far;
-    row["model"] = Info(f.model.kind).name;
-    row["points"] = f.points;
-    if (f.infinite_far) {
-      row["slope"] = row["slope_low"] = row["slope_high"] = nullptr;
-    } else {
-      row["slope"] = Num(f.slope);
-      row["slope_low"] = Num(f.slope_low);
-      row["slope_high"] = Num(f.slope_high);
+    HeadlineRow row;
+    row.cell = Columns(f.cell, f.backend);
+    row.infinite_far = f.infinite_far;
+    row.model = Info(f.model.kind).name;
+    row.points = f.points;
+    if (!f.infinite_far) {
+      row.slope = Shown(f.slope);
+      row.slope_low = Shown(f.slope_low);
+      row.slope_high = Shown(f.slope_high);
     }
-    json predicted = json::object();
-    for (const auto& [name, bits] : f.predicted) predicted[name] = Num(bits);
-    row["predicted_bits"] = predicted;
-    row["ratio_for_1e-3"] = BudgetJson(f, "1e-3");
-    row["ratio_for_1e-6"] = BudgetJson(f, "1e-6");
-    row["holdout_max_miss"] = f.holdout_points > 0 ? Num(f.holdout_max_miss) : json(nullptr);
+    for (const auto& [name, bits] : f.predicted) row.predicted_bits[name] = Shown(bits);
+    row.ratio_for_1e3 = Budget(f, "1e-3");
+    row.ratio_for_1e6 = Budget(f, "1e-6");
+    if (f.holdout_points > 0) row.holdout_max_miss = Shown(f.holdout_max_miss);
     if (const CellResult* r = m.main.Find(f.cell, f.backend)) {
       const BandStats all = r->stats.All();
-      row["p999_bits"] = Num(P999Bits(all, Metric::kTotal));
-      row["max_bits"] = Num(BitsLost(all[Metric::kTotal].max()));
-      row["nan"] = all.nan;
-      row["inf"] = all.inf;
+      row.measured = HeadlineRow::Measured{Shown(P999Bits(all, Metric::kTotal)),
+                                           Shown(BitsLost(all[Metric::kTotal].max())), all.nan, all.inf};
     }
     rows.push_back(std::move(row));
   }
   return rows;
 }
 
-json SplitRows(const FitSweeps& sweeps) {
-  json rows = json::array();
+std::vector<SplitRow> SplitRows(const FitSweeps& sweeps) {
+  std::vector<SplitRow> rows;
   for (std::size_t k = 0; k < sweeps.results.size(); ++k) {
     for (const CellResult& c : sweeps.results[k].cells) {
       const BandStats all = c.stats.All();
       if (all.finite < MinimumSamples(Level::kP999)) continue;
-      json row = CellRow(c.cell, c.backend);
-      row["ratio"] = RatioLabel(sweeps.ratios[k]);
-      row["log10_ratio"] = Log10Ratio(sweeps.ratios[k]);
-      row["total"] = Num(P999Bits(all, Metric::kTotal));
-      row["storage"] = Num(P999Bits(all, Metric::kStorage));
-      row["arith"] = Num(P999Bits(all, Metric::kArith));
-      rows.push_back(std::move(row));
+      rows.push_back({Columns(c.cell, c.backend), RatioLabel(sweeps.ratios[k]), Log10Ratio(sweeps.ratios[k]),
+                      Shown(P999Bits(all, Metric::kTotal)), Shown(P999Bits(all, Metric::kStorage)),
+                      Shown(P999Bits(all, Metric::kArith))});
     }
   }
   return rows;
 }
 
 // Where the GPU and the CPU disagree by more than the statistics resolve.
-json BackendDifferences(const FitSweeps& sweeps, std::span<const std::string> backends) {
+BackendDifferences Differences(const FitSweeps& sweeps, std::span<const std::string> backends) {
   struct Difference {
     double size;
-    json row;
+    BackendDifferenceRow row;
   };
   std::vector<Difference> found;
   double largest = 0.0;
-  std::size_t compared = 0;
+  BackendDifferences out;
   if (backends.size() >= 2) {
+    out.backends = {backends[0], backends[1]};
     for (std::size_t k = 0; k < sweeps.results.size(); ++k) {
       for (const CellResult& a : sweeps.results[k].cells) {
         if (a.backend != backends[0]) continue;
@@ -194,71 +173,53 @@ json BackendDifferences(const FitSweeps& sweeps, std::span<const std::string> ba
         if (b == nullptr) continue;
         const BandStats sa = a.stats.All(), sb = b->stats.All();
         if (sa.finite < MinimumSamples(Level::kP999)) continue;
-        ++compared;
+        ++out.compared;
         for (Metric metric : {Metric::kTotal, Metric::kArith}) {
           const double x = P999Bits(sa, metric), y = P999Bits(sb, metric);
           const double d = y - x;
           largest = std::max(largest, std::fabs(d));
           if (std::fabs(d) <= kNotableDifferenceBits) continue;
-          json row = CellRow(a.cell, "");
-          row.erase("backend");
-          row["ratio"] = RatioLabel(sweeps.ratios[k]);
-          row["metric"] = MetricName(metric);
-          row[backends[0]] = Num(x);
-          row[backends[1]] = Num(y);
-          row["difference"] = Num(d);
-          found.push_back({std::fabs(d), std::move(row)});
+          found.push_back(
+              {std::fabs(d),
+               {Columns(a.cell), RatioLabel(sweeps.ratios[k]), MetricName(metric), Shown(x), Shown(y), Shown(d)}});
         }
       }
     }
   }
   std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.size > b.size; });
-  json rows = json::array();
-  for (std::size_t i = 0; i < found.size() && i < kMostDifferences; ++i) rows.push_back(found[i].row);
-  return {{"backends", backends.size() >= 2 ? json{backends[0], backends[1]} : json::array()},
-          {"compared", compared},
-          {"notable", found.size()},
-          {"largest_bits", Num(largest)},
-          {"threshold_bits", kNotableDifferenceBits},
-          {"rows", rows}};
+  for (std::size_t i = 0; i < found.size() && i < kMostDifferences; ++i) out.rows.push_back(found[i].row);
+  out.notable = found.size();
+  out.largest_bits = Shown(largest);
+  out.threshold_bits = kNotableDifferenceBits;
+  return out;
 }
 
 // NaN/Inf findings of every sweep, and the worst samples of the default one.
-json Findings(const ReportMeasurements& m) {
-  json nonfinite = json::array();
+void Findings(const ReportMeasurements& m, Report& report) {
   auto scan = [&](const Results& r) {
     for (const CellResult& c : r.cells) {
       const BandStats all = c.stats.All();
       if (all.nan + all.inf == 0) continue;
-      json row = CellRow(c.cell, c.backend);
-      row["sweep"] = SweepName(r);
-      row["nan"] = all.nan;
-      row["inf"] = all.inf;
-      row["judged"] = all.judged();
-      row["first_index"] = all.first_nonfinite_index;
-      row["command"] = ReproCommand(r.run.seed, all.first_nonfinite_index, r.run.domain, c.cell, c.backend);
-      nonfinite.push_back(std::move(row));
+      report.nonfinite.push_back(
+          {Columns(c.cell, c.backend), SweepName(r), all.nan, all.inf, all.judged(), all.first_nonfinite_index,
+           ReproCommand(r.run.seed, all.first_nonfinite_index, r.run.domain, c.cell, c.backend)});
     }
   };
   scan(m.main);
   for (const Results& r : m.sweeps.results) scan(r);
 
-  std::vector<std::pair<double, json>> worst;
+  std::vector<std::pair<double, WorstSampleRow>> worst;
   for (const CellResult& c : m.main.cells) {
     const BandStats all = c.stats.All();
     const MetricStats& total = all[Metric::kTotal];
     if (total.Count() == 0) continue;
-    json row = CellRow(c.cell, c.backend);
-    row["bits"] = Num(BitsLost(total.max()));
-    row["relative"] = Num(total.max());
-    row["index"] = total.worst_index;
-    row["command"] = ReproCommand(m.main.run.seed, total.worst_index, m.main.run.domain, c.cell, c.backend);
-    worst.emplace_back(std::isfinite(total.max()) ? total.max() : INFINITY, std::move(row));
+    worst.emplace_back(
+        std::isfinite(total.max()) ? total.max() : INFINITY,
+        WorstSampleRow{Columns(c.cell, c.backend), Shown(BitsLost(total.max())), Shown(total.max()), total.worst_index,
+                       ReproCommand(m.main.run.seed, total.worst_index, m.main.run.domain, c.cell, c.backend)});
   }
   std::stable_sort(worst.begin(), worst.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  json worst_rows = json::array();
-  for (std::size_t i = 0; i < worst.size() && i < kMostWorstSamples; ++i) worst_rows.push_back(worst[i].second);
-  return {{"nonfinite", nonfinite}, {"worst", worst_rows}};
+  for (std::size_t i = 0; i < worst.size() && i < kMostWorstSamples; ++i) report.worst.push_back(worst[i].second);
 }
 
 // One candidate of a speed/accuracy front.
@@ -270,7 +231,8 @@ struct FrontEntry {
 
 // Marks the front of each (convention, format) among `entries` and adds
 // them as rows of `source` at far/near `ratio`.
-void AddFronts(const std::string& source, double ratio, const std::vector<FrontEntry>& entries, json& rows) {
+void AddFronts(const std::string& source, double ratio, const std::vector<FrontEntry>& entries,
+               std::vector<FrontRow>& rows) {
   std::map<std::pair<Convention, Format>, std::vector<std::size_t>> groups;
   for (std::size_t i = 0; i < entries.size(); ++i) {
     groups[{entries[i].cell.convention, entries[i].cell.format}].push_back(i);
@@ -281,16 +243,8 @@ void AddFronts(const std::string& source, double ratio, const std::vector<FrontE
     const std::vector<bool> on_front = ParetoFront(candidates);
     for (std::size_t k = 0; k < members.size(); ++k) {
       const FrontEntry& e = entries[members[k]];
-      json row = CellRow(e.cell, "");
-      row.erase("backend");
-      row["source"] = source;
-      row["ratio"] = RatioLabel(ratio);
-      row["cost"] = Num(e.candidate.cost);
-      row["spread"] = Num(e.candidate.spread);
-      row["bits"] = Num(e.candidate.bits_lost);
-      row["nonfinite"] = e.nonfinite;
-      row["on_front"] = static_cast<bool>(on_front[k]);
-      rows.push_back(std::move(row));
+      rows.push_back({Columns(e.cell), source, RatioLabel(ratio), Shown(e.candidate.cost), Shown(e.candidate.spread),
+                      Shown(e.candidate.bits_lost), e.nonfinite, static_cast<bool>(on_front[k])});
     }
   }
 }
@@ -304,8 +258,13 @@ double FrontBits(double p999_bits) { return std::min(p999_bits, kAllBitsLost); }
 // the cost from each speed file (GPU time per reconstruction) and from the
 // instruction mix (which always exists), the accuracy from this report's
 // sweep at that ratio on the GPU backend.
-Expected<json> SpeedSection(const ReportPlan& plan, const ReportMeasurements& m) {
-  json rows = json::array(), sources = json::array();
+SpeedSection Speed(const ReportMeasurements& m) {
+  SpeedSection section;
+  if (!m.static_costs_status.ok()) {
+    section.error = m.static_costs_status.message();
+    return section;
+  }
+  std::vector<FrontRow>& rows = section.rows;
   const Expected<std::string> trade_backend = TradeBackend(m.main);
   const std::string backend = trade_backend.ok() ? *trade_backend : "cpu";
   std::string device;
@@ -314,7 +273,7 @@ Expected<json> SpeedSection(const ReportPlan& plan, const ReportMeasurements& m)
   }
   const std::string accuracy = fmt::format(
       "this report's sweep at the chosen far/near (camera at the origin) on the {} backend ({})", backend, device);
-  DB_ASSIGN_OR_RETURN(CostLookup lanes, StaticCostLookup(plan.shader_dir.string()));
+  const CostLookup& lanes = m.static_costs;
 
   for (std::size_t k = 0; k < m.sweeps.ratios.size(); ++k) {
     const double ratio = m.sweeps.ratios[k];
@@ -347,52 +306,37 @@ Expected<json> SpeedSection(const ReportPlan& plan, const ReportMeasurements& m)
   }
   for (const auto& [path, speed] : m.speed) {
     if (speed.gpu.empty()) continue;
-    sources.push_back({{"source", fmt::format("{} ({})", speed.run.device.name, path.filename().string())},
-                       {"cost_unit", fmt::format("GPU ns per reconstruction, ALU-bound, {} (measured {})",
-                                                 ResolutionName(speed.run.trade_resolution), speed.run.started_at)},
-                       {"accuracy", accuracy}});
+    section.sources.push_back({fmt::format("{} ({})", speed.run.device.name, path.filename().string()),
+                               fmt::format("GPU ns per reconstruction, ALU-bound, {} (measured {})",
+                                           ResolutionName(speed.run.trade_resolution), speed.run.started_at),
+                               accuracy});
   }
-  sources.push_back({{"source", "instruction count"},
-                     {"cost_unit", "SPIR-V arithmetic lanes of the compiled shader"},
-                     {"accuracy", accuracy}});
-  return json{{"sources", sources}, {"rows", rows}};
+  section.sources.push_back({"instruction count", "SPIR-V arithmetic lanes of the compiled shader", accuracy});
+  return section;
 }
 
-json EnvironmentJson(const ReportPlan& plan, const ReportMeasurements& m) {
-  json backends = json::array();
-  for (const BackendRecord& b : m.main.run.backends) {
-    backends.push_back({{"name", b.name}, {"device", DeviceToJson(b.device)}});
-  }
-  json stages = json::array();
+ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& m) {
+  ReportEnvironment env;
+  env.version = m.main.run.version;
+  env.commit = m.main.run.commit;
+  env.host = m.main.run.host;
+  env.started_at = m.main.run.started_at;
+  for (const BackendRecord& b : m.main.run.backends) env.backends.emplace_back(b.name, b.device);
   double seconds = 0.0;
   for (const auto& [stage, s] : m.stage_seconds) {
-    stages.push_back({{"stage", stage}, {"seconds", Num(s)}});
+    env.stages.emplace_back(stage, Shown(s));
     seconds += s;
   }
-  json ratios = json::array();
-  for (double r : m.sweeps.ratios) ratios.push_back(RatioLabel(r));
-  json speed_files = json::array();
-  for (const auto& [path, speed] : m.speed) speed_files.push_back(path.string());
-  return {{"version", m.main.run.version},
-          {"commit", m.main.run.commit},
-          {"host", m.main.run.host},
-          {"started_at", m.main.run.started_at},
-          {"seconds", Num(seconds)},
-          {"stages", stages},
-          {"backends", backends},
-          {"quick", plan.quick},
-          {"fit_sweeps",
-           {{"seed", plan.fit.seed},
-            {"samples_per_ratio", plan.fit.samples_per_ratio},
-            {"ratios", ratios},
-            {"held_out", json(plan.fit.held_out)},
-            {"domain", plan.fit.domain.Describe()}}},
-          {"default_sweep",
-           {{"seed", m.main.run.seed},
-            {"samples", m.main.run.samples},
-            {"reconstructions", m.main.run.reconstructions},
-            {"domain", m.main.run.domain.Describe()}}},
-          {"speed_files", speed_files}};
+  env.seconds = Shown(seconds);
+  env.quick = plan.quick;
+  env.fit_sweeps.seed = plan.fit.seed;
+  env.fit_sweeps.samples_per_ratio = plan.fit.samples_per_ratio;
+  for (double r : m.sweeps.ratios) env.fit_sweeps.ratios.push_back(RatioLabel(r));
+  env.fit_sweeps.held_out = plan.fit.held_out;
+  env.fit_sweeps.domain = plan.fit.domain.Describe();
+  env.default_sweep = {m.main.run.seed, m.main.run.samples, m.main.run.reconstructions, m.main.run.domain.Describe()};
+  for (const auto& [path, speed] : m.speed) env.speed_files.push_back(path.string());
+  return env;
 }
 
 }  // namespace
@@ -452,40 +396,36 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
     DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path));
     m.speed.emplace_back(path, std::move(speed));
   }
+  // A shader copy that does not compile leaves the front without its
+  // instruction counts, not the report without its other parts.
+  m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string()), m.static_costs);
   end("speed files", fmt::format("{} read", m.speed.size()));
   return m;
 }
 
-nlohmann::json ReportJson(const ReportPlan& plan, const ReportMeasurements& m) {
-  json precision = json::array(), depth = json::array();
+Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
+  Report report;
   for (const PrecisionFit& f : m.fits) {
     if (f.metric != Metric::kTotal) continue;
     if (std::find(std::begin(kChartLevels), std::end(kChartLevels), f.level) != std::end(kChartLevels)) {
-      for (json& row : ModelAlongPoints(f, m.sweeps, plan.fit, true, {}, false)) precision.push_back(std::move(row));
+      for (ModelPointRow& row : ModelAlongPoints(f, m.sweeps, plan.fit, true, {}, false)) {
+        report.precision_points.push_back(std::move(row));
+      }
     }
     if (f.level == Level::kP999) {
-      for (json& row : ModelAlongPoints(f, m.sweeps, plan.fit, false, kDepthCurveRatios, true)) {
-        depth.push_back(std::move(row));
+      for (ModelPointRow& row : ModelAlongPoints(f, m.sweeps, plan.fit, false, kDepthCurveRatios, true)) {
+        report.depth_points.push_back(std::move(row));
       }
     }
   }
   std::vector<std::string> backends;
   for (const BackendRecord& b : m.main.run.backends) backends.push_back(b.name);
-
-  json report = {{"schema", kReportSchema},
-                 {"schema_version", kReportSchemaVersion},
-                 {"environment", EnvironmentJson(plan, m)},
-                 {"headline", HeadlineRows(m)},
-                 {"precision_points", precision},
-                 {"depth_points", depth},
-                 {"split", SplitRows(m.sweeps)},
-                 {"backend_differences", BackendDifferences(m.sweeps, backends)},
-                 {"findings", Findings(m)}};
-  Expected<json> speed = SpeedSection(plan, m);
-  report["speed"] =
-      speed.ok() ? *speed
-                 : json{{"sources", json::array()}, {"rows", json::array()}, {"error", speed.status().message()}};
-  report["history"] = nullptr;
+  report.environment = Environment(plan, m);
+  report.headline = HeadlineRows(m);
+  report.split = SplitRows(m.sweeps);
+  report.backend_differences = Differences(m.sweeps, backends);
+  Findings(m, report);
+  report.speed = Speed(m);
   return report;
 }
 
@@ -495,57 +435,41 @@ std::vector<Baseline> HistoryFigures(const ReportMeasurements& m) {
   return figures;
 }
 
-Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
+Status AddHistory(Report& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
                   int trend_runs) {
   DB_ASSIGN_OR_RETURN(std::int64_t id, history.Record(run, figures));
   DB_ASSIGN_OR_RETURN(std::int64_t runs, history.RunCount());
-  json trend = json::array(), changes = json::array(), previous = json::array(), notes = json::array();
+  HistorySection section;
+  section.database = history.path().string();
+  section.run = id;
+  section.runs_recorded = runs;
   const GateTolerance tolerance;
+  section.tolerance_p999_bits = tolerance.p999_bits;
+  section.tolerance_max_bits = tolerance.max_bits;
   for (const Baseline& now : figures) {
     DB_ASSIGN_OR_RETURN(std::vector<TrendPoint> points, history.Trend(id, now, trend_runs));
     for (const TrendPoint& p : points) {
-      trend.push_back({{"run", p.run},
-                       {"made_at", p.made_at},
-                       {"commit", p.commit},
-                       {"backend", p.backend},
-                       {"cell", p.cell},
-                       {"p999_bits", Num(p.total_p999)},
-                       {"max_bits", Num(p.total_max)},
-                       {"nonfinite", p.nonfinite}});
+      section.trend.push_back(
+          {p.run, p.made_at, p.commit, p.backend, p.cell, Shown(p.total_p999), Shown(p.total_max), p.nonfinite});
     }
     DB_ASSIGN_OR_RETURN(auto before, history.Previous(id, now));
     if (!before) continue;
     const auto& [before_run, before_figures] = *before;
-    previous.push_back({{"backend", now.backend},
-                        {"run", before_run.id},
-                        {"made_at", before_run.made_at},
-                        {"commit", before_run.commit}});
+    section.previous.push_back({now.backend, before_run.id, before_run.made_at, before_run.commit});
     DB_ASSIGN_OR_RETURN(GateComparison comparison, CompareWithBaseline(before_figures, now, tolerance));
-    for (const std::string& note : comparison.notes) notes.push_back(now.backend + ": " + note);
+    for (const std::string& note : comparison.notes) section.notes.push_back(now.backend + ": " + note);
     for (const CellVerdict& v : comparison.cells) {
       auto add = [&](const char* direction, const std::string& band, const std::vector<std::string>& reasons,
                      double before_bits, double after_bits) {
-        changes.push_back({{"direction", direction},
-                           {"backend", now.backend},
-                           {"cell", v.cell},
-                           {"band", band},
-                           {"reasons", reasons},
-                           {"before_p999_bits", Num(before_bits)},
-                           {"after_p999_bits", Num(after_bits)}});
+        section.changes.push_back(
+            {direction, now.backend, v.cell, band, reasons, Shown(before_bits), Shown(after_bits)});
       };
       if (v.disappeared) add("worse", "all", {"the cell is missing from this run"}, NAN, NAN);
       for (const BandChange& c : v.worse) add("worse", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
       for (const BandChange& c : v.better) add("better", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
     }
   }
-  report["history"] = {{"database", history.path().string()},
-                       {"run", id},
-                       {"runs_recorded", runs},
-                       {"previous", previous},
-                       {"tolerance", {{"p999_bits", tolerance.p999_bits}, {"max_bits", tolerance.max_bits}}},
-                       {"notes", notes},
-                       {"changes", changes},
-                       {"trend", trend}};
+  report.history = std::move(section);
   return Status::Ok();
 }
 

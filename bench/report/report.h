@@ -1,8 +1,7 @@
-// The nightly precision report: what it measures, and everything it shows
-// as one JSON document (schema "depthbench.report", version 1; documented
-// in reports/report.schema.json). The page (report_html.h) and the summary
-// (report_markdown.h) are drawn from that document alone: they format, they
-// never compute.
+// The nightly precision report: what it measures (MeasureReport) and the
+// typed model of everything it shows (BuildReport, report_model.h), which
+// its writers only format: the JSON document (report_json.h), the page and
+// the Markdown summary (report_render.h).
 //
 // Measurements:
 //   - the fit sweeps (precision_fit.h): every cell at far/near 10^1, 10^1.5,
@@ -13,7 +12,7 @@
 //     the worst samples, and the per-band figures kept in the history;
 //   - speed files (`depthbench speed --json`) where they exist, joined with
 //     this run's accuracy into the speed/accuracy front; the static
-//     instruction mix of every variant otherwise.
+//     instruction mix of every variant, which always exists.
 #pragma once
 
 #include <cstdint>
@@ -23,21 +22,18 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "bench/backends/backend.h"
 #include "bench/base/status.h"
+#include "bench/choose/choose.h"
 #include "bench/fit/precision_fit.h"
 #include "bench/gate/baseline.h"
 #include "bench/report/history.h"
+#include "bench/report/report_model.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
-
-inline constexpr const char* kReportSchema = "depthbench.report";
-inline constexpr int kReportSchemaVersion = 1;
 
 struct ReportPlan {
   bool quick = false;
@@ -68,23 +64,26 @@ struct ReportMeasurements {
   std::vector<PrecisionFit> fits;
   Results main;
   std::vector<std::pair<std::filesystem::path, SpeedResults>> speed;
-  std::vector<StaticCost> static_costs;
+  // The instruction-mix cost of every variant (compiled from the plan's
+  // shaders), or why there is none.
+  CostLookup static_costs;
+  Status static_costs_status;
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
 Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,
                                            const ReportProgress& progress = {});
 
-// The report document, without its "history" part.
-nlohmann::json ReportJson(const ReportPlan& plan, const ReportMeasurements& measured);
+// The report, without its history part.
+Report BuildReport(const ReportPlan& plan, const ReportMeasurements& measured);
 
 // The headline figures of each backend, as the history keeps them.
 std::vector<Baseline> HistoryFigures(const ReportMeasurements& measured);
 
-// Records the run in the history and adds the "history" part to the
-// document: the trend of every cell, the previous comparable run, and what
-// got worse (or better) since it, by the gate's tolerances.
-Status AddHistory(nlohmann::json& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
+// Records the run in the history and adds the history part to the report:
+// the trend of every cell, the previous comparable run, and what got worse
+// (or better) since it, by the gate's tolerances.
+Status AddHistory(Report& report, History& history, const HistoryRun& run, std::span<const Baseline> figures,
                   int trend_runs);
 
 }  // namespace depthbench

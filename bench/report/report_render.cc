@@ -8,11 +8,10 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/report/report_json.h"
 
 namespace depthbench {
 namespace {
-
-using json = nlohmann::json;
 
 constexpr std::size_t kWorstInSummary = 10;
 constexpr std::size_t kChangesInSummary = 20;
@@ -22,29 +21,18 @@ constexpr std::size_t kFindingsInSummary = 10;
 constexpr std::string_view kLibrariesMark = "<!--DEPTHBENCH:LIBRARIES-->";
 constexpr std::string_view kDataMark = "/*DEPTHBENCH:DATA*/null";
 
-double NumberOr(const json& j, const char* key, double fallback) {
-  auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>() : fallback;
-}
+// Bits lost; a figure that is not finite means every bit is lost.
+std::string Bits(const Figure& bits) { return bits ? fmt::format("{:.1f}", *bits) : "all"; }
+std::string Number(const Figure& x) { return x ? fmt::format("{:.3g}", *x) : "-"; }
 
-std::string Text(const json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end() || it->is_null()) return "-";
-  if (it->is_string()) return it->get<std::string>();
-  if (it->is_number_integer() || it->is_number_unsigned()) return it->dump();
-  if (it->is_number()) return fmt::format("{:.3g}", it->get<double>());
-  return it->dump();
-}
-
-std::string Bits(const json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end()) return "-";
-  if (it->is_null()) return "all";  // not finite: every bit lost
-  return fmt::format("{:.1f}", it->get<double>());
-}
-
-std::string CellName(const json& row) {
-  return fmt::format("{}/{}/{}", row.value("variant", ""), row.value("convention", ""), row.value("format", ""));
+std::string Budget(const BudgetRatio& b) {
+  switch (b.kind) {
+    case BudgetRatio::Kind::kNone: return "-";
+    case BudgetRatio::Kind::kAlways: return "always";
+    case BudgetRatio::Kind::kNever: return "never";
+    case BudgetRatio::Kind::kRatio: return Number(b.ratio);
+  }
+  return "-";
 }
 
 // A table cell must not break the Markdown table.
@@ -61,43 +49,41 @@ std::string Escape(std::string s) {
   return out;
 }
 
-std::string GpuBackend(const json& report) {
+// The backend the headline is about: the last one that is not the CPU's.
+std::string GpuBackend(const Report& report) {
   std::string chosen;
-  for (const json& b : report["environment"]["backends"]) {
-    const std::string name = b.value("name", "");
+  for (const auto& [name, device] : report.environment.backends) {
     if (chosen.empty() || name != "cpu") chosen = name;
   }
   return chosen;
 }
 
-void Changes(const json& report, std::string& out) {
+void Changes(const Report& report, std::string& out) {
   out += "## Since the last report\n\n";
-  const json& h = report["history"];
-  if (h.is_null()) {
+  if (!report.history) {
     out += "No history was kept for this run (`--no-history`).\n\n";
     return;
   }
-  if (h["previous"].empty()) {
+  const HistorySection& h = *report.history;
+  if (h.previous.empty()) {
     out += fmt::format("First run of this sample plan on this device in `{}`: nothing to compare with yet.\n\n",
-                       h.value("database", ""));
+                       h.database);
     return;
   }
   std::vector<std::string> previous;
-  for (const json& p : h["previous"]) {
-    previous.push_back(fmt::format("{}: run {} of {} (commit `{}`)", p.value("backend", ""), p.value("run", 0),
-                                   p.value("made_at", ""), p.value("commit", "").substr(0, 12)));
+  for (const HistorySection::Previous& p : h.previous) {
+    previous.push_back(
+        fmt::format("{}: run {} of {} (commit `{}`)", p.backend, p.run, p.made_at, p.commit.substr(0, 12)));
   }
   out += fmt::format("Compared with {}; tolerance {} bit at p99.9 and {} bit at the maximum.\n\n",
-                     fmt::join(previous, ", "), h["tolerance"].value("p999_bits", 0.0),
-                     h["tolerance"].value("max_bits", 0.0));
+                     fmt::join(previous, ", "), h.tolerance_p999_bits, h.tolerance_max_bits);
   // Worse first, grouped by cell and backend.
   std::map<std::pair<std::string, std::string>, std::vector<std::string>> worse;
   std::set<std::pair<std::string, std::string>> better;
-  for (const json& c : h["changes"]) {
-    const std::pair<std::string, std::string> key{c.value("cell", ""), c.value("backend", "")};
-    if (c.value("direction", "") == "worse") {
-      std::vector<std::string> reasons = c["reasons"].get<std::vector<std::string>>();
-      worse[key].push_back(fmt::format("{}: {}", c.value("band", ""), fmt::join(reasons, ", ")));
+  for (const HistorySection::Change& c : h.changes) {
+    const std::pair<std::string, std::string> key{c.cell, c.backend};
+    if (c.direction == "worse") {
+      worse[key].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
     } else {
       better.insert(key);
     }
@@ -121,23 +107,22 @@ void Changes(const json& report, std::string& out) {
   }
   if (!better.empty()) out += fmt::format("\n{} cell(s) got better.", better.size());
   out += "\n\n";
-  for (const json& note : h["notes"]) out += fmt::format("Note: {}\n\n", note.get<std::string>());
+  for (const std::string& note : h.notes) out += fmt::format("Note: {}\n\n", note);
 }
 
 // Per convention and format, on the GPU backend: the variant that keeps
 // the most bits at the far plane of f/n = 1e8 (or an infinite far plane).
-void Headline(const json& report, std::string& out) {
+void Headline(const Report& report, std::string& out) {
   const std::string backend = GpuBackend(report);
-  std::map<std::pair<std::string, std::string>, const json*> best;
-  auto far_bits = [](const json& row) {
-    const json& p = row["predicted_bits"];
-    const char* key = row.value("infinite_far", false) ? "inf" : "1e8";
-    return p.contains(key) && p[key].is_number() ? p[key].get<double>() : INFINITY;
+  std::map<std::pair<std::string, std::string>, const HeadlineRow*> best;
+  auto far_bits = [](const HeadlineRow& row) {
+    auto it = row.predicted_bits.find(row.infinite_far ? "inf" : "1e8");
+    return it != row.predicted_bits.end() && it->second ? *it->second : INFINITY;
   };
   std::vector<std::pair<std::string, std::string>> order;
-  for (const json& row : report["headline"]) {
-    if (row.value("backend", "") != backend) continue;
-    const std::pair<std::string, std::string> key{row.value("convention", ""), row.value("format", "")};
+  for (const HeadlineRow& row : report.headline) {
+    if (row.cell.backend != backend) continue;
+    const std::pair<std::string, std::string> key{row.cell.convention, row.cell.format};
     auto [it, added] = best.try_emplace(key, &row);
     if (added)
       order.push_back(key);
@@ -150,41 +135,40 @@ void Headline(const json& report, std::string& out) {
       backend);
   out +=
       "| convention | format | best variant | bits lost per doubling of f/n | at 1e4 | at 1e8 | at inf | f/n for 1e-3 "
-      "| f/n for 1e-6 |\n";
+      "| "
+      "f/n for 1e-6 |\n";
   out += "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& key : order) {
-    const json& row = *best[key];
-    const json& p = row["predicted_bits"];
-    auto predicted = [&](const char* at) { return p.contains(at) ? Bits(p, at) : std::string("-"); };
-    const std::string slope = row["slope"].is_null()
-                                  ? "-"
-                                  : fmt::format("{:.2f} [{:.2f}, {:.2f}]", NumberOr(row, "slope", 0),
-                                                NumberOr(row, "slope_low", NAN), NumberOr(row, "slope_high", NAN));
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", key.first, key.second,
-                       row.value("variant", ""), slope, predicted("1e4"), predicted("1e8"), predicted("inf"),
-                       Text(row, "ratio_for_1e-3"), Text(row, "ratio_for_1e-6"));
+    const HeadlineRow& row = *best[key];
+    auto predicted = [&](const char* at) {
+      auto it = row.predicted_bits.find(at);
+      return it != row.predicted_bits.end() ? Bits(it->second) : std::string("-");
+    };
+    const std::string slope = !row.slope ? "-"
+                                         : fmt::format("{:.2f} [{:.2f}, {:.2f}]", *row.slope,
+                                                       row.slope_low.value_or(NAN), row.slope_high.value_or(NAN));
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", key.first, key.second, row.cell.variant,
+                       slope, predicted("1e4"), predicted("1e8"), predicted("inf"), Budget(row.ratio_for_1e3),
+                       Budget(row.ratio_for_1e6));
   }
   out += "\n";
 }
 
-void Worst(const json& report, std::string& out) {
+void Worst(const Report& report, std::string& out) {
   out +=
       "## Worst cells\n\nHighest p99.9 bits lost over the default domain (every projection, pose and depth the "
       "sampler draws).\n\n";
   out += "| cell | backend | p99.9 bits lost | max bits lost | NaN | Inf |\n|---|---|---:|---:|---:|---:|\n";
-  std::vector<std::string> worst = WorstCells(report, kWorstInSummary);
-  for (const std::string& name : worst) {
-    for (const json& row : report["headline"]) {
-      if (CellName(row) + " on " + row.value("backend", "") != name) continue;
-      out += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", CellName(row), row.value("backend", ""),
-                         Bits(row, "p999_bits"), Bits(row, "max_bits"), Text(row, "nan"), Text(row, "inf"));
-    }
+  for (const HeadlineRow* row : WorstRows(report, kWorstInSummary)) {
+    out += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", row->cell.Name(), row->cell.backend,
+                       Bits(row->measured->p999_bits), Bits(row->measured->max_bits), row->measured->nan,
+                       row->measured->inf);
   }
   out += "\n";
 }
 
-void Findings(const json& report, std::string& out) {
-  const json& rows = report["findings"]["nonfinite"];
+void Findings(const Report& report, std::string& out) {
+  const std::vector<NonFiniteRow>& rows = report.nonfinite;
   out += "## NaN and Inf\n\n";
   if (rows.empty()) {
     out += "No cell produced a NaN or an infinity where the true point is finite.\n\n";
@@ -192,14 +176,13 @@ void Findings(const json& report, std::string& out) {
   }
   out += fmt::format("{} (cell, backend, sweep) with NaN or Inf outputs:\n\n", rows.size());
   std::size_t shown = 0;
-  for (const json& row : rows) {
+  for (const NonFiniteRow& row : rows) {
     if (shown++ == kFindingsInSummary) {
       out += fmt::format("- ... and {} more (see report.html)\n", rows.size() - kFindingsInSummary);
       break;
     }
-    out += fmt::format("- `{}` on {}, {}: {} NaN, {} Inf of {}; first: `{}`\n", CellName(row), row.value("backend", ""),
-                       row.value("sweep", ""), Text(row, "nan"), Text(row, "inf"), Text(row, "judged"),
-                       row.value("command", ""));
+    out += fmt::format("- `{}` on {}, {}: {} NaN, {} Inf of {}; first: `{}`\n", row.cell.Name(), row.cell.backend,
+                       row.sweep, row.nan, row.inf, row.judged, row.command);
   }
   out += "\n";
 }
@@ -224,7 +207,7 @@ Status PlotLibrary::Check() const {
   return Status::Ok();
 }
 
-Expected<std::string> RenderHtml(const json& report, const std::filesystem::path& template_file,
+Expected<std::string> RenderHtml(const Report& report, const std::filesystem::path& template_file,
                                  const PlotLibrary& library) {
   DB_RETURN_IF_ERROR(library.Check());
   DB_ASSIGN_OR_RETURN(std::string page, ReadFile(template_file));
@@ -240,7 +223,7 @@ Expected<std::string> RenderHtml(const json& report, const std::filesystem::path
     scripts += fmt::format("<script>/* {} */\n{}\n</script>\n", bundle.filename().string(), code);
   }
   // JSON holds '<' only inside strings, where "<\/" means the same.
-  std::string data = report.dump();
+  std::string data = ReportToJson(report).dump();
   for (std::size_t at = 0; (at = data.find("</", at)) != std::string::npos; at += 3) data.replace(at, 2, "<\\/");
 
   const std::size_t libraries_at = page.find(kLibrariesMark);
@@ -254,18 +237,15 @@ Expected<std::string> RenderHtml(const json& report, const std::filesystem::path
   return page;
 }
 
-std::string RenderMarkdown(const json& report) {
-  const json& env = report["environment"];
+std::string RenderMarkdown(const Report& report) {
+  const ReportEnvironment& env = report.environment;
   std::string out = "# depthbench precision report\n\n";
   std::vector<std::string> devices;
-  for (const json& b : env["backends"]) {
-    devices.push_back(fmt::format("{} ({})", b.value("name", ""), b["device"].value("name", "")));
-  }
+  for (const auto& [name, device] : env.backends) devices.push_back(fmt::format("{} ({})", name, device.name));
   out +=
       fmt::format("{} · commit `{}` · {} · {} samples per far/near ratio, {} default-domain samples{} · {:.0f} s\n\n",
-                  env.value("started_at", ""), env.value("commit", "").substr(0, 12), fmt::join(devices, ", "),
-                  env["fit_sweeps"].value("samples_per_ratio", 0), env["default_sweep"].value("samples", 0),
-                  env.value("quick", false) ? " (quick)" : "", NumberOr(env, "seconds", 0.0));
+                  env.started_at, env.commit.substr(0, 12), fmt::join(devices, ", "), env.fit_sweeps.samples_per_ratio,
+                  env.default_sweep.samples, env.quick ? " (quick)" : "", env.seconds.value_or(0.0));
   Changes(report, out);
   Headline(report, out);
   Worst(report, out);
@@ -274,22 +254,18 @@ std::string RenderMarkdown(const json& report) {
   return out;
 }
 
-std::vector<std::string> WorstCells(const json& report, std::size_t count) {
-  struct Row {
-    double p999, max;
-    std::string name;
-  };
-  std::vector<Row> rows;
-  for (const json& row : report["headline"]) {
-    if (!row.contains("p999_bits")) continue;
-    rows.push_back({NumberOr(row, "p999_bits", INFINITY), NumberOr(row, "max_bits", INFINITY),
-                    CellName(row) + " on " + row.value("backend", "")});
+std::vector<const HeadlineRow*> WorstRows(const Report& report, std::size_t count) {
+  std::vector<const HeadlineRow*> rows;
+  for (const HeadlineRow& row : report.headline) {
+    if (row.measured) rows.push_back(&row);
   }
-  std::stable_sort(rows.begin(), rows.end(),
-                   [](const Row& a, const Row& b) { return a.p999 != b.p999 ? a.p999 > b.p999 : a.max > b.max; });
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < rows.size() && i < count; ++i) names.push_back(rows[i].name);
-  return names;
+  std::stable_sort(rows.begin(), rows.end(), [](const HeadlineRow* a, const HeadlineRow* b) {
+    const double a_p999 = a->measured->p999_bits.value_or(INFINITY), b_p999 = b->measured->p999_bits.value_or(INFINITY);
+    if (a_p999 != b_p999) return a_p999 > b_p999;
+    return a->measured->max_bits.value_or(INFINITY) > b->measured->max_bits.value_or(INFINITY);
+  });
+  if (rows.size() > count) rows.resize(count);
+  return rows;
 }
 
 }  // namespace depthbench

@@ -1,15 +1,14 @@
-// The report's two renderings, both drawn from the report document alone
-// (report.h): a self-contained HTML page with interactive Vega-Lite plots,
-// and a short Markdown summary for a CI job page.
+// The report's two renderings, both drawn from the typed report alone
+// (report_model.h): a self-contained HTML page with interactive Vega-Lite
+// plots, and a short Markdown summary for a CI job page.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "bench/base/status.h"
+#include "bench/report/report_model.h"
 
 namespace depthbench {
 
@@ -24,17 +23,17 @@ struct PlotLibrary {
 };
 
 // The page: `template_file` (reports/report_template.html) with the
-// library bundles and the document inlined, so that it opens offline.
-Expected<std::string> RenderHtml(const nlohmann::json& report, const std::filesystem::path& template_file,
+// library bundles and the report's JSON document inlined, so that it opens
+// offline.
+Expected<std::string> RenderHtml(const Report& report, const std::filesystem::path& template_file,
                                  const PlotLibrary& library);
 
 // The Markdown summary: what changed since the last comparable run, the
 // headline per convention and format, the worst cells, NaN/Inf findings.
-std::string RenderMarkdown(const nlohmann::json& report);
+std::string RenderMarkdown(const Report& report);
 
 // The cells the summary calls worst: the highest p99.9 bits lost over the
-// default domain (then the highest maximum), `count` of them, as
-// "variant/convention/format on backend".
-std::vector<std::string> WorstCells(const nlohmann::json& report, std::size_t count);
+// default domain (then the highest maximum), `count` of them.
+std::vector<const HeadlineRow*> WorstRows(const Report& report, std::size_t count);
 
 }  // namespace depthbench

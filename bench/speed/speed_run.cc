@@ -7,6 +7,7 @@
 
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/build_info.h"
 #include "bench/base/environment.h"
 #include "bench/base/thread_pool.h"
 #include "bench/speed/depth_image.h"
@@ -135,8 +136,8 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
   const auto start = std::chrono::steady_clock::now();
   SpeedResults results;
   SpeedRunInfo& run = results.run;
-  run.version = DEPTHBENCH_VERSION;
-  run.commit = CurrentCommit();
+  run.version = BuildVersion();
+  run.commit = BuildCommit();
   run.started_at = CurrentTimeUtc();
   run.host = HostName();
   const VulkanDeviceProperties& device = timer.device();

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/build_info.h"
 #include "bench/base/environment.h"
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
@@ -92,8 +93,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const auto started = std::chrono::steady_clock::now();
   Results results;
   RunInfo& run = results.run;
-  run.version = DEPTHBENCH_VERSION;
-  run.commit = CurrentCommit();
+  run.version = BuildVersion();
+  run.commit = BuildCommit();
   run.started_at = CurrentTimeUtc();
   run.host = HostName();
   run.seed = options.seed;

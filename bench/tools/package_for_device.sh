@@ -1,15 +1,17 @@
 #!/bin/sh
 # Packs depthbench for a machine that has a Vulkan driver but no package
-# registry (a GPU box reached only by copying files to it): the program, the
-# shaders and shared/ headers it compiles at run time, and every shared
-# library it loads that such a machine may lack, the Vulkan loader
-# (libvulkan.so.1) included. Run it again after every build; the folder it
-# writes is self-contained.
+# registry (a GPU box reached only by copying files to it): the installed
+# program with its data folder (cmake --install: bin/depthbench and
+# share/depthbench, the shaders and shared/ headers it compiles at run time
+# among them), and every shared library it loads that such a machine may
+# lack, the Vulkan loader (libvulkan.so.1) included. Run it again after
+# every build; the folder it writes is self-contained, and the commit the
+# program was built from is recorded in it (depthbench --version).
 #
 #   bench/tools/package_for_device.sh BUILD_DIR OUT_DIR
 #   (copy OUT_DIR to the GPU machine, then there:)
 #   OUT_DIR/run.sh list
-#   OUT_DIR/run.sh speed --shaders OUT_DIR/shaders --json speed.json
+#   OUT_DIR/run.sh speed --json speed.json
 #
 # Left out on purpose: the C library family (libc, libm, libpthread, libdl,
 # librt, the dynamic loader) and the C++ runtime (libstdc++, libgcc_s),
@@ -30,7 +32,6 @@ if [ $# -ne 2 ]; then
 fi
 build=$1
 out=$2
-source_dir=$(cd "$(dirname "$0")/../.." && pwd)
 binary="$build/bench/depthbench"
 if [ ! -x "$binary" ]; then
   echo "$0: $binary does not exist or is not executable; build first (cmake --build $build)" >&2
@@ -38,9 +39,8 @@ if [ ! -x "$binary" ]; then
 fi
 
 rm -rf "$out"
+cmake --install "$build" --prefix "$out" >/dev/null
 mkdir -p "$out/lib"
-cp "$binary" "$out/depthbench"
-cp -r "$source_dir/shaders" "$source_dir/shared" "$out/"
 
 # Every library ldd resolves for the program and for glvnd, but the C and
 # C++ runtimes.
@@ -65,13 +65,6 @@ done
 if [ ! -e "$out/lib/libvulkan.so.1" ]; then
   echo "$0: ldd did not find libvulkan.so.1 for $binary" >&2
   exit 1
-fi
-
-# The commit the package was built from travels in run.sh: the GPU machine
-# has no checkout to ask.
-commit=$(git -C "$source_dir" rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
-if [ -n "$(git -C "$source_dir" status --porcelain --untracked-files=no 2>/dev/null)" ]; then
-  commit="$commit-modified"
 fi
 
 cat > "$out/run.sh" <<'SCRIPT'
@@ -99,9 +92,7 @@ if [ -z "${__EGL_VENDOR_LIBRARY_FILENAMES:-}" ]; then
     fi
   done
 fi
-export DEPTHBENCH_COMMIT="${DEPTHBENCH_COMMIT:-@COMMIT@}"
-exec "$here/depthbench" "$@"
+exec "$here/bin/depthbench" "$@"
 SCRIPT
-sed -i "s/@COMMIT@/$commit/" "$out/run.sh"
 chmod +x "$out/run.sh"
 du -sh "$out"

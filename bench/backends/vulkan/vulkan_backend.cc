@@ -14,6 +14,7 @@
 
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/resources.h"
 #include "bench/numerics/formulas.h"
 
 namespace depthbench {
@@ -205,9 +206,8 @@ VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesy
 Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanContext> context,
                                                          const BackendOptions& options) {
   if (context == nullptr) return InvalidArgument("the Vulkan backend needs a Vulkan context");
-  std::filesystem::path shader_dir = options.shader_dir.empty()
-                                         ? std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders"
-                                         : std::filesystem::path(options.shader_dir);
+  std::filesystem::path shader_dir = options.shader_dir;
+  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
   std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir), options));
   const ValidationScope validation(*backend->context_);
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};

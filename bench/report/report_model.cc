@@ -1,0 +1,23 @@
+#include "bench/report/report_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+namespace depthbench {
+
+Figure Shown(double x) {
+  if (!std::isfinite(x)) return std::nullopt;
+  return std::stod(fmt::format("{:.4g}", x));
+}
+
+std::string CellColumns::Name() const { return fmt::format("{}/{}/{}", variant, convention, format); }
+
+std::size_t HistorySection::worse() const {
+  return static_cast<std::size_t>(
+      std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == "worse"; }));
+}
+
+}  // namespace depthbench

@@ -1,0 +1,189 @@
+// The report as a typed model: everything the nightly report shows, built
+// once from the measurements (report.h) and then only formatted by its
+// writers (report_json.h, report_render.h). Like google/benchmark's Run
+// and its reporters: a writer that needs a figure finds it as a member, so
+// a renamed field fails to compile instead of rendering "-".
+//
+// Figures are kept as the report shows them: four significant digits (the
+// statistics resolve no more), and no value where the figure is not finite
+// (every bit lost, or no quantile to speak of).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bench/backends/device_info.h"
+#include "bench/base/json_reader.h"
+
+namespace depthbench {
+
+inline constexpr JsonSchema kReportSchema{"depthbench.report", 1,
+                                          "a report document (results.json of depthbench report)"};
+
+// A figure as shown: four significant digits; nullopt when not finite.
+using Figure = std::optional<double>;
+Figure Shown(double x);
+
+// The columns every row about a cell starts with.
+struct CellColumns {
+  std::string variant, convention, format;
+  std::string backend;       // empty in rows that compare backends
+  std::string Name() const;  // "variant/convention/format"
+};
+
+struct ReportEnvironment {
+  std::string version, commit, host, started_at;
+  Figure seconds;
+  std::vector<std::pair<std::string, Figure>> stages;        // (stage, seconds)
+  std::vector<std::pair<std::string, DeviceInfo>> backends;  // (backend, device)
+  bool quick = false;
+  struct FitSweeps {
+    std::uint64_t seed = 0, samples_per_ratio = 0;
+    std::vector<std::string> ratios;  // "1e1", "1e1.5", ..., "inf"
+    std::vector<double> held_out;
+    std::string domain;
+  } fit_sweeps;
+  struct DefaultSweep {
+    std::uint64_t seed = 0, samples = 0, reconstructions = 0;
+    std::string domain;
+  } default_sweep;
+  std::vector<std::string> speed_files;
+};
+
+// The far/near ratio at which a budget breaks.
+struct BudgetRatio {
+  enum class Kind { kNone, kAlways, kNever, kRatio } kind = Kind::kNone;  // kNone: an infinite far plane
+  Figure ratio;                                                           // for kRatio
+};
+
+// One cell on one backend: its fitted model at p99.9 and, when the
+// default-domain sweep ran it, that sweep's figures.
+struct HeadlineRow {
+  CellColumns cell;
+  bool infinite_far = false;
+  std::string model;  // the chosen model's name
+  int points = 0;
+  // Bits lost per doubling of far/near and its 95% interval; none for an
+  // infinite far plane.
+  Figure slope, slope_low, slope_high;
+  std::map<std::string, Figure> predicted_bits;  // "1e2" ... "1e8", "inf"
+  BudgetRatio ratio_for_1e3, ratio_for_1e6;
+  Figure holdout_max_miss;  // none without held-out points
+  struct Measured {
+    Figure p999_bits, max_bits;
+    std::uint64_t nan = 0, inf = 0;
+  };
+  std::optional<Measured> measured;  // of the default-domain sweep
+};
+
+// A band a model was fitted through, beside what the model says there.
+struct ModelPointRow {
+  CellColumns cell;
+  std::string level;  // "p99.9", "max"
+  std::string ratio;  // "1e4", "inf"
+  Figure log10_ratio;
+  Figure depth;
+  Figure measured;    // none: see state
+  std::string state;  // "measured", "not finite", "below resolution"
+  Figure model, low, high;
+  bool held_out = false;
+};
+
+// p99.9 bits lost of the total and of its two causes, per sweep.
+struct SplitRow {
+  CellColumns cell;
+  std::string ratio;
+  Figure log10_ratio;
+  Figure total, storage, arith;
+};
+
+struct BackendDifferenceRow {
+  CellColumns cell;  // without backend
+  std::string ratio, metric;
+  Figure first, second;  // bits lost on the two backends compared
+  Figure difference;
+};
+struct BackendDifferences {
+  std::vector<std::string> backends;  // the two compared, or none
+  std::size_t compared = 0, notable = 0;
+  Figure largest_bits;
+  double threshold_bits = 0.0;
+  std::vector<BackendDifferenceRow> rows;  // the largest, largest first
+};
+
+struct NonFiniteRow {
+  CellColumns cell;
+  std::string sweep;  // "default domain", "f/n 1e4", "f/n inf"
+  std::uint64_t nan = 0, inf = 0, judged = 0, first_index = 0;
+  std::string command;  // replays the first
+};
+struct WorstSampleRow {
+  CellColumns cell;
+  Figure bits, relative;
+  std::uint64_t index = 0;
+  std::string command;
+};
+
+struct FrontRow {
+  CellColumns cell;  // without backend
+  std::string source, ratio;
+  Figure cost, spread, bits;
+  std::uint64_t nonfinite = 0;
+  bool on_front = false;
+};
+struct FrontSource {
+  std::string source, cost_unit, accuracy;
+};
+struct SpeedSection {
+  std::vector<FrontSource> sources;
+  std::vector<FrontRow> rows;
+  std::optional<std::string> error;  // why there is no front
+};
+
+struct HistorySection {
+  std::string database;
+  std::int64_t run = 0, runs_recorded = 0;
+  struct Previous {
+    std::string backend;
+    std::int64_t run = 0;
+    std::string made_at, commit;
+  };
+  std::vector<Previous> previous;
+  double tolerance_p999_bits = 0.0, tolerance_max_bits = 0.0;
+  std::vector<std::string> notes;
+  struct Change {
+    std::string direction;  // "worse", "better"
+    std::string backend, cell, band;
+    std::vector<std::string> reasons;
+    Figure before_p999_bits, after_p999_bits;
+  };
+  std::vector<Change> changes;
+  struct TrendPoint {
+    std::int64_t run = 0;
+    std::string made_at, commit, backend, cell;
+    Figure p999_bits, max_bits;
+    std::uint64_t nonfinite = 0;
+  };
+  std::vector<TrendPoint> trend;
+
+  std::size_t worse() const;  // changes for the worse
+};
+
+struct Report {
+  ReportEnvironment environment;
+  std::vector<HeadlineRow> headline;
+  std::vector<ModelPointRow> precision_points;  // deepest decade of each ratio, p99.9 and max
+  std::vector<ModelPointRow> depth_points;      // every decade at a few ratios, p99.9, as relative error
+  std::vector<SplitRow> split;
+  BackendDifferences backend_differences;
+  std::vector<NonFiniteRow> nonfinite;
+  std::vector<WorstSampleRow> worst;
+  SpeedSection speed;
+  std::optional<HistorySection> history;  // none with --no-history
+};
+
+}  // namespace depthbench
