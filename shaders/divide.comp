@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// divide (seed 004): the formula is in shared/variants/divide.h.
+// divide (the engine shader notes): the formula is in shared/variants/divide.h.
 #include "common.glsl"
 #include "../shared/variants/divide.h"
 #define RECONSTRUCT divide_world_position

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// eye_ray (seed 003): the formula is in shared/variants/eye_ray.h.
+// eye_ray (the eye-ray post 2011): the formula is in shared/variants/eye_ray.h.
 #include "common.glsl"
 #include "../shared/variants/eye_ray.h"
 #define RECONSTRUCT eye_ray_world_position

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// reciprocal (seed 004): the formula is in shared/variants/reciprocal.h.
+// reciprocal (the engine shader notes): the formula is in shared/variants/reciprocal.h.
 #include "common.glsl"
 #include "../shared/variants/reciprocal.h"
 #define RECONSTRUCT reciprocal_world_position

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// tan_aspect (seed 001): the formula is in shared/variants/tan_aspect.h.
+// tan_aspect (Coluna 2011): the formula is in shared/variants/tan_aspect.h.
 #include "common.glsl"
 #include "../shared/variants/tan_aspect.h"
 #define RECONSTRUCT tan_aspect_world_position

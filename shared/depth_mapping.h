@@ -47,7 +47,7 @@ DB_FN real eye_depth_from_window_depth(real near, real far, uint convention, rea
 
 // NDC depth coefficients (A, B) with ndc_z = A + B / z, for the convention's
 // clip-depth range. These are the entries a projection matrix carries and
-// the constants seed 004 reads from it.
+// the constants the engine shader notes read from it.
 DB_FN vec2 ndc_depth_coefficients(real near, real far, uint convention) {
   bool reversed = (convention & DB_CONVENTION_REVERSED) != 0u;
   real a;

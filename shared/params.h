@@ -26,16 +26,16 @@ struct FrameParams {
   vec4 camera_position;     // xyz: camera position in world space; w: far plane distance (0 when infinite)
   vec4 lens;                // x: tan(fovY/2)*aspect, y: tan(fovY/2), z: H = 1/x, w: V = 1/y
   vec4 resolution;          // x: width, y: height, z: 1/width, w: 1/height (pixels)
-  vec4 frustum_ray_origin;  // seed 000: world-space camera->far-plane ray, full-screen pass
+  vec4 frustum_ray_origin;  // Pettineo 2009: world-space camera->far-plane ray, full-screen pass
   vec4 frustum_ray_du;
   vec4 frustum_ray_dv;
-  vec4 volume_position_origin;  // seed 000: view-space position on a light volume's surface
+  vec4 volume_position_origin;  // Pettineo 2009: view-space position on a light volume's surface
   vec4 volume_position_du;
   vec4 volume_position_dv;
-  vec4 eye_ray_view_origin;  // seed 003: view-space eye ray (x*tan*aspect, y*tan, -w)
+  vec4 eye_ray_view_origin;  // the eye-ray post 2011: view-space eye ray (x*tan*aspect, y*tan, -w)
   vec4 eye_ray_view_du;
   vec4 eye_ray_view_dv;
-  vec4 eye_ray_world_origin;  // seed 003: the same ray rotated by the inverse view matrix
+  vec4 eye_ray_world_origin;  // the eye-ray post 2011: the same ray rotated by the inverse view matrix
   vec4 eye_ray_world_du;
   vec4 eye_ray_world_dv;
 };
@@ -43,8 +43,8 @@ struct FrameParams {
 // What one depth convention adds to a frame: the mapping between eye depth
 // z (= -view.z > 0) and NDC depth, which is  ndc_z = A + B / z.
 struct DepthParams {
-  mat4 inverse_view_projection;  // seed 002: NDC (x, y, ndc_z, 1) -> homogeneous world position
-  vec4 coefficients;             // x: A, y: B, z: P = 1/B, w: Q = -A/B (seed 004)
+  mat4 inverse_view_projection;  // Unity URP: NDC (x, y, ndc_z, 1) -> homogeneous world position
+  vec4 coefficients;             // x: A, y: B, z: P = 1/B, w: Q = -A/B (the engine shader notes)
   uint convention;               // DB_CONVENTION_* bits
   uint reserved0;
   uint reserved1;

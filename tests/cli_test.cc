@@ -76,11 +76,11 @@ TEST(CliTest, HelpTeachesAndExitsWithZero) {
   }
 }
 
-TEST(CliTest, ListNamesVariantsWithSeedsAndDevices) {
+TEST(CliTest, ListNamesVariantsWithSourcesAndDevices) {
   const auto r = RunDepthbench({"list"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  for (const char* text :
-       {"frustum_ray", "000", "pq", "004", "reversed-inf-gl", "x8_d24_unorm", "106 cells", "llvmpipe"}) {
+  for (const char* text : {"frustum_ray", "Pettineo 2009", "pq", "engine shader notes", "reversed-inf-gl",
+                           "x8_d24_unorm", "106 cells", "llvmpipe"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
 }

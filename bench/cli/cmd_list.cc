@@ -24,11 +24,11 @@ const char* InputName(DepthInput input) {
 Expected<int> List() {
   using Align = TextTable::Align;
   TextTable variants(
-      {{"variant", Align::kLeft}, {"seed", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
+      {{"variant", Align::kLeft}, {"source", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
   for (const auto& v : AllVariants()) {
-    variants.AddRow({std::string(v.name), std::string(v.seed), InputName(v.input), std::string(v.idea)});
+    variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input), std::string(v.idea)});
   }
-  std::cout << "Variants (seeds: ../shared/seeds/NNN_*.txt)\n";
+  std::cout << "Variants (their sources: docs/sources.md)\n";
   variants.Print(std::cout);
 
   TextTable conventions({{"convention", Align::kLeft}, {"meaning", Align::kLeft}});

@@ -37,7 +37,7 @@ inline constexpr int kVariantCount = 8;
 struct VariantInfo {
   Variant id;
   std::string_view name;
-  std::string_view seed;  // the article in ../shared/seeds it restates
+  std::string_view source;  // the article it restates, by its short name in docs/sources.md
   DepthInput input;
   std::string_view idea;
 };
@@ -91,20 +91,22 @@ struct FormatInfo {
 
 namespace catalog {
 inline constexpr std::array<VariantInfo, kVariantCount> kVariants = {{
-    {Variant::kFrustumRay, "frustum_ray", "000", DepthInput::kLinear,
+    {Variant::kFrustumRay, "frustum_ray", "Pettineo 2009", DepthInput::kLinear,
      "full-screen pass: world-space far-plane frustum ray, interpolated; camera + depth * ray"},
-    {Variant::kVolumeRay, "volume_ray", "000", DepthInput::kLinear,
+    {Variant::kVolumeRay, "volume_ray", "Pettineo 2009", DepthInput::kLinear,
      "light-volume geometry: ray = view position * (far / -view.z); view = depth * ray"},
-    {Variant::kTanAspect, "tan_aspect", "001", DepthInput::kLinear,
+    {Variant::kTanAspect, "tan_aspect", "Coluna 2011", DepthInput::kLinear,
      "similar triangles: view.xy = (tan*aspect, tan) * ndc.xy * z, no matrix"},
-    {Variant::kEyeRay, "eye_ray", "003", DepthInput::kViewZ,
+    {Variant::kEyeRay, "eye_ray", "eye-ray post 2011", DepthInput::kViewZ,
      "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside"},
-    {Variant::kInverseVp, "inverse_vp", "002", DepthInput::kHardware,
+    {Variant::kInverseVp, "inverse_vp", "Unity URP", DepthInput::kHardware,
      "inverse view-projection times (ndc, depth, 1), divide by w"},
-    {Variant::kDivide, "divide", "004", DepthInput::kHardware, "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
-    {Variant::kReciprocal, "reciprocal", "004", DepthInput::kHardware,
+    {Variant::kDivide, "divide", "engine shader notes", DepthInput::kHardware,
+     "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
+    {Variant::kReciprocal, "reciprocal", "engine shader notes", DepthInput::kHardware,
      "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW"},
-    {Variant::kPq, "pq", "004", DepthInput::kHardware, "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
+    {Variant::kPq, "pq", "engine shader notes", DepthInput::kHardware,
+     "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
 }};
 
 // The DB_CONVENTION_* bits of shared/params.h (cells.cc checks they agree).

@@ -53,13 +53,13 @@ hp::FrameParams BuildFrameParams(const Frame& frame) {
   auto view_at = [&](DD depth) {
     return [=](DD ndc_x, DD ndc_y) { return hp::vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth); };
   };
-  // Seed 000: far-plane corners rotated to world space.
+  // Pettineo 2009: far-plane corners rotated to world space.
   ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin, p.frustum_ray_du,
                   p.frustum_ray_dv);
-  // Seed 000, light volume: the surface's view-space position.
+  // Pettineo 2009, light volume: the surface's view-space position.
   ScreenAttribute(view_at(DD(frame.volume_depth)), p.volume_position_origin, p.volume_position_du,
                   p.volume_position_dv);
-  // Seed 003: the eye ray at w = 1 in view space and rotated to world space.
+  // The eye-ray post 2011: the eye ray at w = 1 in view space and rotated to world space.
   ScreenAttribute(view_at(DD(1.0)), p.eye_ray_view_origin, p.eye_ray_view_du, p.eye_ray_view_dv);
   ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(DD(1.0))(x, y)); }, p.eye_ray_world_origin,
                   p.eye_ray_world_du, p.eye_ray_world_dv);

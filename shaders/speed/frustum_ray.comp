@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// frustum_ray (seed 000), timed: the formula is in shared/variants/frustum_ray.h.
+// frustum_ray (Pettineo 2009), timed: the formula is in shared/variants/frustum_ray.h.
 #include "../common.glsl"
 #include "../../shared/variants/frustum_ray.h"
 #define RECONSTRUCT frustum_ray_world_position

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// inverse_vp (seed 002), timed: the formula is in shared/variants/inverse_vp.h.
+// inverse_vp (Unity URP), timed: the formula is in shared/variants/inverse_vp.h.
 #include "../common.glsl"
 #include "../../shared/variants/inverse_vp.h"
 #define RECONSTRUCT inverse_vp_world_position

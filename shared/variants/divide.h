@@ -1,7 +1,7 @@
-// divide (seed 004, first form).
+// divide (the engine shader notes, first form; docs/sources.md).
 // From ndc_z = A + B / z it follows 1/z = ndc_z/B - A/B, and the view-space
 // position is (ndc.x/H, ndc.y/V, -1) / (ndc_z/B - A/B), with H and V the
-// projection's horizontal and vertical scales. Seed 004 works in a Z-up
+// projection's horizontal and vertical scales. The engine shader notes work in a Z-up
 // space where y is depth; in our view space depth is -z, hence the -1.
 // Precision trap: ndc_z/B - A/B subtracts two nearly equal quotients near
 // the far plane of a standard-Z projection.

@@ -1,10 +1,10 @@
-// eye_ray (seed 003).
+// eye_ray (the eye-ray post 2011; docs/sources.md).
 // The G-buffer stores view-space z. The vertex stage emits the eye ray
 // (clip.x*tan(fovY/2)*aspect, clip.y*tan(fovY/2), w) and that ray rotated to
 // world space by the inverse view matrix; the pixel stage divides the
 // interpolated view-space ray by its z and multiplies by the stored view z.
 // Restated for our right-handed view space (camera looking down -Z), the
-// ray's third component is -w and the stored view z is negative. Seed 003
+// ray's third component is -w and the stored view z is negative. The eye-ray post 2011
 // multiplies the world-space ray by the depth without the division, which is
 // only right when the ray's z is +1 everywhere (its left-handed full-screen
 // quad); dividing the world-space ray by the same view-space z is the

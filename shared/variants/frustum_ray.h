@@ -1,4 +1,4 @@
-// frustum_ray (seed 000, full-screen pass).
+// frustum_ray (Pettineo 2009, full-screen pass; docs/sources.md).
 // The vertex stage rotates the view-space far-plane frustum corners into world
 // space with the camera world matrix (rotation only); the rasterizer
 // interpolates them, so each pixel receives the ray from the camera to the far

@@ -1,4 +1,4 @@
-// inverse_vp (seed 002, Unity's ComputeWorldSpacePosition).
+// inverse_vp (Unity URP: ComputeWorldSpacePosition; docs/sources.md).
 // Clip-space position (ndc.xy, ndc depth, 1) through the inverse
 // view-projection matrix, then the perspective divide by w. With GL-style
 // clip depth the stored depth is first remapped to [-1, 1].

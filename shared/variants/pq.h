@@ -1,4 +1,4 @@
-// pq (seed 004, multiply-add form).
+// pq (the engine shader notes, multiply-add form; docs/sources.md).
 // invW = 1 / (ndc_z * P + Q) with P = 1/B and Q = -A/B precomputed on the
 // host: one multiply-add and one reciprocal per pixel.
 // Precision trap: ndc_z * P and Q are large and of opposite sign near the

@@ -1,4 +1,4 @@
-// reciprocal (seed 004, second form).
+// reciprocal (the engine shader notes, second form; docs/sources.md).
 // Multiply by the inverse of w instead of dividing: invW = B / (ndc_z - A),
 // view = (ndc.x/H, ndc.y/V, -1) * invW.
 // Precision trap: ndc_z - A cancels near the far plane of a standard-Z

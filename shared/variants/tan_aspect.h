@@ -1,10 +1,10 @@
-// tan_aspect (seed 001, similar triangles).
+// tan_aspect (Coluna 2011, similar triangles; docs/sources.md).
 // With linear depth in [0, 1] (0 at the camera, 1 at the far plane) the
 // view-space position follows from the field of view alone:
 //   view.xy = (tan(fovY/2)*aspect, tan(fovY/2)) * ndc.xy * eye depth,
 //   view.z  = -eye depth,
 // no matrix and no per-pixel division, only multiplies.
-// Seed 001 negates tan(fovY/2) on the host to absorb its flipped texture v;
+// Coluna 2011 negates tan(fovY/2) on the host to absorb its flipped texture v;
 // here uv_from_pixel/ndc_from_uv already give y up, so no negation is needed.
 // No include guard: see compat.h. Needs params.h, screen.h.
 DB_FN vec3 tan_aspect_world_position(FrameParams frame, DepthParams depth, vec2 uv, real stored) {

@@ -1,4 +1,4 @@
-// volume_ray (seed 000, light-volume geometry).
+// volume_ray (Pettineo 2009, light-volume geometry; docs/sources.md).
 // Drawing a light's bounding volume, the vertex stage passes the view-space
 // position of the volume's surface; per pixel, scaling it by far / -z turns
 // it into the camera->far-plane ray through that pixel, and the linear depth
