@@ -110,5 +110,32 @@ TEST(CliTest, IndexReplaysOneSampleOnBothBackends) {
   EXPECT_NE(r.out.find("vulkan:"), std::string::npos);
 }
 
+// The default run is informative: in the typical domain (camera-relative,
+// far/near 1e2 to 1e5) reversed Z with D32F sits near the float32 floor,
+// where the wide domain's cameras a million units out put nearly every
+// cell at 24 bits; standard Z with D24 shows its far/near dependence, about
+// 3.3 bits per decade of far/near, between the ratio bands 1e2 and 1e4.
+TEST(CliTest, TheDefaultRunSeparatesTheConventions) {
+  const std::string dir = testing::MakeTempDir("cli_default_run");
+  const std::string json = dir + "/out.json";
+  const auto r = RunDepthbench({"run", "--samples", "60000", "--backend", "cpu", "--variant", "divide", "--convention",
+                                "standard,reversed", "--format", "d24,d32f", "--json", json});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto results = ReadResults(json);
+  ASSERT_TRUE(results.ok()) << results.status().message();
+  const auto p999 = [](const BandStats& b) { return BitsLost(Summarize(b, Metric::kTotal).p999); };
+  for (const CellResult& c : results->cells) {
+    if (c.cell.convention == Convention::kReversed && c.cell.format == Format::kD32Sfloat) {
+      EXPECT_LT(p999(c.stats.All()), 8.0) << c.cell.Name();
+    }
+    if (c.cell.convention == Convention::kStandard && c.cell.format == Format::kX8D24Unorm) {
+      // Two decades at 3.3 bits each; 2 bits of margin for the bins and
+      // the ~10000 samples a band holds.
+      EXPECT_GT(p999(c.stats.ForRatio(4)) - p999(c.stats.ForRatio(2)), 4.5) << c.cell.Name();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace depthbench

@@ -132,7 +132,7 @@ TEST(EncodeTest, PipelineFloatIsCorrectlyRoundedEverywhere) {
       // Depths spread log-uniformly, and bunched against the far plane.
       double z =
           k % 3 == 0 ? near * ratio * (1.0 - std::ldexp(unit(rng), -20)) : near * std::exp(unit(rng) * std::log(ratio));
-      ASSERT_EQ(PipelineFloat(e, frame, z), ExactPipelineFloat(e, frame, z))
+      ASSERT_EQ(PipelineFloat(e, ProductionModel::kExact, frame, z), ExactPipelineFloat(e, frame, z))
           << Info(c).name << " near " << near << " ratio " << ratio << " z " << z;
     }
   }
@@ -144,13 +144,14 @@ TEST(EncodeTest, ExactTiesAreSettledByMpfr) {
   // floats 1/2 and 1/2 + 2^-24. Ties go to even: 1/2.
   const Frame frame = TestFrame(0.5 - std::ldexp(1.0, -25), INFINITY);
   const EncodeFallbacks before = EncodeFallbackCounts();
-  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, frame, 1.0), 0.5f);
+  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, ProductionModel::kExact, frame, 1.0), 0.5f);
   const EncodeFallbacks after = EncodeFallbackCounts();
   EXPECT_EQ(after.ties, before.ties + 1);
   EXPECT_EQ(after.mpfr, before.mpfr + 1);
   // Just beyond the tie the answer moves up.
   const Frame nearer = TestFrame(std::nextafter(0.5 - std::ldexp(1.0, -25), 0.0), INFINITY);
-  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, nearer, 1.0), 0.5f + std::ldexp(1.0f, -24));
+  EXPECT_EQ(PipelineFloat({Convention::kStandardInf, Format::kD32Sfloat}, ProductionModel::kExact, nearer, 1.0),
+            0.5f + std::ldexp(1.0f, -24));
 }
 
 TEST(EncodeTest, EdgeValuesAreTheFormatsExtremeCodes) {
@@ -171,28 +172,30 @@ TEST(EncodeTest, StoredPlanesDecodeToThePlanes) {
   const Frame finite = TestFrame(0.25, 4000.0);
   const Frame infinite = TestFrame(0.25, INFINITY);
   for (Format f : {Format::kD16Unorm, Format::kX8D24Unorm, Format::kD32Sfloat}) {
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite,
-                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero))
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, ProductionModel::kExact, finite,
+                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredZero).fetched)
                   .hi(),
               0.25);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, finite,
-                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne))
+    EXPECT_EQ(DecodeEyeDepth({Convention::kStandard, f}, ProductionModel::kExact, finite,
+                             EncodeEdge({Convention::kStandard, f}, finite, DepthPick::kStoredOne).fetched)
                   .hi(),
               4000.0);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite,
-                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne))
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, ProductionModel::kExact, finite,
+                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredOne).fetched)
                   .hi(),
               0.25);
-    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, finite,
-                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero))
+    EXPECT_EQ(DecodeEyeDepth({Convention::kReversed, f}, ProductionModel::kExact, finite,
+                             EncodeEdge({Convention::kReversed, f}, finite, DepthPick::kStoredZero).fetched)
                   .hi(),
               4000.0);
-    EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kStandardInf, f}, infinite,
-                                          EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne))
-                               .hi()));
-    EXPECT_TRUE(std::isinf(DecodeEyeDepth({Convention::kReversedInf, f}, infinite,
-                                          EncodeEdge({Convention::kReversedInf, f}, infinite, DepthPick::kStoredZero))
-                               .hi()));
+    EXPECT_TRUE(
+        std::isinf(DecodeEyeDepth({Convention::kStandardInf, f}, ProductionModel::kExact, infinite,
+                                  EncodeEdge({Convention::kStandardInf, f}, infinite, DepthPick::kStoredOne).fetched)
+                       .hi()));
+    EXPECT_TRUE(
+        std::isinf(DecodeEyeDepth({Convention::kReversedInf, f}, ProductionModel::kExact, infinite,
+                                  EncodeEdge({Convention::kReversedInf, f}, infinite, DepthPick::kStoredZero).fetched)
+                       .hi()));
   }
 }
 
@@ -200,9 +203,10 @@ TEST(EncodeTest, LinearDepthUnderflowsInHalfFloatAtLargeRatios) {
   // z/far = 1e-8 is below half float's smallest subnormal (2^-24 = 6e-8):
   // the stored value is 0 and denotes the camera.
   const Frame frame = TestFrame(1.0, 1e8);
-  const StoredDepth s = EncodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, 1.0);
+  const StoredDepth s = EncodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, ProductionModel::kExact, frame, 1.0);
   EXPECT_EQ(s.fetched, 0.0f);
-  EXPECT_EQ(DecodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, frame, s).hi(), 0.0);
+  EXPECT_EQ(DecodeEyeDepth({Convention::kLinear, Format::kR16Sfloat}, ProductionModel::kExact, frame, s.fetched).hi(),
+            0.0);
 }
 
 }  // namespace

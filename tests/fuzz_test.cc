@@ -191,9 +191,6 @@ TEST_P(ExtremeTest, FiniteWithinTheBoundOrACountedFinding) {
   EXPECT_EQ(found, e.expected);
 }
 
-const std::set<std::string> kProjectiveNaN = {"divide nan", "reciprocal nan", "pq nan", "inverse_vp nan",
-                                              "inverse_vp inf"};
-
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, ExtremeTest,
     ::testing::Values(Extreme{"near_1e_6",
@@ -208,14 +205,18 @@ INSTANTIATE_TEST_SUITE_P(
                               },
                               {},
                               {}},
-                      // Far/near beyond 2^24: f/(f - n) rounds to 1 in float32 and the
-                      // projective variants divide by zero at the far plane.
+                      // Far/near beyond 2^24: f/(f - n) rounds to 1 in float32. The
+                      // pipeline, computing depth from that same float A, stores values
+                      // at the far plane that denote infinity: their non-finite outputs
+                      // are expected, no finding. divide alone still returns NaN where
+                      // its own ndc_z/B - A/B cancels for stored values that denote a
+                      // finite point.
                       Extreme{"ratio_1e9",
                               [](Domain& d) {
                                 d.ratio = {1e9, 1e9};
                               },
                               {},
-                              kProjectiveNaN},
+                              {"divide nan"}},
                       // divide forms ndc_z/B - A/B: on [-1, 1] infinite conventions the
                       // two quotients are equal in float32 for depths far enough, the
                       // difference is exactly 0 and the position NaN (seed 004's trap).
@@ -294,17 +295,28 @@ namespace {
 
 // depthbench fuzz as a user runs it, on lavapipe and the CPU together:
 // far/near 1e9 (beyond what float32 constants carry) makes the divide
-// variant divide by zero at the far plane on both backends; the campaign
-// says so, exits 1, writes one shrunk reproducer per backend, and
-// `run --repro` replays it with the same verdict.
+// variant's ndc/B - A/B cancel to 0 near the far plane on both backends.
+// With no known-findings file the campaign says so (one finding, both
+// backends merged), exits 1, writes one shrunk reproducer per backend, and
+// `run --repro` replays it with the same verdict; with the committed file
+// the same finding is known, reported with its reason, and the run exits 0.
 TEST(FuzzCommandTest, FindsShrinksWritesAndReplaysOnBothBackends) {
   const std::string out = testing::MakeTempDir("fuzz_command");
-  const testing::CommandResult fuzz =
-      testing::RunDepthbench({"fuzz", "--cases", "8192", "--ratio", "1e9", "--variant", "divide", "--convention",
-                              "standard", "--format", "d32f", "--out", out, "--quiet", "--validate"});
+  const std::vector<std::string> campaign = {"fuzz",   "--cases",      "8192",      "--ratio",  "1e9",  "--variant",
+                                             "divide", "--convention", "standard",  "--format", "d32f", "--out",
+                                             out,      "--quiet",      "--validate"};
+  std::vector<std::string> unknown = campaign;
+  unknown.insert(unknown.end(), {"--known", "none"});
+  const testing::CommandResult fuzz = testing::RunDepthbench(unknown);
   ASSERT_EQ(fuzz.exit_code, 1) << fuzz.out << fuzz.err;
-  EXPECT_NE(fuzz.out.find("divide/standard/d32_sfloat cpu nan"), std::string::npos) << fuzz.out;
-  EXPECT_NE(fuzz.out.find("divide/standard/d32_sfloat vulkan nan"), std::string::npos) << fuzz.out;
+  EXPECT_NE(fuzz.out.find("1 new shader findings"), std::string::npos) << fuzz.out;
+  EXPECT_NE(fuzz.out.find("divide/standard/d32_sfloat nan  cpu, vulkan"), std::string::npos) << fuzz.out;
+  const testing::CommandResult known = testing::RunDepthbench(campaign);
+  EXPECT_EQ(known.exit_code, 0) << known.out << known.err;
+  EXPECT_NE(known.out.find("no new findings"), std::string::npos) << known.out;
+  EXPECT_NE(known.out.find("- divide nan in 1 cells (divide/standard/d32_sfloat): divide forms ndc/B - A/B"),
+            std::string::npos)
+      << known.out;
   for (const char* backend : {"cpu", "vulkan"}) {
     const std::string file = out + "/divide_standard_d32_sfloat_" + backend + "_nan.json";
     const testing::CommandResult replay = testing::RunDepthbench({"run", "--repro", file, "--validate"});
@@ -319,6 +331,16 @@ TEST(FuzzCommandTest, FindsShrinksWritesAndReplaysOnBothBackends) {
       testing::RunDepthbench({"run", "--repro", std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/baselines/cpu.json"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("schema is 'depthbench.baseline', expected 'depthbench.repro'"), std::string::npos) << bad.err;
+}
+
+// On unchanged code the campaign finds nothing that the committed
+// known-findings file does not explain (each entry with its reason): a
+// fuzz job in CI stays green until something new appears.
+TEST(FuzzCommandTest, UnchangedCodeHasNoNewFindings) {
+  const std::string out = testing::MakeTempDir("fuzz_unchanged");
+  const testing::CommandResult fuzz = testing::RunDepthbench({"fuzz", "--seconds", "30", "--out", out, "--quiet"});
+  EXPECT_EQ(fuzz.exit_code, 0) << fuzz.out << fuzz.err;
+  EXPECT_NE(fuzz.out.find("no new findings"), std::string::npos) << fuzz.out;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/command_runner.h"
 
@@ -118,24 +119,24 @@ TEST_F(GateTest, PlantedNanFailsAndItsReproducerReproducesIt) {
   EXPECT_NE(replay.out.find("NaN"), std::string::npos) << replay.out;
 }
 
-TEST_F(GateTest, NanTurnedIntoInfFailsAndItsReproducerShowsTheInf) {
-  // Every NaN output of pq becomes +inf: as many non-finite outputs as
-  // before, but Inf appears where there was none, and the reproducer must
-  // replay a sample that gives Inf (not the worst finite one).
+TEST_F(GateTest, PlantedInfFailsAndItsReproducerShowsTheInf) {
+  // pq returns +inf for stored depths in one range: Inf appears where there
+  // was none (and no NaN), and the reproducer must replay a sample that
+  // gives Inf (not the worst finite one).
   Edit("shared/variants/pq.h", "  return world_from_view(frame, view);",
        "  vec3 p = world_from_view(frame, view);\n"
-       "  if (isnan(p.x) || isnan(p.y) || isnan(p.z)) p = vec3(uintBitsToFloat(0x7f800000u));\n"
+       "  if (stored > 0.25f && stored < 0.5f) p = vec3(uintBitsToFloat(0x7f800000u));\n"
        "  return p;");
   const auto r = Gate();
   ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("Inf appeared"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("NaN appeared"), std::string::npos) << r.out;
   const auto replay = ReplayFirstReproducer(r);
-  // The line of the GPU's output: "     vulkan: (inf, inf, inf)  Inf".
+  // The line of the GPU's output: "     vulkan: (inf, inf, inf)  Inf (a finding: ...)".
   const auto at = replay.out.find("vulkan: (");
   ASSERT_NE(at, std::string::npos) << replay.out;
   const std::string line = replay.out.substr(at, replay.out.find('\n', at) - at);
-  EXPECT_EQ(line.substr(line.size() - 3), "Inf") << replay.out;
+  EXPECT_NE(line.find("(inf, inf, inf)  Inf (a finding"), std::string::npos) << replay.out;
 }
 
 TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
@@ -158,6 +159,49 @@ TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("another sample plan"), std::string::npos) << r.err;
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace depthbench
+
+namespace depthbench {
+namespace {
+
+// Every band the gate compares can move: a half-bit-scale loss in the
+// shader's arithmetic (its result scaled by 1 + 2^-20, a rounding a
+// shader edit could introduce) shows in the camera-distance band too, not
+// only in the ratio and depth bands (the distance bands once kept no
+// arithmetic figures, so that check compared 0 with 0).
+TEST(GateBandTest, AnArithmeticLossShowsInTheDistanceBand) {
+  const std::string root = testing::MakeTempDir("gate_distance_band");
+  testing::CopyShaderSources(root);
+  ASSERT_TRUE(testing::ReplaceInFile(root + "/shared/variants/reciprocal.h", "  return world_from_view(frame, view);",
+                                     "  return world_from_view(frame, view * (1.0f + 9.5367431640625e-07f));"));
+  const std::string json = root + "/gate.json";
+  const auto r = RunDepthbench({"gate", "--baseline", kBaseline, "--shaders", root + "/shaders", "--json", json});
+  ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
+  const nlohmann::json verdict = nlohmann::json::parse(testing::ReadText(json));
+  bool distance_band_worse = false;
+  for (const auto& cell : verdict["backends"][0]["cells"]) {
+    for (const auto& band : cell["worse"]) {
+      if (band["band"].get<std::string>().rfind("distance ", 0) != 0) continue;
+      for (const auto& reason : band["reasons"]) {
+        distance_band_worse |= reason.get<std::string>().rfind("arith p99.9", 0) == 0;
+      }
+    }
+  }
+  EXPECT_TRUE(distance_band_worse) << r.out;
+  fs::remove_all(root);
+}
+
+// --shaders with baselines that run no shader compares nothing an edit
+// changes: refused, saying why.
+TEST(GateBandTest, ShadersWithOnlyACpuBaselineAreRefused) {
+  const auto r =
+      RunDepthbench({"gate", "--baseline", std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/baselines/cpu.json",
+                     "--shaders", "/no/such/dir"});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("none of the baselines is for the vulkan backend"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -22,6 +22,9 @@ class PhysicsTest : public ::testing::Test {
     SweepOptions options;
     options.seed = 2024;
     options.samples = 600000;
+    // The wide domain's far/near ratios (1e1 to 1e8), with the camera at the
+    // origin and one lens.
+    options.domain = WideDomain();
     options.domain.camera_distance = {0.0, 0.0};
     options.domain.fov_degrees = {60.0, 60.0};
     options.domain.aspect = {16.0 / 9.0, 16.0 / 9.0};
@@ -117,6 +120,49 @@ TEST_F(PhysicsTest, LinearFloat32StaysFlat) {
     ++checked;
   }
   EXPECT_EQ(checked, 3);
+}
+
+}  // namespace
+}  // namespace depthbench
+
+namespace depthbench {
+namespace {
+
+// Attribution: at the far plane of a standard-Z projection the float32 A
+// and B a shader receives differ from the exact ones, and so does the depth
+// a GPU stores, which it computes from the same float matrix. Measured
+// against the pipeline's own mapping, the shader's part of the reciprocal
+// variant is its arithmetic alone: in the deepest decade at far/near 1e4
+// within a bit of what the same variant shows under standard-inf, where
+// A = 1 is exact (it read 13.2 bits when the reference decoded with the
+// exact A and B and blamed that mismatch on the shader).
+TEST(AttributionTest, ReciprocalOnStandardZIsBlamedOnlyForItsArithmetic) {
+  SweepOptions options;
+  options.seed = 99;
+  options.samples = 200000;
+  options.domain.camera_distance = {0.0, 0.0};
+  options.domain.ratio = {1e4, 1e4};
+  options.domain.finite_far = true;
+  options.domain.infinite_far = true;
+  options.cells = {*ParseCell("reciprocal/standard/d24"), *ParseCell("reciprocal/standard-inf/d24")};
+  auto cpu = MakeCpuBackend();
+  Backend* backends[] = {cpu.get()};
+  auto run = RunSweep(options, backends);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  constexpr int kDeepestDecade = 3;  // z/n in [1e3, 1e4): the far plane's decade at f/n 1e4
+  double shader[2], production[2];
+  for (int k = 0; k < 2; ++k) {
+    const BandStats band = run->cells[k].stats.ForDepth(kDeepestDecade);
+    ASSERT_GT(band.finite, 10000u) << run->cells[k].cell.Name();
+    shader[k] = BitsLost(Summarize(band, Metric::kArith).p999);
+    production[k] = BitsLost(Summarize(band, Metric::kProduction).p999);
+  }
+  // 1 bit: a reciprocal and a multiply more or less in the decode, and the
+  // quarter-bit bins. The f/n cost itself (about 13 bits here) is the
+  // production's, as a GPU would produce it.
+  EXPECT_NEAR(shader[0], shader[1], 1.0) << "standard " << shader[0] << ", standard-inf " << shader[1];
+  EXPECT_LT(shader[0], 4.0);
+  EXPECT_GT(production[0], 10.0);
 }
 
 }  // namespace

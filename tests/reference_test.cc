@@ -63,12 +63,10 @@ TEST(ReferenceTest, DecodeIsFarBelowFloatRounding) {
       std::uint32_t code = static_cast<std::uint32_t>(unit(rng) * max_code);
       if (k % 2 == 0) code = max_code - static_cast<std::uint32_t>(unit(rng) * std::min(max_code, 1u << 12));
       const StoredDepth stored{code, FetchTexel(e.format, code)};
-      const DD z = DecodeEyeDepth(e, frame, stored);
+      const DD z = DecodeEyeDepth(e, ProductionModel::kExact, frame, stored.fetched);
       if (!std::isfinite(z.hi()) || z.hi() <= 0.0) continue;
-      // The code's exact value in MPFR.
-      mp::real d = Info(e.format).texel == TexelKind::kUnorm
-                       ? mp::real(code) / mp::real(std::ldexp(1.0, Info(e.format).bits) - 1.0)
-                       : mp::real(FetchTexel(e.format, code));
+      // The fetched value (what the shader reads), exactly.
+      mp::real d = mp::real(stored.fetched);
       const mp::real exact = TextbookDecode(e.convention, near, far, d);
       worst = std::max(worst, RelativeDifference(z, exact));
     }
@@ -143,9 +141,11 @@ TEST(ReferenceTest, NaiveDoubleDecodeIsNotEnoughAtHighRatios) {
   Frame frame;
   frame.near = near;
   frame.far = far;
-  EXPECT_LT(RelativeDifference(DecodeEyeDepth({Convention::kStandard, Format::kX8D24Unorm}, frame,
-                                              {code, FetchTexel(Format::kX8D24Unorm, code)}),
-                               exact),
+  const mp::real exact_fetched =
+      TextbookDecode(Convention::kStandard, near, far, mp::real(FetchTexel(Format::kX8D24Unorm, code)));
+  EXPECT_LT(RelativeDifference(DecodeEyeDepth({Convention::kStandard, Format::kX8D24Unorm}, ProductionModel::kExact,
+                                              frame, FetchTexel(Format::kX8D24Unorm, code)),
+                               exact_fetched),
             std::ldexp(1.0, -96));
 }
 
@@ -177,13 +177,11 @@ TEST(ReferenceTest, EveryVariantFormulaIsExactInHighPrecision) {
       for (std::uint64_t i = f * kSamplesPerFrame; i < f * kSamplesPerFrame + 8; ++i) {
         const PixelSample sample = sampler.SampleAt(i, frame);
         if (sample.pick != DepthPick::kEyeDepth) continue;
-        const StoredDepth stored = EncodeEyeDepth(cell.encoding(), frame, sample.eye_depth);
-        const double z = DecodeEyeDepth(cell.encoding(), frame, stored).hi();
+        const StoredDepth stored = EncodeEyeDepth(cell.encoding(), ProductionModel::kExact, frame, sample.eye_depth);
+        const double z = DecodeEyeDepth(cell.encoding(), ProductionModel::kExact, frame, stored.fetched).hi();
         if (!std::isfinite(z) || z <= 0.0) continue;
-        // The texel's exact value, as the formula reads it.
-        DD value = Info(cell.format).texel == TexelKind::kUnorm
-                       ? DD(stored.code) / DD(std::ldexp(1.0, Info(cell.format).bits) - 1.0)
-                       : DD(static_cast<double>(stored.fetched));
+        // The fetched value, as the formula reads it.
+        const DD value(static_cast<double>(stored.fetched));
         hp::vec2 uv = hp::uv_from_pixel(DD(sample.x), DD(sample.y), params.resolution);
         hp::vec3 p = formula(params, depth, uv, value);
         const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);

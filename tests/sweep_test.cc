@@ -47,31 +47,43 @@ TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
 }
 
 TEST(SweepTest, EverySampleIsCountedOnceInEachSplitAndMetric) {
-  // Each sample of a cell is finite, NaN, Inf, degenerate or outside, in
-  // one joint band and one distance band; a judged sample has a storage
-  // error, a finite one a total, arithmetic and absolute error. Fails when
-  // statistics are lost between the judge and the results (an accumulator
-  // not flushed, the storage errors not copied into the cells).
+  // Each sample of a cell is finite, NaN, Inf, non-finite by its stored
+  // value, degenerate or outside; a sample of the natural distribution in
+  // one joint band and one distance band, a coverage sample in its coverage
+  // band alone. A finite one has a total and absolute error, and an
+  // arithmetic error unless its stored value denotes no holdable point; a
+  // judged one has storage and production errors. Fails when statistics are
+  // lost or counted twice between the judge and the results (an accumulator
+  // not flushed, the encoding's errors not copied into the cells, a coverage
+  // sample counted in the natural bands).
   constexpr std::uint64_t kSamples = 20000;
   const Results results = RunCpu(42, kSamples, {});
   ASSERT_FALSE(results.cells.empty());
+  const auto counted = [](const BandStats& b) { return b.judged() + b.stored_nonfinite + b.degenerate + b.outside; };
   for (const CellResult& result : results.cells) {
     const std::string name = result.cell.Name();
-    const BandStats all = result.stats.All();
-    EXPECT_EQ(all.judged() + all.degenerate + all.outside, kSamples) << name;
+    const BandStats all = result.stats.All(), coverage = result.stats.AllCoverage();
+    EXPECT_EQ(counted(all) + counted(coverage), kSamples) << name;
+    // About 69% of samples are natural: three quarters of depths times 92%
+    // of pixels; 2% either way is many standard deviations of 20000 draws.
+    EXPECT_NEAR(static_cast<double>(counted(all)) / kSamples, 0.69, 0.02) << name;
     EXPECT_GT(all.finite, 0u) << name;
-    EXPECT_EQ(all[Metric::kTotal].Count(), all.finite) << name;
-    EXPECT_EQ(all[Metric::kArith].Count(), all.finite) << name;
-    EXPECT_EQ(all[Metric::kAbsolute].Count(), all.finite) << name;
-    EXPECT_EQ(all[Metric::kStorage].Count(), all.judged()) << name;
-    std::uint64_t by_distance = 0, storage_by_distance = 0;
+    for (const BandStats* b : {&all, &coverage}) {
+      EXPECT_EQ((*b)[Metric::kTotal].Count(), b->finite) << name;
+      EXPECT_EQ((*b)[Metric::kAbsolute].Count(), b->finite) << name;
+      EXPECT_LE((*b)[Metric::kArith].Count(), b->finite) << name;
+      EXPECT_GE((*b)[Metric::kStorage].Count(), b->finite) << name;
+      EXPECT_LE((*b)[Metric::kStorage].Count(), b->judged() + b->stored_nonfinite) << name;
+      EXPECT_EQ((*b)[Metric::kProduction].Count(), (*b)[Metric::kStorage].Count()) << name;
+    }
+    std::uint64_t by_distance = 0, arith_by_distance = 0;
     for (int band = 0; band < kDistanceBands; ++band) {
       const BandStats d = result.stats.ForDistance(band);
-      by_distance += d.judged() + d.degenerate + d.outside;
-      storage_by_distance += d[Metric::kStorage].Count();
+      by_distance += counted(d);
+      arith_by_distance += d[Metric::kArith].Count();
     }
-    EXPECT_EQ(by_distance, kSamples) << name;
-    EXPECT_EQ(storage_by_distance, all.judged()) << name;
+    EXPECT_EQ(by_distance, counted(all)) << name;
+    EXPECT_EQ(arith_by_distance, all[Metric::kArith].Count()) << name;
   }
 }
 
@@ -120,8 +132,9 @@ TEST(SweepTest, NonFiniteOutputsAreCountedByTheirComponents) {
   const auto results = RunSweep(options, backends);
   ASSERT_TRUE(results.ok()) << results.status().message();
   for (const CellResult& result : results->cells) {
-    const BandStats all = result.stats.All();
+    const BandStats all = result.stats.Everything();
     ASSERT_EQ(all.degenerate, 0u) << result.cell.Name();
+    ASSERT_EQ(all.stored_nonfinite, 0u) << result.cell.Name();
     EXPECT_EQ(all.inf, 1000u) << result.cell.Name();
     EXPECT_EQ(all.nan, 2000u) << result.cell.Name();
     EXPECT_EQ(all.finite + all.outside, 1000u) << result.cell.Name();

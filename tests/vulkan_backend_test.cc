@@ -16,8 +16,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backends/factory.h"
 #include "bench/backends/cpu/cpu_backend.h"
+#include "bench/backends/factory.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/thread_pool.h"

@@ -74,6 +74,15 @@ std::pair<double, std::string> PredictAtFarEnd(const Scene& scene, const CellRes
   return {value, Info(ranked.front().kind).name};
 }
 
+// Which cause dominates, in words.
+const char* CauseText(Metric cause) {
+  switch (cause) {
+    case Metric::kProduction: return "the depth the pipeline produces (float32 clip z and divide) dominates";
+    case Metric::kStorage: return "the format's storage error dominates";
+    default: return "the shader's arithmetic dominates";
+  }
+}
+
 }  // namespace
 
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
@@ -150,8 +159,14 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
     v.measured = req.level == Level::kMax ? v.measured_max : v.measured_p999;
     std::tie(v.predicted, v.model) = PredictAtFarEnd(scene, *in_scene, req.level);
     v.nonfinite = band.nan + band.inf + whole_band.nan + whole_band.inf;
-    const double total = band[Metric::kTotal].AtLevel(Level::kP999, Metric::kTotal);
-    v.storage_share = total > 0.0 ? band[Metric::kStorage].AtLevel(Level::kP999, Metric::kStorage) / total : 0.0;
+    double largest = -1.0;
+    for (Metric cause : {Metric::kProduction, Metric::kStorage, Metric::kArith}) {
+      const double p999 = band[cause].AtLevel(Level::kP999, cause);
+      if (p999 > largest) {
+        largest = p999;
+        v.dominant = cause;
+      }
+    }
     v.meets = v.measured <= req.value && v.nonfinite == 0;
     v.cost = costs ? costs(cell) : std::nullopt;
     v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
@@ -187,9 +202,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
     } else if (v.nonfinite > 0) {
       v.reason = fmt::format("fails: {} NaN or Inf outputs inside the scene", v.nonfinite);
     } else {
-      v.reason =
-          fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.measured / limit,
-                      v.storage_share > 0.5 ? "the format's storage error dominates" : "the arithmetic dominates");
+      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.measured / limit, CauseText(v.dominant));
     }
   }
 
@@ -198,13 +211,14 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
     result.suggestions.push_back(fmt::format("nothing meets {}; the closest is {} at {} ({:.3g}x the limit)",
                                              req.Describe(), closest.cell.Name(), InUnitText(req, closest.measured),
                                              closest.measured / limit));
-    const bool storage = closest.storage_share > 0.5;
+    const bool depth = closest.dominant != Metric::kArith;  // production or storage: the depth buffer's own
     const bool reversed_float =
         closest.cell.format == Format::kD32Sfloat && (Info(closest.cell.convention).bits & 1u) != 0u;
-    if (storage && !reversed_float) {
-      result.suggestions.push_back(
-          "storage dominates: a float depth buffer with reversed Z (d32_sfloat, reversed, clip depth [0,1]) keeps "
-          "the relative storage error flat across depth; with a unorm or standard-Z format it grows with z/near");
+    if (depth && !reversed_float) {
+      result.suggestions.push_back(fmt::format(
+          "{}: a float depth buffer with reversed Z (d32_sfloat, reversed, clip depth [0,1]) keeps the relative "
+          "error of the stored depth flat across depth; with a unorm or standard-Z format it grows with z/near",
+          CauseText(closest.dominant)));
       const double factor = closest.measured / limit;
       if (scene.domain.near.fixed()) {
         result.suggestions.push_back(fmt::format(
@@ -212,14 +226,15 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
             "near = {:.3g} (x{:.2g}) would bring the closest candidate to the limit",
             scene.domain.near.min * factor, factor));
       }
-    } else if (storage) {
+    } else if (depth) {
       result.suggestions.push_back(
-          "storage dominates even with reversed-Z float depth: only a larger near plane (or a smaller depth range) "
-          "helps");
+          fmt::format("{} even with reversed-Z float depth: only a larger near plane (or a smaller depth range) helps",
+                      CauseText(closest.dominant)));
     } else {
       const double distance = scene.domain.camera_distance.max;
       result.suggestions.push_back(fmt::format(
-          "the arithmetic dominates{}: a variant with fewer roundings, or positions computed camera-relative{}",
+          "the shader's arithmetic dominates{}: a variant with fewer roundings, or positions computed "
+          "camera-relative{}",
           distance > 0.0
               ? fmt::format(" (the camera goes {:g} from the world origin, where float32 world "
                             "coordinates are {:.3g} apart)",
@@ -275,7 +290,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
          {"predicted_far_end", JsonNumber(v.predicted)},
          {"model", v.model},
          {"nonfinite", v.nonfinite},
-         {"storage_share", JsonNumber(v.storage_share)},
+         {"dominant_cause", MetricName(v.dominant)},
          {"meets", v.meets},
          {"over_budget", v.over_budget},
          {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"unit", v.cost->unit}, {"source", v.cost->source}}

@@ -46,7 +46,9 @@ struct CandidateVerdict {
   double predicted = 0.0;  // the model's value at the scene's far end, same unit and level
   std::string model;       // the error model used for the prediction
   std::uint64_t nonfinite = 0;
-  double storage_share = 0.0;  // storage p99.9 / total p99.9 (relative errors), at the requirement's depth
+  // The cause with the largest p99.9 at the requirement's depth:
+  // kProduction, kStorage or kArith (the shader's part).
+  Metric dominant = Metric::kArith;
   bool meets = false;
   bool over_budget = false;
   std::optional<CandidateCost> cost;

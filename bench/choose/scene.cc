@@ -147,6 +147,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   scene.source = source;
   scene.name = root["name"].value_or(std::string(std::filesystem::path(source).stem()));
   Domain& d = scene.domain;
+  d.name = "scene " + scene.name;
 
   DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
   DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));

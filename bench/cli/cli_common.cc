@@ -12,29 +12,66 @@
 #include <fmt/format.h>
 
 #include "bench/backends/factory.h"
+#include "bench/choose/scene.h"
 
 namespace depthbench::cli {
 
 void DomainFlags::Add(CLI::App& app) {
-  app.add_option("--near", near, "near plane: VALUE or MIN:MAX (default 1e-4:10, log-uniform)")->group("Domain");
-  app.add_option("--far", far, "far plane: VALUE or MIN:MAX, instead of --ratio")->group("Domain");
+  app.add_option("--domain", domain,
+                 "the scenes to sample: typical (the default: what games and viewers render, camera-relative: fov "
+                 "30-100 deg, aspect 1-2.4, near 0.01-1, far/near 1e2-1e5 and infinite), wide (fov 1-179, aspect "
+                 "0.1-10, near 1e-4-10, far/near 1e1-1e8 and infinite, cameras up to 1e6 from the origin), extremes "
+                 "(near 1e-6-1e-2, far/near 1e6-1e9 and infinite, cameras 1e5-1e7 out), or a scene file NAME.toml "
+                 "(as choose reads). The flags below narrow it")
+      ->type_name("NAME|FILE")
+      ->group("Domain");
+  app.add_option("--near", near, "near plane: VALUE or MIN:MAX (log-uniform)")->type_name("RANGE")->group("Domain");
+  app.add_option("--far", far, "far plane: VALUE or MIN:MAX, instead of --ratio")->type_name("RANGE")->group("Domain");
   app.add_option("--ratio", ratio,
-                 "far/near ratio: VALUE, MIN:MAX, inf, or MIN:MAX,inf (default 1e1:1e8,inf). Infinite-far "
-                 "conventions run when inf is allowed")
+                 "far/near ratio: VALUE, MIN:MAX, inf, or MIN:MAX,inf (log-uniform). Infinite-far conventions run "
+                 "when inf is allowed")
+      ->type_name("RANGE")
       ->group("Domain");
-  app.add_option("--fov", fov, "vertical field of view in degrees: VALUE or MIN:MAX, in (0, 180) (default 1:179)")
+  app.add_option("--fov", fov, "vertical field of view in degrees: VALUE or MIN:MAX, in (0, 180) (uniform)")
+      ->type_name("RANGE")
       ->group("Domain");
-  app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (default 0.1:10)")->group("Domain");
+  app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (log-uniform)")
+      ->type_name("RANGE")
+      ->group("Domain");
   app.add_option("--camera-distance", camera_distance,
-                 "camera distance from the world origin: VALUE or MIN:MAX (default 0:1e6; 0 puts the camera at "
-                 "the origin)")
+                 "camera distance from the world origin: VALUE or MIN:MAX (log-uniform; 0 puts the camera at the "
+                 "origin; 0:MAX puts a quarter of the frames there)")
+      ->type_name("RANGE")
       ->group("Domain");
-  app.add_option("--depth", eye_depth, "eye-depth range of interest in world units: VALUE or MIN:MAX")->group("Domain");
-  app.add_option("--resolution", resolution, "render target WIDTHxHEIGHT (default: a mix of common sizes)")
+  app.add_option("--depth", eye_depth, "eye-depth range of interest in world units: VALUE or MIN:MAX")
+      ->type_name("RANGE")
+      ->group("Domain");
+  app.add_option("--resolution", resolution, "render targets WIDTHxHEIGHT, several comma-separated")
+      ->type_name("WxH")
+      ->group("Domain");
+  app.add_option("--production", production,
+                 "how the stored depth is produced: float32 (default: as a GPU does, from the float32 constants "
+                 "an engine uploads) or exact (the exact depth rounded once: the formats and variants alone)")
+      ->type_name("MODEL")
       ->group("Domain");
 }
 
 Expected<Domain> DomainFlags::Apply(Domain d) const {
+  if (!domain.empty()) {
+    const bool file = domain.find('/') != std::string::npos || domain.ends_with(".toml");
+    if (file) {
+      DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(domain));
+      d = scene.domain;
+    } else {
+      DB_RETURN_IF_ERROR(StoreInto(NamedDomain(domain), d).WithContext("--domain"));
+    }
+  }
+  const bool narrowed = !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() &&
+                          camera_distance.empty() && eye_depth.empty() && resolution.empty() && production.empty());
+  if (narrowed) d.name += " (narrowed)";
+  if (!production.empty()) {
+    DB_RETURN_IF_ERROR(StoreInto(ParseProductionModel(production), d.production).WithContext("--production"));
+  }
   if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");
   if (!far.empty()) {
@@ -55,12 +92,19 @@ Expected<Domain> DomainFlags::Apply(Domain d) const {
     d.eye_depth = z;
   }
   if (!resolution.empty()) {
-    unsigned w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(resolution.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
-      return InvalidArgument(fmt::format("--resolution: '{}' is not WIDTHxHEIGHT (e.g. 1920x1080)", resolution));
+    d.resolutions.clear();
+    std::size_t start = 0;
+    while (start <= resolution.size()) {
+      const std::size_t comma = std::min(resolution.find(',', start), resolution.size());
+      const std::string one = resolution.substr(start, comma - start);
+      unsigned w = 0, h = 0;
+      char x = 0, extra = 0;
+      if (std::sscanf(one.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
+        return InvalidArgument(fmt::format("--resolution: '{}' is not WIDTHxHEIGHT (e.g. 1920x1080)", one));
+      }
+      d.resolutions.push_back({w, h});
+      start = comma + 1;
     }
-    d.resolutions = {{w, h}};
   }
   Status valid = d.Validate();
   if (!valid.ok()) return valid;

@@ -22,9 +22,10 @@ inline constexpr int kExitFinding = 1;
 inline constexpr int kExitCannotRun = 2;
 
 struct DomainFlags {
-  std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution;
+  std::string domain;  // a named domain or a scene file
+  std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production;
   void Add(CLI::App& app);
-  // Applies the given flags on top of `base`.
+  // The domain --domain names (or `base`), narrowed by the range flags.
   Expected<Domain> Apply(Domain base) const;
 };
 

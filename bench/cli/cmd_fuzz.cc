@@ -10,6 +10,7 @@
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/fuzz/campaign.h"
+#include "bench/fuzz/known_findings.h"
 #include "bench/fuzz/worst_case.h"
 #include "bench/pipeline/stats.h"
 #include "bench/sweep/sweep.h"
@@ -23,6 +24,7 @@ struct FuzzFlags {
   std::uint64_t seed = 1;
   std::vector<std::string> corpus;  // default: the data folder's fuzz/corpus/formulas
   std::string out = "fuzz-findings";
+  std::string known;  // default: the data folder's fuzz/known_findings.json; "none": no file
   bool search = false;
   std::string against_random;
   bool quiet = false;
@@ -45,7 +47,46 @@ std::string DescribeCase(const FuzzCase& c) {
       depth);
 }
 
+Expected<std::vector<KnownFinding>> KnownFindings(const FuzzFlags& f) {
+  if (f.known == "none") return std::vector<KnownFinding>{};
+  std::filesystem::path path = f.known;
+  if (path.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("fuzz/known_findings.json"), path));
+  Expected<std::vector<KnownFinding>> known = ReadKnownFindings(path);
+  if (!known.ok()) return known.status().WithContext("--known");
+  return known;
+}
+
+// Findings of one cell and kind, merged over the backends that agree.
+struct FindingGroup {
+  const CampaignFinding* first;
+  std::vector<std::string> backends;
+  std::uint64_t hits = 0;
+  const KnownFinding* known;
+};
+
+void PrintFindings(const std::vector<FindingGroup>& groups, std::ostream& out) {
+  using Align = TextTable::Align;
+  TextTable table({{"finding", Align::kLeft},
+                   {"backends", Align::kLeft},
+                   {"hits"},
+                   {"shader bits lost"},
+                   {"bound"},
+                   {"shrunk case", Align::kLeft},
+                   {"reproducer", Align::kLeft}});
+  for (const FindingGroup& g : groups) {
+    const CampaignFinding& finding = *g.first;
+    const Judgement& j = finding.judgement;
+    table.AddRow({fmt::format("{} {}", finding.cell.Name(), FindingKindName(finding.kind)),
+                  fmt::format("{}", fmt::join(g.backends, ", ")), std::to_string(g.hits),
+                  std::isfinite(j.arith) ? fmt::format("{:.1f}", BitsLost(j.arith)) : (j.nan ? "NaN" : "Inf"),
+                  fmt::format("{:.1f}", BitsLost(j.bound)), DescribeCase(finding.shrunk),
+                  finding.file.empty() ? "-" : "depthbench run --repro " + finding.file.string()});
+  }
+  table.Print(out);
+}
+
 Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
+  DB_ASSIGN_OR_RETURN(const std::vector<KnownFinding> known, KnownFindings(f));
   CampaignOptions options;
   options.seconds = f.seconds;
   if (!f.cases.empty()) {
@@ -82,24 +123,48 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
     std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;
   }
-  std::cout << fmt::format("{} findings (deduplicated by cell, backend and kind; each shrunk):\n",
-                           result.findings.size());
-  using Align = TextTable::Align;
-  TextTable table({{"finding", Align::kLeft},
-                   {"hits"},
-                   {"arith bits lost"},
-                   {"bound"},
-                   {"shrunk case", Align::kLeft},
-                   {"reproducer", Align::kLeft}});
+  // Grouped by cell and kind (backends that agree merged), new ones first,
+  // then the known ones under their reason.
+  std::vector<FindingGroup> groups;
   for (const CampaignFinding& finding : result.findings) {
-    const Judgement& j = finding.judgement;
-    table.AddRow({finding.signature, std::to_string(finding.hits),
-                  std::isfinite(j.arith) ? fmt::format("{:.1f}", BitsLost(j.arith)) : (j.nan ? "NaN" : "Inf"),
-                  fmt::format("{:.1f}", BitsLost(j.bound)), DescribeCase(finding.shrunk),
-                  finding.file.empty() ? "-" : "depthbench run --repro " + finding.file.string()});
+    auto same = std::find_if(groups.begin(), groups.end(), [&](const FindingGroup& g) {
+      return g.first->cell == finding.cell && g.first->kind == finding.kind;
+    });
+    if (same == groups.end()) {
+      groups.push_back({&finding, {}, 0, FindKnown(known, finding.cell, finding.kind)});
+      same = groups.end() - 1;
+    }
+    same->backends.push_back(finding.backend);
+    same->hits += finding.hits;
   }
-  table.Print(std::cout);
-  return kExitFinding;
+  std::vector<FindingGroup> fresh, accepted;
+  for (const FindingGroup& g : groups) (g.known == nullptr ? fresh : accepted).push_back(g);
+  if (!fresh.empty()) {
+    std::cout << fmt::format(
+        "{} new shader findings (a NaN, an Inf or an error beyond the bound where exact arithmetic on the shader's "
+        "inputs is fine; each shrunk):\n",
+        fresh.size());
+    PrintFindings(fresh, std::cout);
+  } else {
+    std::cout << "no new findings\n";
+  }
+  if (!accepted.empty()) {
+    std::cout << fmt::format("\n{} known findings (the known-findings file says why each is accepted):\n",
+                             accepted.size());
+    std::vector<const KnownFinding*> reasons;
+    for (const FindingGroup& g : accepted) {
+      if (std::find(reasons.begin(), reasons.end(), g.known) == reasons.end()) reasons.push_back(g.known);
+    }
+    for (const KnownFinding* k : reasons) {
+      std::vector<std::string> cells;
+      for (const FindingGroup& g : accepted) {
+        if (g.known == k) cells.push_back(g.first->cell.Name());
+      }
+      std::cout << fmt::format("- {} {} in {} cells ({}): {}\n", Info(k->variant).name, FindingKindName(k->kind),
+                               cells.size(), fmt::join(cells, ", "), k->reason);
+    }
+  }
+  return fresh.empty() ? kExitOk : kExitFinding;
 }
 
 Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
@@ -200,6 +265,10 @@ void AddFuzzCommand(CLI::App& app, CommandAction& action) {
       "--corpus", flags->corpus,
       "files or folders of inputs to run first (default: the seed corpus, fuzz/corpus/formulas of the data folder)");
   cmd->add_option("--out", flags->out, "folder for the reproducer files (default fuzz-findings)");
+  cmd->add_option("--known", flags->known,
+                  "the known-findings file: findings it lists, each with its reason, are reported apart and do not "
+                  "fail the run (default: fuzz/known_findings.json of the data folder; none: every finding fails)")
+      ->type_name("FILE|none");
   cmd->add_flag("--search", flags->search,
                 "search each cell's worst case (largest total error) in the default domain, narrowed by the domain "
                 "flags, on the CPU backend unless --backend says otherwise");

@@ -70,6 +70,13 @@ Expected<int> Gate(const GateFlags& f) {
       backend_flags.backends.push_back(s.baseline.backend);
     }
   }
+  if (!f.shaders.empty() && std::find(backend_flags.backends.begin(), backend_flags.backends.end(), "vulkan") ==
+                                backend_flags.backends.end()) {
+    return InvalidArgument(
+        "--shaders: none of the baselines is for the vulkan backend, the only one that compiles shaders: this gate "
+        "would compare nothing the edited shaders change (give a vulkan baseline, e.g. "
+        "reports/baselines/lavapipe.json)");
+  }
   backend_flags.device = f.device;
   backend_flags.shaders = f.shaders;
   backend_flags.validate = f.validate;
@@ -94,10 +101,20 @@ Expected<int> Gate(const GateFlags& f) {
     GateRun run;
     run.current = BaselineFromResults(results, s.baseline.backend);
     run.shader_dir = f.shaders;
+    run.baseline_path = s.path;
     if (s.exists) {
-      DB_RETURN_IF_ERROR(StoreInto(CompareWithBaseline(s.baseline, run.current, tolerance), run.comparison)
-                             .WithContext(fmt::format("cannot judge against '{}'", s.path)));
-      run.baseline = s.baseline;
+      Expected<GateComparison> comparison = CompareWithBaseline(s.baseline, run.current, tolerance);
+      if (comparison.ok()) {
+        run.comparison = std::move(comparison).value();
+        run.baseline = s.baseline;
+      } else if (f.update) {
+        // A baseline of another plan or device is what --update replaces.
+        std::cout << fmt::format("note: '{}' is not comparable ({}); --update replaces it\n", s.path,
+                                 comparison.status().message());
+        run.comparison.backend = s.baseline.backend;
+      } else {
+        return comparison.status().WithContext(fmt::format("cannot judge against '{}'", s.path));
+      }
     } else {
       run.comparison.backend = s.baseline.backend;
     }

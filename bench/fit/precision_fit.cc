@@ -15,8 +15,9 @@ namespace depthbench {
 namespace {
 
 constexpr double kInfiniteSpan = Domain::kInfiniteDepthSpan;
-// Far/near range the budgets are searched over.
-constexpr double kLowestRatio = 10.0, kHighestRatio = 1e12;
+// Far/near range the budgets are searched over: the swept one, never
+// beyond the data.
+constexpr double kLowestRatio = 10.0;
 // The relative-error budgets of the depth-precision literature: 1e-3 where
 // z-fighting starts to show, 1e-6 "very good".
 const std::pair<const char*, double> kBudgets[] = {{"1e-3", 1e-3}, {"1e-6", 1e-6}};
@@ -27,28 +28,25 @@ bool InfiniteFar(const Cell& cell) {
   return c.hardware && (c.bits & 2u) != 0u;
 }
 
-// The far plane's b for a model: the point at eye depth = far.
-double FarPlane(const FittedModel& m, double x) { return m.Predict(x, x); }
+// The far plane's b for a model: the point at eye depth = far, where a
+// band's point sits for the deepest band (CollectBandPoints). Bits lost
+// saturate: 24 means nothing left, whatever the model's line says beyond.
+double FarPlane(const FittedModel& m, double x) { return std::clamp(m.Predict(x, x), 0.0, kAllBitsLost); }
+
+// Points at or above this carry no slope: the error has reached the
+// distance itself (a quarter bit below 24: the statistics' resolution).
+constexpr double kSaturatedBits = kAllBitsLost - 0.25;
 
 // Slope of the far-plane curve between f/n = 1e2 and 1e8, as a function of
 // the parameters (exact for the linear models).
 double SlopeOf(const FittedModel& m) {
+  // The model's own line, not saturated: the loss per doubling while there
+  // is precision left to lose.
   const double x1 = std::log2(1e2), x2 = std::log2(1e8);
-  return (FarPlane(m, x2) - FarPlane(m, x1)) / (x2 - x1);
+  return (m.Predict(x2, x2) - m.Predict(x1, x1)) / (x2 - x1);
 }
 
 }  // namespace
-
-std::uint64_t MinimumSamples(Level level) {
-  // A quantile q needs a few samples beyond it: 4 / (1 - q).
-  switch (level) {
-    case Level::kP50: return 20;
-    case Level::kP99: return 400;
-    case Level::kP999: return 4000;
-    case Level::kMax: return 100;
-  }
-  return 0;
-}
 
 FitPlan::FitPlan() {
   domain.camera_distance = {0.0, 0.0};
@@ -66,7 +64,10 @@ Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> 
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < ratios.size(); ++k) {
     SweepOptions options;
-    options.seed = plan.seed;
+    // A seed of its own per ratio: with one seed every ratio would draw the
+    // same pixels and depth units, their errors would move together, and
+    // the fit's intervals would be too narrow.
+    options.seed = plan.seed ^ (0x9E3779B97F4A7C15ull * (k + 1));
     options.samples = plan.samples_per_ratio;
     options.domain = plan.domain;
     options.domain.far.reset();
@@ -114,8 +115,12 @@ std::vector<BandPoint> CollectBandPoints(const FitSweeps& sweeps, const Cell& ce
       const BandStats band = result->stats.ForDepth(d);
       // NaN and Inf outputs count: they are the top of the distribution.
       if (band.judged() < MinimumSamples(level)) continue;
-      // The band's z/n, log-uniform between its edges (the top decade stops
-      // at the far plane).
+      // The band's z/n runs between its edges (the top decade stops at the
+      // far plane). Its point sits at the far edge: where errors grow with
+      // depth, a band's high quantile is set by its deepest samples, and
+      // the deepest band's point is then the far plane's figure, which is
+      // what a run at that ratio reports for the samples nearest the far
+      // plane.
       const double lo = std::max(1.0, DepthBandLow(d)), hi = std::min(DepthBandLow(d) * 10.0, span);
       if (!(hi > lo)) continue;
       // A share of NaN/Inf above 1 - q puts the quantile at infinity.
@@ -126,9 +131,10 @@ std::vector<BandPoint> CollectBandPoints(const FitSweeps& sweeps, const Cell& ce
       BandPoint p;
       p.ratio = ratio;
       p.depth_band = d;
-      p.point = {std::isinf(ratio) ? 0.0 : std::log2(ratio), 0.5 * (std::log2(lo) + std::log2(hi)),
+      p.point = {std::isinf(ratio) ? 0.0 : std::log2(ratio), std::log2(hi),
                  std::isfinite(q) ? std::log2(q) + 24.0 : INFINITY};
-      p.modelled = q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)]) && std::isfinite(q);
+      p.modelled = q > std::ldexp(1.0, kLowestOctave[static_cast<int>(metric)]) && std::isfinite(q) &&
+                   p.point.b < kSaturatedBits;
       points.push_back(p);
     }
   }
@@ -185,14 +191,19 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
           fit.slope = slope.value;
           fit.slope_low = slope.low;
           fit.slope_high = slope.high;
+          double highest_ratio = kLowestRatio;
+          for (double r : sweeps.ratios) {
+            if (std::isfinite(r)) highest_ratio = std::max(highest_ratio, r);
+          }
           for (const auto& [name, ratio] : kPredictedRatios) {
-            fit.predicted[name] = std::max(0.0, FarPlane(m, std::log2(ratio)));
+            // No prediction past the data.
+            if (ratio <= highest_ratio * (1.0 + 1e-9)) fit.predicted[name] = FarPlane(m, std::log2(ratio));
           }
           for (const auto& [name, budget] : kBudgets) {
             const double limit = 24.0 + std::log2(budget);
             std::optional<double> last_met;
             bool ever_failed = false;
-            for (double x = std::log2(kLowestRatio); x <= std::log2(kHighestRatio) + 1e-9; x += 0.05) {
+            for (double x = std::log2(kLowestRatio); x <= std::log2(highest_ratio) + 1e-9; x += 0.05) {
               if (FarPlane(m, x) <= limit) {
                 if (!ever_failed) last_met = std::exp2(x);
               } else {
@@ -220,7 +231,7 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
             fit.holdout_points = static_cast<int>(test.size());
           }
         } else {
-          fit.predicted["inf"] = std::max(0.0, m.Predict(0.0, std::log2(kInfiniteSpan)));
+          fit.predicted["inf"] = std::clamp(m.Predict(0.0, std::log2(kInfiniteSpan)), 0.0, kAllBitsLost);
         }
         fits.push_back(std::move(fit));
       }

@@ -28,9 +28,6 @@ namespace depthbench {
 
 inline constexpr JsonSchema kFitSchema{"depthbench.fit", 1, "the models of depthbench fit --json"};
 
-// Samples a band needs for a quantile at this level to mean something.
-std::uint64_t MinimumSamples(Level level);
-
 struct FitPlan {
   std::uint64_t seed = 7;
   std::uint64_t samples_per_ratio = 100000;

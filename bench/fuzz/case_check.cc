@@ -88,12 +88,13 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
                                       batch_.depth_params[f * kHardwareConventionCount + plan.convention_slot],
                                       batch_.depths[at], distance) *
                       (r.denoted_depth / r.true_depth);
-            if (r.denoted_depth == DBL_MAX) {
-              // The texel denotes a point at infinity (the storage rounded
-              // it there): the point has no finite world position, and
-              // rotating a direction scaled to infinity gives Inf or, where
-              // a matrix entry is 0, NaN (0 * Inf). Neither is the shader's
-              // fault; the sweep counts these as storage losses.
+            if (!r.stored_holdable) {
+              // The texel denotes a point float32 cannot hold (infinity,
+              // the camera, beyond the float range: the pipeline or the
+              // storage put it there): no arithmetic returns it finitely,
+              // and rotating a direction scaled to infinity gives Inf or,
+              // where a matrix entry is 0, NaN (0 * Inf). Neither is the
+              // shader's fault; the sweep counts these as expected.
               j.checked = j.judged = false;
               continue;
             }

@@ -53,6 +53,9 @@ Baseline BaselineFromResults(const Results& results, const std::string& backend)
     for (const auto& [band, stats] : c.stats.distance) {
       figures["distance " + DistanceBandName(band)] = FiguresOf(stats);
     }
+    for (const auto& [band, stats] : c.stats.coverage) {
+      figures["coverage " + CoverageBandName(band)] = FiguresOf(stats);
+    }
   }
   return b;
 }

@@ -33,7 +33,8 @@ struct BandFigures {
   friend bool operator==(const BandFigures&, const BandFigures&) = default;
 };
 
-// Band keys: "all", "ratio 1e3", "depth 1e2", "distance <1".
+// Band keys: "all" (the natural distribution), "ratio 1e3", "depth 1e2", "distance <1",
+// "coverage stored 1" (the samples drawn on purpose, bands.h).
 using CellFigures = std::map<std::string, BandFigures>;
 
 // How the figures were made; a gate refuses to compare across any of this.

@@ -108,6 +108,22 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
       if (v.appeared) out << fmt::format("new cell (not in the baseline): {} on {}\n", v.cell, r.current.backend);
     }
   }
+  // The last line sums up; improvements beyond the tolerance are accepted
+  // by rewriting the baselines.
+  int unchanged = 0;
+  std::vector<std::string> improved_baselines;
+  for (const GateRun& r : runs) {
+    for (const CellVerdict& v : r.comparison.cells) unchanged += !v.failed() && v.better.empty() && !v.appeared;
+    if (r.comparison.improvements() > 0 && !r.baseline_path.empty()) {
+      improved_baselines.push_back("--baseline " + r.baseline_path);
+    }
+  }
+  out << fmt::format("\nsummary: {} cells worse, {} better, {} unchanged, of {}\n", failures, improvements, unchanged,
+                     cells);
+  if (failures == 0 && !improved_baselines.empty()) {
+    out << fmt::format("to keep the improvements: depthbench gate --update {}{}\n", Join(improved_baselines, " "),
+                       runs.front().shader_dir.empty() ? "" : " --shaders " + runs.front().shader_dir);
+  }
 }
 
 std::string GateJUnit(const std::vector<GateRun>& runs) {

@@ -17,9 +17,10 @@ inline constexpr JsonSchema kGateSchema{"depthbench.gate", 1, "a gate verdict of
 
 struct GateRun {
   GateComparison comparison;
-  Baseline baseline;       // what the run was compared with
-  Baseline current;        // what the run measured
-  std::string shader_dir;  // "" when the built-in shaders ran
+  Baseline baseline;          // what the run was compared with
+  Baseline current;           // what the run measured
+  std::string shader_dir;     // "" when the built-in shaders ran
+  std::string baseline_path;  // the file, for the --update command
 };
 
 void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out);

@@ -1,13 +1,21 @@
-// Bands: how results are split. Three families, each by decades:
+// Bands: how results are split. The samples of the domain's natural
+// distribution (log-uniform eye depth, uniform pixels) fall in three
+// families, each by decades:
 //   far/near ratio (the frame's f/n; "inf" for infinite-far conventions),
 //   eye depth over near (z/n, where in the frustum the point lies),
 //   camera distance from the world origin (how large world coordinates are).
-// Ratio and depth are kept jointly (the error models need both at once),
-// with every metric; camera distance separately, with the total and the
-// storage error (what camera distance does shows there whole).
+// Ratio and depth are kept jointly (the error models need both at once);
+// camera distance separately. Every band keeps every metric.
+//
+// The samples drawn on purpose where reconstructions break (stored values
+// at the ends of the format, the first and last doubling of depth, the
+// corners and edges of the screen) are coverage, not population: they fall
+// in coverage bands of their own, one per kind, and never in the three
+// families, so that the families' quantiles describe what a user renders.
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 namespace depthbench {
@@ -17,6 +25,26 @@ inline constexpr int kInfiniteRatioBand = 10;
 inline constexpr int kDepthBands = 10;  // z/n in 1e0.., ..., 1e9 and above
 inline constexpr int kJointBands = kRatioBands * kDepthBands;
 inline constexpr int kDistanceBands = 5;  // [0,1), [1,1e2), [1e2,1e4), [1e4,1e6), 1e6 and above
+
+// What a sample was drawn for: the natural distribution, or one of the
+// coverage kinds (a stored-value pick first, then a depth band, then a
+// pixel pick).
+enum class Coverage : std::uint8_t {
+  kNatural,
+  kStoredZero,
+  kStoredOne,
+  kStoredAfterZero,
+  kStoredBeforeOne,
+  kNearDoubling,
+  kFarDoubling,
+  kCornerPixel,
+  kEdgePixel,
+};
+inline constexpr int kCoverageBands = static_cast<int>(Coverage::kEdgePixel);  // the kinds but kNatural
+// Band index of a coverage kind (not kNatural), and its label ("stored 0",
+// "far doubling", "corner pixel", ...).
+inline int CoverageBand(Coverage kind) { return static_cast<int>(kind) - 1; }
+std::string CoverageBandName(int band);
 
 // floor(log10(x)) clamped to [0, count), by comparison with exact powers of
 // ten (cheaper than a logarithm, and exact at the edges): the number of

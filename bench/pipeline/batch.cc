@@ -22,7 +22,7 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
 }
 
 BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
-    : sampler_(sampler), encodings_(std::move(encodings)), isa_(isa) {
+    : sampler_(sampler), encodings_(std::move(encodings)), model_(sampler.production()), isa_(isa) {
   for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
     auto shares = [&](std::uint32_t k) {
       const Encoding a = encodings_[pipeline_slots_[k]], b = encodings_[s];
@@ -88,20 +88,45 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       },
       256);
 
-  // Encodings, in chunks of samples, each loop over arrays: the pipeline's
-  // floats (shared by a convention's formats), then per depth slot the
+  // Encodings, in chunks of samples, each loop over arrays: per pipeline
+  // (shared by a convention's formats) the mapping's float32 constants, the
+  // pipeline's floats and the depths they denote; then per depth slot the
   // stored texels, their decode and the reference.
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
+  for (auto* v : {&mapping_a_, &mapping_b_, &produced_hi_, &produced_lo_}) v->resize(pipelines * count);
   pipeline_floats_.resize(pipelines * count);
+  const auto mapping_of = [&](std::size_t k) {
+    return DepthMappings{samples.near.data(), samples.far.data(), mapping_a_.data() + k * count,
+                         mapping_b_.data() + k * count};
+  };
   constexpr std::size_t kChunk = 1024;
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t k = job / chunks;
       const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
-      PipelineFloats(encodings_[pipeline_slots_[k]], samples.near.data() + lo, samples.far.data() + lo,
-                     samples.eye_depth.data() + lo, n, pipeline_floats_.data() + k * count + lo);
+      const Encoding encoding = encodings_[pipeline_slots_[k]];
+      const std::size_t convention = static_cast<std::size_t>(encoding.convention);
+      const DepthInput stores = Info(encoding.format).stores;
+      for (std::size_t i = lo; i < lo + n; ++i) {
+        const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
+        double a = 0.0, b = 0.0;
+        if (stores == DepthInput::kHardware) {
+          const f32::DepthParams& depth = batch.depth_params[frame * kHardwareConventionCount + convention];
+          a = depth.coefficients.x;
+          b = depth.coefficients.y;
+        } else if (stores == DepthInput::kLinear) {
+          a = batch.frame_params[frame].camera_position.w;
+        }
+        mapping_a_[k * count + i] = a;
+        mapping_b_[k * count + i] = b;
+      }
+      const DepthMappings mapping = mapping_of(k).At(lo);
+      float* floats = pipeline_floats_.data() + k * count + lo;
+      PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
+      DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_hi_.data() + k * count + lo,
+                      produced_lo_.data() + k * count + lo, isa_);
     }
   });
 
@@ -135,9 +160,12 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }
-      DecodeEyeDepths(encoding, samples.near.data() + lo, samples.far.data() + lo, batch.codes.data() + at,
-                      batch.depths.data() + at, n, denoted_hi.data(), denoted_lo.data(), isa_);
-      References(encoding, samples, lo, n, denoted_hi.data(), denoted_lo.data(), batch.reference, at, isa_);
+      const std::size_t pipeline = pipeline_of_slot_[s];
+      DecodeEyeDepths(encoding, model_, mapping_of(pipeline).At(lo), batch.depths.data() + at, n, denoted_hi.data(),
+                      denoted_lo.data(), isa_);
+      References(encoding, samples, lo, n, {denoted_hi.data(), denoted_lo.data()},
+                 {produced_hi_.data() + pipeline * count + lo, produced_lo_.data() + pipeline * count + lo},
+                 batch.reference, at, isa_);
     }
   });
 }

@@ -34,7 +34,8 @@ struct Batch : ShaderInputs {
 
 class BatchBuilder {
  public:
-  // `isa`: what the decode and reference loops are compiled for (bench/base/isa.h).
+  // `isa`: what the decode and reference loops are compiled for
+  // (bench/base/isa.h). Depth is produced as the source says (domain.h).
   BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa = Isa::kWidest);
 
   // Fills `batch` with samples [first, first + count).
@@ -43,13 +44,18 @@ class BatchBuilder {
  private:
   const SampleSource& sampler_;
   std::vector<Encoding> encodings_;
+  ProductionModel model_;
   Isa isa_;
   // The formats of one convention share the pipeline's float (encode.h):
   // encodings_[s] reads pipeline value pipeline_of_slot_[s], which is
   // computed for encodings_[pipeline_slots_[k]].
   std::vector<std::uint32_t> pipeline_of_slot_;
   std::vector<std::uint32_t> pipeline_slots_;
-  mutable std::vector<float> pipeline_floats_;  // [pipeline * count + sample], reused across batches
+  // Reused across batches, [pipeline * count + sample]: the pipeline's
+  // floats, the float32 constants of their mapping (encode.h) and the
+  // depth each float denotes (the produced depth).
+  mutable std::vector<float> pipeline_floats_;
+  mutable std::vector<double> mapping_a_, mapping_b_, produced_hi_, produced_lo_;
 };
 
 }  // namespace depthbench

@@ -94,6 +94,55 @@ Status ParseRatioInto(std::string_view text, Domain& domain) {
   return Status::Ok();
 }
 
+const char* ProductionModelName(ProductionModel model) {
+  return model == ProductionModel::kExact ? "exact" : "float32";
+}
+
+Expected<ProductionModel> ParseProductionModel(std::string_view name) {
+  if (name == "float32") return ProductionModel::kFloat32;
+  if (name == "exact") return ProductionModel::kExact;
+  return InvalidArgument(fmt::format("production model '{}' is not one of float32, exact", name));
+}
+
+bool operator==(const Domain& a, const Domain& b) {
+  return a.fov_degrees == b.fov_degrees && a.aspect == b.aspect && a.near == b.near && a.ratio == b.ratio &&
+         a.finite_far == b.finite_far && a.infinite_far == b.infinite_far && a.far == b.far &&
+         a.camera_distance == b.camera_distance && a.eye_depth == b.eye_depth && a.resolutions == b.resolutions &&
+         a.production == b.production;
+}
+
+Domain TypicalDomain() { return Domain{}; }
+
+Domain WideDomain() {
+  Domain d;
+  d.name = "wide";
+  d.fov_degrees = {1.0, 179.0};
+  d.aspect = {0.1, 10.0};
+  d.near = {1e-4, 10.0};
+  d.ratio = {10.0, 1e8};
+  d.camera_distance = {0.0, 1e6};
+  d.resolutions = {{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}, {1366, 768}, {800, 600}};
+  return d;
+}
+
+Domain ExtremesDomain() {
+  Domain d = WideDomain();
+  d.name = "extremes";
+  d.fov_degrees = {0.5, 179.5};
+  d.aspect = {0.05, 20.0};
+  d.near = {1e-6, 1e-2};
+  d.ratio = {1e6, 1e9};
+  d.camera_distance = {1e5, 1e7};
+  return d;
+}
+
+Expected<Domain> NamedDomain(std::string_view name) {
+  if (name == "typical") return TypicalDomain();
+  if (name == "wide") return WideDomain();
+  if (name == "extremes") return ExtremesDomain();
+  return InvalidArgument(fmt::format("domain '{}' is not one of {} (or a scene file, NAME.toml)", name, kDomainNames));
+}
+
 Status Domain::Validate() const {
   DB_RETURN_IF_ERROR(CheckRange(fov_degrees, "fov", kFovLimits));
   DB_RETURN_IF_ERROR(CheckRange(aspect, "aspect", kAspectLimits));
@@ -137,8 +186,13 @@ std::string Domain::ToFlags() const {
   flags += " --camera-distance " + range(camera_distance);
   if (eye_depth) flags += " --depth " + range(*eye_depth);
   if (resolutions != Domain{}.resolutions) {
-    flags += fmt::format(" --resolution {}x{}", resolutions.front().width, resolutions.front().height);
+    std::string sizes;
+    for (const Resolution& r : resolutions)
+      sizes += fmt::format("{}{}x{}", sizes.empty() ? "" : ",", r.width, r.height);
+    flags += " --resolution " + sizes;
   }
+  if (production != ProductionModel::kFloat32)
+    flags += fmt::format(" --production {}", ProductionModelName(production));
   return flags;
 }
 
@@ -153,7 +207,8 @@ std::string Domain::Describe() const {
   std::string text = fmt::format("fov {} deg, aspect {}, near {}, {}, camera distance {}", fov_degrees.ToString(),
                                  aspect.ToString(), near.ToString(), far_text, camera_distance.ToString());
   if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
-  return text;
+  if (production != ProductionModel::kFloat32) text += fmt::format(", {} production", ProductionModelName(production));
+  return fmt::format("{}: {}", name, text);
 }
 
 }  // namespace depthbench

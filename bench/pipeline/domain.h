@@ -1,5 +1,7 @@
-// The domain: the ranges the sampler draws from. Defaults cover what the
-// bench is for; CLI flags and scene files narrow or fix them.
+// The domain: the scenes the sampler draws (its ranges, each with a stated
+// distribution) and how their depth is produced. A named domain
+// (TypicalDomain, WideDomain, ExtremesDomain) or a scene file sets it;
+// CLI flags narrow or fix its ranges.
 #pragma once
 
 #include <cstdint>
@@ -41,24 +43,41 @@ struct Resolution {
   friend bool operator==(const Resolution&, const Resolution&) = default;
 };
 
+// How the pipeline produces the depth it stores from a scene point's eye
+// depth z (encode.h):
+//   kFloat32  as a GPU does: the float32 constants an engine uploads (the
+//             projection's A and B of ndc = A + B / z, or the far plane of
+//             linear depth), the view-space z as a float32, and every
+//             operation in float32: clip z, the divide, the viewport
+//             transform;
+//   kExact    the exact value, correctly rounded to float32 once: the best
+//             any pipeline could do, to measure the formats and the
+//             variants alone.
+enum class ProductionModel : std::uint8_t { kFloat32, kExact };
+const char* ProductionModelName(ProductionModel model);  // "float32", "exact"
+Expected<ProductionModel> ParseProductionModel(std::string_view name);
+
+// The members' defaults are the `typical` domain (TypicalDomain).
 struct Domain {
-  Range fov_degrees{1.0, 179.0};  // vertical field of view, uniform in degrees
-  Range aspect{0.1, 10.0};        // width / height, log-uniform
-  Range near{1e-4, 10.0};         // log-uniform
+  std::string name = "typical";    // the named domain or scene it started from ("custom" once narrowed)
+  Range fov_degrees{30.0, 100.0};  // vertical field of view, uniform in degrees
+  Range aspect{1.0, 2.4};          // width / height, log-uniform
+  Range near{0.01, 1.0};           // log-uniform
   // Far/near ratio of finite projections (log-uniform), and whether the
   // infinite-far conventions are sampled. Every frame has a finite ratio when
   // finite_far is set; infinite-far cells read the same frames with the far
   // plane at infinity.
-  Range ratio{10.0, 1e8};
+  Range ratio{1e2, 1e5};
   bool finite_far = true;
   bool infinite_far = true;
   std::optional<Range> far;  // absolute far plane; the ratio then follows from near
   // Camera distance from the world origin. With min 0 and max > 0, a quarter
   // of the frames sit exactly at the origin and the rest are log-uniform in
   // [max * 1e-6, max]; otherwise log-uniform in [min, max] (or fixed).
-  Range camera_distance{0.0, 1e6};
+  Range camera_distance{0.0, 0.0};
   std::optional<Range> eye_depth;  // absolute eye-depth range of interest (clipped to the frustum)
-  std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}, {1366, 768}, {800, 600}};
+  std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}};
+  ProductionModel production = ProductionModel::kFloat32;
 
   // Far/near span used by frames whose far plane is infinite only.
   static constexpr double kInfiniteDepthSpan = 1e8;
@@ -68,8 +87,24 @@ struct Domain {
   // The command-line flags that rebuild this domain exactly (numbers with
   // 17 significant digits), e.g. "--fov 1:179 --near 0.0001:10 ...".
   std::string ToFlags() const;
-  friend bool operator==(const Domain&, const Domain&) = default;
+  // Domains are equal when they draw the same samples: the name is left out.
+  friend bool operator==(const Domain& a, const Domain& b);
 };
+
+// The named domains. `typical`: what games and viewers render, camera-relative
+// (the camera at the world origin, as engines with large worlds render):
+// vertical fov 30 to 100 degrees, aspect 1 to 2.4, near 0.01 to 1, far/near
+// 1e2 to 1e5 and infinite, the common render-target sizes. `wide`: far
+// beyond that (fov 1 to 179, aspect 0.1 to 10, near 1e-4 to 10, far/near
+// 1e1 to 1e8 and infinite, cameras up to 1e6 from the origin). `extremes`:
+// the edges a fuzzer looks for (near 1e-6 to 1e-2, far/near 1e6 to 1e9 and
+// infinite, fov 0.5 to 179.5, aspect 0.05 to 20, cameras 1e5 to 1e7 out).
+Domain TypicalDomain();
+Domain WideDomain();
+Domain ExtremesDomain();
+// "typical", "wide" or "extremes"; InvalidArgument naming them otherwise.
+Expected<Domain> NamedDomain(std::string_view name);
+inline constexpr const char* kDomainNames = "typical, wide, extremes";
 
 // The limits the flags enforce (also what --help prints).
 extern const RangeLimits kFovLimits;

@@ -68,10 +68,11 @@ float SettleLane(DoubleDouble x, Exact exact) {
   return exact().ToFloat();
 }
 
-// Steps 1 and 2 for four samples: the exact value in double-double, then
-// correctly rounded to float32 (GL-style clip depth: NDC depth, then the
-// viewport transform in float32, exact in double with one rounding).
-Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, const double* z, int lanes) {
+// Steps 1 and 2 for four samples under kExact: the exact value in
+// double-double, then correctly rounded to float32 (GL-style clip depth:
+// NDC depth, then the viewport transform in float32, exact in double with
+// one rounding).
+Float4 ExactPipelineFloat4(Encoding encoding, const double* near, const double* far, const double* z, int lanes) {
   const std::uint32_t bits = Info(encoding.convention).bits;
   Double4 n, f, depth;
   for (int k = 0; k < 4; ++k) {
@@ -103,30 +104,87 @@ Float4 PipelineFloat4(Encoding encoding, const double* near, const double* far, 
   return Float4{};
 }
 
+// Steps 1 and 2 for four samples under kFloat32: every operation in
+// float32 (the vector types round each one; -ffp-contract=off keeps a
+// multiply and an add from fusing).
+Float4 Float32PipelineFloat4(Encoding encoding, const double* a, const double* b, const double* z) {
+  Float4 fa, fb, fz;
+  for (int k = 0; k < 4; ++k) {
+    fa[k] = static_cast<float>(a[k]);
+    fb[k] = static_cast<float>(b[k]);
+    fz[k] = static_cast<float>(z[k]);  // the view-space depth an engine holds
+  }
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: {
+      const Float4 clip = fa * fz + fb;
+      const Float4 ndc = clip / fz;
+      if ((Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) return ndc;
+      return ndc * 0.5f + 0.5f;
+    }
+    case DepthInput::kLinear: return fz / fa;
+    case DepthInput::kViewZ: return -fz;
+  }
+  return Float4{};
+}
+
 }  // namespace
 
 EncodeFallbacks EncodeFallbackCounts() { return {tie_fallbacks.load(), mpfr_fallbacks.load()}; }
 
-void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth, std::size_t n,
-                    float* out) {
+void FrameMapping(Encoding encoding, const Frame& frame, double& a, double& b) {
+  // What shader_constants.cc rounds for the shaders: the exact coefficients
+  // (and the far plane) rounded once to float32.
+  a = b = 0.0;
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: {
+      const hp::vec2 ab =
+          hp::ndc_depth_coefficients(DD(frame.near), DD(FarOrZero(frame)), Info(encoding.convention).bits);
+      a = RoundToFloat(ab.x);
+      b = RoundToFloat(ab.y);
+      return;
+    }
+    case DepthInput::kLinear: a = static_cast<float>(FarOrZero(frame)); return;
+    case DepthInput::kViewZ: return;
+  }
+}
+
+void PipelineFloats(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const double* eye_depth,
+                    std::size_t n, float* out) {
   for (std::size_t i = 0; i < n; i += 4) {
-    double lanes[3][4];
+    double lanes[5][4];
     for (std::size_t k = 0; k < 4; ++k) {
       const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
-      lanes[0][k] = near[at];
-      lanes[1][k] = far[at];
+      lanes[0][k] = mapping.near[at];
+      lanes[1][k] = mapping.far[at];
       lanes[2][k] = eye_depth[at];
+      lanes[3][k] = mapping.a[at];
+      lanes[4][k] = mapping.b[at];
     }
-    const Float4 f =
-        PipelineFloat4(encoding, lanes[0], lanes[1], lanes[2], static_cast<int>(std::min<std::size_t>(4, n - i)));
+    const Float4 f = model == ProductionModel::kExact
+                         ? ExactPipelineFloat4(encoding, lanes[0], lanes[1], lanes[2],
+                                               static_cast<int>(std::min<std::size_t>(4, n - i)))
+                         : Float32PipelineFloat4(encoding, lanes[3], lanes[4], lanes[2]);
     for (std::size_t k = 0; k < 4 && i + k < n; ++k) out[i + k] = f[k];
   }
 }
 
-float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth) {
-  const double far = FarOrZero(frame);
+namespace {
+
+// The mapping of one frame and encoding, as one-element arrays.
+struct OneMapping {
+  double near, far, a, b;
+  OneMapping(Encoding encoding, const Frame& frame) : near(frame.near), far(FarOrZero(frame)) {
+    FrameMapping(encoding, frame, a, b);
+  }
+  DepthMappings Arrays() const { return {&near, &far, &a, &b}; }
+};
+
+}  // namespace
+
+float PipelineFloat(Encoding encoding, ProductionModel model, const Frame& frame, double eye_depth) {
+  const OneMapping mapping(encoding, frame);
   float out;
-  PipelineFloats(encoding, &frame.near, &far, &eye_depth, 1, &out);
+  PipelineFloats(encoding, model, mapping.Arrays(), &eye_depth, 1, &out);
   return out;
 }
 
@@ -274,73 +332,50 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick) {
 
 namespace {
 
-// The decode of four texels. `texel` is the unorm code itself or the
-// float's value: both exact.
-[[gnu::always_inline]] inline DoubleDouble4 DecodeTexel(Encoding encoding, DoubleDouble4 near, DoubleDouble4 far,
-                                                        DoubleDouble4 texel) {
+// The eye depth four float values denote (each exact as a double).
+[[gnu::always_inline]] inline DoubleDouble4 DecodeValue(Encoding encoding, ProductionModel model, Double4 near,
+                                                        Double4 far, Double4 a, Double4 b, Double4 value) {
   using DD = DoubleDouble4;
-  const FormatInfo& info = Info(encoding.format);
-  // The texel's value v and 1 - v, both exact to double-double precision;
-  // for unorm codes c, v = c / (2^b - 1) and 1 - v = (2^b - 1 - c) / (2^b - 1).
-  DD value, complement;
-  if (info.texel == TexelKind::kUnorm) {
-    // Times the double-double reciprocal of 2^b - 1 (good to 2^-104): two
-    // multiplications instead of two divisions.
-    static const DoubleDouble kInverse16 = DoubleDouble(1.0) / DoubleDouble(UnormScale(16));
-    static const DoubleDouble kInverse24 = DoubleDouble(1.0) / DoubleDouble(UnormScale(24));
-    const DoubleDouble inverse = info.bits == 16 ? kInverse16 : kInverse24;
-    const DD scale(UnormScale(info.bits));
-    const DD inverse_lanes = DD::FromParts(inverse.hi() + texel.hi() * 0.0, inverse.lo() + texel.hi() * 0.0);
-    value = texel * inverse_lanes;
-    complement = (scale - texel) * inverse_lanes;
-  } else {
-    value = texel;
-    complement = DD(1.0) - texel;
-  }
-  switch (info.stores) {
-    case DepthInput::kHardware:
-      return hp4::eye_depth_from_window_depth(near, far, Info(encoding.convention).bits, value, complement);
-    case DepthInput::kLinear: return value * far;
-    case DepthInput::kViewZ: return -value;
+  const auto wide = [](Double4 x) { return DD::FromParts(x, Double4{}); };
+  const std::uint32_t bits = Info(encoding.convention).bits;
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: {
+      if (model == ProductionModel::kExact) {
+        // 1 - value is exact in double-double, and the decode needs no
+        // difference of nearly equal numbers.
+        return hp4::eye_depth_from_window_depth(wide(near), wide(far), bits, wide(value), DD(1.0) - wide(value));
+      }
+      const DD ndc = (bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u ? wide(value) : wide(value) * DD(2.0) - DD(1.0);
+      return wide(b) / (ndc - wide(a));  // the difference of two floats is exact in double-double
+    }
+    case DepthInput::kLinear: return wide(value) * wide(model == ProductionModel::kExact ? far : a);
+    case DepthInput::kViewZ: return -wide(value);
   }
   return DD(NAN);
 }
 
-[[gnu::always_inline]] inline void DecodeEyeDepthsBody(Encoding encoding, const double* near, const double* far,
-                                                       const std::uint32_t* codes, const float* fetched, std::size_t n,
+[[gnu::always_inline]] inline void DecodeEyeDepthsBody(Encoding encoding, ProductionModel model,
+                                                       const DepthMappings& mapping, const float* values, std::size_t n,
                                                        double* hi, double* lo) {
-  const bool unorm = Info(encoding.format).texel == TexelKind::kUnorm;
   // Two groups of four per step: their dependency chains interleave.
   constexpr std::size_t kStep = 8;
-  const auto decode = [&](const Double4(&n4)[2], const Double4(&f4)[2], const Double4(&texel)[2])
-      __attribute__((always_inline)) {
+  const auto decode = [&](const Double4(&in)[5][2]) __attribute__((always_inline)) {
     std::array<DoubleDouble4, 2> z;
-    for (int g = 0; g < 2; ++g) {
-      z[g] = DecodeTexel(encoding, DoubleDouble4::FromParts(n4[g], Double4{}),
-                         DoubleDouble4::FromParts(f4[g], Double4{}), DoubleDouble4::FromParts(texel[g], Double4{}));
-    }
+    for (int g = 0; g < 2; ++g) z[g] = DecodeValue(encoding, model, in[0][g], in[1][g], in[2][g], in[3][g], in[4][g]);
     return z;
   };
+  const double* arrays[4] = {mapping.near, mapping.far, mapping.a, mapping.b};
   std::size_t i = 0;
   for (; i + kStep <= n; i += kStep) {  // whole steps: lanes loaded and stored whole
-    Double4 n4[2], f4[2], texel[2];
+    Double4 in[5][2];
     for (int g = 0; g < 2; ++g) {
       const std::size_t at = i + 4 * g;
-      std::memcpy(&n4[g], near + at, sizeof(Double4));
-      std::memcpy(&f4[g], far + at, sizeof(Double4));
-      // The texel as an exact number: the unorm code (below 2^24), or the
-      // float's value.
-      if (unorm) {
-        std::int32_t __attribute__((vector_size(16))) c;
-        std::memcpy(&c, codes + at, sizeof(c));
-        texel[g] = __builtin_convertvector(c, Double4);
-      } else {
-        Float4 f;
-        std::memcpy(&f, fetched + at, sizeof(f));
-        texel[g] = __builtin_convertvector(f, Double4);
-      }
+      for (int p = 0; p < 4; ++p) std::memcpy(&in[p][g], arrays[p] + at, sizeof(Double4));
+      Float4 f;
+      std::memcpy(&f, values + at, sizeof(f));
+      in[4][g] = __builtin_convertvector(f, Double4);
     }
-    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    const std::array<DoubleDouble4, 2> z = decode(in);
     for (int g = 0; g < 2; ++g) {
       const Double4 h = z[g].hi(), l = z[g].lo();
       std::memcpy(hi + i + 4 * g, &h, sizeof(h));
@@ -348,14 +383,13 @@ namespace {
     }
   }
   if (i < n) {  // the tail, padded with its last sample
-    Double4 n4[2], f4[2], texel[2];
+    Double4 in[5][2];
     for (std::size_t k = 0; k < kStep; ++k) {
       const std::size_t at = i + k < n ? i + k : n - 1;
-      n4[k / 4][k % 4] = near[at];
-      f4[k / 4][k % 4] = far[at];
-      texel[k / 4][k % 4] = unorm ? static_cast<double>(codes[at]) : static_cast<double>(fetched[at]);
+      for (int p = 0; p < 4; ++p) in[p][k / 4][k % 4] = arrays[p][at];
+      in[4][k / 4][k % 4] = static_cast<double>(values[at]);
     }
-    const std::array<DoubleDouble4, 2> z = decode(n4, f4, texel);
+    const std::array<DoubleDouble4, 2> z = decode(in);
     for (std::size_t k = 0; i + k < n; ++k) {
       hi[i + k] = z[k / 4].hi()[k % 4];
       lo[i + k] = z[k / 4].lo()[k % 4];
@@ -365,17 +399,17 @@ namespace {
 
 }  // namespace
 
-void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
-                     const float* fetched, std::size_t n, double* hi, double* lo, Isa isa) {
+void DecodeEyeDepths(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const float* values,
+                     std::size_t n, double* hi, double* lo, Isa isa) {
   RunWith(
       isa, [&](auto)
-               __attribute__((always_inline)) { DecodeEyeDepthsBody(encoding, near, far, codes, fetched, n, hi, lo); });
+               __attribute__((always_inline)) { DecodeEyeDepthsBody(encoding, model, mapping, values, n, hi, lo); });
 }
 
-DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored) {
-  const double far = FarOrZero(frame);
+DoubleDouble DecodeEyeDepth(Encoding encoding, ProductionModel model, const Frame& frame, float value) {
+  const OneMapping mapping(encoding, frame);
   double hi, lo;
-  DecodeEyeDepths(encoding, &frame.near, &far, &stored.code, &stored.fetched, 1, &hi, &lo);
+  DecodeEyeDepths(encoding, model, mapping.Arrays(), &value, 1, &hi, &lo);
   return DoubleDouble::FromParts(hi, lo);
 }
 

@@ -1,20 +1,31 @@
 // Encode: what a depth buffer or G-buffer channel holds for a scene point,
-// rounded exactly as an ideal pipeline and the storage format round it, and
-// what a stored value denotes.
+// produced as the pipeline produces it and rounded exactly as the storage
+// format rounds it, and what a stored value denotes.
 //
-// The pipeline model, the same for every format:
-//   1. the exact value: window depth (hardware), eye depth / far (linear) or
-//      view z (view-z);
-//   2. the rasterizer/shader produces it as a float32, correctly rounded;
-//      with GL-style clip depth the float32 is NDC depth in [-1, 1] and the
-//      viewport transform 0.5 * ndc + 0.5 rounds once more;
+// The pipeline, the same for every format:
+//   1. the value: window depth (hardware), eye depth / far (linear) or view
+//      z (view-z);
+//   2. produced as a float32, by the domain's ProductionModel (domain.h):
+//      kFloat32: as a GPU computes it from the float32 constants the
+//        shaders receive too (A and B of ndc = A + B / z, the far plane):
+//        z = float(eye depth); clip = A * z + B, ndc = clip / z (w = z),
+//        each operation rounded to float32; GL-style clip depth then the
+//        viewport transform 0.5 * ndc + 0.5 in float32;
+//      kExact: the exact value correctly rounded (GL-style: exact NDC depth
+//        rounded, then the viewport transform in float32);
 //   3. the format converts that float: unorm round-to-nearest-even of
 //      value * (2^b - 1), float16 round-to-nearest-even, float32 as is.
 // A texture fetch returns the texel as float32: the correctly rounded value
-// of the code (exact for float formats). Backends read the fetched float;
-// the reference reads the exact value of the code.
+// of the code (exact for float formats). Backends read the fetched float.
 //
-// "Correctly rounded" is meant literally: step 2 evaluates the exact value
+// What a value denotes (DecodeEyeDepths) is the eye depth that exact
+// arithmetic gives for it under the same mapping: the float32 constants
+// (kFloat32) or the exact frame (kExact). Decoding the pipeline's float
+// gives the produced depth; decoding the fetched texel, the stored depth.
+// Their differences from the truth and from each other are the production
+// and the storage error (reference.h).
+//
+// "Correctly rounded" is meant literally: kExact evaluates the exact value
 // in double-double, and where that lies too close to a float rounding
 // boundary to decide, in MPFR.
 #pragma once
@@ -33,34 +44,49 @@ struct StoredDepth {
   float fetched = 0.0f;    // what a texture fetch returns for it
 };
 
+// The depth mapping of n samples, an array per parameter: the frame's exact
+// planes (far 0 for an infinite far plane), and the float32 constants the
+// shaders receive: A and B of ndc = A + B / z (hardware formats) or the far
+// plane in `a` (linear formats); view z needs neither.
+struct DepthMappings {
+  const double* near = nullptr;
+  const double* far = nullptr;
+  const double* a = nullptr;
+  const double* b = nullptr;
+  DepthMappings At(std::size_t first) const { return {near + first, far + first, a + first, b + first}; }
+};
+// The float32 constants of one frame and encoding (shader_constants.h).
+void FrameMapping(Encoding encoding, const Frame& frame, double& a, double& b);
+
 // Steps 1 and 2: the float32 the pipeline produces for eye depth z. It
 // depends only on the convention and on what the format stores, so the
 // formats of one convention share it.
-float PipelineFloat(Encoding encoding, const Frame& frame, double eye_depth);
-// The same for n samples, four lanes at a time (far is 0 for an infinite
-// far plane); every lane computes exactly what the scalar form does.
-void PipelineFloats(Encoding encoding, const double* near, const double* far, const double* eye_depth, std::size_t n,
-                    float* out);
+float PipelineFloat(Encoding encoding, ProductionModel model, const Frame& frame, double eye_depth);
+// The same for n samples, four lanes at a time; every lane computes exactly
+// what the scalar form does.
+void PipelineFloats(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const double* eye_depth,
+                    std::size_t n, float* out);
 // Step 3 and the fetch, for one value and for n.
 StoredDepth StoreFloat(Format format, float value);
 void StoreFloats(Format format, const float* values, std::size_t n, std::uint32_t* codes, float* fetched);
 
-inline StoredDepth EncodeEyeDepth(Encoding encoding, const Frame& frame, double eye_depth) {
-  return StoreFloat(encoding.format, PipelineFloat(encoding, frame, eye_depth));
+inline StoredDepth EncodeEyeDepth(Encoding encoding, ProductionModel model, const Frame& frame, double eye_depth) {
+  return StoreFloat(encoding.format, PipelineFloat(encoding, model, frame, eye_depth));
 }
 StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick);
 
-// Eye depth a stored texel denotes, in double-double through the
-// cancellation-free decode of shared/depth_mapping.h (relative error below
-// 2^-100; tests/reference_test.cc checks it against MPFR). Zero or
-// +infinity for texels that denote the camera or infinity.
-DoubleDouble DecodeEyeDepth(Encoding encoding, const Frame& frame, StoredDepth stored);
-// The same for n texels, four lanes at a time (far is 0 for an infinite far
-// plane), as the two parts of each double-double. Every lane computes
-// exactly what the scalar form does.
+// Eye depth a float value (a fetched texel, or the pipeline's float)
+// denotes, in double-double: under kExact through the cancellation-free
+// decode of shared/depth_mapping.h (relative error below 2^-100;
+// tests/reference_test.cc checks it against MPFR), under kFloat32 as
+// B / (ndc - A) with the float constants. Zero or +infinity for values that
+// denote the camera or infinity.
+DoubleDouble DecodeEyeDepth(Encoding encoding, ProductionModel model, const Frame& frame, float value);
+// The same for n values, four lanes at a time, as the two parts of each
+// double-double. Every lane computes exactly what the scalar form does.
 // Compiled for each instruction set `isa` can name (bench/base/isa.h).
-void DecodeEyeDepths(Encoding encoding, const double* near, const double* far, const std::uint32_t* codes,
-                     const float* fetched, std::size_t n, double* hi, double* lo, Isa isa = Isa::kWidest);
+void DecodeEyeDepths(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const float* values,
+                     std::size_t n, double* hi, double* lo, Isa isa = Isa::kWidest);
 
 // Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);

@@ -52,6 +52,8 @@ struct RunInputs {
   const double *true_depth, *denoted_depth, *inverse_distance_sq;
   const std::uint8_t* joint_band;
   const ReferenceStatus* status;
+  const std::uint8_t* stored_holdable;
+  const Coverage* coverage;
 };
 
 // Pass 1: errors and bins of a run of samples, N at a time.
@@ -100,38 +102,53 @@ template <int N>
   }
 }
 
+// The slots a sample's figures go to: the joint and the distance band of a
+// sample of the natural distribution, or its coverage band alone.
+struct SampleSlots {
+  CellAccumulator::Slot* slots[2];
+  int count;
+};
+[[gnu::always_inline]] inline SampleSlots SlotsOf(CellAccumulator& accumulator, CellAccumulator::Slot& distance,
+                                                  std::uint8_t joint_band, Coverage coverage) {
+  if (coverage != Coverage::kNatural) return {{&accumulator.Coverage(CoverageBand(coverage)), nullptr}, 1};
+  return {{&accumulator.Joint(joint_band), &distance}, 2};
+}
+
 // Pass 2: counts and histograms. What a sample is to the cell follows from
 // its reference's status and from its output, which is NaN when a component
 // is NaN, and infinite when one is infinite (of either sign) and none is
 // NaN. The absolute error's square tells those apart: it is a sum of
 // squares (+inf and -inf components both give +inf, never NaN), of the
 // output minus a point that is finite wherever the sample is not
-// degenerate, and a finite float output cannot overflow it.
-[[gnu::always_inline]] inline void Record(const ReferenceStatus* status, const std::uint8_t* joint_band,
-                                          std::uint64_t first_index, std::uint32_t n, const RunScratch& s,
-                                          CellAccumulator& accumulator, CellAccumulator::Slot& distance) {
+// degenerate, and a finite float output cannot overflow it. A non-finite
+// output is a finding only where the stored value denotes a point float32
+// can hold; otherwise it is what any arithmetic returns.
+[[gnu::always_inline]] inline void Record(const RunInputs& in, std::uint64_t first_index, std::uint32_t n,
+                                          const RunScratch& s, CellAccumulator& accumulator,
+                                          CellAccumulator::Slot& distance) {
   for (std::uint32_t i = 0; i < n; ++i) {
-    CellAccumulator::Slot& joint = accumulator.Joint(joint_band[i]);
+    const SampleSlots to = SlotsOf(accumulator, distance, in.joint_band[i], in.coverage[i]);
     const std::uint64_t index = first_index + i;
     const double absolute_sq = s.absolute[i];
     const bool finite = absolute_sq < std::numeric_limits<double>::infinity();  // false for NaN
-    if (status[i] == ReferenceStatus::kJudged && finite) {
-      // Distance bands keep the total error only: what camera distance
-      // does to a reconstruction shows there whole.
-      joint.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
-      joint.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
-      joint.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
-      distance.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
-    } else if (status[i] == ReferenceStatus::kDegenerate) {
-      ++joint.degenerate;
-      ++distance.degenerate;
-    } else if (finite) {  // outside the frustum: only a non-finite output counts
-      ++joint.outside;
-      ++distance.outside;
-    } else {
-      const bool nan = absolute_sq != absolute_sq;
-      joint.RecordNonFinite(nan, index);
-      distance.RecordNonFinite(nan, index);
+    const bool holdable = in.stored_holdable[i] != 0;
+    for (int k = 0; k < to.count; ++k) {
+      CellAccumulator::Slot& slot = *to.slots[k];
+      if (in.status[i] == ReferenceStatus::kJudged && finite) {
+        slot.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
+        slot.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
+        // Against a stored value that denotes no holdable point, the
+        // shader has no error to speak of.
+        if (holdable) slot.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
+      } else if (in.status[i] == ReferenceStatus::kDegenerate) {
+        ++slot.degenerate;
+      } else if (finite) {  // outside the frustum: only a non-finite output counts
+        ++slot.outside;
+      } else if (!holdable) {
+        ++slot.stored_nonfinite;
+      } else {
+        slot.RecordNonFinite(absolute_sq != absolute_sq, index);
+      }
     }
   }
 }
@@ -185,42 +202,55 @@ template <int N>
                              ref.denoted_depth.data() + at,
                              ref.inverse_distance_sq.data() + at,
                              ref.joint_band.data() + at,
-                             ref.status.data() + at};
+                             ref.status.data() + at,
+                             ref.stored_holdable.data() + at,
+                             batch.samples.coverage.data() + begin};
           Measure<N>(in, camera, n, scratch);
-          Record(in.status, in.joint_band, batch.first_index + begin, n, scratch, *cell.accumulator,
+          Record(in, batch.first_index + begin, n, scratch, *cell.accumulator,
                  cell.accumulator->Distance(batch.distance_bands[frame]));
         }
       });
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 
+// The errors that belong to the encoding, not the variant: storage and
+// production.
 template <int N>
-[[gnu::always_inline]] inline void RecordStorageBody(const Batch& batch, std::uint32_t depth_slot,
-                                                     CellAccumulator& accumulator) {
+[[gnu::always_inline]] inline void RecordEncodingBody(const Batch& batch, std::uint32_t depth_slot,
+                                                      CellAccumulator& accumulator) {
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * batch.count;
-  const ReferenceStatus* status = batch.reference.status.data() + offset;
-  const std::uint8_t* joint_band = batch.reference.joint_band.data() + offset;
-  const double* storage = batch.reference.storage_square.data() + offset;
-  constexpr int kStorage = static_cast<int>(Metric::kStorage);
-  std::array<std::int64_t, kMaxRun> bins;
+  const ReferenceArrays& ref = batch.reference;
+  const ReferenceStatus* status = ref.status.data() + offset;
+  const std::uint8_t* joint_band = ref.joint_band.data() + offset;
+  const Coverage* coverage = batch.samples.coverage.data();
+  constexpr Metric kMetrics[] = {Metric::kStorage, Metric::kProduction};
+  const double* squares_of[] = {ref.storage_square.data() + offset, ref.production_square.data() + offset};
+  std::array<std::array<std::int64_t, kMaxRun>, 2> bins;
   ForEachFrameRun(
       batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
         // The bins N at a time (as the judge's Measure does), then the counts.
-        std::uint32_t i = begin;
-        for (; i + N <= end; i += N) {
-          typename Lanes<N>::Double squares;
-          std::memcpy(&squares, storage + i, sizeof(squares));
-          const auto lanes = DenseBinsOfSquares<typename Lanes<N>::Int>(squares, kLowestOctave[kStorage]);
-          std::memcpy(&bins[i - begin], &lanes, sizeof(lanes));
+        for (int m = 0; m < 2; ++m) {
+          const double* squares = squares_of[m];
+          const int lowest = kLowestOctave[static_cast<int>(kMetrics[m])];
+          std::uint32_t i = begin;
+          for (; i + N <= end; i += N) {
+            typename Lanes<N>::Double lanes;
+            std::memcpy(&lanes, squares + i, sizeof(lanes));
+            const auto slots = DenseBinsOfSquares<typename Lanes<N>::Int>(lanes, lowest);
+            std::memcpy(&bins[m][i - begin], &slots, sizeof(slots));
+          }
+          for (; i < end; ++i) bins[m][i - begin] = DenseBinOfSquare(squares[i], lowest);
         }
-        for (; i < end; ++i) bins[i - begin] = DenseBinOfSquare(storage[i], kLowestOctave[kStorage]);
         CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
-        for (i = begin; i < end; ++i) {
+        for (std::uint32_t i = begin; i < end; ++i) {
           if (status[i] != ReferenceStatus::kJudged) continue;
           const std::uint64_t index = batch.first_index + i;
-          const int bin = static_cast<int>(bins[i - begin]);
-          accumulator.Joint(joint_band[i]).Record(Metric::kStorage, bin, storage[i], index);
-          distance.Record(Metric::kStorage, bin, storage[i], index);
+          const SampleSlots to = SlotsOf(accumulator, distance, joint_band[i], coverage[i]);
+          for (int k = 0; k < to.count; ++k) {
+            for (int m = 0; m < 2; ++m) {
+              to.slots[k]->Record(kMetrics[m], static_cast<int>(bins[m][i - begin]), squares_of[m][i], index);
+            }
+          }
         }
       });
   accumulator.Count(batch.count);
@@ -234,10 +264,10 @@ void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const Jud
                __attribute__((always_inline)) { JudgeSlotBody<decltype(lanes)::value>(batch, depth_slot, cells); });
 }
 
-void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
+void RecordEncodingErrors(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa) {
   RunWith(
       isa, [&](auto lanes) __attribute__((always_inline)) {
-        RecordStorageBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
+        RecordEncodingBody<decltype(lanes)::value>(batch, depth_slot, accumulator);
       });
 }
 

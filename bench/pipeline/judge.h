@@ -20,13 +20,15 @@ struct JudgedCell {
 };
 
 // Judges every listed cell that reads depth slot `depth_slot` (they share
-// the slot's reference, read once). Records total, arithmetic and absolute
-// errors; storage errors belong to the encoding (RecordStorage). `isa` must
-// be one the processor runs.
+// the slot's reference, read once). Records total, arithmetic (the
+// shader's part) and absolute errors, and non-finite outputs by cause;
+// storage and production errors belong to the encoding
+// (RecordEncodingErrors). `isa` must be one the processor runs.
 void JudgeSlot(const Batch& batch, std::uint32_t depth_slot, std::span<const JudgedCell> cells, Isa isa = Isa::kWidest);
 
-// Records the storage error of one depth slot's samples.
-void RecordStorage(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator, Isa isa = Isa::kWidest);
+// Records the storage and production errors of one depth slot's samples.
+void RecordEncodingErrors(const Batch& batch, std::uint32_t depth_slot, CellAccumulator& accumulator,
+                          Isa isa = Isa::kWidest);
 
 // The squared errors of one output (for reproducers and tests): relative
 // total, relative arithmetic, absolute total.

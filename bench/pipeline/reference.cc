@@ -19,13 +19,17 @@ constexpr double kLargestFloatSquared = static_cast<double>(FLT_MAX) * static_ca
 }  // namespace
 
 void ReferenceArrays::Resize(std::size_t n) {
-  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square}) v->resize(n);
+  for (auto* v : {&true_depth, &denoted_depth, &inverse_distance_sq, &storage_square, &production_square}) {
+    v->resize(n);
+  }
   joint_band.resize(n);
+  stored_holdable.resize(n);
   status.resize(n);
 }
 
 ReferenceSample ReferenceArrays::Get(std::size_t at) const {
-  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at], joint_band[at], status[at]};
+  return {true_depth[at], denoted_depth[at], inverse_distance_sq[at],
+          joint_band[at], status[at],        stored_holdable[at] != 0};
 }
 
 void SampleArrays::Resize(std::size_t n) {
@@ -36,6 +40,7 @@ void SampleArrays::Resize(std::size_t n) {
   }
   depth_band.resize(n);
   ratio_band.resize(n);
+  coverage.resize(n);
 }
 
 void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
@@ -51,6 +56,7 @@ void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sam
   inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
   depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
   ratio_band[i] = static_cast<std::uint8_t>(RatioBand(frame.ratio()));
+  coverage[i] = sample.coverage;
 }
 
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
@@ -77,21 +83,24 @@ namespace {
 // their own.
 template <class D, class I>
 struct ReferenceLanes {
-  D true_depth, denoted_depth, inverse_distance_sq, storage_square;
+  D true_depth, denoted_depth, inverse_distance_sq, storage_square, production_square;
   I status;  // ReferenceStatus
+  I stored_holdable;
 };
 template <class D, class I>
 [[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo,
-                                                               D near, D depth_limit, D interest_min, D interest_max,
-                                                               D ray_length_sq, D eye_inverse_distance_sq,
-                                                               bool infinite_far) {
+                                                               D produced_hi, D produced_lo, D near, D depth_limit,
+                                                               D interest_min, D interest_max, D ray_length_sq,
+                                                               D eye_inverse_distance_sq, bool infinite_far) {
   using DD = BasicDoubleDouble<D>;
   const auto eye = eye_pick != 0.0;
   // Stored-value picks have no scene point of their own: the truth is what
-  // the stored value denotes, and their storage error is zero.
+  // the stored value denotes, and their storage and production errors are
+  // zero.
   const DD denoted = DD::FromParts(denoted_hi, denoted_lo);
   const D zero = D{} * 0.0;
   const DD truth = DD::FromParts(eye ? eye_depth : denoted_hi, eye ? zero : denoted_lo);
+  const DD produced = DD::FromParts(eye ? produced_hi : denoted_hi, eye ? produced_lo : denoted_lo);
   const D t = truth.hi();
   ReferenceLanes<D, I> out;
   out.true_depth = t;
@@ -108,20 +117,27 @@ template <class D, class I>
   const I degenerate = I{} + static_cast<std::int64_t>(ReferenceStatus::kDegenerate);
   const I outside_status = I{} + static_cast<std::int64_t>(ReferenceStatus::kOutside);
   out.status = holdable ? (outside ? outside_status : judged) : degenerate;
+  const D s = denoted_hi;
+  const auto stored_holdable = (s > 0.0) & (s * s * ray_length_sq < kLargestFloatSquared);
+  out.stored_holdable = stored_holdable ? I{} + 1 : I{};
   const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (t * t * ray_length_sq);
   out.inverse_distance_sq = out.status == judged ? inverse : zero;
   // The difference of the two depths is taken in double-double (they may
   // be close); its ratio to the distance needs no more than double. Both
   // points lie on the same ray, so the relative error of the position is
   // the relative error of the depth.
-  const D difference = (denoted - truth).hi();
-  out.storage_square = difference * difference * out.inverse_distance_sq * ray_length_sq;
+  const D scale = out.inverse_distance_sq * ray_length_sq;  // 1 / t^2 where judged
+  const D storage = (denoted - produced).hi(), production = (produced - truth).hi();
+  out.storage_square = storage * storage * scale;
+  out.production_square = production * production * scale;
   return out;
 }
 
 [[gnu::always_inline]] inline void ReferencesBody(Encoding encoding, const SampleArrays& samples, std::size_t first,
-                                                  std::size_t n, const double* denoted_hi, const double* denoted_lo,
+                                                  std::size_t n, DepthArrays denoted, DepthArrays produced,
                                                   ReferenceArrays& out, std::size_t out_first) {
+  const double *denoted_hi = denoted.hi, *denoted_lo = denoted.lo, *produced_hi = produced.hi,
+               *produced_lo = produced.lo;
   const ConventionInfo& convention = Info(encoding.convention);
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
   // Plain pointers, read once: the stores below cannot then be taken for
@@ -134,13 +150,16 @@ template <class D, class I>
                *eye_inverse_distance_sq = samples.inverse_distance_sq.data() + first;
   double *true_depth = out.true_depth.data() + out_first, *denoted_depth = out.denoted_depth.data() + out_first,
          *inverse_distance_sq = out.inverse_distance_sq.data() + out_first,
-         *storage_square = out.storage_square.data() + out_first;
+         *storage_square = out.storage_square.data() + out_first,
+         *production_square = out.production_square.data() + out_first;
   ReferenceStatus* status = out.status.data() + out_first;
+  std::uint8_t* stored_holdable = out.stored_holdable.data() + out_first;
   const auto store = [&](std::size_t k, const auto& lanes, auto put) {
     put(true_depth + k, lanes.true_depth);
     put(denoted_depth + k, lanes.denoted_depth);
     put(inverse_distance_sq + k, lanes.inverse_distance_sq);
     put(storage_square + k, lanes.storage_square);
+    put(production_square + k, lanes.production_square);
   };
   std::size_t k = 0;
   for (; k + 4 <= n; k += 4) {
@@ -152,17 +171,23 @@ template <class D, class I>
     Double4 eye_pick;
     for (int lane = 0; lane < 4; ++lane) eye_pick[lane] = pick[k + lane] == DepthPick::kEyeDepth;
     const ReferenceLanes<Double4, Int4> lanes = ReferenceOf<Double4, Int4>(
-        eye_pick, load(eye_depth), load(denoted_hi), load(denoted_lo), load(near), load(depth_limit),
-        load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq), infinite_far);
+        eye_pick, load(eye_depth), load(denoted_hi), load(denoted_lo), load(produced_hi), load(produced_lo), load(near),
+        load(depth_limit), load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq),
+        infinite_far);
     store(k, lanes, [](double* to, Double4 v) { std::memcpy(to, &v, sizeof(v)); });
-    for (int lane = 0; lane < 4; ++lane) status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
+    for (int lane = 0; lane < 4; ++lane) {
+      status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
+      stored_holdable[k + lane] = static_cast<std::uint8_t>(lanes.stored_holdable[lane] != 0);
+    }
   }
   for (; k < n; ++k) {  // the tail
-    const ReferenceLanes<double, std::int64_t> one = ReferenceOf<double, std::int64_t>(
-        pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], denoted_lo[k], near[k], depth_limit[k],
-        interest_min[k], interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
+    const ReferenceLanes<double, std::int64_t> one =
+        ReferenceOf<double, std::int64_t>(pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], denoted_lo[k],
+                                          produced_hi[k], produced_lo[k], near[k], depth_limit[k], interest_min[k],
+                                          interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
     store(k, one, [](double* to, double v) { *to = v; });
     status[k] = static_cast<ReferenceStatus>(one.status);
+    stored_holdable[k] = static_cast<std::uint8_t>(one.stored_holdable != 0);
   }
   // Bands: stored-value picks (rare) take the decade of their denoted depth.
   const std::uint8_t *depth_band = samples.depth_band.data() + first, *ratio_band = samples.ratio_band.data() + first;
@@ -176,12 +201,11 @@ template <class D, class I>
 
 }  // namespace
 
-void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
-                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
-                Isa isa) {
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, DepthArrays denoted,
+                DepthArrays produced, ReferenceArrays& out, std::size_t out_first, Isa isa) {
   RunWith(
       isa, [&](auto) __attribute__((always_inline)) {
-        ReferencesBody(encoding, samples, first, n, denoted_hi, denoted_lo, out, out_first);
+        ReferencesBody(encoding, samples, first, n, denoted, produced, out, out_first);
       });
 }
 

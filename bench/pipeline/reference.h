@@ -1,5 +1,7 @@
-// Reference: for each sample, the true scene point and the point that the
-// stored depth value denotes, from the frame's exact parameters.
+// Reference: for each sample, the true scene point, the point the
+// pipeline's float denotes (produced) and the point the fetched texel
+// denotes (stored), the last two under the pipeline's own mapping
+// (encode.h).
 //
 // Both points lie on the pixel's ray through the camera, so the reference
 // keeps, per sample, the world-space ray at unit eye depth, and per
@@ -41,13 +43,18 @@ struct ReferenceSample {
   double inverse_distance_sq = 0.0;  // 1 / |true point - camera|^2 (0 unless judged)
   std::uint8_t joint_band = 0;
   ReferenceStatus status = ReferenceStatus::kDegenerate;
+  // Whether float32 world coordinates can hold the denoted point: when not
+  // (the stored value denotes infinity or the camera, or lies beyond the
+  // float range), no arithmetic could return it finitely, so a non-finite
+  // output is expected, not a finding, and there is no shader error.
+  bool stored_holdable = true;
 };
 
 // ReferenceSample fields, one array each (the judge reads them in SIMD
-// lanes), plus the square of the relative storage error.
+// lanes), plus the squares of the relative storage and production errors.
 struct ReferenceArrays {
-  std::vector<double> true_depth, denoted_depth, inverse_distance_sq, storage_square;
-  std::vector<std::uint8_t> joint_band;
+  std::vector<double> true_depth, denoted_depth, inverse_distance_sq, storage_square, production_square;
+  std::vector<std::uint8_t> joint_band, stored_holdable;
   std::vector<ReferenceStatus> status;
 
   void Resize(std::size_t n);
@@ -65,6 +72,7 @@ struct SampleArrays {
   std::vector<double> inverse_distance_sq;         // 1 / (eye depth * |ray|)^2, for eye-depth picks
   std::vector<std::uint8_t> depth_band;            // of the eye depth, for eye-depth picks
   std::vector<std::uint8_t> ratio_band;            // the frame's far/near band
+  std::vector<Coverage> coverage;                  // natural, or the coverage kind (bands.h)
 
   void Resize(std::size_t n);
   // Fills entry i for a sample of `frame` whose ray is `ray`.
@@ -75,12 +83,18 @@ struct SampleArrays {
 // R * (ndc.x * tan_x, ndc.y * tan_y, -1).
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
+// Eye depths as the two parts of double-doubles, one array each.
+struct DepthArrays {
+  const double* hi;
+  const double* lo;
+};
+
 // The references of samples [first, first + n) under an encoding whose
-// stored values denote eye depths denoted_hi[k] + denoted_lo[k]
-// (DecodeEyeDepths), written to out at [out_first, out_first + n).
+// stored values denote eye depths `denoted` and whose pipeline floats
+// denote `produced` (DecodeEyeDepths; k-th entry for sample first + k),
+// written to out at [out_first, out_first + n).
 // Compiled for each instruction set `isa` can name (bench/base/isa.h).
-void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n,
-                const double* denoted_hi, const double* denoted_lo, ReferenceArrays& out, std::size_t out_first,
-                Isa isa = Isa::kWidest);
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, DepthArrays denoted,
+                DepthArrays produced, ReferenceArrays& out, std::size_t out_first, Isa isa = Isa::kWidest);
 
 }  // namespace depthbench

@@ -165,37 +165,47 @@ PixelSample SampleFromUnits(const SampleUnits& u, const Frame& frame, std::uint6
   PixelSample s;
   s.index = index;
 
-  // Depth: mostly log-uniform eye depth, with the bands and stored values
-  // where reconstructions break drawn on purpose.
+  // Depth: three quarters log-uniform eye depth (the natural distribution),
+  // the rest drawn on purpose where reconstructions break: stored values at
+  // the ends of the format, the first and the last doubling of depth.
   const double pick = u.pick;
   const double lo = frame.eye_depth_min, hi = frame.eye_depth_max;
   if (pick < 0.05) {
     static constexpr DepthPick kEdges[4] = {DepthPick::kStoredZero, DepthPick::kStoredOne, DepthPick::kStoredAfterZero,
                                             DepthPick::kStoredBeforeOne};
-    s.pick = kEdges[std::min(3, static_cast<int>(pick / 0.05 * 4.0))];
+    static constexpr Coverage kKinds[4] = {Coverage::kStoredZero, Coverage::kStoredOne, Coverage::kStoredAfterZero,
+                                           Coverage::kStoredBeforeOne};
+    const int edge = std::min(3, static_cast<int>(pick / 0.05 * 4.0));
+    s.pick = kEdges[edge];
+    s.coverage = kKinds[edge];
   } else if (pick < 0.15) {  // near band: the first doubling of depth
     s.eye_depth = std::min(hi, lo * std::exp2(u.depth));
+    s.coverage = Coverage::kNearDoubling;
   } else if (pick < 0.25) {  // far band: the last doubling
     s.eye_depth = std::max(lo, hi * std::exp2(-u.depth));
+    s.coverage = Coverage::kFarDoubling;
   } else {
     s.eye_depth = std::min(hi, lo * std::exp(u.depth * frame.log_eye_depth_span));
   }
 
-  // Pixel: mostly uniform over the render target, with its exact corners
-  // and edges drawn on purpose.
+  // Pixel: mostly uniform over the render target (natural), with its exact
+  // corners and edges drawn on purpose.
   const double kind = u.pixel_kind;
   auto scaled = [](double unit, std::uint32_t n) {
     return std::min(n - 1, static_cast<std::uint32_t>(std::floor(unit * n)));
   };
   const std::uint32_t w = frame.width, h = frame.height;
+  const bool natural_depth = s.coverage == Coverage::kNatural;
   if (kind < 0.04) {
     int corner = std::min(3, static_cast<int>(kind / 0.04 * 4.0));
     s.x = (corner & 1) ? w - 1 : 0;
     s.y = (corner & 2) ? h - 1 : 0;
+    if (natural_depth) s.coverage = Coverage::kCornerPixel;
   } else if (kind < 0.08) {
     int edge = std::min(3, static_cast<int>((kind - 0.04) / 0.04 * 4.0));
     s.x = edge < 2 ? (edge == 0 ? 0 : w - 1) : scaled(u.x, w);
     s.y = edge < 2 ? scaled(u.y, h) : (edge == 2 ? 0 : h - 1);
+    if (natural_depth) s.coverage = Coverage::kEdgePixel;
   } else {
     s.x = scaled(u.x, w);
     s.y = scaled(u.y, h);

@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "bench/pipeline/bands.h"
 #include "bench/pipeline/domain.h"
 
 namespace depthbench {
@@ -63,6 +64,9 @@ struct PixelSample {
   std::uint32_t y = 0;
   DepthPick pick = DepthPick::kEyeDepth;
   double eye_depth = 0.0;  // for kEyeDepth
+  // Drawn from the domain's natural distribution (log-uniform eye depth,
+  // uniform pixel), or on purpose for coverage (bands.h).
+  Coverage coverage = Coverage::kNatural;
 };
 
 // Where a batch's frames and samples come from: the random sampler, or an
@@ -73,6 +77,8 @@ class SampleSource {
   virtual ~SampleSource() = default;
   virtual Frame FrameAt(std::uint64_t frame_index) const = 0;
   virtual PixelSample SampleAt(std::uint64_t index, const Frame& frame) const = 0;
+  // How the pipeline produces its samples' stored depth.
+  virtual ProductionModel production() const { return ProductionModel::kFloat32; }
 };
 
 // A point of the domain in unit coordinates: every random choice the
@@ -102,6 +108,7 @@ class Sampler : public SampleSource {
 
   Frame FrameAt(std::uint64_t frame_index) const override;
   PixelSample SampleAt(std::uint64_t index, const Frame& frame) const override;
+  ProductionModel production() const override { return domain_.production; }
   FrameUnits FrameUnitsAt(std::uint64_t frame_index) const;
   SampleUnits SampleUnitsAt(std::uint64_t index) const;
 

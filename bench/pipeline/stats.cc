@@ -17,6 +17,7 @@ const char* MetricName(Metric m) {
     case Metric::kTotal: return "total";
     case Metric::kArith: return "arith";
     case Metric::kStorage: return "storage";
+    case Metric::kProduction: return "production";
     case Metric::kAbsolute: return "absolute";
   }
   return "?";
@@ -33,6 +34,12 @@ std::string DepthBandName(int band) {
 std::string DistanceBandName(int band) {
   if (band == 0) return "<1";
   return band == kDistanceBands - 1 ? fmt::format("1e{}+", 2 * band - 2) : fmt::format("1e{}", 2 * band - 2);
+}
+std::string CoverageBandName(int band) {
+  static const char* const kNames[kCoverageBands] = {"stored 0",        "stored 1",      "stored after 0",
+                                                     "stored before 1", "near doubling", "far doubling",
+                                                     "corner pixel",    "edge pixel"};
+  return band >= 0 && band < kCoverageBands ? kNames[band] : "?";
 }
 double RatioBandLow(int band) { return band == kInfiniteRatioBand ? INFINITY : std::pow(10.0, band); }
 double DepthBandLow(int band) { return std::pow(10.0, band); }
@@ -124,6 +131,26 @@ double LevelQuantile(Level level) {
   return 1.0;
 }
 
+std::uint64_t MinimumSamples(Level level) {
+  switch (level) {
+    case Level::kP50: return 20;
+    case Level::kP99: return 400;
+    case Level::kP999: return 4000;
+    case Level::kMax: return 100;
+  }
+  return 0;
+}
+
+Interval MetricStats::LevelInterval(Level level, Metric metric) const {
+  if (level == Level::kMax) return {max(), max()};
+  const double n = static_cast<double>(Count());
+  if (n == 0.0) return {};
+  const double q = LevelQuantile(level);
+  const double spread = 1.96 * std::sqrt(n * q * (1.0 - q));
+  const int lowest = kLowestOctave[static_cast<int>(metric)];
+  return {Quantile(std::max(0.0, n * q - spread) / n, lowest), Quantile(std::min(n, n * q + spread + 1.0) / n, lowest)};
+}
+
 double MetricStats::AtLevel(Level level, Metric metric) const {
   return level == Level::kMax ? max() : Quantile(LevelQuantile(level), kLowestOctave[static_cast<int>(metric)]);
 }
@@ -132,6 +159,7 @@ void BandStats::MergeCounts(const BandStats& other) {
   finite += other.finite;
   nan += other.nan;
   inf += other.inf;
+  stored_nonfinite += other.stored_nonfinite;
   degenerate += other.degenerate;
   outside += other.outside;
   first_nonfinite_index = std::min(first_nonfinite_index, other.first_nonfinite_index);
@@ -148,8 +176,9 @@ void BandStats::Merge(BandStats&& other) {
 }
 
 double BitsLost(double relative_error) {
+  if (std::isnan(relative_error)) return kAllBitsLost;
   if (!(relative_error > 0.0)) return 0.0;
-  return std::max(0.0, std::log2(relative_error) + 24.0);
+  return std::clamp(std::log2(relative_error) + 24.0, 0.0, kAllBitsLost);
 }
 
 Summary Summarize(const BandStats& band, Metric metric) {
@@ -159,6 +188,8 @@ Summary Summarize(const BandStats& band, Metric metric) {
   s.p50 = m.Quantile(0.5, low);
   s.p99 = m.Quantile(0.99, low);
   s.p999 = m.Quantile(0.999, low);
+  s.p999_interval = m.LevelInterval(Level::kP999, metric);
+  s.p999_supported = m.Count() >= MinimumSamples(Level::kP999);
   s.max = m.max();
   s.worst_index = m.worst_index;
   return s;
@@ -167,6 +198,19 @@ Summary Summarize(const BandStats& band, Metric metric) {
 void CellStats::Merge(const CellStats& other) {
   for (const auto& [band, stats] : other.joint) joint[band].Merge(stats);
   for (const auto& [band, stats] : other.distance) distance[band].Merge(stats);
+  for (const auto& [band, stats] : other.coverage) coverage[band].Merge(stats);
+}
+
+BandStats CellStats::AllCoverage() const {
+  BandStats all;
+  for (const auto& [band, stats] : coverage) all.Merge(stats);
+  return all;
+}
+
+BandStats CellStats::Everything() const {
+  BandStats all = All();
+  all.Merge(AllCoverage());
+  return all;
 }
 
 BandStats CellStats::All() const {
@@ -217,6 +261,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
     for (std::uint32_t n : slot.bins[static_cast<int>(Metric::kTotal)]) add.finite += n;
     add.nan = slot.nan;
     add.inf = slot.inf;
+    add.stored_nonfinite = slot.stored_nonfinite;
     add.degenerate = slot.degenerate;
     add.outside = slot.outside;
     add.first_nonfinite_index = slot.nan + slot.inf > 0 ? slot.first_nonfinite_index : kNone;
@@ -227,7 +272,10 @@ void CellAccumulator::FlushInto(CellStats& out) {
       ms.max_square = slot.max_square[m];
       ms.worst_index = slot.max_square[m] > 0.0 ? slot.worst_index[m] : kNone;
     }
-    (s < kDistanceBands ? out.distance[s] : out.joint[s - kDistanceBands]).Merge(std::move(add));
+    BandStats& to = s < kDistanceBands                 ? out.distance[s]
+                    : s < kDistanceBands + kJointBands ? out.joint[s - kDistanceBands]
+                                                       : out.coverage[s - kDistanceBands - kJointBands];
+    to.Merge(std::move(add));
     std::memset(&slot, 0, sizeof(Slot));
   }
   pending_ = 0;

@@ -7,13 +7,18 @@
 // index of the sample that reached it (ties: the smallest index).
 // Quantiles are read from the bins, interpolated within a bin.
 //
-// Four metrics per sample (relative ones are over the distance from the
-// camera to the true point):
-//   total    |p - truth| / distance       what the engine gets
-//   arith    |p - denoted| / distance     the variant's arithmetic alone
-//   storage  |denoted - truth| / distance what the format's rounding costs
-//   absolute |p - truth|                  in world units
-// Bits lost = max(0, log2(relative error / 2^-24)).
+// Five metrics per sample (relative ones are over the distance from the
+// camera to the true point; "produced" is the point the pipeline's float
+// denotes, "denoted" the point the fetched texel denotes, both under the
+// pipeline's own mapping, encode.h):
+//   total       |p - truth| / distance        what the engine gets
+//   arith       |p - denoted| / distance      the shader's part: its float32
+//                                             arithmetic on the value it
+//                                             fetched and the constants it got
+//   storage     |denoted - produced| / dist.  the format's rounding and fetch
+//   production  |produced - truth| / distance the pipeline's float32 depth
+//   absolute    |p - truth|                   in world units
+// Bits lost = min(24, max(0, log2(relative error / 2^-24))).
 #pragma once
 
 #include <array>
@@ -33,8 +38,8 @@
 
 namespace depthbench {
 
-enum class Metric : int { kTotal = 0, kArith = 1, kStorage = 2, kAbsolute = 3 };
-inline constexpr int kMetricCount = 4;
+enum class Metric : int { kTotal = 0, kArith = 1, kStorage = 2, kProduction = 3, kAbsolute = 4 };
+inline constexpr int kMetricCount = 5;
 const char* MetricName(Metric m);
 
 inline constexpr int kBinsPerOctave = 4;
@@ -44,7 +49,7 @@ inline constexpr int kBinsKept = kBinsPerOctave * kOctavesKept;
 // float32's rounding, where every bit-lost figure is 0 anyway) up to 2^8;
 // absolute errors from 2^-48 to 2^16 world units. Values outside fall into
 // an underflow or overflow bin; exact zeros into the underflow bin.
-inline constexpr std::array<int, kMetricCount> kLowestOctave = {-56, -56, -56, -48};
+inline constexpr std::array<int, kMetricCount> kLowestOctave = {-56, -56, -56, -56, -48};
 
 // The bin arithmetic below is written once for one value (Int = int64_t,
 // Real = double) and for four SIMD lanes (Int4, Double4): GCC's vector
@@ -88,6 +93,14 @@ const char* LevelName(Level level);
 Expected<Level> ParseLevel(const std::string& name);
 // The quantile a level stands for (1 for the maximum).
 double LevelQuantile(Level level);
+// Samples a band needs for a quantile at this level to mean something: a
+// few beyond it, 4 / (1 - q).
+std::uint64_t MinimumSamples(Level level);
+
+// A quantile's 95% sampling interval.
+struct Interval {
+  double low = 0.0, high = 0.0;
+};
 
 // Statistics of one metric in one band: sparse bins keyed by dense slot.
 struct MetricStats {
@@ -106,6 +119,11 @@ struct MetricStats {
   double Quantile(double q, int lowest_octave) const;
   // The value at a level (a quantile, or the maximum) of metric `metric`.
   double AtLevel(Level level, Metric metric) const;
+  // The 95% interval of the q-quantile: the values at the order-statistic
+  // ranks n q -/+ 1.96 sqrt(n q (1 - q)) (the normal approximation of the
+  // binomial count of samples below it), read from the bins as Quantile
+  // reads them. The maximum's interval is the maximum itself.
+  Interval LevelInterval(Level level, Metric metric) const;
   friend bool operator==(const MetricStats&, const MetricStats&) = default;
 
  private:
@@ -115,9 +133,15 @@ struct MetricStats {
 
 // Statistics of one band of one cell.
 struct BandStats {
-  std::uint64_t finite = 0;      // samples with a finite output and a finite reference
-  std::uint64_t nan = 0;         // outputs with a NaN component (reference finite)
-  std::uint64_t inf = 0;         // outputs with an infinite component and no NaN
+  std::uint64_t finite = 0;  // samples with a finite output and a finite reference
+  // Non-finite outputs by cause. A finding: exact arithmetic on the
+  // shader's inputs is finite, the output is not (NaN when a component is
+  // NaN, Inf when one is infinite and none NaN).
+  std::uint64_t nan = 0;
+  std::uint64_t inf = 0;
+  // Expected: the stored value itself denotes infinity, the camera, or a
+  // point float32 cannot hold, so no arithmetic could return it finitely.
+  std::uint64_t stored_nonfinite = 0;
   std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
   std::uint64_t outside = 0;     // finite point outside the frustum: only NaN/Inf judged
   std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
@@ -136,19 +160,30 @@ struct BandStats {
 // The quantile summary a table row shows.
 struct Summary {
   double p50 = 0, p99 = 0, p999 = 0, max = 0;
+  Interval p999_interval;
+  bool p999_supported = false;  // enough samples for a p99.9 (MinimumSamples)
   std::uint64_t worst_index = 0;
 };
 Summary Summarize(const BandStats& band, Metric metric);
-// Bits lost of a relative error: max(0, log2(x / 2^-24)).
+// Bits lost of a relative error: log2(x / 2^-24), from 0 (as good as
+// float32 rounding allows) to 24 (nothing left: an error as large as the
+// distance, or larger).
+inline constexpr double kAllBitsLost = 24.0;
 double BitsLost(double relative_error);
 
 // All statistics of one cell on one backend.
 struct CellStats {
   std::map<int, BandStats> joint;     // JointBand(ratio, depth) -> stats
   std::map<int, BandStats> distance;  // DistanceBand -> stats
+  std::map<int, BandStats> coverage;  // CoverageBand -> stats (bands.h)
 
   void Merge(const CellStats& other);
+  // The domain's natural distribution: every joint band.
   BandStats All() const;
+  // Every coverage band together.
+  BandStats AllCoverage() const;
+  // Every sample: the natural distribution and the coverage bands.
+  BandStats Everything() const;
   BandStats ForRatio(int ratio_band) const;
   BandStats ForDepth(int depth_band) const;
   BandStats ForDistance(int distance_band) const;
@@ -173,7 +208,7 @@ class CellAccumulator {
     std::array<std::uint64_t, kMetricCount> worst_index;
     // (Finite samples are not counted here: every one lands in a bin of the
     // total error, and the flush counts them from there.)
-    std::uint64_t nan, inf, degenerate, outside;
+    std::uint64_t nan, inf, stored_nonfinite, degenerate, outside;
     std::uint64_t first_nonfinite_index;
 
     // One value (squared) of one metric, in dense bin `bin`. Samples come
@@ -198,6 +233,7 @@ class CellAccumulator {
 
   Slot& Joint(int band) { return slots_.get()[kDistanceBands + band]; }
   Slot& Distance(int band) { return slots_.get()[band]; }
+  Slot& Coverage(int band) { return slots_.get()[kDistanceBands + kJointBands + band]; }
 
   // Samples recorded since the last flush (the caller counts them).
   void Count(std::uint64_t samples) { pending_ += samples; }
@@ -205,11 +241,11 @@ class CellAccumulator {
   void FlushInto(CellStats& out);
 
  private:
-  static constexpr int kSlots = kDistanceBands + kJointBands;
+  static constexpr int kSlots = kDistanceBands + kJointBands + kCoverageBands;
   struct Unmap {
     void operator()(Slot* slots) const;
   };
-  // [0, kDistanceBands): distance bands; then joint bands.
+  // [0, kDistanceBands): distance bands; then joint bands, then coverage.
   std::unique_ptr<Slot, Unmap> slots_;
   std::uint64_t pending_ = 0;
 };

@@ -148,8 +148,8 @@ std::vector<SplitRow> SplitRows(const FitSweeps& sweeps) {
       const BandStats all = c.stats.All();
       if (all.finite < MinimumSamples(Level::kP999)) continue;
       rows.push_back({Columns(c.cell, c.backend), RatioLabel(sweeps.ratios[k]), Log10Ratio(sweeps.ratios[k]),
-                      Shown(P999Bits(all, Metric::kTotal)), Shown(P999Bits(all, Metric::kStorage)),
-                      Shown(P999Bits(all, Metric::kArith))});
+                      Shown(P999Bits(all, Metric::kTotal)), Shown(P999Bits(all, Metric::kProduction)),
+                      Shown(P999Bits(all, Metric::kStorage)), Shown(P999Bits(all, Metric::kArith))});
     }
   }
   return rows;

@@ -182,6 +182,7 @@ nlohmann::json ReportToJson(const Report& report) {
                                                      return CellRow(r.cell, {{"ratio", r.ratio},
                                                                              {"log10_ratio", Value(r.log10_ratio)},
                                                                              {"total", Value(r.total)},
+                                                                             {"production", Value(r.production)},
                                                                              {"storage", Value(r.storage)},
                                                                              {"arith", Value(r.arith)}});
                                                    })},

@@ -21,7 +21,7 @@
 
 namespace depthbench {
 
-inline constexpr JsonSchema kReportSchema{"depthbench.report", 1,
+inline constexpr JsonSchema kReportSchema{"depthbench.report", 2,
                                           "a report document (results.json of depthbench report)"};
 
 // A figure as shown: four significant digits; nullopt when not finite.
@@ -98,7 +98,7 @@ struct SplitRow {
   CellColumns cell;
   std::string ratio;
   Figure log10_ratio;
-  Figure total, storage, arith;
+  Figure total, production, storage, arith;
 };
 
 struct BackendDifferenceRow {

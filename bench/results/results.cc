@@ -60,9 +60,13 @@ json MetricToJson(const MetricStats& m) {
 json BandToJson(const BandStats& b) {
   json metrics = json::object();
   for (int m = 0; m < kMetricCount; ++m) metrics[MetricName(static_cast<Metric>(m))] = MetricToJson(b.metrics[m]);
-  return {{"finite", b.finite},   {"nan", b.nan},
-          {"inf", b.inf},         {"degenerate", b.degenerate},
-          {"outside", b.outside}, {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
+  return {{"finite", b.finite},
+          {"nan", b.nan},
+          {"inf", b.inf},
+          {"stored_nonfinite", b.stored_nonfinite},
+          {"degenerate", b.degenerate},
+          {"outside", b.outside},
+          {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
           {"metrics", metrics}};
 }
 
@@ -115,7 +119,9 @@ json DomainToJson(const Domain& d) {
               {"far", d.far ? RangeToJson(*d.far) : json(nullptr)},
               {"camera_distance", RangeToJson(d.camera_distance)},
               {"eye_depth", d.eye_depth ? RangeToJson(*d.eye_depth) : json(nullptr)},
-              {"resolutions", resolutions}};
+              {"resolutions", resolutions},
+              {"name", d.name},
+              {"production", ProductionModelName(d.production)}};
   return out;
 }
 
@@ -145,6 +151,13 @@ json ToJson(const Results& results) {
       entry["distance"] = DistanceBandName(band);
       distance.push_back(entry);
     }
+    json coverage = json::array();
+    for (const auto& [band, stats] : c.stats.coverage) {
+      json entry = BandToJson(stats);
+      entry["coverage_band"] = band;
+      entry["coverage"] = CoverageBandName(band);
+      coverage.push_back(entry);
+    }
     cells.push_back({{"cell", c.cell.Name()},
                      {"variant", Info(c.cell.variant).name},
                      {"convention", Info(c.cell.convention).name},
@@ -154,11 +167,12 @@ json ToJson(const Results& results) {
                       {{"finite", all.finite},
                        {"nan", all.nan},
                        {"inf", all.inf},
+                       {"stored_nonfinite", all.stored_nonfinite},
                        {"degenerate", all.degenerate},
                        {"outside", all.outside},
                        {"first_nonfinite_index", JsonIndex(all.first_nonfinite_index)}}},
                      {"summary", SummaryToJson(all)},
-                     {"bands", {{"joint", joint}, {"distance", distance}}}});
+                     {"bands", {{"joint", joint}, {"distance", distance}, {"coverage", coverage}}}});
   }
 
   return WithSchema(kResultsSchema, {{"run",
@@ -216,6 +230,7 @@ Expected<BandStats> BandFrom(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(b.finite, r.Unsigned("finite"));
   DB_ASSIGN_OR_RETURN(b.nan, r.Unsigned("nan"));
   DB_ASSIGN_OR_RETURN(b.inf, r.Unsigned("inf"));
+  DB_ASSIGN_OR_RETURN(b.stored_nonfinite, r.Unsigned("stored_nonfinite"));
   DB_ASSIGN_OR_RETURN(b.degenerate, r.Unsigned("degenerate"));
   DB_ASSIGN_OR_RETURN(b.outside, r.Unsigned("outside"));
   DB_ASSIGN_OR_RETURN(b.first_nonfinite_index, r.Unsigned("first_nonfinite_index"));
@@ -267,6 +282,18 @@ Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
     d.resolutions.push_back({static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
     return Status::Ok();
   }));
+  // Files written before these fields existed: their depth was produced
+  // exactly, and their domain had no name.
+  d.name = "custom";
+  if (r.Has("name")) DB_RETURN_IF_ERROR(StoreInto(r.String("name"), d.name));
+  d.production = ProductionModel::kExact;
+  if (r.Has("production")) {
+    DB_ASSIGN_OR_RETURN(const JsonReader production, r.Field("production"));
+    DB_ASSIGN_OR_RETURN(const std::string name, production.String());
+    const Expected<ProductionModel> model = ParseProductionModel(name);
+    if (!model.ok()) return production.Error(model.status().message());
+    d.production = *model;
+  }
   Status valid = d.Validate();
   if (!valid.ok()) return r.Error(valid.message());
   return d;
@@ -325,6 +352,12 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
       DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "distance_band", kDistanceBands));
       DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
       result.stats.distance[band].Merge(stats);
+      return Status::Ok();
+    }));
+    DB_RETURN_IF_ERROR(bands.ForEach("coverage", [&](const JsonReader& b) -> Status {
+      DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "coverage_band", kCoverageBands));
+      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
+      result.stats.coverage[band].Merge(stats);
       return Status::Ok();
     }));
     results.cells.push_back(std::move(result));

@@ -21,7 +21,9 @@
 
 namespace depthbench {
 
-inline constexpr JsonSchema kResultsSchema{"depthbench.results", 1, "a results file of depthbench run --json"};
+// Version 2: the production metric, non-finite outputs by cause, coverage
+// bands, the domain's name and production model.
+inline constexpr JsonSchema kResultsSchema{"depthbench.results", 2, "a results file of depthbench run --json"};
 
 // Shard K of N (1-based, as "--shard K/N" spells it): samples
 // [total * (K-1) / N, total * K / N) of the sweep.

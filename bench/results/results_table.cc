@@ -41,7 +41,8 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions), run.seconds,
                        SiCount(run.reconstructions / run.seconds));
   }
-  out << "bits lost = max(0, log2(relative error / 2^-24)); relative to the distance from the camera\n\n";
+  out << "bits lost = log2(relative error / 2^-24), from 0 (float32's own rounding) to 24 (nothing left); relative "
+         "to the distance from the camera\n\n";
 }
 
 void PrintResultsTable(const Results& results, std::ostream& out) {
@@ -53,24 +54,29 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
                    {"p99"},
                    {"p99.9"},
                    {"max"},
-                   {"arith p99.9"},
-                   {"storage p99.9"},
+                   {"prod"},
+                   {"stor"},
+                   {"shader"},
                    {"abs p99.9"},
                    {"abs max"},
                    {"NaN"},
                    {"Inf"},
-                   {"degen"}});
+                   {"stored inf"}});
   for (const CellResult& c : results.cells) {
     const BandStats all = c.stats.All();
     const Summary total = Summarize(all, Metric::kTotal);
     const Summary absolute = Summarize(all, Metric::kAbsolute);
     table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99), Bits(total.p999),
-                  Bits(total.max), Bits(Summarize(all, Metric::kArith).p999),
-                  Bits(Summarize(all, Metric::kStorage).p999), fmt::format("{:.2g}", absolute.p999),
-                  fmt::format("{:.2g}", absolute.max), Count(all.nan), Count(all.inf), Count(all.degenerate)});
+                  Bits(total.max), Bits(Summarize(all, Metric::kProduction).p999),
+                  Bits(Summarize(all, Metric::kStorage).p999), Bits(Summarize(all, Metric::kArith).p999),
+                  fmt::format("{:.2g}", absolute.p999), fmt::format("{:.2g}", absolute.max), Count(all.nan),
+                  Count(all.inf), Count(all.stored_nonfinite)});
   }
-  out << "bits lost of the total error (p50 / p99 / p99.9 / max), of its arithmetic and storage parts,\n"
-         "and the absolute error in world units\n";
+  out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
+         "(p50 / p99 / p99.9 / max) and, at p99.9, of its three causes: prod (the depth the pipeline produced),\n"
+         "stor (the format's rounding and fetch), shader (the variant's float32 arithmetic); the absolute error in\n"
+         "world units; NaN and Inf outputs where exact arithmetic on the shader's inputs is finite (findings), and\n"
+         "'stored inf', non-finite outputs of stored values that denote infinity or the camera (expected)\n";
   table.Print(out);
 }
 

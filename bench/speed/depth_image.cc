@@ -42,14 +42,16 @@ std::vector<std::uint32_t> EncodeDepthRows(Encoding encoding, const Frame& frame
                                            std::uint32_t rows) {
   const std::uint32_t width = frame.width;
   const std::size_t n = static_cast<std::size_t>(width) * rows;
-  std::vector<double> near(n, frame.near), far(n, frame.far), eye(n);
+  std::vector<double> near(n, frame.near), far(n, frame.far), eye(n), a(n), b(n);
   for (std::uint32_t r = 0; r < rows; ++r) {
     for (std::uint32_t x = 0; x < width; ++x) eye[std::size_t{r} * width + x] = EyeDepthAt(frame, x, first_row + r);
   }
-  // The pipeline's float, then the format's code (encode.h).
+  // The pipeline's float, then the format's code (encode.h). The image is
+  // only timed, so its depth is the exactly rounded one.
   std::vector<float> floats(n), fetched(n);
   std::vector<std::uint32_t> codes(n);
-  PipelineFloats(encoding, near.data(), far.data(), eye.data(), n, floats.data());
+  PipelineFloats(encoding, ProductionModel::kExact, {near.data(), far.data(), a.data(), b.data()}, eye.data(), n,
+                 floats.data());
   StoreFloats(encoding.format, floats.data(), n, codes.data(), fetched.data());
   return codes;
 }

@@ -20,7 +20,6 @@ inline constexpr double kBitsResolution = 1.0 / 4.0;
 // A cell whose NaN and Inf outputs exceed this share of its judged samples
 // has a non-finite p99.9: it counts as losing every bit.
 inline constexpr double kNonfiniteShareAtP999 = 0.001;
-inline constexpr double kAllBitsLost = 24.0;
 
 struct FrontCandidate {
   double cost = 0.0;

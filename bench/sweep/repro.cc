@@ -86,6 +86,8 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
     cell.true_depth = r.true_depth;
     cell.denoted_depth = r.denoted_depth;
     cell.storage = std::sqrt(batch.reference.storage_square[plan.depth_slot]);
+    cell.production = std::sqrt(batch.reference.production_square[plan.depth_slot]);
+    cell.stored_holdable = r.stored_holdable;
     cell.status = StatusName(r.status);
     for (std::size_t b = 0; b < backends.size(); ++b) {
       ReproCellOutput o;
@@ -109,14 +111,16 @@ void PrintRepro(const Repro& repro, std::ostream& out) {
   for (const ReproCell& c : repro.cells) {
     out << fmt::format(
         "\n{}: stored 0x{:08x} (fetched as {:.9g}); true eye depth {:.17g}, stored value denotes "
-        "{:.17g} (storage error {:.3g}); {}\n",
-        c.cell.Name(), c.code, c.fetched, c.true_depth, c.denoted_depth, c.storage, c.status);
+        "{:.17g} (production error {:.3g}, storage error {:.3g}); {}\n",
+        c.cell.Name(), c.code, c.fetched, c.true_depth, c.denoted_depth, c.production, c.storage, c.status);
     for (const ReproCellOutput& o : c.outputs) {
       out << fmt::format("  {:>6}: ({:.9g}, {:.9g}, {:.9g})", o.backend, o.position[0], o.position[1], o.position[2]);
       if (o.nan || o.inf) {
-        out << (o.nan ? "  NaN\n" : "  Inf\n");
+        out << (o.nan ? "  NaN" : "  Inf")
+            << (c.stored_holdable ? " (a finding: exact arithmetic on these inputs is finite)\n"
+                                  : " (expected: the stored value denotes no point float32 can hold)\n");
       } else {
-        out << fmt::format("  error {:.3g} ({:.1f} bits lost; arithmetic {:.3g}), {:.3g} world units\n", o.total,
+        out << fmt::format("  error {:.3g} ({:.1f} bits lost; shader {:.3g}), {:.3g} world units\n", o.total,
                            BitsLost(o.total), o.arith, o.absolute);
       }
     }
@@ -143,6 +147,8 @@ nlohmann::json ReproToJson(const Repro& repro) {
                      {"true_depth", c.true_depth},
                      {"denoted_depth", c.denoted_depth},
                      {"storage_error", c.storage},
+                     {"production_error", c.production},
+                     {"stored_holdable", c.stored_holdable},
                      {"status", c.status},
                      {"outputs", outputs}});
   }

@@ -32,8 +32,9 @@ struct ReproCell {
   Cell cell;
   std::uint32_t code = 0;
   float fetched = 0.0f;
-  double true_depth = 0, denoted_depth = 0, storage = 0;
-  std::string status;  // "judged", "degenerate", "outside"
+  double true_depth = 0, denoted_depth = 0, storage = 0, production = 0;  // relative errors
+  bool stored_holdable = true;  // a non-finite output of a value that denotes no holdable point is expected
+  std::string status;           // "judged", "degenerate", "outside"
   std::vector<ReproCellOutput> outputs;
 };
 

@@ -49,11 +49,19 @@ class FirstError {
   Status status_;
 };
 
-// Storage statistics live per encoding; each cell reports its encoding's.
-void CopyStorageMetric(const CellStats& from, CellStats& to) {
-  constexpr int kStorage = static_cast<int>(Metric::kStorage);
-  for (const auto& [band, stats] : from.joint) to.joint[band].metrics[kStorage] = stats.metrics[kStorage];
-  for (const auto& [band, stats] : from.distance) to.distance[band].metrics[kStorage] = stats.metrics[kStorage];
+// Storage and production statistics live per encoding; each cell reports
+// its encoding's.
+void CopyEncodingMetrics(const CellStats& from, CellStats& to) {
+  const auto copy = [](const std::map<int, BandStats>& bands, std::map<int, BandStats>& into) {
+    for (const auto& [band, stats] : bands) {
+      for (Metric m : {Metric::kStorage, Metric::kProduction}) {
+        into[band].metrics[static_cast<int>(m)] = stats.metrics[static_cast<int>(m)];
+      }
+    }
+  };
+  copy(from.joint, to.joint);
+  copy(from.distance, to.distance);
+  copy(from.coverage, to.coverage);
 }
 
 }  // namespace
@@ -110,8 +118,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const std::size_t cell_count = layout.cells.size();
   std::vector<CellAccumulator> accumulators(backends.size() * cell_count);
   std::vector<CellStats> stats(backends.size() * cell_count);
-  // Storage errors belong to an encoding, whatever reads it: one
-  // accumulator per depth slot, copied into its cells at the end.
+  // Storage and production errors belong to an encoding, whatever reads
+  // it: one accumulator per depth slot, copied into its cells at the end.
   const std::size_t slot_count = layout.encodings.size();
   std::vector<CellAccumulator> storage_accumulators(slot_count);
   std::vector<CellStats> storage_stats(slot_count);
@@ -147,7 +155,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         for (std::uint32_t c : cells_of_slot[slot]) judged.push_back({positions_of(c), &acc[c]});
         const auto depth_slot = static_cast<std::uint32_t>(slot);
         JudgeSlot(batch, depth_slot, judged, options.isa);
-        if (b == 0) RecordStorage(batch, depth_slot, storage_accumulators[slot], options.isa);
+        if (b == 0) RecordEncodingErrors(batch, depth_slot, storage_accumulators[slot], options.isa);
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (backend.concurrent()) {
@@ -203,7 +211,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (std::size_t b = 0; b < backends.size(); ++b) {
     for (std::size_t c = 0; c < cell_count; ++c) {
       const std::size_t k = b * cell_count + c;
-      CopyStorageMetric(storage_stats[layout.cells[c].depth_slot], stats[k]);
+      CopyEncodingMetrics(storage_stats[layout.cells[c].depth_slot], stats[k]);
       results.cells.push_back({layout.cells[c].cell, backends[b]->name(), std::move(stats[k])});
     }
   }
