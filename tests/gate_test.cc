@@ -204,5 +204,20 @@ TEST(GateBandTest, ShadersWithOnlyACpuBaselineAreRefused) {
   EXPECT_NE(r.err.find("none of the baselines is for the vulkan backend"), std::string::npos) << r.err;
 }
 
+// A regression of half a bit at the float32 floor is caught: two more ulps
+// of relative error on every divide output (the result scaled by 1 + 2^-23)
+// lift reversed D32F's p99.9 from about 2 bits by about half a bit, above
+// the 0.25-bit tolerance and the band's sampling interval.
+TEST(GateBandTest, HalfABitAtTheFloorIsCaught) {
+  const std::string root = testing::MakeTempDir("gate_half_bit");
+  testing::CopyShaderSources(root);
+  ASSERT_TRUE(testing::ReplaceInFile(root + "/shared/variants/divide.h", "  return world_from_view(frame, view);",
+                                     "  return world_from_view(frame, view * (1.0f + 1.1920928955078125e-07f));"));
+  const auto r = RunDepthbench({"gate", "--baseline", kBaseline, "--shaders", root + "/shaders"});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("worse: divide/reversed/d32_sfloat"), std::string::npos) << r.out;
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace depthbench

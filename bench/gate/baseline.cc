@@ -18,6 +18,8 @@ BandFigures FiguresOf(const BandStats& band) {
   const Summary total = Summarize(band, Metric::kTotal);
   const Summary arith = Summarize(band, Metric::kArith);
   f.total_p999 = BitsLost(total.p999);
+  f.p999_interval_bits = std::max(f.total_p999 - BitsLost(total.p999_interval.low),
+                                  BitsLost(total.p999_interval.high) - f.total_p999);
   f.total_max = BitsLost(total.max);
   f.arith_p999 = BitsLost(arith.p999);
   f.arith_max = BitsLost(arith.max);
@@ -87,6 +89,7 @@ json BaselineToJson(const Baseline& b) {
                      {"total_max_bits", JsonNumber(f.total_max)},
                      {"arith_p999_bits", f.arith_p999},
                      {"arith_max_bits", JsonNumber(f.arith_max)},
+                     {"p999_interval_bits", f.p999_interval_bits},
                      {"judged", f.judged},
                      {"nan", f.nan},
                      {"inf", f.inf},
@@ -132,6 +135,9 @@ Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
       DB_ASSIGN_OR_RETURN(f.total_max, r.Number("total_max_bits"));
       DB_ASSIGN_OR_RETURN(f.arith_p999, r.Number("arith_p999_bits"));
       DB_ASSIGN_OR_RETURN(f.arith_max, r.Number("arith_max_bits"));
+      if (r.Has("p999_interval_bits")) {
+        DB_RETURN_IF_ERROR(StoreInto(r.Number("p999_interval_bits"), f.p999_interval_bits));
+      }
       DB_ASSIGN_OR_RETURN(f.judged, r.Unsigned("judged"));
       DB_ASSIGN_OR_RETURN(f.nan, r.Unsigned("nan"));
       DB_ASSIGN_OR_RETURN(f.inf, r.Unsigned("inf"));

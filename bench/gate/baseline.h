@@ -27,6 +27,9 @@ inline constexpr JsonSchema kBaselineSchema{"depthbench.baseline", 1, "a gate ba
 struct BandFigures {
   double total_p999 = 0, total_max = 0;
   double arith_p999 = 0, arith_max = 0;
+  // Half the width, in bits, of the total p99.9's 95% sampling interval
+  // (the larger side): how far the figure could move with other samples.
+  double p999_interval_bits = 0;
   std::uint64_t judged = 0, nan = 0, inf = 0;
   std::uint64_t worst_index = 0;            // the sample with the largest total error
   std::uint64_t first_nonfinite_index = 0;  // UINT64_MAX when there is none

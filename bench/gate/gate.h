@@ -6,7 +6,10 @@
 // change (the order of a float sum: a few units in the last place), not
 // noise. In bits lost, a few ulps at the p99.9 (where errors are at least a
 // few ulps) move the figure by under 0.25 bit; the maximum is one sample
-// and may move by up to 0.5 bit.
+// and may move by up to 0.5 bit. Where a band's p99.9 has a wider sampling
+// interval (few samples above it), that interval is the tolerance, and a
+// band with too few samples for a p99.9 (MinimumSamples) is compared at
+// its maximum only.
 #pragma once
 
 #include <string>

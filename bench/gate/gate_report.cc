@@ -66,8 +66,10 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
                         : fmt::format("FAIL: {} of {} cells got worse ({})", failures, cells, Join(backends, ", ")))
       << "\n";
   if (improvements > 0) out << fmt::format("{} cells improved\n", improvements);
-  out << fmt::format("(tolerance: {} bit at p99.9, {} bit at the maximum; NaN or Inf appearing always counts)\n",
-                     tolerance.p999_bits, tolerance.max_bits);
+  out << fmt::format(
+      "(tolerance: {} bit at p99.9, or its sampling interval where wider, {} bit at the maximum; NaN or Inf appearing "
+      "always counts)\n",
+      tolerance.p999_bits, tolerance.max_bits);
   for (const GateRun& r : runs) {
     for (const std::string& note : r.comparison.notes) out << "note (" << r.current.backend << "): " << note << "\n";
   }

@@ -80,10 +80,15 @@ json SummaryToJson(const BandStats& all) {
                   {"p999", JsonNumber(s.p999)},
                   {"max", JsonNumber(s.max)},
                   {"worst_index", JsonIndex(s.worst_index)}};
+    entry["p999_low"] = JsonNumber(s.p999_interval.low);
+    entry["p999_high"] = JsonNumber(s.p999_interval.high);
+    entry["p999_supported"] = s.p999_supported;
     if (metric != Metric::kAbsolute) {
       entry["p50_bits"] = BitsLost(s.p50);
       entry["p99_bits"] = BitsLost(s.p99);
       entry["p999_bits"] = BitsLost(s.p999);
+      entry["p999_low_bits"] = BitsLost(s.p999_interval.low);
+      entry["p999_high_bits"] = BitsLost(s.p999_interval.high);
       entry["max_bits"] = JsonNumber(BitsLost(s.max));
     }
     out[MetricName(metric)] = entry;

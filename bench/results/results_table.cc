@@ -10,6 +10,14 @@ namespace depthbench {
 namespace {
 
 std::string Bits(double relative) { return fmt::format("{:.1f}", BitsLost(relative)); }
+
+// A p99.9 with the larger half of its 95% interval, or what it lacks.
+std::string P999(const Summary& s) {
+  if (!s.p999_supported) return "few";
+  const double bits = BitsLost(s.p999);
+  const double spread = std::max(bits - BitsLost(s.p999_interval.low), BitsLost(s.p999_interval.high) - bits);
+  return fmt::format("{:.1f}±{:.1f}", bits, spread);
+}
 std::string Count(std::uint64_t n) { return n == 0 ? "0" : fmt::format("{}", n); }
 
 std::string SiCount(double x) {
@@ -66,14 +74,15 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
     const BandStats all = c.stats.All();
     const Summary total = Summarize(all, Metric::kTotal);
     const Summary absolute = Summarize(all, Metric::kAbsolute);
-    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99), Bits(total.p999),
+    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99), P999(total),
                   Bits(total.max), Bits(Summarize(all, Metric::kProduction).p999),
                   Bits(Summarize(all, Metric::kStorage).p999), Bits(Summarize(all, Metric::kArith).p999),
                   fmt::format("{:.2g}", absolute.p999), fmt::format("{:.2g}", absolute.max), Count(all.nan),
                   Count(all.inf), Count(all.stored_nonfinite)});
   }
   out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
-         "(p50 / p99 / p99.9 / max) and, at p99.9, of its three causes: prod (the depth the pipeline produced),\n"
+         "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
+         "three causes: prod (the depth the pipeline produced),\n"
          "stor (the format's rounding and fetch), shader (the variant's float32 arithmetic); the absolute error in\n"
          "world units; NaN and Inf outputs where exact arithmetic on the shader's inputs is finite (findings), and\n"
          "'stored inf', non-finite outputs of stored values that denote infinity or the camera (expected)\n";
@@ -106,13 +115,15 @@ void PrintBandTable(const Results& results, BandFamily family, std::ostream& out
       BandStats s = family == BandFamily::kRatio   ? c.stats.ForRatio(band)
                     : family == BandFamily::kDepth ? c.stats.ForDepth(band)
                                                    : c.stats.ForDistance(band);
-      std::string text = s.finite == 0 ? "-" : Bits(Summarize(s, Metric::kTotal).p999);
+      const Summary total = Summarize(s, Metric::kTotal);
+      std::string text = s.finite == 0 ? "-" : total.p999_supported ? Bits(total.p999) : "few";
       if (s.nan + s.inf > 0) text += "!";
       row.push_back(text);
     }
     table.AddRow(std::move(row));
   }
-  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples)\n", title);
+  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under 4000)\n",
+                     title);
   table.Print(out);
 }
 
