@@ -17,12 +17,7 @@
 namespace depthbench::cli {
 
 void DomainFlags::Add(CLI::App& app) {
-  app.add_option("--domain", domain,
-                 "the scenes to sample: typical (the default: what games and viewers render, camera-relative: fov "
-                 "30-100 deg, aspect 1-2.4, near 0.01-1, far/near 1e2-1e5 and infinite), wide (fov 1-179, aspect "
-                 "0.1-10, near 1e-4-10, far/near 1e1-1e8 and infinite, cameras up to 1e6 from the origin), extremes "
-                 "(near 1e-6-1e-2, far/near 1e6-1e9 and infinite, cameras 1e5-1e7 out), or a scene file NAME.toml "
-                 "(as choose reads). The flags below narrow it")
+  app.add_option("--domain", domain, std::string(kDomainHelp) + ". The flags below narrow it")
       ->type_name("NAME|FILE")
       ->group("Domain");
   app.add_option("--near", near, "near plane: VALUE or MIN:MAX (log-uniform)")->type_name("RANGE")->group("Domain");
@@ -56,16 +51,19 @@ void DomainFlags::Add(CLI::App& app) {
       ->group("Domain");
 }
 
-Expected<Domain> DomainFlags::Apply(Domain d) const {
-  if (!domain.empty()) {
-    const bool file = domain.find('/') != std::string::npos || domain.ends_with(".toml");
-    if (file) {
-      DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(domain));
-      d = scene.domain;
-    } else {
-      DB_RETURN_IF_ERROR(StoreInto(NamedDomain(domain), d).WithContext("--domain"));
-    }
+Expected<Domain> DomainByName(const std::string& name_or_file) {
+  const bool file = name_or_file.find('/') != std::string::npos || name_or_file.ends_with(".toml");
+  if (!file) {
+    Expected<Domain> named = NamedDomain(name_or_file);
+    if (!named.ok()) return named.status().WithContext("--domain");
+    return named;
   }
+  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(name_or_file));
+  return scene.domain;
+}
+
+Expected<Domain> DomainFlags::Apply(Domain d) const {
+  if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain), d));
   const bool narrowed = !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() &&
                           camera_distance.empty() && eye_depth.empty() && resolution.empty() && production.empty());
   if (narrowed) d.name += " (narrowed)";

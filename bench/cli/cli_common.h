@@ -21,6 +21,15 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFinding = 1;
 inline constexpr int kExitCannotRun = 2;
 
+// A named domain (typical, wide, extremes) or the domain of a scene file.
+Expected<Domain> DomainByName(const std::string& name_or_file);
+// What --domain says, for the commands that take it.
+inline constexpr const char* kDomainHelp =
+    "the scenes to sample: typical (the default: what games and viewers render, camera-relative: fov 30-100 deg, "
+    "aspect 1-2.4, near 0.01-1, far/near 1e2-1e5 and infinite), wide (fov 1-179, aspect 0.1-10, near 1e-4-10, "
+    "far/near 1e1-1e8 and infinite, cameras up to 1e6 from the origin), extremes (near 1e-6-1e-2, far/near 1e6-1e9 "
+    "and infinite, cameras 1e5-1e7 out), or a scene file NAME.toml (as choose reads)";
+
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production;

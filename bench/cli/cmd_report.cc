@@ -33,6 +33,7 @@ struct ReportFlags {
   std::string plot_library;   // default: the data folder's
   std::string page_template;  // default: the data folder's
   bool fail_on_regression = false;
+  DomainFlags domain;
   CellFlags cells;
   BackendFlags backends;
 };
@@ -65,6 +66,11 @@ Expected<int> RunReport(const ReportFlags& f) {
     DB_ASSIGN_OR_RETURN(plan.main_samples, ParseCount(f.default_samples, "--default-samples"));
   }
   plan.fit.seed = f.seed;
+  // The default-domain sweep's domain; the fit sweeps take its lens,
+  // planes and targets, with the camera at the origin and their own ratios.
+  DB_ASSIGN_OR_RETURN(plan.main_domain, f.domain.Apply(plan.main_domain));
+  plan.fit.domain = plan.main_domain;
+  plan.fit.domain.camera_distance = {0.0, 0.0};
   plan.shader_dir = f.backends.shaders;
   DB_ASSIGN_OR_RETURN(std::vector<Cell> cells, f.cells.Select());
   if (cells.size() != AllCells().size()) plan.cells = std::move(cells);
@@ -188,6 +194,7 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
                   "the page's HTML template (default: the data folder's reports/report_template.html)");
   cmd->add_flag("--fail-on-regression", flags->fail_on_regression,
                 "exit 1 when a cell got worse since the previous comparable run");
+  flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
   cmd->callback([flags, &action] { action = [flags] { return RunReport(*flags); }; });

@@ -30,6 +30,7 @@ struct SpeedFlags {
   std::uint32_t warmup = 2;
   std::string results;
   std::string accuracy_samples = "1e5";
+  std::string domain;  // of the accuracy run (default typical)
   std::string json;
   std::string compare;
   bool quick = false;
@@ -50,9 +51,10 @@ Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cell
   DB_ASSIGN_OR_RETURN(std::unique_ptr<Backend> backend, MakeVulkanBackend(std::move(context), backend_options));
   SweepOptions sweep;
   sweep.samples = samples;
+  if (!f.domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(f.domain), sweep.domain));
   sweep.cells = CellsForDomain(cells, sweep.domain);
   Backend* backends[] = {backend.get()};
-  source = fmt::format("internal run of {} samples, seed {}, default domain", samples, sweep.seed);
+  source = fmt::format("internal run of {} samples, seed {}, {}", samples, sweep.seed, sweep.domain.Describe());
   return RunSweep(sweep, backends);
 }
 
@@ -175,6 +177,8 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--results", flags->results,
                   "accuracy results (depthbench run --json) for the trade; default: an internal run on the same "
                   "device");
+  cmd->add_option("--domain", flags->domain, std::string("the internal accuracy run's domain: ") + kDomainHelp)
+      ->type_name("NAME|FILE");
   cmd->add_option("--accuracy-samples", flags->accuracy_samples,
                   "samples of the internal accuracy run when no --results is given (default 1e5)")
       ->each([flags](const std::string&) { flags->accuracy_samples_given = true; });
