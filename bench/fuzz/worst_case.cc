@@ -50,7 +50,10 @@ Expected<SearchResult> SearchWorstCase(const SearchOptions& options, Backend& ba
   const std::uint32_t frames = std::max<std::uint32_t>(1, options.frames_per_generation);
   constexpr int kFrameUnits = 13;
 
-  while (elapsed() < options.seconds) {
+  auto budget_left = [&] {
+    return elapsed() < options.seconds && (options.evaluations == 0 || result.evaluations < options.evaluations);
+  };
+  while (budget_left()) {
     PointBatch batch(options.domain);
     for (std::uint32_t f = 0; f < frames; ++f) {
       // A frame: a fresh random one (a quarter of them, and all until the

@@ -24,6 +24,7 @@ struct SearchOptions {
   Domain domain;
   std::uint64_t seed = 1;
   double seconds = 1.0;                      // time budget
+  std::uint64_t evaluations = 0;             // evaluation budget too, when not 0
   std::uint32_t frames_per_generation = 32;  // x 64 samples
   std::uint32_t elite = 16;                  // best inputs kept
   std::function<void(double fraction, double best_bits)> progress;

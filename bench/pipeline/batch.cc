@@ -94,7 +94,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // stored texels, their decode and the reference.
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
-  for (auto* v : {&mapping_a_, &mapping_b_, &produced_hi_, &produced_lo_}) v->resize(pipelines * count);
+  for (auto* v : {&mapping_a_, &mapping_b_, &produced_}) v->resize(pipelines * count);
   pipeline_floats_.resize(pipelines * count);
   const auto mapping_of = [&](std::size_t k) {
     return DepthMappings{samples.near.data(), samples.far.data(), mapping_a_.data() + k * count,
@@ -125,8 +125,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       const DepthMappings mapping = mapping_of(k).At(lo);
       float* floats = pipeline_floats_.data() + k * count + lo;
       PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
-      DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_hi_.data() + k * count + lo,
-                      produced_lo_.data() + k * count + lo, isa_);
+      DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);
     }
   });
 
@@ -134,7 +133,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.codes.resize(slots * count);
   batch.reference.Resize(slots * count);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
-    std::array<double, kChunk> denoted_hi, denoted_lo;
+    std::array<double, kChunk> denoted;
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
       const Encoding encoding = encodings_[s];
@@ -161,11 +160,10 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.depths[s * count + i] = edge.fetched;
       }
       const std::size_t pipeline = pipeline_of_slot_[s];
-      DecodeEyeDepths(encoding, model_, mapping_of(pipeline).At(lo), batch.depths.data() + at, n, denoted_hi.data(),
-                      denoted_lo.data(), isa_);
-      References(encoding, samples, lo, n, {denoted_hi.data(), denoted_lo.data()},
-                 {produced_hi_.data() + pipeline * count + lo, produced_lo_.data() + pipeline * count + lo},
-                 batch.reference, at, isa_);
+      DecodeEyeDepths(encoding, model_, mapping_of(pipeline).At(lo), batch.depths.data() + at, n, denoted.data(),
+                      nullptr, isa_);
+      References(encoding, samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo, batch.reference,
+                 at, isa_);
     }
   });
 }

@@ -55,7 +55,7 @@ class BatchBuilder {
   // floats, the float32 constants of their mapping (encode.h) and the
   // depth each float denotes (the produced depth).
   mutable std::vector<float> pipeline_floats_;
-  mutable std::vector<double> mapping_a_, mapping_b_, produced_hi_, produced_lo_;
+  mutable std::vector<double> mapping_a_, mapping_b_, produced_;
 };
 
 }  // namespace depthbench

@@ -379,7 +379,7 @@ namespace {
     for (int g = 0; g < 2; ++g) {
       const Double4 h = z[g].hi(), l = z[g].lo();
       std::memcpy(hi + i + 4 * g, &h, sizeof(h));
-      std::memcpy(lo + i + 4 * g, &l, sizeof(l));
+      if (lo != nullptr) std::memcpy(lo + i + 4 * g, &l, sizeof(l));
     }
   }
   if (i < n) {  // the tail, padded with its last sample
@@ -392,7 +392,7 @@ namespace {
     const std::array<DoubleDouble4, 2> z = decode(in);
     for (std::size_t k = 0; i + k < n; ++k) {
       hi[i + k] = z[k / 4].hi()[k % 4];
-      lo[i + k] = z[k / 4].lo()[k % 4];
+      if (lo != nullptr) lo[i + k] = z[k / 4].lo()[k % 4];
     }
   }
 }

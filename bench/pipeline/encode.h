@@ -83,7 +83,8 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick);
 // denote the camera or infinity.
 DoubleDouble DecodeEyeDepth(Encoding encoding, ProductionModel model, const Frame& frame, float value);
 // The same for n values, four lanes at a time, as the two parts of each
-// double-double. Every lane computes exactly what the scalar form does.
+// double-double (the low parts only where lo is not null). Every lane
+// computes exactly what the scalar form does.
 // Compiled for each instruction set `isa` can name (bench/base/isa.h).
 void DecodeEyeDepths(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const float* values,
                      std::size_t n, double* hi, double* lo, Isa isa = Isa::kWidest);

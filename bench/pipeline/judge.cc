@@ -102,18 +102,6 @@ template <int N>
   }
 }
 
-// The slots a sample's figures go to: the joint and the distance band of a
-// sample of the natural distribution, or its coverage band alone.
-struct SampleSlots {
-  CellAccumulator::Slot* slots[2];
-  int count;
-};
-[[gnu::always_inline]] inline SampleSlots SlotsOf(CellAccumulator& accumulator, CellAccumulator::Slot& distance,
-                                                  std::uint8_t joint_band, Coverage coverage) {
-  if (coverage != Coverage::kNatural) return {{&accumulator.Coverage(CoverageBand(coverage)), nullptr}, 1};
-  return {{&accumulator.Joint(joint_band), &distance}, 2};
-}
-
 // Pass 2: counts and histograms. What a sample is to the cell follows from
 // its reference's status and from its output, which is NaN when a component
 // is NaN, and infinite when one is infinite (of either sign) and none is
@@ -123,31 +111,42 @@ struct SampleSlots {
 // degenerate, and a finite float output cannot overflow it. A non-finite
 // output is a finding only where the stored value denotes a point float32
 // can hold; otherwise it is what any arithmetic returns.
+//
+// A sample of the natural distribution goes to its joint band, with every
+// figure, and to its camera-distance band, with the total and the shader's
+// part (what camera distance does shows there whole); a targeted pick to
+// its coverage band alone (CellAccumulator::SlotsOf).
 [[gnu::always_inline]] inline void Record(const RunInputs& in, std::uint64_t first_index, std::uint32_t n,
                                           const RunScratch& s, CellAccumulator& accumulator,
                                           CellAccumulator::Slot& distance) {
   for (std::uint32_t i = 0; i < n; ++i) {
-    const SampleSlots to = SlotsOf(accumulator, distance, in.joint_band[i], in.coverage[i]);
+    const CellAccumulator::SampleSlots to = accumulator.SlotsOf(in.joint_band[i], in.coverage[i], distance);
     const std::uint64_t index = first_index + i;
     const double absolute_sq = s.absolute[i];
     const bool finite = absolute_sq < std::numeric_limits<double>::infinity();  // false for NaN
     const bool holdable = in.stored_holdable[i] != 0;
-    for (int k = 0; k < to.count; ++k) {
-      CellAccumulator::Slot& slot = *to.slots[k];
-      if (in.status[i] == ReferenceStatus::kJudged && finite) {
-        slot.Record(Metric::kTotal, static_cast<int>(s.total_bin[i]), s.total[i], index);
-        slot.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
-        // Against a stored value that denotes no holdable point, the
-        // shader has no error to speak of.
-        if (holdable) slot.Record(Metric::kArith, static_cast<int>(s.arith_bin[i]), s.arith[i], index);
-      } else if (in.status[i] == ReferenceStatus::kDegenerate) {
-        ++slot.degenerate;
-      } else if (finite) {  // outside the frustum: only a non-finite output counts
-        ++slot.outside;
-      } else if (!holdable) {
-        ++slot.stored_nonfinite;
-      } else {
-        slot.RecordNonFinite(absolute_sq != absolute_sq, index);
+    if (in.status[i] == ReferenceStatus::kJudged && finite) {
+      const int total_bin = static_cast<int>(s.total_bin[i]), arith_bin = static_cast<int>(s.arith_bin[i]);
+      to.band.Record(Metric::kTotal, total_bin, s.total[i], index);
+      to.band.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
+      to.distance.Record(Metric::kTotal, total_bin, s.total[i], index);
+      // Against a stored value that denotes no holdable point, the shader
+      // has no error to speak of.
+      if (holdable) {
+        to.band.Record(Metric::kArith, arith_bin, s.arith[i], index);
+        to.distance.Record(Metric::kArith, arith_bin, s.arith[i], index);
+      }
+    } else {
+      for (CellAccumulator::Slot* slot : {&to.band, &to.distance}) {
+        if (in.status[i] == ReferenceStatus::kDegenerate) {
+          ++slot->degenerate;
+        } else if (finite) {  // outside the frustum: only a non-finite output counts
+          ++slot->outside;
+        } else if (!holdable) {
+          ++slot->stored_nonfinite;
+        } else {
+          slot->RecordNonFinite(absolute_sq != absolute_sq, index);
+        }
       }
     }
   }
@@ -241,15 +240,15 @@ template <int N>
           }
           for (; i < end; ++i) bins[m][i - begin] = DenseBinOfSquare(squares[i], lowest);
         }
-        CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
+        // Into the sample's band only: camera distance bands keep what the
+        // variant's arithmetic does (the total and the shader's part), and
+        // neither part here depends on where the camera stands.
         for (std::uint32_t i = begin; i < end; ++i) {
           if (status[i] != ReferenceStatus::kJudged) continue;
           const std::uint64_t index = batch.first_index + i;
-          const SampleSlots to = SlotsOf(accumulator, distance, joint_band[i], coverage[i]);
-          for (int k = 0; k < to.count; ++k) {
-            for (int m = 0; m < 2; ++m) {
-              to.slots[k]->Record(kMetrics[m], static_cast<int>(bins[m][i - begin]), squares_of[m][i], index);
-            }
+          CellAccumulator::Slot& band = accumulator.BandOf(joint_band[i], coverage[i]);
+          for (int m = 0; m < 2; ++m) {
+            band.Record(kMetrics[m], static_cast<int>(bins[m][i - begin]), squares_of[m][i], index);
           }
         }
       });

@@ -88,20 +88,17 @@ struct ReferenceLanes {
   I stored_holdable;
 };
 template <class D, class I>
-[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D denoted_lo,
-                                                               D produced_hi, D produced_lo, D near, D depth_limit,
-                                                               D interest_min, D interest_max, D ray_length_sq,
-                                                               D eye_inverse_distance_sq, bool infinite_far) {
-  using DD = BasicDoubleDouble<D>;
+[[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D produced_hi,
+                                                               D near, D depth_limit, D interest_min, D interest_max,
+                                                               D ray_length_sq, D eye_inverse_distance_sq,
+                                                               bool infinite_far) {
   const auto eye = eye_pick != 0.0;
   // Stored-value picks have no scene point of their own: the truth is what
   // the stored value denotes, and their storage and production errors are
   // zero.
-  const DD denoted = DD::FromParts(denoted_hi, denoted_lo);
   const D zero = D{} * 0.0;
-  const DD truth = DD::FromParts(eye ? eye_depth : denoted_hi, eye ? zero : denoted_lo);
-  const DD produced = DD::FromParts(eye ? produced_hi : denoted_hi, eye ? produced_lo : denoted_lo);
-  const D t = truth.hi();
+  const D t = eye ? eye_depth : denoted_hi;
+  const D produced = eye ? produced_hi : denoted_hi;
   ReferenceLanes<D, I> out;
   out.true_depth = t;
   out.denoted_depth = (denoted_hi - denoted_hi) == 0.0 ? denoted_hi : zero + DBL_MAX;  // finite, or DBL_MAX
@@ -122,22 +119,21 @@ template <class D, class I>
   out.stored_holdable = stored_holdable ? I{} + 1 : I{};
   const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (t * t * ray_length_sq);
   out.inverse_distance_sq = out.status == judged ? inverse : zero;
-  // The difference of the two depths is taken in double-double (they may
-  // be close); its ratio to the distance needs no more than double. Both
-  // points lie on the same ray, so the relative error of the position is
-  // the relative error of the depth.
+  // Both points lie on the same ray, so the relative error of the
+  // position is the relative error of the depth. The differences need no
+  // more than double: an error below 2^-53 of the depth reads as 0 bits
+  // lost, and two equal decodes (a float format's texel is the pipeline's
+  // float) differ by exactly 0.
   const D scale = out.inverse_distance_sq * ray_length_sq;  // 1 / t^2 where judged
-  const D storage = (denoted - produced).hi(), production = (produced - truth).hi();
+  const D storage = denoted_hi - produced, production = produced - t;
   out.storage_square = storage * storage * scale;
   out.production_square = production * production * scale;
   return out;
 }
 
 [[gnu::always_inline]] inline void ReferencesBody(Encoding encoding, const SampleArrays& samples, std::size_t first,
-                                                  std::size_t n, DepthArrays denoted, DepthArrays produced,
+                                                  std::size_t n, const double* denoted_hi, const double* produced_hi,
                                                   ReferenceArrays& out, std::size_t out_first) {
-  const double *denoted_hi = denoted.hi, *denoted_lo = denoted.lo, *produced_hi = produced.hi,
-               *produced_lo = produced.lo;
   const ConventionInfo& convention = Info(encoding.convention);
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
   // Plain pointers, read once: the stores below cannot then be taken for
@@ -171,9 +167,8 @@ template <class D, class I>
     Double4 eye_pick;
     for (int lane = 0; lane < 4; ++lane) eye_pick[lane] = pick[k + lane] == DepthPick::kEyeDepth;
     const ReferenceLanes<Double4, Int4> lanes = ReferenceOf<Double4, Int4>(
-        eye_pick, load(eye_depth), load(denoted_hi), load(denoted_lo), load(produced_hi), load(produced_lo), load(near),
-        load(depth_limit), load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq),
-        infinite_far);
+        eye_pick, load(eye_depth), load(denoted_hi), load(produced_hi), load(near), load(depth_limit),
+        load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq), infinite_far);
     store(k, lanes, [](double* to, Double4 v) { std::memcpy(to, &v, sizeof(v)); });
     for (int lane = 0; lane < 4; ++lane) {
       status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
@@ -181,10 +176,9 @@ template <class D, class I>
     }
   }
   for (; k < n; ++k) {  // the tail
-    const ReferenceLanes<double, std::int64_t> one =
-        ReferenceOf<double, std::int64_t>(pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], denoted_lo[k],
-                                          produced_hi[k], produced_lo[k], near[k], depth_limit[k], interest_min[k],
-                                          interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
+    const ReferenceLanes<double, std::int64_t> one = ReferenceOf<double, std::int64_t>(
+        pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], produced_hi[k], near[k], depth_limit[k],
+        interest_min[k], interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
     store(k, one, [](double* to, double v) { *to = v; });
     status[k] = static_cast<ReferenceStatus>(one.status);
     stored_holdable[k] = static_cast<std::uint8_t>(one.stored_holdable != 0);
@@ -201,8 +195,8 @@ template <class D, class I>
 
 }  // namespace
 
-void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, DepthArrays denoted,
-                DepthArrays produced, ReferenceArrays& out, std::size_t out_first, Isa isa) {
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, const double* denoted,
+                const double* produced, ReferenceArrays& out, std::size_t out_first, Isa isa) {
   RunWith(
       isa, [&](auto) __attribute__((always_inline)) {
         ReferencesBody(encoding, samples, first, n, denoted, produced, out, out_first);

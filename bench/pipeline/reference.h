@@ -83,18 +83,13 @@ struct SampleArrays {
 // R * (ndc.x * tan_x, ndc.y * tan_y, -1).
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
-// Eye depths as the two parts of double-doubles, one array each.
-struct DepthArrays {
-  const double* hi;
-  const double* lo;
-};
-
 // The references of samples [first, first + n) under an encoding whose
 // stored values denote eye depths `denoted` and whose pipeline floats
-// denote `produced` (DecodeEyeDepths; k-th entry for sample first + k),
+// denote `produced` (DecodeEyeDepths, rounded to double; k-th entry for
+// sample first + k),
 // written to out at [out_first, out_first + n).
 // Compiled for each instruction set `isa` can name (bench/base/isa.h).
-void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, DepthArrays denoted,
-                DepthArrays produced, ReferenceArrays& out, std::size_t out_first, Isa isa = Isa::kWidest);
+void References(Encoding encoding, const SampleArrays& samples, std::size_t first, std::size_t n, const double* denoted,
+                const double* produced, ReferenceArrays& out, std::size_t out_first, Isa isa = Isa::kWidest);
 
 }  // namespace depthbench

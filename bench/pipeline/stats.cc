@@ -242,12 +242,12 @@ static_assert(std::is_trivially_default_constructible_v<CellAccumulator::Slot>);
 
 CellAccumulator::CellAccumulator() {
   // Fresh anonymous pages read as zeros and take memory only when written.
-  void* pages = mmap(nullptr, kSlots * sizeof(Slot), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  void* pages = mmap(nullptr, (kSlots + 1) * sizeof(Slot), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (pages == MAP_FAILED) throw std::bad_alloc();
   slots_.reset(static_cast<Slot*>(pages));
 }
 
-void CellAccumulator::Unmap::operator()(Slot* slots) const { munmap(slots, kSlots * sizeof(Slot)); }
+void CellAccumulator::Unmap::operator()(Slot* slots) const { munmap(slots, (kSlots + 1) * sizeof(Slot)); }
 
 void CellAccumulator::FlushInto(CellStats& out) {
   constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
@@ -278,6 +278,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
     to.Merge(std::move(add));
     std::memset(&slot, 0, sizeof(Slot));
   }
+  std::memset(&slots_.get()[kDiscarded], 0, sizeof(Slot));  // (its 32-bit counts must not overflow)
   pending_ = 0;
 }
 

@@ -234,6 +234,24 @@ class CellAccumulator {
   Slot& Joint(int band) { return slots_.get()[kDistanceBands + band]; }
   Slot& Distance(int band) { return slots_.get()[band]; }
   Slot& Coverage(int band) { return slots_.get()[kDistanceBands + kJointBands + band]; }
+  // The slots a sample's figures go to, chosen without a branch (targeted
+  // picks interleave with natural samples at random, and a mispredicted
+  // branch per sample and cell costs more than counts thrown away): a
+  // natural sample's joint band and the run's distance band `distance`; a
+  // targeted pick's coverage band and a slot that every flush discards.
+  struct SampleSlots {
+    Slot& band;
+    Slot& distance;
+  };
+  SampleSlots SlotsOf(std::uint8_t joint_band, depthbench::Coverage coverage, Slot& distance) {
+    const bool natural = coverage == depthbench::Coverage::kNatural;
+    return {BandOf(joint_band, coverage), natural ? distance : slots_.get()[kDiscarded]};
+  }
+  // A sample's joint band, or its coverage band if it is a targeted pick.
+  Slot& BandOf(std::uint8_t joint_band, depthbench::Coverage coverage) {
+    const bool natural = coverage == depthbench::Coverage::kNatural;
+    return slots_.get()[natural ? kDistanceBands + joint_band : kDistanceBands + kJointBands + CoverageBand(coverage)];
+  }
 
   // Samples recorded since the last flush (the caller counts them).
   void Count(std::uint64_t samples) { pending_ += samples; }
@@ -242,10 +260,12 @@ class CellAccumulator {
 
  private:
   static constexpr int kSlots = kDistanceBands + kJointBands + kCoverageBands;
+  static constexpr int kDiscarded = kSlots;  // one past the slots flushed
   struct Unmap {
     void operator()(Slot* slots) const;
   };
-  // [0, kDistanceBands): distance bands; then joint bands, then coverage.
+  // [0, kDistanceBands): distance bands; then joint bands, then coverage,
+  // then the discarded slot.
   std::unique_ptr<Slot, Unmap> slots_;
   std::uint64_t pending_ = 0;
 };
