@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "bench/backends/factory.h"
+#include "bench/base/json_reader.h"
 #include "bench/choose/choose.h"
 #include "bench/fit/precision_fit.h"
 #include "tests/command_runner.h"
@@ -15,15 +16,23 @@ namespace {
 
 const std::string kScenes = std::string(DEPTHBENCH_SOURCE_DIR) + "/bench/scenes/";
 
-ChooseResult ChooseFor(const std::string& scene_file) {
+ChooseResult ChooseFor(const std::string& scene_file, const std::string& speed_file = "") {
   auto scene = LoadScene(scene_file);
   EXPECT_TRUE(scene.ok()) << scene.status().message();
   auto backend = MakeBackend("cpu", {});
-  auto costs = StaticCostLookup("");
-  EXPECT_TRUE(costs.ok()) << costs.status().message();
+  CostSources costs;
+  auto static_model = StaticCostLookup("");
+  EXPECT_TRUE(static_model.ok()) << static_model.status().message();
+  costs.static_model = *static_model;
+  if (!speed_file.empty()) {
+    auto measured = SpeedCostLookup(speed_file);
+    EXPECT_TRUE(measured.ok()) << measured.status().message();
+    costs.measured = *measured;
+    costs.measured_from = speed_file;
+  }
   ChooseOptions options;
   options.samples = 40000;
-  auto result = Choose(*scene, **backend, *costs, options);
+  auto result = Choose(*scene, **backend, costs, options);
   EXPECT_TRUE(result.ok()) << result.status().message();
   return std::move(result).value();
 }
@@ -66,7 +75,133 @@ relative_error = 0.05
     cheapest = std::min(cheapest, v.cost->value);
   }
   EXPECT_EQ(r.ranked.front().cost->value, cheapest);
-  EXPECT_NE(r.ranked.front().reason.find("the cheapest that meets it"), std::string::npos);
+  EXPECT_NE(r.ranked.front().reason.find("the cheapest that meets it"), std::string::npos) << r.ranked.front().reason;
+  std::filesystem::remove_all(dir);
+}
+
+// The static model costs a variant the same in every convention and
+// format: those candidates tie on cost, share a rank, and go in order of
+// accuracy (the upper end of the interval).
+TEST(ChooseTest, CostTiesShareARankInOrderOfAccuracy) {
+  const std::string dir = testing::MakeTempDir("tie_scene");
+  std::ofstream(dir + "/easy.toml") << R"(name = "easy"
+[projection]
+near = 1
+far = 100
+fov_degrees = 60
+aspect = 1.5
+[requirement]
+relative_error = 0.05
+)";
+  const ChooseResult r = ChooseFor(dir + "/easy.toml");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(r.Met());
+  EXPECT_EQ(r.cost_unit, kStaticCostUnit);
+  int tied_first = 0;
+  for (std::size_t k = 0; k < r.ranked.size(); ++k) {
+    const CandidateVerdict& v = r.ranked[k];
+    if (v.rank != 1) continue;
+    ++tied_first;
+    EXPECT_TRUE(v.meets) << v.cell.Name();
+    EXPECT_EQ(v.cell.variant, r.ranked.front().cell.variant) << v.cell.Name();
+    EXPECT_EQ(v.cost->value, r.ranked.front().cost->value) << v.cell.Name();
+    if (k > 0) {
+      EXPECT_GE(v.interval.high, r.ranked[k - 1].interval.high) << v.cell.Name();
+    }
+  }
+  EXPECT_GE(tied_first, 2);
+  EXPECT_TRUE(r.ranked.front().tied);
+  EXPECT_NE(r.ranked.front().reason.find("tied for the cheapest"), std::string::npos) << r.ranked.front().reason;
+  // A rank is 1 + the candidates ahead of it.
+  for (std::size_t k = 1; k < r.ranked.size(); ++k) {
+    if (r.ranked[k].rank != r.ranked[k - 1].rank) {
+      EXPECT_EQ(r.ranked[k].rank, static_cast<int>(k) + 1);
+    }
+  }
+}
+
+// A speed file ranks by measured GPU time when it has every candidate; a
+// file that lacks one is not mixed with the static model: the static model
+// ranks every candidate, and the note says why.
+TEST(ChooseTest, SpeedFileCostsAllCandidatesOrNone) {
+  const std::string speed = std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/speed/nvidia-h100.json";
+  const ChooseResult measured = ChooseFor(kScenes + "cad_viewer.toml", speed);
+  EXPECT_NE(measured.cost_unit.find("per 1920x1080 frame"), std::string::npos) << measured.cost_unit;
+  EXPECT_TRUE(measured.cost_note.empty()) << measured.cost_note;
+  for (const CandidateVerdict& v : measured.ranked) {
+    ASSERT_TRUE(v.cost.has_value()) << v.cell.Name();
+    EXPECT_EQ(v.cost->unit, measured.cost_unit);
+  }
+
+  // The same file without the trade point of the first candidate.
+  auto json = ReadJsonFile(speed);
+  ASSERT_TRUE(json.ok()) << json.status().message();
+  const Cell dropped = measured.ranked.front().cell;
+  bool removed = false;
+  for (auto& front : (*json)["trade"]) {
+    if (front["convention"] != Info(dropped.convention).name || front["format"] != Info(dropped.format).name) continue;
+    auto& points = front["points"];
+    for (auto it = points.begin(); it != points.end(); ++it) {
+      if ((*it)["variant"] == Info(dropped.variant).name) {
+        points.erase(it);
+        removed = true;
+        break;
+      }
+    }
+  }
+  ASSERT_TRUE(removed);
+  const std::string dir = testing::MakeTempDir("partial_speed");
+  std::ofstream(dir + "/partial.json") << json->dump();
+  const ChooseResult partial = ChooseFor(kScenes + "cad_viewer.toml", dir + "/partial.json");
+  EXPECT_EQ(partial.cost_unit, kStaticCostUnit);
+  EXPECT_NE(partial.cost_note.find("static cost model"), std::string::npos) << partial.cost_note;
+  for (const CandidateVerdict& v : partial.ranked) EXPECT_EQ(v.cost->unit, kStaticCostUnit) << v.cell.Name();
+  std::filesystem::remove_all(dir);
+}
+
+// choose gates a scene in CI: exit 1 when nothing meets the requirement,
+// with the decision in --json.
+TEST(ChooseTest, NothingMeetsExitsWithOne) {
+  const std::string dir = testing::MakeTempDir("impossible_scene");
+  std::ofstream(dir + "/impossible.toml") << R"(name = "impossible"
+[projection]
+near = 0.1
+far = 100000
+fov_degrees = 60
+aspect = 1.5
+[requirement]
+relative_error = 1e-9
+)";
+  const auto r = testing::RunDepthbench({"choose", "--scene", dir + "/impossible.toml", "--backend", "cpu", "--samples",
+                                         "2e4", "--json", dir + "/choice.json"});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("nothing meets"), std::string::npos) << r.out;
+  auto json = ReadJsonFile(dir + "/choice.json");
+  ASSERT_TRUE(json.ok()) << json.status().message();
+  EXPECT_EQ((*json)["met"], false);
+  EXPECT_TRUE((*json)["choice"].is_null());
+  std::filesystem::remove_all(dir);
+}
+
+// A scene whose depths stop well short of an infinite far plane is not
+// charged for what a texel at the far plane (infinity) reconstructs to.
+TEST(ChooseTest, DepthRangeShortOfTheFarPlaneHasNoFarPlaneFindings) {
+  const std::string dir = testing::MakeTempDir("short_scene");
+  std::ofstream(dir + "/short.toml") << R"(name = "short"
+[projection]
+near = 0.1
+far = "inf"
+fov_degrees = 60
+aspect = 1.5
+[depth]
+range = [0.1, 1000]
+[requirement]
+relative_error = 1e-3
+)";
+  const ChooseResult r = ChooseFor(dir + "/short.toml");
+  ASSERT_FALSE(r.ranked.empty());
+  for (const CandidateVerdict& v : r.ranked) EXPECT_EQ(v.nonfinite, 0u) << v.cell.Name() << ": " << v.reason;
+  EXPECT_TRUE(r.Met());
   std::filesystem::remove_all(dir);
 }
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bench/base/text_table.h"
 #include "bench/results/results.h"
 #include "tests/command_runner.h"
 
@@ -57,7 +58,17 @@ INSTANTIATE_TEST_SUITE_P(
                  "cannot write '/no/such/dir/out.json': directory '/no/such/dir' does not exist"},
         BadInput{{"run", "--index", "-3"}, "--index: '-3' is not a sample index"},
         BadInput{{"merge", "/no/such/file.json", "--json", "x.json"}, "File does not exist: /no/such/file.json"},
-        BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"}),
+        BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"},
+        // Near misses get the name they were probably meant to be.
+        BadInput{{"rnu"}, "did you mean 'run'?"},
+        BadInput{{"run", "--sample", "1e5"}, "unknown option '--sample'; did you mean '--samples'?"},
+        BadInput{{"choose", "--secne", "x.toml"}, "unknown option '--secne'; did you mean '--scene'?"},
+        BadInput{{"run", "--variant", "recipocal"}, "did you mean 'reciprocal'?"},
+        BadInput{{"run", "--convention", "revresed"}, "did you mean 'reversed'?"},
+        BadInput{{"run", "--domain", "typcial"}, "did you mean 'typical'?"},
+        // Fields that are valid alone but not together.
+        BadInput{{"run", "--depth", "1e9", "--near", "1", "--far", "100"}, "lies beyond every far plane"},
+        BadInput{{"run", "--depth", "0.001:0.01", "--near", "1"}, "lies nearer than every near plane"}),
     [](const ::testing::TestParamInfo<BadInput>& info) {
       // A readable test name from the arguments: run_near_0, ...
       std::string name;
@@ -135,6 +146,55 @@ TEST(CliTest, TheDefaultRunSeparatesTheConventions) {
     }
   }
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace depthbench
+
+namespace depthbench {
+namespace {
+
+// Every line a subcommand prints fits a terminal of 120 columns: tables
+// leave out their secondary columns and wrap their text, and say so.
+TEST(CliTest, OutputFitsOneHundredTwentyColumns) {
+  const std::string dir = testing::MakeTempDir("cli_width");
+  const std::string root = DEPTHBENCH_SOURCE_DIR;
+  const std::vector<std::vector<std::string>> commands{
+      {"run", "--samples", "3000", "--split", "ratio,depth,distance"},
+      {"fit", "--samples", "4000", "--variant", "divide,reciprocal"},
+      {"choose", "--scene", root + "/bench/scenes/indoor_shooter.toml", "--backend", "cpu", "--samples", "2e4"},
+      {"gate", "--baseline", root + "/reports/baselines/cpu.json"},
+      {"fuzz", "--seconds", "2", "--out", dir + "/fuzz"},
+      {"speed", "--quick", "--resolution", "64x64", "--quiet"}};
+  for (const auto& args : commands) {
+    const auto r = RunDepthbench(args);
+    EXPECT_LE(r.exit_code, 1) << args.front() << ": " << r.err;
+    std::size_t line_number = 0, start = 0;
+    while (start < r.out.size()) {
+      std::size_t end = r.out.find('\n', start);
+      if (end == std::string::npos) end = r.out.size();
+      const std::string line = r.out.substr(start, end - start);
+      ++line_number;
+      EXPECT_LE(DisplayWidth(line), 120u) << args.front() << ", line " << line_number << ": " << line;
+      start = end + 1;
+    }
+    EXPECT_GT(line_number, 3u) << args.front() << " printed almost nothing";
+  }
+  // --wide brings the secondary columns back.
+  const auto wide = RunDepthbench({"run", "--samples", "3000", "--wide"});
+  EXPECT_EQ(wide.out.find("left out to fit"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// Numeric options say so in --help; none is left as CLI11's TEXT.
+TEST(CliTest, HelpNamesWhatEachOptionTakes) {
+  for (const char* command : {"run", "merge", "speed", "gate", "fit", "choose", "report", "fuzz"}) {
+    const auto r = RunDepthbench({command, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << command;
+    EXPECT_EQ(r.out.find(" TEXT"), std::string::npos) << command << ":\n" << r.out;
+  }
+  const auto run = RunDepthbench({"run", "--help"});
+  EXPECT_NE(run.out.find("--samples N"), std::string::npos) << run.out;
 }
 
 }  // namespace

@@ -285,8 +285,8 @@ TEST(WorstCaseTest, SearchFindsAtLeastTheRandomMaximum) {
     ASSERT_TRUE(found.ok()) << found.status().message();
     EXPECT_GE(found->evaluations, options.evaluations);
     EXPECT_GE(found->worst, random_worst)
-        << name << ": search " << BitsLost(found->worst) << " bits in " << found->evaluations
-        << " evaluations, random " << BitsLost(random_worst) << " bits in " << sweep.samples;
+        << name << ": search " << BitsLost(found->worst) << " bits in " << found->evaluations << " evaluations, random "
+        << BitsLost(random_worst) << " bits in " << sweep.samples;
   }
 }
 

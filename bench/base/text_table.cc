@@ -1,6 +1,7 @@
 #include "bench/base/text_table.h"
 
 #include <algorithm>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -13,30 +14,176 @@ void TextTable::AddRow(std::vector<std::string> cells) {
 
 void TextTable::AddSeparator() { rows_.emplace_back(); }
 
-void TextTable::Print(std::ostream& out) const {
-  std::vector<std::size_t> width(columns_.size());
-  for (std::size_t c = 0; c < columns_.size(); ++c) {
-    width[c] = columns_[c].header.size();
-    for (const auto& row : rows_)
-      if (!row.empty()) width[c] = std::max(width[c], row[c].size());
+namespace {
+
+std::size_t g_max_width = 120;
+
+// Words of `text` in lines of at most `width` columns (a longer word has a
+// line of its own).
+std::vector<std::string> Wrap(const std::string& text, std::size_t width) {
+  std::vector<std::string> lines(1);
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    std::string& line = lines.back();
+    if (!line.empty() && DisplayWidth(line) + 1 + DisplayWidth(word) > width) {
+      lines.push_back(word);
+    } else {
+      line += (line.empty() ? "" : " ") + word;
+    }
+    start = end + 1;
   }
-  auto print_row = [&](const std::vector<std::string>& cells) {
+  return lines;
+}
+
+}  // namespace
+
+std::size_t DisplayWidth(std::string_view text) {
+  return static_cast<std::size_t>(
+      std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+class WrappedOutput::Buffer : public std::streambuf {
+ public:
+  explicit Buffer(std::streambuf* target) : target_(target) {}
+  ~Buffer() override { Flush(); }
+  void Flush() {
+    if (!line_.empty()) Emit();
+    target_->pubsync();
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    line_.push_back(traits_type::to_char_type(c));
+    if (c == '\n') Emit();
+    return c;
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    for (std::streamsize k = 0; k < n; ++k) overflow(traits_type::to_int_type(s[k]));
+    return n;
+  }
+  int sync() override {
+    Flush();
+    return 0;
+  }
+
+ private:
+  void Emit() {
+    const bool newline = !line_.empty() && line_.back() == '\n';
+    if (newline) line_.pop_back();
+    std::string text;
+    const std::size_t limit = g_max_width;
+    // A line that holds a command to copy ("depthbench run --seed ...")
+    // stays whole: a command broken across lines does not paste.
+    const std::size_t command = line_.find("depthbench ");
+    const bool copyable = command != std::string::npos && line_.find(" --", command) != std::string::npos;
+    if (limit == 0 || copyable || DisplayWidth(line_) <= limit) {
+      text = line_;
+    } else {
+      const std::size_t indent = std::min(line_.find_first_not_of(' '), limit / 2);
+      const std::string continuation(std::min<std::size_t>(indent + 2, limit / 2), ' ');
+      const std::vector<std::string> first = Wrap(line_.substr(indent), limit - indent);
+      text = std::string(indent, ' ') + first.front();
+      std::string rest;
+      for (std::size_t k = 1; k < first.size(); ++k) rest += (k > 1 ? " " : "") + first[k];
+      if (!rest.empty()) {
+        for (const std::string& part : Wrap(rest, limit - continuation.size())) text += "\n" + continuation + part;
+      }
+    }
+    if (newline) text += '\n';
+    target_->sputn(text.data(), static_cast<std::streamsize>(text.size()));
+    line_.clear();
+  }
+
+  std::streambuf* target_;
+  std::string line_;
+};
+
+WrappedOutput::WrappedOutput(std::ostream& out)
+    : out_(out), original_(out.rdbuf()), buffer_(std::make_unique<Buffer>(original_)) {
+  out_.rdbuf(buffer_.get());
+}
+
+WrappedOutput::~WrappedOutput() {
+  out_.flush();
+  buffer_->Flush();
+  out_.rdbuf(original_);
+}
+
+std::size_t TextTable::MaxWidth() { return g_max_width; }
+void TextTable::SetMaxWidth(std::size_t columns) { g_max_width = columns; }
+
+void TextTable::Print(std::ostream& out) const {
+  const std::size_t n = columns_.size();
+  std::vector<std::size_t> width(n);
+  for (std::size_t c = 0; c < n; ++c) {
+    width[c] = DisplayWidth(columns_[c].header);
+    for (const auto& row : rows_)
+      if (!row.empty()) width[c] = std::max(width[c], DisplayWidth(row[c]));
+  }
+  std::vector<bool> shown(n, true);
+  const auto total = [&] {
+    std::size_t sum = 0, count = 0;
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!shown[c]) continue;
+      sum += width[c];
+      ++count;
+    }
+    return sum + 2 * (count > 0 ? count - 1 : 0);
+  };
+  std::vector<std::string> left_out;
+  const std::size_t limit = g_max_width;
+  if (limit > 0) {
+    for (std::size_t c = n; c-- > 0 && total() > limit;) {
+      if (!columns_[c].secondary) continue;
+      shown[c] = false;
+      left_out.insert(left_out.begin(), columns_[c].header);
+    }
+    std::size_t wrapped = n;
+    for (std::size_t c = 0; c < n; ++c)
+      if (columns_[c].wrap && shown[c]) wrapped = c;
+    if (wrapped < n && total() > limit) {
+      const std::size_t others = total() - width[wrapped];
+      constexpr std::size_t kNarrowest = 16;
+      width[wrapped] = std::max(kNarrowest, limit > others ? limit - others : 0);
+    }
+  }
+  auto print_line = [&](const std::vector<std::string>& cells) {
     std::string line;
-    for (std::size_t c = 0; c < columns_.size(); ++c) {
+    bool first = true;
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!shown[c]) continue;
       const std::string& text = cells[c];
-      std::string pad(width[c] - text.size(), ' ');
-      if (c > 0) line += "  ";
+      const std::size_t used = DisplayWidth(text);
+      std::string pad(width[c] > used ? width[c] - used : 0, ' ');
+      if (!first) line += "  ";
+      first = false;
       line += columns_[c].align == Align::kLeft ? text + pad : pad + text;
     }
     while (!line.empty() && line.back() == ' ') line.pop_back();
     out << line << '\n';
   };
+  // A row whose wrapping cell is too wide takes continuation lines, the
+  // other cells blank there.
+  auto print_row = [&](const std::vector<std::string>& cells) {
+    std::vector<std::vector<std::string>> lines{cells};
+    for (std::size_t c = 0; c < n; ++c) {
+      if (!columns_[c].wrap || !shown[c] || DisplayWidth(cells[c]) <= width[c]) continue;
+      const std::vector<std::string> parts = Wrap(cells[c], width[c]);
+      for (std::size_t k = 0; k < parts.size(); ++k) {
+        if (k >= lines.size()) lines.emplace_back(n);
+        lines[k][c] = parts[k];
+      }
+    }
+    for (const auto& line : lines) print_line(line);
+  };
   std::vector<std::string> headers;
   for (const auto& c : columns_) headers.push_back(c.header);
-  print_row(headers);
-  std::size_t total = 0;
-  for (std::size_t w : width) total += w;
-  const std::string rule(total + 2 * (columns_.size() - 1), '-');
+  print_line(headers);
+  const std::string rule(total(), '-');
   out << rule << '\n';
   for (const auto& row : rows_) {
     if (row.empty()) {
@@ -44,6 +191,11 @@ void TextTable::Print(std::ostream& out) const {
     } else {
       print_row(row);
     }
+  }
+  if (!left_out.empty()) {
+    std::string names;
+    for (const std::string& name : left_out) names += (names.empty() ? "'" : ", '") + name + "'";
+    out << fmt::format("(left out to fit {} columns: {}; --wide shows them)\n", limit, names);
   }
 }
 

@@ -2,8 +2,11 @@
 // every subcommand. Numbers right-aligned, text left-aligned.
 #pragma once
 
+#include <memory>
 #include <ostream>
+#include <streambuf>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace depthbench {
@@ -14,18 +17,55 @@ class TextTable {
   struct Column {
     std::string header;
     Align align = Align::kRight;
+    // Left out, rightmost first, when the table would not fit the width.
+    bool secondary = false;
+    // Wrapped at spaces onto continuation lines when the table would not
+    // fit the width (one such column per table: the last that asks).
+    bool wrap = false;
   };
 
   explicit TextTable(std::vector<Column> columns) : columns_(std::move(columns)) {}
   void AddRow(std::vector<std::string> cells);
   void AddSeparator();
+  // Prints the table within `MaxWidth()` columns: secondary columns left
+  // out, then the wrapping column wrapped, as far as that takes; a line
+  // after the table names the columns left out.
   void Print(std::ostream& out) const;
   bool empty() const { return rows_.empty(); }
+
+  // The width every table fits: 120 by default (a terminal of 120
+  // columns), 0 for no limit (the --wide flag).
+  static std::size_t MaxWidth();
+  static void SetMaxWidth(std::size_t columns);
 
  private:
   std::vector<Column> columns_;
   std::vector<std::vector<std::string>> rows_;  // an empty row is a separator
 };
+
+// While it lives, lines written to `out` that are wider than
+// TextTable::MaxWidth() are wrapped at spaces, continuation lines indented
+// two columns past the line's own indent (a word wider than the line stays
+// whole, and so does a line that holds a depthbench command with flags, so
+// that it can be copied). What the program prints for people goes through
+// one of these; tables already fit and pass unchanged.
+class WrappedOutput {
+ public:
+  explicit WrappedOutput(std::ostream& out);
+  ~WrappedOutput();
+  WrappedOutput(const WrappedOutput&) = delete;
+  WrappedOutput& operator=(const WrappedOutput&) = delete;
+
+ private:
+  class Buffer;
+  std::ostream& out_;
+  std::streambuf* original_;
+  std::unique_ptr<Buffer> buffer_;
+};
+
+// Columns a terminal gives a UTF-8 string (code points; every character
+// depthbench prints is one column wide).
+std::size_t DisplayWidth(std::string_view text);
 
 // A count in few characters: 950, 12k, 4.20M, 1.50G.
 std::string ShortCount(double x);

@@ -1,15 +1,17 @@
 #include "bench/choose/choose.h"
-#include "bench/base/resources.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/resources.h"
 #include "bench/base/text_table.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/speed_results.h"
@@ -18,19 +20,40 @@
 namespace depthbench {
 namespace {
 
-std::uint32_t ArithmeticLanes(const InstructionMix& m) {
-  return m.fdiv.lanes + m.fmul.lanes + m.fadd.lanes + m.fneg.lanes + m.fma.lanes + m.dot.lanes + m.matrix_vector.lanes +
-         m.matrix_matrix.lanes + m.extended.lanes;
+// The special-function unit's operations among GLSL.std.450's.
+bool OnSpecialFunctionUnit(const std::string& name) {
+  static const std::set<std::string> kNames{"Sqrt", "InverseSqrt", "Exp", "Exp2", "Log",  "Log2", "Pow",
+                                            "Sin",  "Cos",         "Tan", "Asin", "Acos", "Atan", "Atan2"};
+  return kNames.count(name) != 0;
+}
+
+double WeighedCost(const InstructionMix& m) {
+  const auto weight = [](std::size_t row) { return kOperationCosts[row].weight; };
+  double special = 0.0, other = 0.0;
+  for (const auto& [name, count] : m.extended_by_name) (OnSpecialFunctionUnit(name) ? special : other) += count.lanes;
+  return weight(0) * (m.fadd.lanes + m.fmul.lanes) + weight(1) * m.fneg.lanes + weight(2) * m.fma.lanes +
+         weight(3) * (m.dot.lanes + m.matrix_vector.lanes + m.matrix_matrix.lanes) + weight(4) * m.fdiv.lanes +
+         weight(5) * special + weight(6) * other;
+}
+
+// Two costs that the ranking cannot tell apart.
+bool CostsTie(const CandidateCost& a, const CandidateCost& b) {
+  return std::fabs(a.value - b.value) <= std::max(a.spread, b.spread);
 }
 
 // The requirement's unit, from a band's statistics.
+double InUnit(const Requirement& req, double value) {
+  return req.kind == Requirement::Kind::kBitsLost ? BitsLost(value) : value;
+}
+Metric MetricOf(const Requirement& req) {
+  return req.kind == Requirement::Kind::kAbsolute ? Metric::kAbsolute : Metric::kTotal;
+}
 double InUnit(const Requirement& req, const BandStats& band, Level level) {
-  switch (req.kind) {
-    case Requirement::Kind::kAbsolute: return band[Metric::kAbsolute].AtLevel(level, Metric::kAbsolute);
-    case Requirement::Kind::kRelative: return band[Metric::kTotal].AtLevel(level, Metric::kTotal);
-    case Requirement::Kind::kBitsLost: return BitsLost(band[Metric::kTotal].AtLevel(level, Metric::kTotal));
-  }
-  return 0.0;
+  return InUnit(req, band[MetricOf(req)].AtLevel(level, MetricOf(req)));
+}
+Interval InUnitInterval(const Requirement& req, const BandStats& band, Level level) {
+  const Interval i = band[MetricOf(req)].LevelInterval(level, MetricOf(req));
+  return {InUnit(req, i.low), InUnit(req, i.high)};
 }
 
 std::string InUnitText(const Requirement& req, double v) {
@@ -85,6 +108,20 @@ const char* CauseText(Metric cause) {
 
 }  // namespace
 
+const std::vector<OperationCost> kOperationCosts{
+    {"add, subtract, multiply (OpFAdd, OpFSub, OpFMul)", 1.0, "one issue slot of the FMA pipes"},
+    {"negate (OpFNegate)", 0.0, "folded into the instruction that uses it, as a source modifier"},
+    {"fused multiply-add (GLSL.std.450 Fma)", 1.0, "one issue slot"},
+    {"multiply-add of a dot or matrix product (OpDot, OpMatrixTimesVector, ...)", 1.0,
+     "one FMA per multiply-add: a mat4 x vec4 is 16"},
+    {"division or reciprocal (OpFDiv; SPIR-V has no reciprocal)", 9.0,
+     "a reciprocal on the special-function unit, which issues at 1/8 of the FMA rate (16 against 128 lanes per "
+     "clock on an NVIDIA SM), then a multiply"},
+    {"square root, inverse square root, exp2, log2, trigonometry (GLSL.std.450)", 8.0,
+     "the special-function unit, at 1/8 of the FMA rate"},
+    {"other GLSL.std.450 (min, max, abs, clamp, floor, ...)", 1.0, "one issue slot"},
+};
+
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
   std::filesystem::path dir = shader_dir;
   if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
@@ -92,31 +129,35 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
   for (const VariantInfo& v : AllVariants()) {
     DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileComputeShader(dir / (std::string(v.name) + ".comp")));
     DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, std::string(v.name) + "_world_position"));
-    by_variant[v.id] = {static_cast<double>(ArithmeticLanes(mix)), "SPIR-V arithmetic lanes",
-                        "the compiled shader's instruction mix"};
+    by_variant[v.id] = {
+        WeighedCost(mix), 0.0, kStaticCostUnit,
+        "static model: the compiled shader's instructions, weighed per operation as choose --help lists"};
   }
   return CostLookup(
       [by_variant](const Cell& cell) -> std::optional<CandidateCost> { return by_variant.at(cell.variant); });
 }
 
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, CostLookup fallback) {
+Expected<CostLookup> SpeedCostLookup(const std::string& speed_file) {
   DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(speed_file));
+  // Per 1080p frame: what a frame budget is counted in.
+  constexpr double kFramePixels = 1920.0 * 1080.0;
+  const std::string unit = "µs per 1920x1080 frame on " + speed.run.device.name;
   std::map<Cell, CandidateCost> measured;
   for (const TradeFront& front : speed.trade) {
     for (const TradePoint& p : front.points) {
       if (!(p.gpu_ns_per_reconstruction > 0.0)) continue;
       measured[Cell{p.variant, front.convention, front.format}] = {
-          p.gpu_ns_per_reconstruction, "ns per reconstruction on " + speed.run.device.name, speed_file};
+          p.gpu_ns_per_reconstruction * kFramePixels * 1e-3, p.gpu_spread_ns * kFramePixels * 1e-3, unit, speed_file};
     }
   }
-  return CostLookup([measured, fallback](const Cell& cell) -> std::optional<CandidateCost> {
+  return CostLookup([measured](const Cell& cell) -> std::optional<CandidateCost> {
     auto it = measured.find(cell);
     if (it != measured.end()) return it->second;
-    return fallback ? fallback(cell) : std::nullopt;
+    return std::nullopt;
   });
 }
 
-Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLookup& costs,
+Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
                               const ChooseOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   const Requirement& req = scene.requirement;
@@ -146,6 +187,24 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
   result.requirement = req.Describe();
   result.backend = backend.name();
   result.device = backend.device().name;
+
+  // One cost unit for the whole ranking.
+  CostLookup cost_of = costs.static_model;
+  if (costs.measured) {
+    std::vector<std::string> missing;
+    for (const Cell& cell : cells)
+      if (!costs.measured(cell)) missing.push_back(cell.Name());
+    if (missing.empty()) {
+      cost_of = costs.measured;
+    } else {
+      result.cost_note = fmt::format(
+          "{} has no GPU time for {} of the {} candidates ({}{}): every candidate is ranked by the static cost "
+          "model instead, so that one unit ranks them all",
+          costs.measured_from, missing.size(), cells.size(), missing.front(), missing.size() > 1 ? ", ..." : "");
+    }
+  }
+
+  const std::uint64_t needed = MinimumSamples(req.level);
   for (const Cell& cell : cells) {
     const CellResult* at_depth = judged->Find(cell, backend.name());
     const CellResult* in_scene = scene_results.Find(cell, backend.name());
@@ -154,10 +213,15 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
     const BandStats whole_band = in_scene->stats.All();
     CandidateVerdict v;
     v.cell = cell;
+    v.samples = band.finite;
+    v.supported = band.finite >= needed;
     v.measured_p999 = InUnit(req, band, Level::kP999);
     v.measured_max = InUnit(req, band, Level::kMax);
     v.measured = req.level == Level::kMax ? v.measured_max : v.measured_p999;
+    v.interval = InUnitInterval(req, band, req.level);
     std::tie(v.predicted, v.model) = PredictAtFarEnd(scene, *in_scene, req.level);
+    // Findings only: outputs that are NaN or Inf where exact arithmetic on
+    // the same inputs is finite, for samples inside the scene's ranges.
     v.nonfinite = band.nan + band.inf + whole_band.nan + whole_band.inf;
     double largest = -1.0;
     for (Metric cause : {Metric::kProduction, Metric::kStorage, Metric::kArith}) {
@@ -167,42 +231,76 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
         v.dominant = cause;
       }
     }
-    v.meets = v.measured <= req.value && v.nonfinite == 0;
-    v.cost = costs ? costs(cell) : std::nullopt;
+    // On the upper end of the interval: a candidate meets the requirement
+    // only if the sampling error cannot be what makes it pass.
+    v.meets = v.supported && v.interval.high <= req.value && v.nonfinite == 0;
+    v.cost = cost_of ? cost_of(cell) : std::nullopt;
     v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
     result.ranked.push_back(v);
   }
+  if (!result.ranked.empty() && result.ranked.front().cost) {
+    result.cost_unit = result.ranked.front().cost->unit;
+    result.cost_source = result.ranked.front().cost->source;
+  }
 
   // Meeting and affordable, cheapest first; then meeting but too costly;
-  // then failing, closest first. Ties go to the more precise.
+  // then failing, closest first. Candidates whose costs tie (within the
+  // spread of a measurement) go in order of accuracy, and share a rank.
   auto group = [](const CandidateVerdict& v) { return !v.meets ? 2 : v.over_budget ? 1 : 0; };
-  auto cost_of = [](const CandidateVerdict& v) { return v.cost ? v.cost->value : INFINITY; };
+  auto value_of = [](const CandidateVerdict& v) { return v.cost ? v.cost->value : INFINITY; };
   std::stable_sort(result.ranked.begin(), result.ranked.end(),
                    [&](const CandidateVerdict& a, const CandidateVerdict& b) {
                      if (group(a) != group(b)) return group(a) < group(b);
-                     if (group(a) < 2 && cost_of(a) != cost_of(b)) return cost_of(a) < cost_of(b);
+                     if (group(a) < 2 && value_of(a) != value_of(b)) return value_of(a) < value_of(b);
                      if (a.nonfinite != b.nonfinite) return a.nonfinite < b.nonfinite;
-                     return a.measured < b.measured;
+                     if (a.supported != b.supported) return a.supported;
+                     return a.interval.high < b.interval.high;
                    });
+  // Cost ties among the meeting candidates: a run of candidates whose costs
+  // all tie with the run's first is reordered by accuracy.
+  for (std::size_t k = 0; k < result.ranked.size();) {
+    std::size_t end = k + 1;
+    const CandidateVerdict& first = result.ranked[k];
+    while (end < result.ranked.size() && group(result.ranked[end]) == group(first) && group(first) < 2 && first.cost &&
+           result.ranked[end].cost && CostsTie(*first.cost, *result.ranked[end].cost)) {
+      ++end;
+    }
+    std::stable_sort(
+        result.ranked.begin() + static_cast<std::ptrdiff_t>(k),
+        result.ranked.begin() + static_cast<std::ptrdiff_t>(end),
+        [](const CandidateVerdict& a, const CandidateVerdict& b) { return a.interval.high < b.interval.high; });
+    for (std::size_t i = k; i < end; ++i) {
+      result.ranked[i].rank = static_cast<int>(k) + 1;
+      result.ranked[i].tied = end - k > 1;
+    }
+    k = end;
+  }
 
   const double limit = req.value;
-  const CandidateVerdict* cheapest =
-      result.ranked.empty() || !result.ranked.front().meets ? nullptr : &result.ranked.front();
+  const CandidateVerdict* cheapest = result.Met() ? &result.ranked.front() : nullptr;
   for (CandidateVerdict& v : result.ranked) {
-    const std::string measured = InUnitText(req, v.measured);
+    const std::string measured = InUnitText(req, v.interval.high);
     const std::string cost =
         v.cost ? fmt::format("{:.3g} {}", v.cost->value, v.cost->unit) : std::string("unknown cost");
-    if (v.meets && &v == cheapest) {
-      v.reason = fmt::format("the cheapest that meets it: {} against {} ({:.1f}x margin), {}", measured,
-                             InUnitText(req, limit), limit / std::max(v.measured, 1e-300), cost);
+    if (v.meets && v.rank == 1) {
+      v.reason = fmt::format("{}: {} at most (95% interval) against {} ({:.1f}x margin), {}",
+                             v.tied ? "tied for the cheapest that meets it" : "the cheapest that meets it", measured,
+                             InUnitText(req, limit), limit / std::max(v.interval.high, 1e-300), cost);
     } else if (v.meets && v.over_budget) {
       v.reason = fmt::format("meets it ({}), but {} is over the budget of {:g}", measured, cost, *scene.max_cost);
     } else if (v.meets) {
       v.reason = fmt::format("meets it ({}), but costs more: {}", measured, cost);
+    } else if (!v.supported) {
+      v.reason = fmt::format("unsupported: {} samples at the requirement's depth, a {} needs {} (raise --samples)",
+                             v.samples, LevelName(req.level), needed);
     } else if (v.nonfinite > 0) {
       v.reason = fmt::format("fails: {} NaN or Inf outputs inside the scene", v.nonfinite);
+    } else if (v.measured <= limit) {
+      v.reason = fmt::format("fails: {} measured, but the interval reaches {}: too close to call",
+                             InUnitText(req, v.measured), measured);
     } else {
-      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.measured / limit, CauseText(v.dominant));
+      v.reason =
+          fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.interval.high / limit, CauseText(v.dominant));
     }
   }
 
@@ -248,65 +346,109 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLo
   return result;
 }
 
+namespace {
+
+// What holds a candidate back, in a word.
+std::string Limit(const CandidateVerdict& v) {
+  if (v.meets) return "";
+  if (!v.supported) return "samples";
+  if (v.nonfinite > 0) return "NaN/Inf";
+  if (v.interval.low <= 0.0 && v.measured <= 0.0) return "interval";
+  switch (v.dominant) {
+    case Metric::kProduction: return "production";
+    case Metric::kStorage: return "storage";
+    default: return "shader";
+  }
+}
+
+}  // namespace
+
 void PrintChoice(const ChooseResult& r, std::ostream& out) {
   using Align = TextTable::Align;
-  out << fmt::format("scene '{}': {}\nbackend {} on {}; {:.1f} s\n\n", r.scene, r.requirement, r.backend, r.device,
+  out << fmt::format("scene '{}': {}\nbackend {} on {}; {:.1f} s\n", r.scene, r.requirement, r.backend, r.device,
                      r.seconds);
-  if (!r.ranked.empty() && r.ranked.front().meets) {
-    out << fmt::format("choice: {} ({})\n\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+  out << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
+  if (!r.cost_note.empty()) out << "note: " << r.cost_note << "\n";
+  out << "\n";
+  if (r.Met()) {
+    out << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+    std::vector<std::string> tied;
+    for (const CandidateVerdict& v : r.ranked)
+      if (v.rank == 1 && &v != &r.ranked.front()) tied.push_back(v.cell.Name());
+    if (!tied.empty()) out << fmt::format("tied on cost with it: {}\n", fmt::join(tied, ", "));
+    out << "\n";
   }
   for (const std::string& s : r.suggestions) out << s << "\n";
   if (!r.suggestions.empty()) out << "\n";
   TextTable table({{"rank"},
                    {"candidate", Align::kLeft},
-                   {"p99.9"},
-                   {"max"},
+                   {"measured (upper)"},
                    {"far end (model)"},
                    {"NaN/Inf"},
-                   {"meets"},
-                   {"cost"},
-                   {"why", Align::kLeft}});
-  int rank = 0;
+                   {"meets", Align::kLeft},
+                   {"held back by", Align::kLeft, true},
+                   {"cost"}});
   for (const CandidateVerdict& v : r.ranked) {
-    table.AddRow({std::to_string(++rank), v.cell.Name(), fmt::format("{:.3g}", v.measured_p999),
-                  fmt::format("{:.3g}", v.measured_max), fmt::format("{:.3g} ({})", v.predicted, v.model),
-                  std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no",
-                  v.cost ? fmt::format("{:.3g}", v.cost->value) : "-", v.reason});
+    table.AddRow({fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
+                  v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
+                                               : fmt::format("{:.3g}", v.measured),
+                  fmt::format("{:.3g} ({})", v.predicted, v.model), std::to_string(v.nonfinite),
+                  v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+                  v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
   }
   table.Print(out);
-  if (!r.ranked.empty() && r.ranked.front().cost) out << "cost: " << r.ranked.front().cost->unit << "\n";
+  out << fmt::format(
+      "measured: at the requirement's level and depth, with the upper end of its 95% interval where it differs "
+      "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end; NaN/Inf: findings "
+      "inside the scene's "
+      "ranges;\nheld back by: the part of the error that dominates (production, storage or shader), or what else "
+      "fails it;\nrank: '=' marks costs that tie; exit status 0 when a candidate meets the requirement, 1 when none "
+      "does\n");
 }
 
 nlohmann::json ChoiceToJson(const ChooseResult& r) {
   nlohmann::json ranked = nlohmann::json::array();
   for (const CandidateVerdict& v : r.ranked) {
-    ranked.push_back(
-        {{"cell", v.cell.Name()},
-         {"variant", Info(v.cell.variant).name},
-         {"convention", Info(v.cell.convention).name},
-         {"format", Info(v.cell.format).name},
-         {"measured_p999", JsonNumber(v.measured_p999)},
-         {"measured_max", JsonNumber(v.measured_max)},
-         {"predicted_far_end", JsonNumber(v.predicted)},
-         {"model", v.model},
-         {"nonfinite", v.nonfinite},
-         {"dominant_cause", MetricName(v.dominant)},
-         {"meets", v.meets},
-         {"over_budget", v.over_budget},
-         {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"unit", v.cost->unit}, {"source", v.cost->source}}
-                         : nlohmann::json(nullptr)},
-         {"reason", v.reason}});
+    ranked.push_back({{"rank", v.rank},
+                      {"tied", v.tied},
+                      {"cell", v.cell.Name()},
+                      {"variant", Info(v.cell.variant).name},
+                      {"convention", Info(v.cell.convention).name},
+                      {"format", Info(v.cell.format).name},
+                      {"samples", v.samples},
+                      {"supported", v.supported},
+                      {"measured", JsonNumber(v.measured)},
+                      {"interval", {JsonNumber(v.interval.low), JsonNumber(v.interval.high)}},
+                      {"measured_p999", JsonNumber(v.measured_p999)},
+                      {"measured_max", JsonNumber(v.measured_max)},
+                      {"predicted_far_end", JsonNumber(v.predicted)},
+                      {"model", v.model},
+                      {"nonfinite", v.nonfinite},
+                      {"dominant_cause", MetricName(v.dominant)},
+                      {"meets", v.meets},
+                      {"over_budget", v.over_budget},
+                      {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"spread", v.cost->spread}}
+                                      : nlohmann::json(nullptr)},
+                      {"reason", v.reason}});
   }
-  return WithSchema(kChooseSchema, {{"scene", r.scene},
-                                    {"requirement", r.requirement},
-                                    {"backend", r.backend},
-                                    {"device", r.device},
-                                    {"seconds", r.seconds},
-                                    {"choice", r.ranked.empty() || !r.ranked.front().meets
-                                                   ? nlohmann::json(nullptr)
-                                                   : nlohmann::json(r.ranked.front().cell.Name())},
-                                    {"suggestions", r.suggestions},
-                                    {"ranked", ranked}});
+  nlohmann::json model = nlohmann::json::array();
+  for (const OperationCost& c : kOperationCosts)
+    model.push_back({{"operation", c.operation}, {"weight", c.weight}, {"why", c.why}});
+  return WithSchema(kChooseSchema,
+                    {{"scene", r.scene},
+                     {"requirement", r.requirement},
+                     {"backend", r.backend},
+                     {"device", r.device},
+                     {"seconds", r.seconds},
+                     {"met", r.Met()},
+                     {"choice", r.Met() ? nlohmann::json(r.ranked.front().cell.Name()) : nlohmann::json(nullptr)},
+                     {"cost",
+                      {{"unit", r.cost_unit},
+                       {"source", r.cost_source},
+                       {"note", r.cost_note},
+                       {"static_model", r.cost_unit == kStaticCostUnit ? model : nlohmann::json(nullptr)}}},
+                     {"suggestions", r.suggestions},
+                     {"ranked", ranked}});
 }
 
 }  // namespace depthbench

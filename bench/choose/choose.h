@@ -19,39 +19,63 @@
 
 namespace depthbench {
 
-inline constexpr JsonSchema kChooseSchema{"depthbench.choose", 1, "a choice of depthbench choose --json"};
+inline constexpr JsonSchema kChooseSchema{"depthbench.choose", 2, "a choice of depthbench choose --json"};
 
 class Backend;  // bench/backends/backend.h
 
-// The cost of a candidate, in one unit for the whole ranking.
+// The cost of a candidate, in the one unit of its ranking.
 struct CandidateCost {
   double value = 0.0;
-  std::string unit;    // "ns per reconstruction (llvmpipe ...)", "SPIR-V arithmetic lanes"
-  std::string source;  // where it came from
+  double spread = 0.0;  // two costs closer than the larger spread are a tie (0: exact)
+  std::string unit;     // "us per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
+  std::string source;   // where it came from
 };
 
 // Costs per cell; `nullopt` when none is known for a cell.
 using CostLookup = std::function<std::optional<CandidateCost>(const Cell&)>;
-// The static cost: arithmetic lanes of the variant's compiled shader.
+
+// The static cost model: the compiled shader's floating-point instructions,
+// lane by lane, each weighed by what it costs on GPU hardware relative to
+// one fused multiply-add (kOperationCosts).
+struct OperationCost {
+  const char* operation;
+  double weight;  // FMA-equivalent issue slots per lane
+  const char* why;
+};
+extern const std::vector<OperationCost> kOperationCosts;
+inline constexpr const char* kStaticCostUnit = "FMA-equivalent slots";
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir);
-// Measured costs from a `depthbench speed --json` file (GPU time per
-// reconstruction, ALU-bound regime), falling back to `fallback`.
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, CostLookup fallback);
+// Measured GPU time per frame from a `depthbench speed --json` file
+// (ALU-bound regime), for the cells the file has.
+Expected<CostLookup> SpeedCostLookup(const std::string& speed_file);
+
+// Where a ranking's costs come from: measured times when they cover every
+// candidate, else the static model for all (a ranking never mixes units).
+struct CostSources {
+  CostLookup measured;  // empty: none given
+  std::string measured_from;
+  CostLookup static_model;
+};
 
 struct CandidateVerdict {
   Cell cell;
   // In the requirement's own unit (world units, relative error or bits).
   double measured_p999 = 0.0, measured_max = 0.0;
-  double measured = 0.0;   // at the requirement's level
-  double predicted = 0.0;  // the model's value at the scene's far end, same unit and level
-  std::string model;       // the error model used for the prediction
-  std::uint64_t nonfinite = 0;
+  double measured = 0.0;  // at the requirement's level: the point estimate
+  Interval interval;      // its 95% sampling interval; the verdict uses `high`
+  bool supported = true;  // enough samples at the requirement's depth for the level
+  std::uint64_t samples = 0;
+  double predicted = 0.0;       // the model's value at the scene's far end, same unit and level
+  std::string model;            // the error model used for the prediction
+  std::uint64_t nonfinite = 0;  // NaN or Inf findings inside the scene's ranges
   // The cause with the largest p99.9 at the requirement's depth:
   // kProduction, kStorage or kArith (the shader's part).
   Metric dominant = Metric::kArith;
   bool meets = false;
   bool over_budget = false;
   std::optional<CandidateCost> cost;
+  int rank = 0;        // 1 = the choice; candidates that tie share a rank
+  bool tied = false;   // shares its rank with another candidate
   std::string reason;  // one sentence
 };
 
@@ -64,12 +88,15 @@ struct ChooseResult {
   std::string scene;
   std::string requirement;
   std::string backend, device;
+  std::string cost_unit, cost_source;
+  std::string cost_note;                 // why the static model ranks, when a speed file was given
   std::vector<CandidateVerdict> ranked;  // best first
   std::vector<std::string> suggestions;  // when nothing meets the requirement
+  bool Met() const { return !ranked.empty() && ranked.front().meets; }
   double seconds = 0.0;
 };
 
-Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostLookup& costs,
+Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
                               const ChooseOptions& options);
 
 void PrintChoice(const ChooseResult& result, std::ostream& out);

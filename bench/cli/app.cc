@@ -1,12 +1,17 @@
 #include "bench/cli/app.h"
 
+#include <algorithm>
 #include <iostream>
+#include <map>
 #include <string>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "bench/base/build_info.h"
 #include "bench/base/resources.h"
+#include "bench/base/suggest.h"
+#include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 
@@ -17,6 +22,86 @@ namespace {
 // ("depthbench: error: ...") and exit code 2.
 int ExitCode(const Expected<int>& ran) { return ran.ok() ? *ran : ReportError(ran.status()); }
 
+// What an option takes, for --help, where its declaration leaves CLI11
+// to say TEXT (counts are read as text so that 1e6 parses, files as
+// strings): one table for every subcommand, by flag.
+void NameOptionTypes(CLI::App& app) {
+  static const std::map<std::string, std::string> kTypes{{"--samples", "N"},
+                                                         {"--default-samples", "N"},
+                                                         {"--accuracy-samples", "N"},
+                                                         {"--against-random", "N"},
+                                                         {"--cases", "N"},
+                                                         {"--index", "N"},
+                                                         {"--seed", "N"},
+                                                         {"--threads", "N"},
+                                                         {"--batch", "N"},
+                                                         {"--warmup", "N"},
+                                                         {"--repetitions", "N"},
+                                                         {"--taps", "N"},
+                                                         {"--seconds", "SECONDS"},
+                                                         {"--shard", "K/N"},
+                                                         {"--level", "LEVEL"},
+                                                         {"--split", "BAND[,BAND]"},
+                                                         {"--json", "FILE"},
+                                                         {"--junit", "FILE"},
+                                                         {"--scene", "FILE"},
+                                                         {"--baseline", "FILE"},
+                                                         {"--results", "FILE"},
+                                                         {"--repro", "FILE"},
+                                                         {"--speed", "FILE"},
+                                                         {"--compare", "FILE"},
+                                                         {"--known", "FILE"},
+                                                         {"--history", "FILE"},
+                                                         {"--template", "FILE"},
+                                                         {"--plot-library", "FILE"},
+                                                         {"--shaders", "DIR"},
+                                                         {"--out", "DIR"},
+                                                         {"--backend", "NAME[,NAME]"},
+                                                         {"--device", "NAME"},
+                                                         {"--variant", "NAME[,NAME]"},
+                                                         {"--convention", "NAME[,NAME]"},
+                                                         {"--format", "NAME[,NAME]"},
+                                                         {"--domain", "NAME|FILE"},
+                                                         {"--production", "MODEL"},
+                                                         {"--resolution", "WxH[,WxH]"},
+                                                         {"--corpus", "PATH"},
+                                                         {"inputs", "FILE"}};
+  for (CLI::App* sub : app.get_subcommands({})) {
+    for (CLI::Option* option : sub->get_options()) {
+      if (option->get_type_name().rfind("TEXT", 0) != 0 && !option->get_type_name().empty()) continue;
+      std::vector<std::string> keys{option->get_name(true, false)};
+      for (const std::string& name : option->get_lnames()) keys.push_back("--" + name);
+      for (const std::string& key : keys) {
+        auto it = kTypes.find(key);
+        if (it != kTypes.end()) option->type_name(it->second);
+      }
+    }
+  }
+}
+
+// "depthbench SUB: error: unknown option '--x'; did you mean '--y'?" for
+// each flag in argv that subcommand `sub` (and the program) does not know.
+std::string UnknownOptions(const CLI::App& sub, int argc, const char* const* argv) {
+  std::vector<std::string> flags;
+  for (const CLI::App* app : {&sub, sub.get_parent()}) {
+    if (app == nullptr) continue;
+    for (const CLI::Option* option : app->get_options()) {
+      for (const std::string& name : option->get_lnames()) flags.push_back("--" + name);
+    }
+  }
+  std::string message;
+  for (int k = 1; k < argc; ++k) {
+    const std::string word(argv[k]);
+    if (word == "--") break;
+    if (word.rfind("--", 0) != 0) continue;
+    const std::string flag = word.substr(0, word.find('='));
+    if (std::find(flags.begin(), flags.end(), flag) != flags.end()) continue;
+    message +=
+        fmt::format("depthbench {}: error: unknown option '{}'{}\n", sub.get_name(), flag, DidYouMean(flag, flags));
+  }
+  return message;
+}
+
 }  // namespace
 
 std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
@@ -26,6 +111,12 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
       "(Vulkan) and the CPU",
       "depthbench");
   app->require_subcommand(1);
+  // Flags of the whole program, taken after a subcommand's name too.
+  app->fallthrough();
+  app->add_flag_callback(
+      "--wide", [] { TextTable::SetMaxWidth(0); },
+      "print tables as wide as their contents; by default they fit 120 columns, leaving secondary columns out "
+      "(a line after each table names them)");
   app->set_version_flag("--version", [] {
     const Expected<DataFolder> data = FindDataFolder();
     return fmt::format(
@@ -44,6 +135,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   AddChooseCommand(*app, action);
   AddReportCommand(*app, action);
   AddFuzzCommand(*app, action);
+  NameOptionTypes(*app);
   return app;
 }
 
@@ -52,15 +144,25 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
   // that names it (CLI11 would only say a subcommand is required).
   if (argc > 1 && argv[1][0] != '-' &&
       app.get_subcommands([&](const CLI::App* sub) { return sub->get_name() == argv[1]; }).empty()) {
-    std::string names;
-    for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
-    err << "depthbench: error: unknown subcommand '" << argv[1] << "'; available: " << names
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+    err << "depthbench: error: unknown subcommand '" << argv[1]
+        << "'; available: " << fmt::format("{}", fmt::join(names, ", ")) << DidYouMean(argv[1], names)
         << " (see depthbench --help)\n";
     return {false, kExitCannotRun};
   }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // An option that no subcommand knows is named, with the flag it could
+    // have been, whatever else CLI11 found wrong (a required flag then
+    // looks missing).
+    const std::vector<CLI::App*> chosen = app.get_subcommands();
+    const std::string unknown = chosen.empty() ? "" : UnknownOptions(*chosen.front(), argc, argv);
+    if (e.get_exit_code() != 0 && !unknown.empty()) {
+      err << unknown << fmt::format("(see depthbench {} --help)\n", chosen.front()->get_name());
+      return {false, kExitCannotRun};
+    }
     const int code = app.exit(e, out, err);
     return {false, code == 0 ? kExitOk : kExitCannotRun};
   }
@@ -68,6 +170,8 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
 }
 
 int RunDepthbench(int argc, const char* const* argv) {
+  // Lines for people fit 120 columns, unless --wide.
+  const WrappedOutput wrapped(std::cout);
   CommandAction action;
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);

@@ -31,17 +31,19 @@ Expected<int> RunChoose(const ChooseFlags& f) {
   DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
-  DB_ASSIGN_OR_RETURN(CostLookup lookup, StaticCostLookup(f.shaders));
+  CostSources costs;
+  DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders));
   if (!f.speed.empty()) {
-    DB_ASSIGN_OR_RETURN(lookup, SpeedCostLookup(f.speed, lookup));
+    DB_ASSIGN_OR_RETURN(costs.measured, SpeedCostLookup(f.speed));
+    costs.measured_from = f.speed;
   }
   DB_ASSIGN_OR_RETURN(const std::unique_ptr<Backend> backend, MakeBackend(f.backend, {f.device, f.shaders, false}));
   Progress progress("choose", StderrIsTerminal());
-  DB_ASSIGN_OR_RETURN(const ChooseResult choice, Choose(scene, *backend, lookup, options));
+  DB_ASSIGN_OR_RETURN(const ChooseResult choice, Choose(scene, *backend, costs, options));
   progress.Finish(fmt::format("{} candidates", choice.ranked.size()));
   PrintChoice(choice, std::cout);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ChoiceToJson(choice).dump(1) + "\n"));
-  return kExitOk;
+  return choice.Met() ? kExitOk : kExitFinding;
 }
 
 }  // namespace
@@ -50,20 +52,31 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<ChooseFlags>();
   CLI::App* cmd = app.add_subcommand(
       "choose", "Rank the reconstructions a scene can use: the cheapest that meets its requirement first");
+  std::string cost_table;
+  for (const OperationCost& c : kOperationCosts)
+    cost_table += fmt::format("  {:<4g} {}: {}\n", c.weight, c.operation, c.why);
   cmd->footer(
       "Measures every (variant, convention, format) the scene's engine allows, inside the scene's ranges (and at "
-      "the requirement's depth), models its error over eye depth to predict the scene's far end, costs it (GPU "
-      "time from a `depthbench speed --json` file when given, otherwise the arithmetic instructions of its "
-      "compiled shader), and ranks: the cheapest candidate that meets the requirement first. When nothing does, "
-      "it says so, shows the closest, and what would have to change. Example scenes: bench/scenes/*.toml.\n\n"
+      "the requirement's depth), models its error over eye depth to predict the scene's far end, costs it, and "
+      "ranks: the cheapest candidate that meets the requirement first. A candidate meets it when the upper end of "
+      "the 95% interval of its measured level is within the limit, it has enough samples for that level, and it "
+      "has no NaN or Inf findings inside the scene's ranges. When nothing does, it says so, shows the closest, and "
+      "what would have to change. Example scenes: bench/scenes/*.toml.\n\n"
+      "Costs come in one unit per ranking: GPU time per 1920x1080 frame from a `depthbench speed --json` file "
+      "(--speed) when it has every candidate, with its spread (costs within it tie, shown '='), otherwise the "
+      "static model for every candidate: the compiled shader's floating-point instructions, each lane weighed in "
+      "FMA-equivalent issue slots:\n" +
+      cost_table +
+      "\nExit status: 0 when a candidate meets the requirement, 1 when none does (so a CI job can gate a scene "
+      "on it), 2 when it cannot run.\n\n"
       "Examples:\n"
       "  depthbench choose --scene bench/scenes/open_world.toml\n"
-      "  depthbench choose --scene my_scene.toml --backend cpu --json choice.json");
+      "  depthbench choose --scene my_scene.toml --speed reports/speed/nvidia-h100.json --json choice.json");
   cmd->add_option("--scene", flags->scene, "scene file (TOML; see bench/scenes/)")->required();
   cmd->add_option("--samples", flags->samples, "samples in the scene (default 1e5)");
   cmd->add_option("--seed", flags->seed, "random seed (default 11)");
-  cmd->add_option("--speed", flags->speed, "costs from a `depthbench speed --json` file");
-  cmd->add_option("--json", flags->json, "write the ranking (schema depthbench.choose v1) to FILE");
+  cmd->add_option("--speed", flags->speed, "rank by the GPU times of a `depthbench speed --json` file");
+  cmd->add_option("--json", flags->json, "write the whole decision (schema depthbench.choose v2) to FILE");
   cmd->add_option("--backend", flags->backend, "the backend the scene's engine runs: vulkan (default) or cpu");
   cmd->add_option("--device", flags->device, "Vulkan device (part of its name); default lavapipe");
   cmd->add_option("--shaders", flags->shaders, "shader directory (default: the source tree's shaders/)");

@@ -186,7 +186,7 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--speed", flags->speed,
                   "speed files (depthbench speed --json) for the speed/accuracy front (default: every "
                   "reports/speed/*.json of the data folder: those committed with depthbench)");
-  cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses instruction counts only");
+  cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses the static cost model only");
   cmd->add_option("--plot-library", flags->plot_library,
                   "node_modules folder holding vega, vega-lite and vega-embed (default: the data folder's "
                   "reports/node_modules, which ./setup.sh installs with npm ci --prefix reports)");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "bench/base/suggest.h"
 #include "bench/numerics/formulas.h"
 
 namespace depthbench {
@@ -31,6 +32,14 @@ std::string JoinNames(const Table& table, NameOf name_of) {
     out += name_of(entry);
   }
   return out;
+}
+
+// "; did you mean ..." among the names of a catalogue.
+template <class Catalogue>
+std::string Suggest(std::string_view word, const Catalogue& catalogue) {
+  std::vector<std::string> names;
+  for (const auto& entry : catalogue) names.emplace_back(entry.name);
+  return DidYouMean(word, names);
 }
 
 }  // namespace
@@ -69,8 +78,8 @@ Expected<Variant> ParseVariant(std::string_view name) {
   std::string key = Lower(name);
   for (const auto& v : kVariants)
     if (v.name == key) return v.id;
-  return InvalidArgument("unknown variant '" + std::string(name) +
-                         "'; allowed: " + JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }));
+  return InvalidArgument("unknown variant '" + std::string(name) + "'; allowed: " +
+                         JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }) + Suggest(name, kVariants));
 }
 
 Expected<Convention> ParseConvention(std::string_view name) {
@@ -78,7 +87,8 @@ Expected<Convention> ParseConvention(std::string_view name) {
   for (const auto& c : kConventions)
     if (c.name == key) return c.id;
   return InvalidArgument("unknown convention '" + std::string(name) +
-                         "'; allowed: " + JoinNames(kConventions, [](const ConventionInfo& c) { return c.name; }));
+                         "'; allowed: " + JoinNames(kConventions, [](const ConventionInfo& c) { return c.name; }) +
+                         Suggest(name, kConventions));
 }
 
 Expected<Format> ParseFormat(std::string_view name) {
@@ -88,10 +98,11 @@ Expected<Format> ParseFormat(std::string_view name) {
   // VK_FORMAT_R32_SFLOAT names two of our formats; it means the linear one.
   for (const auto& f : kFormats)
     if (Lower(f.vulkan_name) == key) return f.id;
-  return InvalidArgument("unknown format '" + std::string(name) +
-                         "'; allowed: " + JoinNames(kFormats, [](const FormatInfo& f) {
-                           return std::string(f.name) + " (" + std::string(f.short_name) + ")";
-                         }));
+  return InvalidArgument(
+      "unknown format '" + std::string(name) + "'; allowed: " +
+      JoinNames(kFormats,
+                [](const FormatInfo& f) { return std::string(f.name) + " (" + std::string(f.short_name) + ")"; }) +
+      Suggest(name, kFormats));
 }
 
 Expected<Cell> ParseCell(std::string_view name) {

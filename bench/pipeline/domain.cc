@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/suggest.h"
+
 namespace depthbench {
 
 const RangeLimits kFovLimits{0.0, 180.0, true, true, "degrees"};
@@ -140,7 +142,9 @@ Expected<Domain> NamedDomain(std::string_view name) {
   if (name == "typical") return TypicalDomain();
   if (name == "wide") return WideDomain();
   if (name == "extremes") return ExtremesDomain();
-  return InvalidArgument(fmt::format("domain '{}' is not one of {} (or a scene file, NAME.toml)", name, kDomainNames));
+  const std::string names[] = {"typical", "wide", "extremes"};
+  return InvalidArgument(fmt::format("domain '{}' is not one of {} (or a scene file, NAME.toml){}", name, kDomainNames,
+                                     DidYouMean(name, names)));
 }
 
 Status Domain::Validate() const {
@@ -162,7 +166,19 @@ Status Domain::Validate() const {
       DB_RETURN_IF_ERROR(CheckRange(ratio, "ratio", kRatioLimits));
     }
   }
-  if (eye_depth) DB_RETURN_IF_ERROR(CheckRange(*eye_depth, "eye depth", kEyeDepthLimits));
+  if (eye_depth) {
+    DB_RETURN_IF_ERROR(CheckRange(*eye_depth, "eye depth", kEyeDepthLimits));
+    // The depths asked for must meet some frustum of the domain.
+    if (eye_depth->max < near.min) {
+      return InvalidArgument(fmt::format("eye depth {} lies nearer than every near plane of the domain (near {})",
+                                         eye_depth->ToString(), near.ToString()));
+    }
+    const double deepest = infinite_far ? INFINITY : far ? far->max : near.max * ratio.max;
+    if (eye_depth->min > deepest) {
+      return InvalidArgument(fmt::format("eye depth {} lies beyond every far plane of the domain (at most {:g})",
+                                         eye_depth->ToString(), deepest));
+    }
+  }
   if (resolutions.empty()) return InvalidArgument("the domain has no resolution");
   for (const auto& r : resolutions) {
     if (r.width == 0 || r.height == 0 || r.width > 65535 || r.height > 65535) {

@@ -140,7 +140,10 @@ template <int N>
       for (CellAccumulator::Slot* slot : {&to.band, &to.distance}) {
         if (in.status[i] == ReferenceStatus::kDegenerate) {
           ++slot->degenerate;
-        } else if (finite) {  // outside the frustum: only a non-finite output counts
+        } else if (in.status[i] == ReferenceStatus::kOutside) {
+          // Outside the frustum or the range of depths asked for: not
+          // judged, whatever the output (a texel beyond the far plane may
+          // well reconstruct to infinity).
           ++slot->outside;
         } else if (!holdable) {
           ++slot->stored_nonfinite;
@@ -226,7 +229,7 @@ template <int N>
   const double* squares_of[] = {ref.storage_square.data() + offset, ref.production_square.data() + offset};
   std::array<std::array<std::int64_t, kMaxRun>, 2> bins;
   ForEachFrameRun(
-      batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
+      batch, [&](std::uint32_t /*frame*/, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
         // The bins N at a time (as the judge's Measure does), then the counts.
         for (int m = 0; m < 2; ++m) {
           const double* squares = squares_of[m];

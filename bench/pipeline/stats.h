@@ -143,7 +143,7 @@ struct BandStats {
   // point float32 cannot hold, so no arithmetic could return it finitely.
   std::uint64_t stored_nonfinite = 0;
   std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
-  std::uint64_t outside = 0;     // finite point outside the frustum: only NaN/Inf judged
+  std::uint64_t outside = 0;     // outside the frustum or the depths asked for: not judged
   std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
   std::array<MetricStats, kMetricCount> metrics;
 

@@ -273,7 +273,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
   }
   const std::string accuracy = fmt::format(
       "this report's sweep at the chosen far/near (camera at the origin) on the {} backend ({})", backend, device);
-  const CostLookup& lanes = m.static_costs;
+  const CostLookup& static_model = m.static_costs;
 
   for (std::size_t k = 0; k < m.sweeps.ratios.size(); ++k) {
     const double ratio = m.sweeps.ratios[k];
@@ -297,12 +297,12 @@ SpeedSection Speed(const ReportMeasurements& m) {
     }
     std::vector<FrontEntry> entries;
     for (const CellResult& c : at.cells) {
-      const std::optional<CandidateCost> cost = c.backend == backend ? lanes(c.cell) : std::nullopt;
+      const std::optional<CandidateCost> cost = c.backend == backend ? static_model(c.cell) : std::nullopt;
       if (!cost) continue;
       const CellAccuracy cell = AccuracyOf(c.stats);
       entries.push_back({c.cell, {cost->value, 0.0, FrontBits(cell.p999_bits_lost)}, cell.nonfinite});
     }
-    AddFronts("instruction count", ratio, entries, rows);
+    AddFronts("static cost model", ratio, entries, rows);
   }
   for (const auto& [path, speed] : m.speed) {
     if (speed.gpu.empty()) continue;
@@ -311,7 +311,8 @@ SpeedSection Speed(const ReportMeasurements& m) {
                                            ResolutionName(speed.run.trade_resolution), speed.run.started_at),
                                accuracy});
   }
-  section.sources.push_back({"instruction count", "SPIR-V arithmetic lanes of the compiled shader", accuracy});
+  section.sources.push_back(
+      {"static cost model", std::string(kStaticCostUnit) + " of the compiled shader (docs/choosing.md)", accuracy});
   return section;
 }
 
