@@ -37,6 +37,32 @@ void ExpectSameStats(const Results& a, const Results& b) {
   }
 }
 
+// A lone camera-distance band made from the joint bands at the end holds
+// exactly what recording it sample by sample gives, for cameras at the
+// origin and at a fixed distance; a range across bands is recorded.
+TEST(SweepTest, LoneDistanceBandIsTheWholeNaturalDistribution) {
+  for (const Range distance : {Range{0.0, 0.0}, Range{50.0, 50.0}, Range{0.0, 1e4}}) {
+    SweepOptions options;
+    options.seed = 9;
+    options.samples = 30000;
+    options.domain.camera_distance = distance;
+    auto cpu = MakeCpuBackend();
+    Backend* backends[] = {cpu.get()};
+    auto derived = RunSweep(options, backends);
+    options.derive_lone_distance_band = false;
+    auto recorded = RunSweep(options, backends);
+    ASSERT_TRUE(derived.ok() && recorded.ok());
+    ExpectSameStats(*derived, *recorded);
+    // 0 to 1e4: the origin, [1, 1e2) and [1e2, 1e4).
+    EXPECT_EQ(derived->cells.front().stats.distance.size(), distance.max == 1e4 ? 3u : 1u) << distance.ToString();
+  }
+  EXPECT_EQ(OnlyDistanceBand({0.0, 0.0}), 0);
+  EXPECT_EQ(OnlyDistanceBand({50.0, 50.0}), 1);
+  EXPECT_EQ(OnlyDistanceBand({100.0, 100.0}), std::nullopt);  // a rounding away from band 1
+  EXPECT_EQ(OnlyDistanceBand({0.0, 0.5}), 0);
+  EXPECT_EQ(OnlyDistanceBand({0.0, 5.0}), std::nullopt);
+}
+
 TEST(SweepTest, SameSeedSameResultsWhateverTheBatchingAndThreads) {
   Results a = RunCpu(42, 20000, {});
   Results b = RunCpu(42, 20000, {}, /*batch=*/777, /*threads=*/1);

@@ -48,6 +48,18 @@ double LogUniform(double u, double lo, double hi) { return LogUniform(u, Range{l
 
 }  // namespace
 
+std::optional<int> OnlyDistanceBand(const Range& camera_distance) {
+  if (camera_distance.max == 0.0) return 0;  // every camera at the origin
+  // A frame's distance is that of its camera position rounded to float32:
+  // within a few parts in 10^7 of the distance drawn. A range from 0 puts
+  // cameras at the origin too.
+  constexpr double kRounding = 1e-6;
+  const double low = camera_distance.min == 0.0 ? 0.0 : camera_distance.min * (1.0 - kRounding);
+  const int band = DistanceBand(low);
+  if (band != DistanceBand(camera_distance.max * (1.0 + kRounding))) return std::nullopt;
+  return band;
+}
+
 Sampler::Sampler(std::uint64_t seed, Domain domain) : seed_(seed), domain_(std::move(domain)) {}
 
 std::uint32_t Sampler::State(std::uint64_t index) const {

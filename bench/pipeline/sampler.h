@@ -102,6 +102,11 @@ PixelSample SampleFromUnits(const SampleUnits& units, const Frame& frame, std::u
 // domain's range of interest, if any.
 void CompleteFrame(Frame& frame, const std::optional<Range>& eye_depth);
 
+// The camera-distance band of every frame the sampler draws from this
+// range, when they all share one (nullopt when they may not): a fixed
+// distance not within a float32 rounding of a band's edge, or the origin.
+std::optional<int> OnlyDistanceBand(const Range& camera_distance);
+
 class Sampler : public SampleSource {
  public:
   Sampler(std::uint64_t seed, Domain domain);

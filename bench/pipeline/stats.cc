@@ -249,6 +249,14 @@ CellAccumulator::CellAccumulator() {
 
 void CellAccumulator::Unmap::operator()(Slot* slots) const { munmap(slots, (kSlots + 1) * sizeof(Slot)); }
 
+BandStats CellStats::DistanceBandOf() const {
+  BandStats band = All();
+  for (int m = 0; m < kMetricCount; ++m) {
+    if (m != static_cast<int>(Metric::kTotal) && m != static_cast<int>(Metric::kArith)) band.metrics[m] = {};
+  }
+  return band;
+}
+
 void CellAccumulator::FlushInto(CellStats& out) {
   constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
   static const Slot kEmpty{};

@@ -187,6 +187,10 @@ struct CellStats {
   BandStats ForRatio(int ratio_band) const;
   BandStats ForDepth(int depth_band) const;
   BandStats ForDistance(int distance_band) const;
+  // What a camera-distance band holds when every natural sample is in it:
+  // the counts and the total and shader metrics of All() (the figures a
+  // distance band records).
+  BandStats DistanceBandOf() const;
   friend bool operator==(const CellStats&, const CellStats&) = default;
 };
 
@@ -232,7 +236,13 @@ class CellAccumulator {
   };
 
   Slot& Joint(int band) { return slots_.get()[kDistanceBands + band]; }
-  Slot& Distance(int band) { return slots_.get()[band]; }
+  // Where a frame's camera-distance band is recorded: its own slot, or
+  // the discarded one once SkipDistanceBands() is called.
+  Slot& Distance(int band) { return slots_.get()[skip_distance_ ? kDiscarded : band]; }
+  // For a run whose cameras all lie in one distance band: that band holds
+  // what the whole natural distribution does, so it is not recorded sample
+  // by sample; DistanceBandOf() makes it from the joint bands at the end.
+  void SkipDistanceBands() { skip_distance_ = true; }
   Slot& Coverage(int band) { return slots_.get()[kDistanceBands + kJointBands + band]; }
   // The slots a sample's figures go to, chosen without a branch (targeted
   // picks interleave with natural samples at random, and a mispredicted
@@ -268,6 +278,7 @@ class CellAccumulator {
   // then the discarded slot.
   std::unique_ptr<Slot, Unmap> slots_;
   std::uint64_t pending_ = 0;
+  bool skip_distance_ = false;
 };
 
 }  // namespace depthbench

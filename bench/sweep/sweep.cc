@@ -118,6 +118,13 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const std::size_t cell_count = layout.cells.size();
   std::vector<CellAccumulator> accumulators(backends.size() * cell_count);
   std::vector<CellStats> stats(backends.size() * cell_count);
+  // Cameras in one distance band (the origin, in the typical domain): the
+  // band is the whole natural distribution, made once at the end.
+  const std::optional<int> only_distance_band =
+      options.derive_lone_distance_band ? OnlyDistanceBand(options.domain.camera_distance) : std::nullopt;
+  if (only_distance_band) {
+    for (CellAccumulator& a : accumulators) a.SkipDistanceBands();
+  }
   // Storage and production errors belong to an encoding, whatever reads
   // it: one accumulator per depth slot, copied into its cells at the end.
   const std::size_t slot_count = layout.encodings.size();
@@ -208,6 +215,11 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       }
     }
   });
+  if (only_distance_band) {
+    for (CellStats& s : stats) {
+      if (!s.joint.empty()) s.distance[*only_distance_band] = s.DistanceBandOf();
+    }
+  }
   for (std::size_t b = 0; b < backends.size(); ++b) {
     for (std::size_t c = 0; c < cell_count; ++c) {
       const std::size_t k = b * cell_count + c;

@@ -37,6 +37,10 @@ struct SweepOptions {
   std::uint32_t batch_size = 16384;
   unsigned threads = 0;    // 0: one per hardware thread
   Isa isa = Isa::kWidest;  // of the hot loops (bench/base/isa.h): the same results whatever it is
+  // When every camera lies in one distance band, that band is made from the
+  // joint bands at the end rather than recorded per sample: the same
+  // figures, less work (false: record it, as tests do to compare).
+  bool derive_lone_distance_band = true;
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 
