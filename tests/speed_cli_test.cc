@@ -75,7 +75,9 @@ TEST(SpeedCliTest, QuickRunPrintsTheTradeAndWritesItsFile) {
   EXPECT_NE(r.out.find("is a CPU implementation of Vulkan: its timings are of JIT-compiled CPU code"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("GPU time per pixel"), std::string::npos);
+  EXPECT_NE(r.out.find("GPU time of a whole frame"), std::string::npos);
+  EXPECT_NE(r.out.find("64x64 µs/frame"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("64x64 G recon/s"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Static cost"), std::string::npos);
   EXPECT_NE(r.out.find("CPU backend"), std::string::npos);
   EXPECT_NE(r.out.find("The trade at 64x64"), std::string::npos);
@@ -102,6 +104,18 @@ TEST(SpeedCliTest, QuickRunPrintsTheTradeAndWritesItsFile) {
   const auto second = RunDepthbench(again);
   EXPECT_TRUE(second.exit_code == 0 || second.exit_code == 1) << second.err;
   EXPECT_NE(second.out.find("Repeatability: 6 pairs of variants compared"), std::string::npos) << second.out;
+}
+
+// --budget: depth images whose timings would end past it are left out and
+// listed; what was measured still makes a table.
+TEST(SpeedCliTest, BudgetLeavesOutWhatWouldEndPastIt) {
+  const auto r = RunDepthbench({"speed", "--variant", "divide", "--convention", "standard,reversed", "--format", "d32f",
+                                "--resolution", "64x64,128x128", "--quick", "--quiet", "--budget", "1e-6"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("over the --budget of 1e-06 s"), std::string::npos) << r.out;
+  // The first depth image is always measured: the rate comes from it.
+  EXPECT_NE(r.out.find("divide   standard"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not measured: divide/reversed/d32_sfloat at 64x64"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ struct SpeedFlags {
   std::string compare;
   bool quick = false;
   bool quiet = false;
+  double budget = 0.0;  // seconds of GPU timings; 0: no limit
   // Which flags were given (quick must not override them).
   bool repetitions_given = false, warmup_given = false, accuracy_samples_given = false;
 };
@@ -114,6 +115,17 @@ Expected<int> Speed(const SpeedFlags& f) {
   options.progress = [&](std::size_t done, std::size_t total, const std::string& what) {
     progress.Update(static_cast<double>(done) / static_cast<double>(total), what);
   };
+  options.budget_seconds = f.budget;
+  options.estimate = [&](double seconds) {
+    // Said before a run that takes more than about a minute, so that the
+    // user can stop it and ask for less.
+    if (seconds > 60.0 && !f.quiet) {
+      std::cerr << fmt::format(
+          "speed: the GPU timings will take about {:.0f} min at this rate ({} cells, {} resolutions); --budget "
+          "SECONDS, --quick, fewer --resolution or cell filters take less\n",
+          seconds / 60.0, options.cells.size(), options.resolutions.size());
+    }
+  };
   DB_ASSIGN_OR_RETURN(SpeedResults results, RunSpeed(*timer, shader_dir, options));
   if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results.gpu.size(), results.run.seconds));
 
@@ -189,6 +201,11 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
   cmd->add_flag("--quick", flags->quick,
                 "fewer repetitions (1 warm-up, 5 repetitions) and a 1e4-sample accuracy run, for tests");
   cmd->add_flag("--quiet", flags->quiet, "no progress line");
+  cmd->add_option("--budget", flags->budget,
+                  "seconds the GPU timings may take: depth images whose timings would end past it are left out "
+                  "(listed as not measured); a run that will take over a minute says how long first")
+      ->type_name("SECONDS")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([flags, &action] { action = [flags] { return Speed(*flags); }; });
 }
 

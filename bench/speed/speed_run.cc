@@ -73,10 +73,13 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
   std::size_t done = 0;
   ThreadPool pool;
   std::vector<GpuTiming> timings;
+  const auto started = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  };
+  std::size_t over_budget = 0;
   for (const Resolution& resolution : options.resolutions) {
     for (const Encoding& encoding : layout.encodings) {
-      DB_ASSIGN_OR_RETURN(const DepthImage image, MakeDepthImage(encoding, resolution, pool));
-      DB_RETURN_IF_ERROR(timer.LoadImage(image));
       // The variants reading this image compete: they are timed together.
       std::vector<Cell> group;
       std::vector<Variant> variants;
@@ -85,6 +88,22 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
         group.push_back(plan.cell);
         variants.push_back(plan.cell.variant);
       }
+      const double per_measurement = done > 0 ? elapsed() / static_cast<double>(done) : 0.0;
+      // The first depth image is always measured: the rate comes from it.
+      const bool past_budget =
+          options.budget_seconds > 0.0 && done > 0 &&
+          (over_budget > 0 ||
+           elapsed() + per_measurement * 2.0 * static_cast<double>(group.size()) > options.budget_seconds);
+      if (past_budget) {
+        over_budget += 2 * group.size();
+        for (const Cell& cell : group) {
+          skipped.push_back(fmt::format("{} at {}: over the --budget of {:g} s", cell.Name(),
+                                        ResolutionName(resolution), options.budget_seconds));
+        }
+        continue;
+      }
+      DB_ASSIGN_OR_RETURN(const DepthImage image, MakeDepthImage(encoding, resolution, pool));
+      DB_RETURN_IF_ERROR(timer.LoadImage(image));
       for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
         const std::uint32_t taps = regime == Regime::kMemory ? 1 : options.alu_taps;
         if (options.progress) {
@@ -107,6 +126,9 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
           timings.push_back(std::move(timing));
           ++done;
         }
+      }
+      if (options.estimate && done == 2 * group.size()) {
+        options.estimate(elapsed() / static_cast<double>(done) * static_cast<double>(total));
       }
     }
   }

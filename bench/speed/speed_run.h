@@ -32,6 +32,13 @@ struct SpeedOptions {
   CpuCostOptions cpu;
   // Called before each measurement: (measurements done, of how many, which).
   std::function<void(std::size_t, std::size_t, const std::string&)> progress;
+  // Called once, after the first depth image's measurements: the seconds
+  // the GPU timings are expected to take in all, at the rate so far.
+  std::function<void(double)> estimate;
+  // Seconds the GPU timings may take (0: no limit): no depth image is
+  // started whose measurements would, at the rate so far, end past it; the
+  // cells left out are listed in SpeedResults::skipped.
+  double budget_seconds = 0.0;
 };
 
 // Ok, or InvalidArgument naming the violated constraint.

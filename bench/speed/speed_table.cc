@@ -1,6 +1,7 @@
 #include "bench/speed/speed_table.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include <fmt/format.h>
@@ -13,7 +14,16 @@ namespace {
 using Align = TextTable::Align;
 
 // "2.41 ±0.031": the median and its spread, three significant digits.
-std::string WithSpread(double value, double spread) { return fmt::format("{:.3g} ±{:.2g}", value, spread); }
+// Three significant digits, without an exponent from 1e-3 to 1e6.
+std::string Readable(double x, int digits) {
+  const double magnitude = std::fabs(x);
+  if (magnitude >= 1e6 || (magnitude < 1e-3 && magnitude > 0.0)) return fmt::format("{:.{}g}", x, digits);
+  const int exponent = magnitude > 0.0 ? static_cast<int>(std::floor(std::log10(magnitude))) : 0;
+  return fmt::format("{:.{}f}", x, std::max(0, digits - 1 - exponent));
+}
+std::string WithSpread(double value, double spread) {
+  return fmt::format("{} ±{}", Readable(value, 3), Readable(spread, 2));
+}
 
 // A rank, with '=' where another member of the group shares it.
 std::string RankText(const SpeedResults& results, const GpuTiming& timing) {
@@ -50,10 +60,10 @@ void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
   std::vector<TextTable::Column> columns = {
       {"variant", Align::kLeft}, {"convention", Align::kLeft}, {"format", Align::kLeft}};
   for (const Resolution& r : results.run.resolutions) {
-    columns.push_back({fmt::format("{} mem ns/px", ResolutionName(r))});
-    columns.push_back({"rank"});
-    columns.push_back({fmt::format("{} alu ns/recon", ResolutionName(r))});
-    columns.push_back({"rank"});
+    columns.push_back({fmt::format("{} µs/frame", ResolutionName(r))});
+    columns.push_back({"rank", Align::kRight, true});
+    columns.push_back({fmt::format("{} G recon/s", ResolutionName(r))});
+    columns.push_back({"rank", Align::kRight, true});
   }
   TextTable table(columns);
   std::vector<Cell> cells;
@@ -75,16 +85,25 @@ void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
           row.insert(row.end(), {"-", "-"});
           continue;
         }
+        // Memory-bound: a whole frame, one reconstruction per pixel, in
+        // microseconds. ALU-bound: reconstructions per second, 10^9 (the
+        // spread carried over to first order: d(1/x) = dx / x^2).
+        const double pixels = static_cast<double>(r.width) * r.height;
+        const double ns = t->ns_per_reconstruction(), spread = t->spread_ns_per_pixel() / t->taps;
         row.push_back(regime == Regime::kMemory
-                          ? WithSpread(t->ns_per_pixel(), t->spread_ns_per_pixel())
-                          : WithSpread(t->ns_per_reconstruction(), t->spread_ns_per_pixel() / t->taps));
+                          ? WithSpread(t->ns_per_pixel() * pixels * 1e-3, t->spread_ns_per_pixel() * pixels * 1e-3)
+                          : WithSpread(1.0 / ns, spread / (ns * ns)));
         row.push_back(RankText(results, *t));
       }
     }
     table.AddRow(row);
   }
-  out << "GPU time per pixel (memory-bound, 1 reconstruction per pixel) and per reconstruction (ALU-bound, "
-      << results.run.alu_taps << " per pixel), ns\n";
+  out << "GPU time of a whole frame, memory-bound (one reconstruction per pixel: reading the depth image "
+         "and writing positions), in µs; and reconstructions per second when ALU-bound ("
+      << results.run.alu_taps
+      << " per pixel), in 10^9. On a real GPU the memory-bound figures of all variants are "
+         "nearly equal: the pass is bound by memory bandwidth, not by the variant's arithmetic; the ALU-bound "
+         "figures are where variants differ\n";
   table.Print(out);
   out << "\n";
 }
@@ -132,11 +151,13 @@ void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
                    {"format", Align::kLeft},
                    {"variant", Align::kLeft},
                    {"p99.9 bits"},
-                   {"gpu ns/recon"},
+                   {"gpu µs/frame"},
                    {"gpu front", Align::kLeft},
                    {"cpu ns/recon"},
                    {"cpu front", Align::kLeft},
                    {"NaN/Inf"}});
+  // The ALU-bound cost of one reconstruction for every pixel of a frame.
+  const double pixels = static_cast<double>(results.run.trade_resolution.width) * results.run.trade_resolution.height;
   bool first = true;
   for (const TradeFront& front : results.trade) {
     if (!first) table.AddSeparator();
@@ -144,15 +165,15 @@ void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
     for (const TradePoint& p : front.points) {
       table.AddRow({std::string(Info(front.convention).name), std::string(Info(front.format).short_name),
                     std::string(Info(p.variant).name), fmt::format("{:.1f}", p.p999_bits_lost),
-                    WithSpread(p.gpu_ns_per_reconstruction, p.gpu_spread_ns), p.on_gpu_front ? "*" : "",
-                    WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns), p.on_cpu_front ? "*" : "",
-                    fmt::format("{}", p.nonfinite)});
+                    WithSpread(p.gpu_ns_per_reconstruction * pixels * 1e-3, p.gpu_spread_ns * pixels * 1e-3),
+                    p.on_gpu_front ? "*" : "", WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns),
+                    p.on_cpu_front ? "*" : "", fmt::format("{}", p.nonfinite)});
     }
   }
   out << fmt::format(
-      "The trade at {} (ALU-bound GPU cost) and on the CPU: cost against p99.9 bits lost ({} "
-      "backend, {}); * = on the Pareto front (no variant is as cheap, to the spread, and as "
-      "accurate, to 1/4 bit, and better in one)\n",
+      "The trade at {} and on the CPU: cost against p99.9 bits lost ({} backend, {}). GPU cost: the ALU-bound "
+      "time of one reconstruction per pixel of a frame; * = on the Pareto front of its convention and format (no "
+      "variant is as cheap, to the spread, and as accurate, to 1/4 bit, and better in one)\n",
       ResolutionName(results.run.trade_resolution), results.run.accuracy_backend, results.run.accuracy_source);
   table.Print(out);
   out << "\n";
