@@ -95,8 +95,40 @@ def check_browser(report_dir, artifact_dir):
             fail("plot '%s' drew %s data marks" % (plot, drawn))
     if not os.path.isfile(shot) or os.path.getsize(shot) < 10000:
         fail("no screenshot")
+    check_first_screen(page, artifact_dir, chromium)
     print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
           (check["headline_rows"], check["plots"], shot))
+
+
+def check_first_screen(page, artifact_dir, chromium):
+    """At 1024x768 the first-screen table is wholly visible, with a row
+    per convention and format and the variant, cost and budget columns;
+    its screenshot is saved (docs/report-first-screen.png is one)."""
+    with tempfile.TemporaryDirectory() as profile:
+        common = [chromium] + CHROMIUM_FLAGS + ["--user-data-dir=" + profile, "--virtual-time-budget=" + VIRTUAL_TIME_MS,
+                                                "--window-size=1024,768", "--hide-scrollbars"]
+        dom = subprocess.run(common + ["--dump-dom", page], capture_output=True, text=True, timeout=300)
+        shot = os.path.join(artifact_dir, "report-first-screen.png")
+        subprocess.run(common + ["--screenshot=" + shot, page], capture_output=True, text=True, timeout=300)
+    match = re.search(r'<pre id="render-check"[^>]*data-done="true"[^>]*>(.*?)</pre>', dom.stdout, re.S)
+    if not match:
+        fail("the page did not finish drawing at 1024x768")
+    first = json.loads(match.group(1).replace("&quot;", '"').replace("&amp;", "&")).get("first_screen")
+    if not first:
+        fail("no first-screen table")
+    # Headless Chromium gives a 1024x768 window a viewport a little shorter
+    # than 768 (625 here): visible there is visible at 768.
+    if first["window"][0] != 1024 or first["window"][1] > 768:
+        fail("the viewport is %s, not within 1024x768" % first["window"])
+    if first["rows"] < 1:
+        fail("the first-screen table is empty")
+    for column in ["use", "cost", "f/n for 1e-3", "f/n for 1e-6"]:
+        if column not in first["columns"]:
+            fail("the first-screen table has no '%s' column: %s" % (column, first["columns"]))
+    if not first["visible"]:
+        fail("the first-screen table is not wholly visible at 1024x768: it ends at x %d, y %d" %
+             (first["right"], first["bottom"]))
+    print("first screen at 1024x768: %d rows, columns %s, ends at y %d" % (first["rows"], first["columns"], first["bottom"]))
 
 
 if __name__ == "__main__":

@@ -316,6 +316,82 @@ SpeedSection Speed(const ReportMeasurements& m) {
   return section;
 }
 
+// Two variants whose far-plane predictions are closer than this are tied:
+// the gate's tolerance at p99.9, below what the fits resolve.
+constexpr double kTieBits = 0.25;
+// Pixels of the frame a GPU cost is given for.
+constexpr double kFramePixels = 1920.0 * 1080.0;
+
+// The first screen, from the headline (fits), the precision points (their
+// intervals) and the speed section (costs): on the GPU backend where the
+// report ran one, at far/near 1e4 for finite conventions.
+std::vector<RecommendationRow> Recommendations(const Report& report) {
+  std::string backend;
+  for (const HeadlineRow& h : report.headline)
+    if (backend.empty() || h.cell.backend == "vulkan") backend = h.cell.backend;
+  // Costs: the first speed file's device, else the static model.
+  std::string source = report.speed.sources.empty() ? "" : report.speed.sources.front().source;
+  std::map<std::string, double> cost_of;  // variant/convention/format -> cost
+  for (const FrontRow& r : report.speed.rows)
+    if (r.source == source && r.cost) cost_of.emplace(r.cell.Name(), *r.cost);
+  const bool measured = source != "static cost model" && !source.empty();
+  const std::string device = source.substr(0, source.find(" ("));
+  const std::string unit = measured ? "µs per 1920x1080 frame on " + device : kStaticCostUnit;
+
+  std::map<std::pair<std::string, std::string>, std::vector<const HeadlineRow*>> groups;
+  std::vector<std::pair<std::string, std::string>> order;
+  for (const HeadlineRow& h : report.headline) {
+    if (h.cell.backend != backend) continue;
+    const auto key = std::make_pair(h.cell.convention, h.cell.format);
+    if (groups[key].empty()) order.push_back(key);
+    groups[key].push_back(&h);
+  }
+  std::vector<RecommendationRow> rows;
+  for (const auto& key : order) {
+    RecommendationRow row;
+    row.convention = key.first;
+    row.format = key.second;
+    row.backend = backend;
+    row.ratio = groups[key].front()->infinite_far ? "inf" : "1e4";
+    const auto bits_of = [&](const HeadlineRow* h) {
+      auto it = h->predicted_bits.find(row.ratio);
+      return it == h->predicted_bits.end() || !it->second ? kAllBitsLost : *it->second;
+    };
+    const auto cost = [&](const HeadlineRow* h) -> std::optional<double> {
+      auto it = cost_of.find(h->cell.Name());
+      if (it == cost_of.end()) return std::nullopt;
+      return measured ? it->second * kFramePixels * 1e-3 : it->second;
+    };
+    double best = kAllBitsLost;
+    for (const HeadlineRow* h : groups[key]) best = std::min(best, bits_of(h));
+    std::vector<const HeadlineRow*> tied;
+    for (const HeadlineRow* h : groups[key])
+      if (bits_of(h) <= best + kTieBits) tied.push_back(h);
+    // The cheapest of the tied first (unknown costs last), then the more precise.
+    std::stable_sort(tied.begin(), tied.end(), [&](const HeadlineRow* a, const HeadlineRow* b) {
+      const double ca = cost(a).value_or(INFINITY), cb = cost(b).value_or(INFINITY);
+      if (ca != cb) return ca < cb;
+      return bits_of(a) < bits_of(b);
+    });
+    const HeadlineRow& chosen = *tied.front();
+    for (const HeadlineRow* h : tied) row.variants.push_back(h->cell.variant);
+    row.bits = Shown(bits_of(&chosen));
+    for (const ModelPointRow& p : report.precision_points) {
+      if (p.cell.Name() == chosen.cell.Name() && p.cell.backend == backend && p.level == "p99.9" &&
+          p.ratio == row.ratio) {
+        row.bits_low = p.low;
+        row.bits_high = p.high;
+      }
+    }
+    if (const std::optional<double> c = cost(&chosen)) row.cost = Shown(*c);
+    row.cost_unit = unit;
+    row.ratio_for_1e3 = chosen.ratio_for_1e3;
+    row.ratio_for_1e6 = chosen.ratio_for_1e6;
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
 ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& m) {
   ReportEnvironment env;
   env.version = m.main.run.version;
@@ -427,6 +503,7 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   report.backend_differences = Differences(m.sweeps, backends);
   Findings(m, report);
   report.speed = Speed(m);
+  report.recommendations = Recommendations(report);
   return report;
 }
 

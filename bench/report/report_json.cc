@@ -174,6 +174,21 @@ json History(const std::optional<HistorySection>& h) {
 
 nlohmann::json ReportToJson(const Report& report) {
   return WithSchema(kReportSchema, {{"environment", Environment(report.environment)},
+                                    {"recommendations", Rows(report.recommendations,
+                                                             [](const RecommendationRow& r) {
+                                                               return json{{"convention", r.convention},
+                                                                           {"format", r.format},
+                                                                           {"backend", r.backend},
+                                                                           {"ratio", r.ratio},
+                                                                           {"variants", r.variants},
+                                                                           {"bits", Value(r.bits)},
+                                                                           {"bits_low", Value(r.bits_low)},
+                                                                           {"bits_high", Value(r.bits_high)},
+                                                                           {"cost", Value(r.cost)},
+                                                                           {"cost_unit", r.cost_unit},
+                                                                           {"ratio_for_1e-3", Budget(r.ratio_for_1e3)},
+                                                                           {"ratio_for_1e-6", Budget(r.ratio_for_1e6)}};
+                                                             })},
                                     {"headline", Rows(report.headline, Headline)},
                                     {"precision_points", Rows(report.precision_points, ModelPoint)},
                                     {"depth_points", Rows(report.depth_points, ModelPoint)},

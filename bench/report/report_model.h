@@ -173,8 +173,22 @@ struct HistorySection {
   std::size_t worse() const;  // changes for the worse
 };
 
+// The first screen: per convention and format, the variant to use (with
+// those it ties with), how precise it is at the far plane, what it costs,
+// and where it stops meeting the usual budgets.
+struct RecommendationRow {
+  std::string convention, format, backend;
+  std::string ratio;                  // the far/near the bits are predicted at: "1e4", or "inf"
+  std::vector<std::string> variants;  // the recommended first, then those tied with it
+  Figure bits, bits_low, bits_high;   // p99.9 bits lost at the far plane, the model's 95% interval
+  Figure cost;                        // none: no cost known
+  std::string cost_unit;              // "µs per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
+  BudgetRatio ratio_for_1e3, ratio_for_1e6;
+};
+
 struct Report {
   ReportEnvironment environment;
+  std::vector<RecommendationRow> recommendations;
   std::vector<HeadlineRow> headline;
   std::vector<ModelPointRow> precision_points;  // deepest decade of each ratio, p99.9 and max
   std::vector<ModelPointRow> depth_points;      // every decade at a few ratios, p99.9, as relative error
