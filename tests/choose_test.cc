@@ -37,6 +37,18 @@ ChooseResult ChooseFor(const std::string& scene_file, const std::string& speed_f
   return std::move(result).value();
 }
 
+// A scene file in `dir`: a fixed lens, the near and far planes given, and
+// the rest of the TOML (the requirement, a depth range) as written.
+std::string WriteScene(const std::string& dir, const std::string& name, const std::string& near, const std::string& far,
+                       const std::string& rest) {
+  const std::string path = dir + "/" + name + ".toml";
+  std::ofstream(path) << "name = \"" << name << "\"\n[projection]\nnear = " << near << "\nfar = " << far
+                      << "\nfov_degrees = 60\naspect = 1.5\n"
+                      << rest;
+  return path;
+}
+constexpr const char* kEasyRequirement = "[requirement]\nrelative_error = 0.05\n";
+
 TEST(ChooseTest, OpenWorldIsNotGivenStandardZ) {
   const ChooseResult r = ChooseFor(kScenes + "open_world.toml");
   ASSERT_FALSE(r.ranked.empty());
@@ -57,16 +69,8 @@ TEST(ChooseTest, OpenWorldIsNotGivenStandardZ) {
 
 TEST(ChooseTest, SceneThatEveryCandidateMeetsGetsTheCheapest) {
   const std::string dir = testing::MakeTempDir("easy_scene");
-  std::ofstream(dir + "/easy.toml") << R"(name = "easy"
-[projection]
-near = 1
-far = 100
-fov_degrees = 60
-aspect = 1.5
-[requirement]
-relative_error = 0.05
-)";
-  const ChooseResult r = ChooseFor(dir + "/easy.toml");
+  const std::string easy = WriteScene(dir, "easy", "1", "100", kEasyRequirement);
+  const ChooseResult r = ChooseFor(easy);
   ASSERT_FALSE(r.ranked.empty());
   double cheapest = INFINITY;
   for (const CandidateVerdict& v : r.ranked) {
@@ -84,16 +88,8 @@ relative_error = 0.05
 // accuracy (the upper end of the interval).
 TEST(ChooseTest, CostTiesShareARankInOrderOfAccuracy) {
   const std::string dir = testing::MakeTempDir("tie_scene");
-  std::ofstream(dir + "/easy.toml") << R"(name = "easy"
-[projection]
-near = 1
-far = 100
-fov_degrees = 60
-aspect = 1.5
-[requirement]
-relative_error = 0.05
-)";
-  const ChooseResult r = ChooseFor(dir + "/easy.toml");
+  const std::string easy = WriteScene(dir, "easy", "1", "100", kEasyRequirement);
+  const ChooseResult r = ChooseFor(easy);
   std::filesystem::remove_all(dir);
   ASSERT_TRUE(r.Met());
   EXPECT_EQ(r.cost_unit, kStaticCostUnit);
@@ -163,17 +159,10 @@ TEST(ChooseTest, SpeedFileCostsAllCandidatesOrNone) {
 // with the decision in --json.
 TEST(ChooseTest, NothingMeetsExitsWithOne) {
   const std::string dir = testing::MakeTempDir("impossible_scene");
-  std::ofstream(dir + "/impossible.toml") << R"(name = "impossible"
-[projection]
-near = 0.1
-far = 100000
-fov_degrees = 60
-aspect = 1.5
-[requirement]
-relative_error = 1e-9
-)";
-  const auto r = testing::RunDepthbench({"choose", "--scene", dir + "/impossible.toml", "--backend", "cpu", "--samples",
-                                         "2e4", "--json", dir + "/choice.json"});
+  const std::string impossible =
+      WriteScene(dir, "impossible", "0.1", "100000", "[requirement]\nrelative_error = 1e-9\n");
+  const auto r = testing::RunDepthbench(
+      {"choose", "--scene", impossible, "--backend", "cpu", "--samples", "2e4", "--json", dir + "/choice.json"});
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("nothing meets"), std::string::npos) << r.out;
   auto json = ReadJsonFile(dir + "/choice.json");
@@ -187,18 +176,9 @@ relative_error = 1e-9
 // charged for what a texel at the far plane (infinity) reconstructs to.
 TEST(ChooseTest, DepthRangeShortOfTheFarPlaneHasNoFarPlaneFindings) {
   const std::string dir = testing::MakeTempDir("short_scene");
-  std::ofstream(dir + "/short.toml") << R"(name = "short"
-[projection]
-near = 0.1
-far = "inf"
-fov_degrees = 60
-aspect = 1.5
-[depth]
-range = [0.1, 1000]
-[requirement]
-relative_error = 1e-3
-)";
-  const ChooseResult r = ChooseFor(dir + "/short.toml");
+  const std::string short_scene = WriteScene(dir, "short", "0.1", "\"inf\"",
+                                             "[depth]\nrange = [0.1, 1000]\n[requirement]\nrelative_error = 1e-3\n");
+  const ChooseResult r = ChooseFor(short_scene);
   ASSERT_FALSE(r.ranked.empty());
   for (const CandidateVerdict& v : r.ranked) EXPECT_EQ(v.nonfinite, 0u) << v.cell.Name() << ": " << v.reason;
   EXPECT_TRUE(r.Met());
