@@ -113,6 +113,13 @@ TEST_F(ReportTest, PlantedRegressionIsFlaggedAndOnlyThere) {
   const std::string summary = ReadText(*root_ + "/night2/report.md");
   EXPECT_NE(summary.find("got worse"), std::string::npos) << summary;
   EXPECT_NE(summary.find("`divide/reversed/d32_sfloat` on vulkan"), std::string::npos) << summary;
+  // A CI job summary: the verdict, with counts, before any section.
+  const auto verdict = summary.find("**Verdict: ");
+  ASSERT_NE(verdict, std::string::npos) << summary;
+  EXPECT_LT(verdict, summary.find("\n## ")) << summary;
+  EXPECT_NE(summary.find("cell(s) got worse** since", verdict), std::string::npos) << summary;
+  EXPECT_NE(summary.find("cells worse,", verdict), std::string::npos) << summary;
+  EXPECT_LE(std::count(summary.begin(), summary.end(), '\n'), 50) << summary;
 }
 
 TEST_F(ReportTest, SummaryNamesTheWorstCells) {

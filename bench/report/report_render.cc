@@ -13,9 +13,9 @@
 namespace depthbench {
 namespace {
 
-constexpr std::size_t kWorstInSummary = 10;
+constexpr std::size_t kWorstInSummary = 5;
 constexpr std::size_t kChangesInSummary = 20;
-constexpr std::size_t kFindingsInSummary = 10;
+constexpr std::size_t kFindingsInSummary = 5;
 
 // Where the page's template takes the libraries and the document.
 constexpr std::string_view kLibrariesMark = "<!--DEPTHBENCH:LIBRARIES-->";
@@ -49,107 +49,84 @@ std::string Escape(std::string s) {
   return out;
 }
 
-// The backend the headline is about: the last one that is not the CPU's.
-std::string GpuBackend(const Report& report) {
-  std::string chosen;
-  for (const auto& [name, device] : report.environment.backends) {
-    if (chosen.empty() || name != "cpu") chosen = name;
-  }
-  return chosen;
-}
-
-void Changes(const Report& report, std::string& out) {
-  out += "## Since the last report\n\n";
+// The verdict line first (what changed since the last report, in counts
+// of cells), then the cells that got worse.
+void Verdict(const Report& report, std::string& out) {
   if (!report.history) {
-    out += "No history was kept for this run (`--no-history`).\n\n";
+    out += "**Verdict: not compared** (no history was kept for this run, `--no-history`).\n\n";
     return;
   }
   const HistorySection& h = *report.history;
   if (h.previous.empty()) {
-    out += fmt::format("First run of this sample plan on this device in `{}`: nothing to compare with yet.\n\n",
-                       h.database);
+    out += fmt::format(
+        "**Verdict: first run** of this sample plan on this device in `{}`: nothing to compare with yet.\n\n",
+        h.database);
     return;
   }
   std::vector<std::string> previous;
   for (const HistorySection::Previous& p : h.previous) {
-    previous.push_back(
-        fmt::format("{}: run {} of {} (commit `{}`)", p.backend, p.run, p.made_at, p.commit.substr(0, 12)));
+    previous.push_back(fmt::format("{} run {} (commit `{}`)", p.backend, p.run, p.commit.substr(0, 12)));
   }
-  out += fmt::format("Compared with {}; tolerance {} bit at p99.9 and {} bit at the maximum.\n\n",
-                     fmt::join(previous, ", "), h.tolerance_p999_bits, h.tolerance_max_bits);
-  // Worse first, grouped by cell and backend.
+  // Worse first, grouped by cell and backend; a cell worse in one band and
+  // better in another counts as worse.
   std::map<std::pair<std::string, std::string>, std::vector<std::string>> worse;
   std::set<std::pair<std::string, std::string>> better;
   for (const HistorySection::Change& c : h.changes) {
     const std::pair<std::string, std::string> key{c.cell, c.backend};
-    if (c.direction == "worse") {
-      worse[key].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
-    } else {
-      better.insert(key);
-    }
+    if (c.direction == "worse") worse[key].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
   }
-  if (worse.empty()) {
-    out += "**Nothing got worse.**";
-  } else {
-    out += fmt::format("**{} cell(s) got worse:**\n\n", worse.size());
-    std::size_t shown = 0;
-    for (const auto& [key, bands] : worse) {
-      if (shown++ == kChangesInSummary) {
-        out += fmt::format("- ... and {} more (see report.html)\n", worse.size() - kChangesInSummary);
-        break;
-      }
-      const std::size_t kBandsShown = 3;
-      std::vector<std::string> first(bands.begin(), bands.begin() + std::min(bands.size(), kBandsShown));
-      out +=
-          fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
-                      bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
-    }
+  for (const HistorySection::Change& c : h.changes) {
+    const std::pair<std::string, std::string> key{c.cell, c.backend};
+    if (c.direction == "better" && !worse.count(key)) better.insert(key);
   }
-  if (!better.empty()) out += fmt::format("\n{} cell(s) got better.", better.size());
-  out += "\n\n";
+  const std::size_t cells = report.headline.size();
+  const std::size_t unchanged = cells - std::min(cells, worse.size() + better.size());
+  out += fmt::format(
+      "**Verdict: {}** since {}: {} cells worse, {} better, {} unchanged of {} (tolerance {} bit at "
+      "p99.9, {} bit at the maximum).\n\n",
+      worse.empty() ? "nothing got worse" : fmt::format("{} cell(s) got worse", worse.size()),
+      fmt::join(previous, ", "), worse.size(), better.size(), unchanged, cells, h.tolerance_p999_bits,
+      h.tolerance_max_bits);
+  std::size_t shown = 0;
+  for (const auto& [key, bands] : worse) {
+    if (shown++ == kChangesInSummary) {
+      out += fmt::format("- ... and {} more (see report.html)\n", worse.size() - kChangesInSummary);
+      break;
+    }
+    const std::size_t kBandsShown = 3;
+    std::vector<std::string> first(bands.begin(), bands.begin() + std::min(bands.size(), kBandsShown));
+    out += fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
+                       bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
+  }
+  if (!worse.empty()) out += "\n";
   for (const std::string& note : h.notes) out += fmt::format("Note: {}\n\n", note);
 }
 
-// Per convention and format, on the GPU backend: the variant that keeps
-// the most bits at the far plane of f/n = 1e8 (or an infinite far plane).
-void Headline(const Report& report, std::string& out) {
-  const std::string backend = GpuBackend(report);
-  std::map<std::pair<std::string, std::string>, const HeadlineRow*> best;
-  auto far_bits = [](const HeadlineRow& row) {
-    auto it = row.predicted_bits.find(row.infinite_far ? "inf" : "1e8");
-    return it != row.predicted_bits.end() && it->second ? *it->second : INFINITY;
-  };
-  std::vector<std::pair<std::string, std::string>> order;
-  for (const HeadlineRow& row : report.headline) {
-    if (row.cell.backend != backend) continue;
-    const std::pair<std::string, std::string> key{row.cell.convention, row.cell.format};
-    auto [it, added] = best.try_emplace(key, &row);
-    if (added)
-      order.push_back(key);
-    else if (far_bits(row) < far_bits(*it->second))
-      it->second = &row;
-  }
+// What to use: the report's first screen (Report::recommendations).
+void WhatToUse(const Report& report, std::string& out) {
+  if (report.recommendations.empty()) return;
+  const RecommendationRow& first = report.recommendations.front();
   out += fmt::format(
-      "## Headline ({})\n\nPer convention and format, the variant that keeps the most bits at the far plane; "
-      "bits lost at p99.9 of the relative error, from the fitted model.\n\n",
-      backend);
-  out +=
-      "| convention | format | best variant | bits lost per doubling of f/n | at 1e4 | at 1e8 | at inf | f/n for 1e-3 "
-      "| "
-      "f/n for 1e-6 |\n";
-  out += "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
-  for (const auto& key : order) {
-    const HeadlineRow& row = *best[key];
-    auto predicted = [&](const char* at) {
-      auto it = row.predicted_bits.find(at);
-      return it != row.predicted_bits.end() ? Bits(it->second) : std::string("-");
-    };
-    const std::string slope = !row.slope ? "-"
-                                         : fmt::format("{:.2f} [{:.2f}, {:.2f}]", *row.slope,
-                                                       row.slope_low.value_or(NAN), row.slope_high.value_or(NAN));
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", key.first, key.second, row.cell.variant,
-                       slope, predicted("1e4"), predicted("1e8"), predicted("inf"), Budget(row.ratio_for_1e3),
-                       Budget(row.ratio_for_1e6));
+      "## What to use ({})\n\nPer convention and format: the cheapest variant within 0.25 bit of the most precise "
+      "(tied ones in parentheses), p99.9 bits lost at the far plane with the model's 95% interval, cost in {}, and "
+      "the far/near up to which the far plane keeps 1e-3 and 1e-6.\n\n",
+      first.backend, first.cost_unit);
+  out += "| convention | format | use | f/n | bits lost [95%] | cost | f/n for 1e-3 | f/n for 1e-6 |\n";
+  out += "|---|---|---|---|---:|---:|---:|---:|\n";
+  for (const RecommendationRow& r : report.recommendations) {
+    std::string use = "`" + r.variants.front() + "`";
+    if (r.variants.size() > 1) {
+      use +=
+          fmt::format(" (= {})", fmt::join(std::vector<std::string>(r.variants.begin() + 1, r.variants.end()), ", "));
+    }
+    const std::string interval =
+        r.bits_low && r.bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r.bits_low, *r.bits_high) : "";
+    out += fmt::format("| {} | {} | {} | {} | {}{} | {} | {} | {} |\n", r.convention, r.format, use, r.ratio,
+                       Bits(r.bits), interval,
+                       !r.cost            ? "-"
+                       : *r.cost >= 100.0 ? fmt::format("{:.0f}", *r.cost)
+                                          : fmt::format("{:.3g}", *r.cost),
+                       Budget(r.ratio_for_1e3), Budget(r.ratio_for_1e6));
   }
   out += "\n";
 }
@@ -246,8 +223,8 @@ std::string RenderMarkdown(const Report& report) {
       fmt::format("{} · commit `{}` · {} · {} samples per far/near ratio, {} default-domain samples{} · {:.0f} s\n\n",
                   env.started_at, env.commit.substr(0, 12), fmt::join(devices, ", "), env.fit_sweeps.samples_per_ratio,
                   env.default_sweep.samples, env.quick ? " (quick)" : "", env.seconds.value_or(0.0));
-  Changes(report, out);
-  Headline(report, out);
+  Verdict(report, out);
+  WhatToUse(report, out);
   Worst(report, out);
   Findings(report, out);
   out += "The whole report, with plots: `report.html`; every figure it shows: `results.json`.\n";
