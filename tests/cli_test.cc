@@ -66,6 +66,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{{"run", "--variant", "recipocal"}, "did you mean 'reciprocal'?"},
         BadInput{{"run", "--convention", "revresed"}, "did you mean 'reversed'?"},
         BadInput{{"run", "--domain", "typcial"}, "did you mean 'typical'?"},
+        // Numbers read strictly, never wrapped, clamped or defaulted.
+        BadInput{{"run", "--threads", "100000"}, "'100000' is not a thread count (0: one per core) from 0 to 1024"},
+        BadInput{{"run", "--seed", "-1"}, "'-1' is not a whole number from 0 to 18446744073709551615"},
+        BadInput{{"run", "--seed", ""}, "'' is not a whole number from 0 to"},
+        BadInput{{"run", "--seed", "18446744073709551616"}, "is not a whole number from 0 to 18446744073709551615"},
+        BadInput{{"run", "--samples", "0x10"}, "--samples: '0x10' is not a whole number"},
+        // Too few samples to say anything: refused, not an empty table.
+        BadInput{{"fit", "--samples", "64", "--backend", "cpu", "--variant", "divide"},
+                 "--samples: no cell could be fitted at p99.9 from 64 samples per far/near ratio"},
+        BadInput{{"report", "--quick", "--no-history", "--backend", "cpu", "--variant", "divide", "--samples", "1",
+                  "--out", "/tmp/depthbench_cli_test_never_written"},
+                 "--samples: no cell could be fitted at p99.9 from 1 samples per far/near ratio"},
         // Fields that are valid alone but not together.
         BadInput{{"run", "--depth", "1e9", "--near", "1", "--far", "100"}, "lies beyond every far plane"},
         BadInput{{"run", "--depth", "0.001:0.01", "--near", "1"}, "lies nearer than every near plane"}),
@@ -161,7 +173,7 @@ TEST(CliTest, OutputFitsOneHundredTwentyColumns) {
   const std::string root = DEPTHBENCH_SOURCE_DIR;
   const std::vector<std::vector<std::string>> commands{
       {"run", "--samples", "3000", "--split", "ratio,depth,distance"},
-      {"fit", "--samples", "4000", "--variant", "divide,reciprocal"},
+      {"fit", "--samples", "2e4", "--variant", "divide,reciprocal", "--backend", "cpu"},
       {"choose", "--scene", root + "/bench/scenes/indoor_shooter.toml", "--backend", "cpu", "--samples", "2e4"},
       {"gate", "--baseline", root + "/reports/baselines/cpu.json"},
       {"fuzz", "--seconds", "2", "--out", dir + "/fuzz"},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -102,6 +103,35 @@ std::string UnknownOptions(const CLI::App& sub, int argc, const char* const* arg
   return message;
 }
 
+// Seeds and thread counts are read strictly: CLI11 would wrap -1 to
+// 2^64 - 1, clamp what is past 2^64 and read '' as 0.
+constexpr unsigned kMostThreads = 1024;
+std::string WholeNumberError(const std::string& text, std::uint64_t most, const std::string& what) {
+  const bool digits = !text.empty() && text.size() <= 20 &&
+                      std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  // Twenty digits may still pass 2^64 - 1: compare as text of equal length.
+  const std::string largest = std::to_string(most);
+  const bool in_range = digits && (text.size() < largest.size() || (text.size() == largest.size() && text <= largest));
+  return in_range ? "" : fmt::format("'{}' is not {} from 0 to {}", text, what, most);
+}
+void CheckWholeNumbers(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands({})) {
+    for (CLI::Option* option : sub->get_options()) {
+      if (option->check_lname("seed")) {
+        option->check(CLI::Validator(
+            [](std::string& text) {
+              return WholeNumberError(text, std::numeric_limits<std::uint64_t>::max(), "a whole number");
+            },
+            ""));
+      } else if (option->check_lname("threads")) {
+        option->check(CLI::Validator(
+            [](std::string& text) { return WholeNumberError(text, kMostThreads, "a thread count (0: one per core)"); },
+            ""));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
@@ -136,6 +166,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   AddReportCommand(*app, action);
   AddFuzzCommand(*app, action);
   NameOptionTypes(*app);
+  CheckWholeNumbers(*app);
   return app;
 }
 

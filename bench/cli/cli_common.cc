@@ -176,7 +176,9 @@ Expected<BackendSet> BackendFlags::Make() const {
 Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what) {
   char* end = nullptr;
   double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !(value >= 1.0) || value > 1e15 ||
+  // Decimal only: strtod also reads hexadecimal (0x10), "inf" and "nan".
+  const bool decimal = text.find_first_not_of("0123456789.eE+") == std::string::npos;
+  if (text.empty() || !decimal || end != text.c_str() + text.size() || !(value >= 1.0) || value > 1e15 ||
       value != std::floor(value)) {
     return InvalidArgument(fmt::format("{}: '{}' is not a whole number from 1 to 1e15", what, text));
   }

@@ -1,5 +1,6 @@
 // depthbench fit: error models per cell, and the precision lost as the
 // far/near ratio grows.
+#include <algorithm>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -44,6 +45,14 @@ Expected<int> Fit(const FitFlags& f) {
   const Metric metrics[] = {Metric::kTotal, Metric::kStorage, Metric::kArith};
   const std::vector<PrecisionFit> fits = FitPrecision(sweeps, plan, metrics, kAllLevels);
   progress.Finish(fmt::format("{} fits", fits.size()));
+  // An empty table with exit 0 would read as success.
+  if (std::none_of(fits.begin(), fits.end(),
+                   [&](const PrecisionFit& p) { return p.metric == Metric::kTotal && p.level == level; })) {
+    return InvalidArgument(fmt::format(
+        "--samples: no cell could be fitted at {} from {} samples per far/near ratio: a model needs bands with "
+        "enough samples for the level at each ratio ({} for a {}); try 1e5",
+        LevelName(level), plan.samples_per_ratio, MinimumSamples(level), LevelName(level)));
+  }
 
   PrintPrecisionFits(fits, level, std::cout);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, PrecisionFitsToJson(fits, plan).dump(1) + "\n"));

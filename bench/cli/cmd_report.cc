@@ -121,6 +121,14 @@ Expected<int> RunReport(const ReportFlags& f) {
 
   progress.begin("write");
   Report report = BuildReport(plan, *measured);
+  // A page with no fitted cell would pass for a report: nothing is written
+  // or recorded.
+  if (report.headline.empty()) {
+    return InvalidArgument(
+        fmt::format("--samples: no cell could be fitted at p99.9 from {} samples per far/near ratio (a model needs "
+                    "bands of {} samples or more at each ratio); try 1e5",
+                    plan.fit.samples_per_ratio, MinimumSamples(Level::kP999)));
+  }
   if (history) {
     HistoryRun run;
     run.made_at = started_at;

@@ -296,14 +296,14 @@ void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std:
                    {"backend", Align::kLeft},
                    {"model", Align::kLeft},
                    {"bits/doubling f/n [95%]"},
-                   {"1e2"},
+                   {"1e2", Align::kRight, true},
                    {"1e4"},
-                   {"1e6"},
+                   {"1e6", Align::kRight, true},
                    {"1e8"},
                    {"inf"},
-                   {"f/n for 1e-3"},
-                   {"f/n for 1e-6"},
-                   {"held-out miss"}});
+                   {"f/n 1e-3"},
+                   {"f/n 1e-6"},
+                   {"held-out miss", Align::kRight, true}});
   auto ratio_text = [](const std::map<std::string, std::optional<double>>& budgets, const char* name) {
     auto it = budgets.find(name);
     if (it == budgets.end()) return std::string("-");
@@ -324,8 +324,9 @@ void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std:
                   f.holdout_points == 0 ? "-" : fmt::format("{:.2f} bit", f.holdout_max_miss)});
   }
   out << fmt::format(
-      "{} bits lost of the total error at the far plane, from the fitted model chosen by BIC; the far/near ratio "
-      "up to which the far plane meets a relative error of 1e-3 and 1e-6 ('always': up to 1e12, 'never': not even "
+      "{} bits lost of the total error at the far plane, from the fitted model chosen by BIC; f/n 1e-3 and 1e-6: "
+      "the far/near ratio up to which the far plane meets a relative error of 1e-3 and 1e-6 ('always': up to 1e12, "
+      "'never': not even "
       "at 10); the largest miss on held-out ratios\n",
       LevelName(level));
   table.Print(out);
