@@ -234,6 +234,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     // On the upper end of the interval: a candidate meets the requirement
     // only if the sampling error cannot be what makes it pass.
     v.meets = v.supported && v.interval.high <= req.value && v.nonfinite == 0;
+    v.too_close = v.supported && v.nonfinite == 0 && v.measured <= req.value && !v.meets;
     v.cost = cost_of ? cost_of(cell) : std::nullopt;
     v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
     result.ranked.push_back(v);
@@ -295,7 +296,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
                              v.samples, LevelName(req.level), needed);
     } else if (v.nonfinite > 0) {
       v.reason = fmt::format("fails: {} NaN or Inf outputs inside the scene", v.nonfinite);
-    } else if (v.measured <= limit) {
+    } else if (v.too_close) {
       v.reason = fmt::format("fails: {} measured, but the interval reaches {}: too close to call",
                              InUnitText(req, v.measured), measured);
     } else {
@@ -353,7 +354,7 @@ std::string Limit(const CandidateVerdict& v) {
   if (v.meets) return "";
   if (!v.supported) return "samples";
   if (v.nonfinite > 0) return "NaN/Inf";
-  if (v.interval.low <= 0.0 && v.measured <= 0.0) return "interval";
+  if (v.too_close) return "interval";
   switch (v.dominant) {
     case Metric::kProduction: return "production";
     case Metric::kStorage: return "storage";
@@ -402,7 +403,8 @@ void PrintChoice(const ChooseResult& r, std::ostream& out) {
       "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end; NaN/Inf: findings "
       "inside the scene's "
       "ranges;\nheld back by: the part of the error that dominates (production, storage or shader), or what else "
-      "fails it;\nrank: '=' marks costs that tie; exit status 0 when a candidate meets the requirement, 1 when none "
+      "fails it (interval: the measured value meets it, the upper end of its interval does not);\nrank: '=' marks "
+      "costs that tie; exit status 0 when a candidate meets the requirement, 1 when none "
       "does\n");
 }
 
@@ -426,6 +428,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"nonfinite", v.nonfinite},
                       {"dominant_cause", MetricName(v.dominant)},
                       {"meets", v.meets},
+                      {"too_close", v.too_close},
                       {"over_budget", v.over_budget},
                       {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"spread", v.cost->spread}}
                                       : nlohmann::json(nullptr)},

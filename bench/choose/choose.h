@@ -72,6 +72,9 @@ struct CandidateVerdict {
   // kProduction, kStorage or kArith (the shader's part).
   Metric dominant = Metric::kArith;
   bool meets = false;
+  // The point estimate is within the limit but the interval's upper end is
+  // not: more samples could tell.
+  bool too_close = false;
   bool over_budget = false;
   std::optional<CandidateCost> cost;
   int rank = 0;        // 1 = the choice; candidates that tie share a rank
