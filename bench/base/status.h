@@ -15,6 +15,7 @@ enum class StatusCode {
   kUnavailable,      // no Vulkan device, a driver failure (exit 2)
   kCompileError,     // a shader that does not compile (exit 2)
   kIoError,          // a file that cannot be read or written (exit 2)
+  kInterrupted,      // stopped by SIGINT or SIGTERM (exit 128 + signal; base/interrupt.h)
   kInternal,         // a bug in depthbench itself
 };
 

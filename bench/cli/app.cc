@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "bench/base/build_info.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/resources.h"
 #include "bench/base/suggest.h"
 #include "bench/base/text_table.h"
@@ -20,8 +21,13 @@ namespace depthbench::cli {
 namespace {
 
 // The one place where a command that could not run becomes a message
-// ("depthbench: error: ...") and exit code 2.
-int ExitCode(const Expected<int>& ran) { return ran.ok() ? *ran : ReportError(ran.status()); }
+// ("depthbench: error: ...") and exit code 2. A command that returns after
+// SIGINT or SIGTERM (its long work stopped early) ends with 128 + signal,
+// whatever it returned.
+int ExitCode(const Expected<int>& ran) {
+  if (ran.ok() && Interrupted()) return ReportError(InterruptedError("what was written is partial"));
+  return ran.ok() ? *ran : ReportError(ran.status());
+}
 
 // What an option takes, for --help, where its declaration leaves CLI11
 // to say TEXT (counts are read as text so that 1e6 parses, files as
@@ -207,6 +213,7 @@ int RunDepthbench(int argc, const char* const* argv) {
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
+  InstallInterruptHandlers();
   return action ? ExitCode(action()) : kExitCannotRun;
 }
 

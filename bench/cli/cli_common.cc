@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/factory.h"
+#include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
 
 namespace depthbench::cli {
@@ -213,6 +214,10 @@ Status CheckWritable(const std::string& path, const std::string& what) {
 bool StderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
 
 int ReportError(const Status& status) {
+  if (status.code() == StatusCode::kInterrupted) {
+    std::cerr << "depthbench: " << status.message() << "\n";
+    return 128 + InterruptSignal();
+  }
   std::cerr << "depthbench: error: " << status.message() << "\n";
   return kExitCannotRun;
 }

@@ -10,6 +10,7 @@
 
 #include "bench/base/build_info.h"
 #include "bench/base/environment.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
@@ -147,7 +148,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   SweepProgress progress;
   progress.samples_total = end - begin;
   Batch batch;
-  for (std::uint64_t first = begin; first < end; first += options.batch_size) {
+  // On SIGINT or SIGTERM the sweep stops between batches and returns what it
+  // judged (base/interrupt.h); the caller marks it partial.
+  for (std::uint64_t first = begin; first < end && !Interrupted(); first += options.batch_size) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(options.batch_size, end - first));
     builder.Build(first, count, batch, pool);
     for (std::size_t b = 0; b < backends.size(); ++b) {
