@@ -1,5 +1,6 @@
 // Progress of long work on stderr: a self-updating line when stderr is a
-// terminal, otherwise one quiet log line when a stage ends.
+// terminal; otherwise (a CI log) a plain line every ten seconds or so, and
+// one when a stage ends.
 #pragma once
 
 #include <chrono>

@@ -97,6 +97,12 @@ std::pair<double, std::string> PredictAtFarEnd(const Scene& scene, const CellRes
   return {value, Info(ranked.front().kind).name};
 }
 
+// 5861 -> 5900: a sample count to suggest.
+double RoundUpToTwoDigits(double x) {
+  const double step = std::pow(10.0, std::max(0.0, std::floor(std::log10(x)) - 1.0));
+  return std::ceil(x / step) * step;
+}
+
 // Which cause dominates, in words.
 const char* CauseText(Metric cause) {
   switch (cause) {
@@ -238,6 +244,22 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     v.cost = cost_of ? cost_of(cell) : std::nullopt;
     v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
     result.ranked.push_back(v);
+  }
+  // No candidate has the samples the level needs: no verdict can be given,
+  // and a ranking of unsupported figures would read as one.
+  std::uint64_t most_samples = 0;
+  bool any_supported = false;
+  for (const CandidateVerdict& v : result.ranked) {
+    most_samples = std::max(most_samples, v.samples);
+    any_supported = any_supported || v.supported;
+  }
+  if (!result.ranked.empty() && !any_supported) {
+    const double scale = static_cast<double>(needed) / static_cast<double>(std::max<std::uint64_t>(most_samples, 1));
+    return InvalidArgument(fmt::format(
+        "--samples {}: too few for a {} verdict: at most {} samples fall where the requirement is judged, and a {} "
+        "needs {}; raise --samples to at least {:.0f}",
+        options.samples, LevelName(req.level), most_samples, LevelName(req.level), needed,
+        RoundUpToTwoDigits(static_cast<double>(options.samples) * scale * 1.1)));
   }
   if (!result.ranked.empty() && result.ranked.front().cost) {
     result.cost_unit = result.ranked.front().cost->unit;

@@ -203,6 +203,21 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
     const int code = app.exit(e, out, err);
     return {false, code == 0 ? kExitOk : kExitCannotRun};
   }
+  // An option given an empty value ('--near ""', often an unset shell
+  // variable) is refused: read as "not given", it would silently change
+  // what runs.
+  for (const CLI::App* sub : app.get_subcommands()) {
+    for (const CLI::Option* option : sub->get_options()) {
+      if (option->get_expected_min() == 0) continue;  // a flag without a value
+      for (const std::string& value : option->results()) {
+        if (!value.empty()) continue;
+        err << fmt::format(
+            "depthbench: error: {}: empty value; give a value or leave the option out (see depthbench {} --help)\n",
+            option->get_name(), sub->get_name());
+        return {false, kExitCannotRun};
+      }
+    }
+  }
   return {true, kExitOk};
 }
 

@@ -96,12 +96,23 @@ Expected<Domain> DomainFlags::Apply(Domain d) const {
     while (start <= resolution.size()) {
       const std::size_t comma = std::min(resolution.find(',', start), resolution.size());
       const std::string one = resolution.substr(start, comma - start);
-      unsigned w = 0, h = 0;
-      char x = 0, extra = 0;
-      if (std::sscanf(one.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
-        return InvalidArgument(fmt::format("--resolution: '{}' is not WIDTHxHEIGHT (e.g. 1920x1080)", one));
+      // Digits only, each side 1..kMaxSide: sscanf's %u would wrap
+      // 4294967297 to 1.
+      constexpr unsigned long kMaxSide = 65536;
+      const std::size_t x = one.find_first_of("xX");
+      auto side = [&](std::size_t from, std::size_t to) -> unsigned long {
+        const std::string digits = one.substr(from, to - from);
+        if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
+          return 0;
+        return std::stoul(digits);
+      };
+      const unsigned long w = x == std::string::npos ? 0 : side(0, x);
+      const unsigned long h = x == std::string::npos ? 0 : side(x + 1, one.size());
+      if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide) {
+        return InvalidArgument(fmt::format(
+            "--resolution: '{}' is not WIDTHxHEIGHT with each side 1 to {} (e.g. 1920x1080)", one, kMaxSide));
       }
-      d.resolutions.push_back({w, h});
+      d.resolutions.push_back({static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h)});
       start = comma + 1;
     }
   }
