@@ -119,6 +119,25 @@ f32::PassConstants PassConstantsFor(const ShaderInputs& batch, const SliceLayout
 
 std::size_t VariantIndex(Variant variant) { return static_cast<std::size_t>(variant); }
 
+// What the output buffer holds before each run, so that an output the
+// shader never wrote (it returned early, or wrote elsewhere) is told apart
+// from any result: a signalling NaN with a payload. Arithmetic only ever
+// produces quiet NaNs, so no reconstruction can store these bits.
+constexpr std::uint32_t kUnwrittenBits = 0x7fa0'0badu;
+
+// The number of samples of the listed cell `k` with a component the
+// shader left unwritten.
+std::size_t UnwrittenSamples(const float* positions, const SliceLayout& slices, std::size_t k, std::size_t count) {
+  std::size_t unwritten = 0;
+  const auto* bits = reinterpret_cast<const std::uint32_t*>(positions) + k * 3 * slices.length + slices.lead;
+  for (std::size_t i = 0; i < count; ++i) {
+    const bool any = (bits[i] == kUnwrittenBits) | (bits[slices.length + i] == kUnwrittenBits) |
+                     (bits[2 * slices.length + i] == kUnwrittenBits);
+    unwritten += any ? 1 : 0;
+  }
+  return unwritten;
+}
+
 // A run's dispatches, one per variant among the listed cells, and the
 // CellSlice entries they read: one dispatch's entries are consecutive. A
 // cell writes the output slices of its place k in the list, whatever its
@@ -176,6 +195,8 @@ class VulkanBackend final : public Backend {
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
+  Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
+                                 std::span<const std::uint32_t> which, const SliceLayout& slices) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
   Status Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
                 std::span<const f32::CellSlice> cell_slices);
@@ -285,6 +306,7 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
   DB_RETURN_IF_ERROR(buffers_[kPositions].InvalidateForHostReads());
   DB_RETURN_IF_ERROR(validation.Check("Run"));
   const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
+  DB_RETURN_IF_ERROR(CheckEveryOutputWritten(device_positions, batch, which, slices));
   if (slices.compact(batch)) return std::span<const float>(device_positions, output_floats);
   // Every slice's samples, without the lead and the padding.
   scratch.resize(output_floats);
@@ -293,6 +315,22 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
                 batch.count * sizeof(float));
   }
   return std::span<const float>(scratch);
+}
+
+// Outputs a shader never wrote would be judged as if it had: refused, with
+// the variant and the count.
+Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
+                                              std::span<const std::uint32_t> which, const SliceLayout& slices) const {
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const std::size_t unwritten = UnwrittenSamples(positions, slices, k, batch.count);
+    if (unwritten == 0) continue;
+    const Cell& cell = cells_[which[k]].cell;
+    return InvalidArgument(fmt::format(
+        "the {} shader did not write its output for {} of {} samples (cell {}): it returns before writing, or "
+        "writes another element; nothing it did not write is judged",
+        Info(cell.variant).name, unwritten, batch.count, cell.Name()));
+  }
+  return Status::Ok();
 }
 
 // What the shaders would otherwise read or write out of bounds, and what
@@ -347,9 +385,12 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
   // Growing geometrically keeps reallocations rare when batches vary a little.
   const VkDeviceSize size = std::max(bytes, buffer.size() + buffer.size() / 2);
   const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
+  // The output is filled with kUnwrittenBits on the device before each run.
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | (binding == kPositions ? VK_BUFFER_USAGE_TRANSFER_DST_BIT : 0u);
   // The previous run has completed (Run waits), so the old buffer can go.
   buffer = VulkanBuffer();
-  DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, access));
+  DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, usage, access));
   return Status::Ok();
 }
 
@@ -399,6 +440,14 @@ void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
 void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
                            const DispatchPlan& plan) const {
   const std::uint32_t groups = WorkgroupsFor(batch, shape_);
+  // Every output starts as kUnwrittenBits; the shaders' writes come after.
+  vkCmdFillBuffer(commands, buffers_[kPositions].handle(), 0, VK_WHOLE_SIZE, kUnwrittenBits);
+  VkMemoryBarrier filled{};
+  filled.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  filled.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  filled.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &filled, 0,
+                       nullptr, 0, nullptr);
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
   for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
     pass_->Bind(commands, pipelines_[VariantIndex(dispatch.variant)].get());
