@@ -45,6 +45,10 @@ class Backend {
   virtual Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch) = 0;
 
+  // The most samples one Run of every prepared cell can take (a device's
+  // buffer and dispatch limits); the sweep cuts its batches to it. Results
+  // do not depend on the batch size.
+  virtual std::uint64_t MaxBatchSamples() const { return UINT64_MAX; }
   // Whether Run may be called from several threads at once (with disjoint
   // scratch). The sweep then spreads cells over threads.
   virtual bool concurrent() const = 0;

@@ -153,7 +153,8 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   "whether the finding still holds (exit 1) or not (exit 0)");
   cmd->add_option("--split", flags->split, "also print p99.9 per band: ratio, depth, distance")->delimiter(',');
   cmd->add_option("--threads", flags->threads, "worker threads (default: one per core)");
-  cmd->add_option("--batch", flags->batch, "samples per batch (memory is proportional to it)")
+  cmd->add_option("--batch", flags->batch,
+                  "samples per batch (memory is proportional to it; cut to what the Vulkan device can bind at once)")
       ->check(CLI::Range(64u, 1u << 22));
   cmd->add_flag("--quiet", flags->quiet, "no progress line");
   flags->domain.Add(*cmd);

@@ -98,6 +98,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (Backend* backend : backends) {
     DB_RETURN_IF_ERROR(backend->Prepare(layout.cells).WithContext("preparing the " + backend->name() + " backend"));
   }
+  // A batch no backend can take whole is cut to what the smallest takes.
+  std::uint64_t batch_size = options.batch_size;
+  for (const Backend* backend : backends) batch_size = std::min(batch_size, backend->MaxBatchSamples());
 
   const auto started = std::chrono::steady_clock::now();
   Results results;
@@ -150,8 +153,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   Batch batch;
   // On SIGINT or SIGTERM the sweep stops between batches and returns what it
   // judged (base/interrupt.h); the caller marks it partial.
-  for (std::uint64_t first = begin; first < end && !Interrupted(); first += options.batch_size) {
-    const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(options.batch_size, end - first));
+  for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size) {
+    const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     builder.Build(first, count, batch, pool);
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];

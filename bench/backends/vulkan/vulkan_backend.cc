@@ -182,6 +182,7 @@ class VulkanBackend final : public Backend {
   Status Prepare(std::span<const CellPlan> cells, PassKind pass) override;
   Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override;
+  std::uint64_t MaxBatchSamples() const override;
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -266,6 +267,23 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
   shape_ = shape;
   cells_.assign(cells.begin(), cells.end());
   return Status::Ok();
+}
+
+std::uint64_t VulkanBackend::MaxBatchSamples() const {
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  std::uint64_t slots = 1;
+  for (const CellPlan& plan : cells_) slots = std::max<std::uint64_t>(slots, plan.depth_slot + 1u);
+  // The widest per-sample binding (every cell's positions, or every slot's
+  // stored depths), less the lead and padding of the quad layout.
+  const std::uint64_t per_sample_bytes = sizeof(float) * std::max<std::uint64_t>(3 * cells_.size(), slots);
+  const std::uint64_t fit = limits.maxStorageBufferRange / per_sample_bytes;
+  std::uint64_t most = fit > 8 ? fit - 8 : 1;
+  // Workgroups along x, each taking frames_per_workgroup frames (the first
+  // frame of a batch may be partial).
+  const std::uint64_t frames =
+      std::uint64_t{limits.maxComputeWorkGroupCount[0]} * std::max<std::uint32_t>(shape_.frames_per_workgroup, 1);
+  most = std::min(most, (frames - 1) * kSamplesPerFrame);
+  return most;
 }
 
 Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape) const {

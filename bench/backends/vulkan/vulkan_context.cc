@@ -32,9 +32,13 @@ std::string Lower(std::string_view text) {
   return lower;
 }
 
-bool ValidationRequestedByEnvironment() {
+// DEPTHBENCH_VALIDATION: 1 on, 0 or unset off; anything else is refused
+// ("yes" meant off, silently).
+Expected<bool> ValidationRequestedByEnvironment() {
   const char* value = std::getenv(kValidationEnvironment);
-  return value != nullptr && std::string_view(value) == "1";
+  if (value == nullptr || std::string_view(value) == "0") return false;
+  if (std::string_view(value) == "1") return true;
+  return InvalidArgument(fmt::format("{}='{}': use 1 (validation on) or 0 (off)", kValidationEnvironment, value));
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL RecordValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -72,7 +76,7 @@ Status CheckValidationLayerInstalled() {
     if (std::strcmp(layer.layerName, kValidationLayer) == 0) return Status::Ok();
   }
   return Unavailable(
-      fmt::format("Vulkan validation was requested (--validation or {}=1) but the layer {} is not "
+      fmt::format("Vulkan validation was requested (--validate or {}=1) but the layer {} is not "
                   "installed; install the Debian package vulkan-validationlayers",
                   kValidationEnvironment, kValidationLayer));
 }
@@ -329,7 +333,8 @@ Status VulkanBuffer::InvalidateForHostReads() const {
 
 Expected<std::unique_ptr<VulkanContext>> VulkanContext::Create(const VulkanContextOptions& options) {
   std::unique_ptr<VulkanContext> context(new VulkanContext());
-  DB_RETURN_IF_ERROR(context->CreateInstance(options.validation || ValidationRequestedByEnvironment()));
+  DB_ASSIGN_OR_RETURN(const bool validation_by_environment, ValidationRequestedByEnvironment());
+  DB_RETURN_IF_ERROR(context->CreateInstance(options.validation || validation_by_environment));
   DB_RETURN_IF_ERROR(context->PickPhysicalDevice(options.device));
   DB_RETURN_IF_ERROR(context->CreateDevice().WithContext(context->properties_.name));
   return context;
