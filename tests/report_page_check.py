@@ -10,7 +10,13 @@
       opens report.html in headless Chromium (no network, fresh profile),
       waits for the page's own render check, and asserts: no console or
       page errors, every plot drawn with data in it, the headline table
-      present; saves a screenshot and the rendered DOM as test artifacts.
+      present; the bits-lost plots as small multiples (a panel per
+      convention and format, every panel on the same y domain) with the
+      theory lines; the speed/accuracy front per convention and format with
+      interval bars and a cost axis that names its unit; the GPU-against-CPU
+      differences in words when there are none; the findings by cause; the
+      first screen wholly visible at 1024x768. Saves screenshots and the
+      rendered DOM as test artifacts.
 """
 import copy
 import json
@@ -95,9 +101,71 @@ def check_browser(report_dir, artifact_dir):
             fail("plot '%s' drew %s data marks" % (plot, drawn))
     if not os.path.isfile(shot) or os.path.getsize(shot) < 10000:
         fail("no screenshot")
+    with open(os.path.join(report_dir, "results.json")) as f:
+        document = json.load(f)
+    check_small_multiples(check, document)
+    check_differences_and_findings(check, document)
     check_first_screen(page, artifact_dir, chromium)
     print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
           (check["headline_rows"], check["plots"], shot))
+
+
+def check_shared_y(name, plot, panels):
+    if plot is None:
+        fail("no small-multiple check for the %s plot" % name)
+    if plot["panels"] != panels:
+        fail("the %s plot has %d panels, not one per convention and format (%d)" % (name, plot["panels"], panels))
+    domains = {json.dumps(d) for d in plot["y_domains"]}
+    if len(domains) != 1 or None in plot["y_domains"]:
+        fail("the %s plot's panels are not on one y domain: %s" % (name, sorted(domains)))
+
+
+# The theory lines a panel of each format draws beside the float32 floor
+# and, for every convention but linear, the one-bit-per-doubling line.
+STORAGE_BOUNDS = {"d16_unorm": "16-bit unorm storage bound", "r16_unorm": "16-bit unorm storage bound",
+                  "x8_d24_unorm": "24-bit unorm storage bound", "r16_sfloat": "fp16 storage bound"}
+
+
+def check_small_multiples(check, document):
+    """Bits lost against far/near: a panel per convention and format (an
+    infinite-far convention in its finite twin's), one y domain, the theory
+    lines; the front: a panel per convention and format, one y domain,
+    interval bars, its cost unit named."""
+    points = document["precision_points"]
+    encodings = {(p["convention"].replace("-inf", ""), p["format"]) for p in points}
+    precision = check.get("precision")
+    check_shared_y("precision", precision, len(encodings))
+    expected = {"float32 floor (24-bit mantissa)"} | {STORAGE_BOUNDS[f] for _, f in encodings if f in STORAGE_BOUNDS}
+    if any(c != "linear" for c, _ in encodings):
+        expected.add("standard Z: 1 bit lost per doubling of far/near")
+    missing = expected - set(precision["theory"])
+    if missing:
+        fail("theory lines missing from the precision plot: %s (drawn: %s)" % (sorted(missing), precision["theory"]))
+    rows = document["speed"]["rows"]
+    if not rows:
+        return
+    best = next(s for s in document["speed"]["sources"] if any(r["source"] == s["source"] for r in rows))
+    speed = check.get("speed")
+    check_shared_y("speed", speed, len({(r["convention"], r["format"]) for r in rows if r["source"] == best["source"]}))
+    if speed["intervals"] < 1:
+        fail("the speed/accuracy front draws no accuracy intervals")
+    if best["cost_title"] not in speed["titles"] or not re.search(r"\(µs\) on |static cost", best["cost_title"]):
+        fail("the front's cost axis does not name its unit: titles %s, expected %r" % (speed["titles"], best["cost_title"]))
+    print("small multiples: %d bits-lost panels on y %s with %s; %d front panels, %d interval bars, cost axis %r" %
+          (precision["panels"], precision["y_domains"][0], sorted(precision["theory"]), speed["panels"],
+           speed["intervals"], best["cost_title"]))
+
+
+def check_differences_and_findings(check, document):
+    d = document["backend_differences"]
+    if len(d["backends"]) == 2 and not d["rows"] and "No cell differs" not in check["diff_text"]:
+        fail("no GPU-against-CPU difference, and the page does not say so: %r" % check["diff_text"])
+    if d["rows"] and "No cell differs" in check["diff_text"]:
+        fail("the page says no cell differs, but %d do" % len(d["rows"]))
+    groups = document["findings"]["groups"]
+    if check["finding_groups"] != max(1, len(groups)):
+        fail("the page lists %d finding groups, the document has %d" % (check["finding_groups"], len(groups)))
+    print("GPU against CPU: %r; findings: %d causes" % (check["diff_text"][:80], len(groups)))
 
 
 def check_first_screen(page, artifact_dir, chromium):

@@ -1,6 +1,7 @@
 #include "bench/base/text_table.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <fmt/format.h>
@@ -204,6 +205,24 @@ std::string ShortCount(double x) {
   if (x >= 1e6) return fmt::format("{:.2f}M", x / 1e6);
   if (x >= 1e4) return fmt::format("{:.0f}k", x / 1e3);
   return fmt::format("{:.0f}", x);
+}
+
+std::string Readable(double x, int digits) {
+  if (!std::isfinite(x)) return fmt::format("{}", x);
+  const double magnitude = std::fabs(x);
+  if (magnitude == 0.0) return "0";
+  if (magnitude >= 1e6 || magnitude < 1e-3) {
+    // "1.06e+07" as "1.06e7": the exponent's sign and zeros add nothing.
+    std::string text = fmt::format("{:.{}g}", x, digits);
+    const std::size_t e = text.find('e');
+    if (e == std::string::npos) return text;
+    std::string exponent = text.substr(e + 1);
+    const bool negative = exponent[0] == '-';
+    exponent.erase(0, exponent.find_first_not_of("+-0"));
+    return text.substr(0, e) + "e" + (negative ? "-" : "") + exponent;
+  }
+  const int exponent = static_cast<int>(std::floor(std::log10(magnitude)));
+  return fmt::format("{:.{}f}", x, std::max(0, digits - 1 - exponent));
 }
 
 }  // namespace depthbench

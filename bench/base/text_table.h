@@ -70,4 +70,10 @@ std::size_t DisplayWidth(std::string_view text);
 // A count in few characters: 950, 12k, 4.20M, 1.50G.
 std::string ShortCount(double x);
 
+// A figure for people: `digits` significant digits written out in full
+// from 1e-3 to 1e6 (12630, 0.0106, 2.41), a short exponent outside that
+// range (1.06e7, 5e-5); "-0" never shows. For tables, the report's page and
+// its Markdown summary alike.
+std::string Readable(double x, int digits = 3);
+
 }  // namespace depthbench

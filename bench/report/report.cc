@@ -194,19 +194,49 @@ BackendDifferences Differences(const FitSweeps& sweeps, std::span<const std::str
   return out;
 }
 
+// Appends `value` to `list` unless it is there already.
+void AddOnce(std::vector<std::string>& list, const std::string& value) {
+  if (std::find(list.begin(), list.end(), value) == list.end()) list.push_back(value);
+}
+
+// The non-finite rows by cause (variant and kind), the most rows first.
+std::vector<FindingGroup> GroupFindings(const std::vector<NonFiniteRow>& rows) {
+  std::vector<FindingGroup> groups;
+  for (const NonFiniteRow& row : rows) {
+    auto it = std::find_if(groups.begin(), groups.end(),
+                           [&](const FindingGroup& g) { return g.variant == row.cell.variant && g.kind == row.kind; });
+    if (it == groups.end()) {
+      groups.push_back({row.cell.variant, row.kind, 0, 0, {}, {}, {}, row.command});
+      it = std::prev(groups.end());
+    }
+    ++it->rows;
+    it->outputs += row.nan + row.inf;
+    AddOnce(it->encodings, row.cell.convention + "/" + row.cell.format);
+    AddOnce(it->sweeps, row.sweep);
+    AddOnce(it->backends, row.cell.backend);
+  }
+  std::stable_sort(groups.begin(), groups.end(),
+                   [](const FindingGroup& a, const FindingGroup& b) { return a.rows > b.rows; });
+  return groups;
+}
+
 // NaN/Inf findings of every sweep, and the worst samples of the default one.
 void Findings(const ReportMeasurements& m, Report& report) {
   auto scan = [&](const Results& r) {
     for (const CellResult& c : r.cells) {
       const BandStats all = c.stats.All();
       if (all.nan + all.inf == 0) continue;
+      const NonFiniteKind kind = all.inf == 0   ? NonFiniteKind::kNaN
+                                 : all.nan == 0 ? NonFiniteKind::kInf
+                                                : NonFiniteKind::kNaNAndInf;
       report.nonfinite.push_back(
-          {Columns(c.cell, c.backend), SweepName(r), all.nan, all.inf, all.judged(), all.first_nonfinite_index,
+          {Columns(c.cell, c.backend), SweepName(r), kind, all.nan, all.inf, all.judged(), all.first_nonfinite_index,
            ReproCommand(r.run.seed, all.first_nonfinite_index, r.run.domain, c.cell, c.backend)});
     }
   };
   scan(m.main);
   for (const Results& r : m.sweeps.results) scan(r);
+  report.finding_groups = GroupFindings(report.nonfinite);
 
   std::vector<std::pair<double, WorstSampleRow>> worst;
   for (const CellResult& c : m.main.cells) {
@@ -226,8 +256,13 @@ void Findings(const ReportMeasurements& m, Report& report) {
 struct FrontEntry {
   Cell cell;
   FrontCandidate candidate;
-  std::uint64_t nonfinite = 0;
+  CellAccuracy accuracy;
 };
+
+// On the front, bits lost stop at every bit: a relative error of 1 or more
+// leaves nothing of the position right. (AccuracyOf already counts a cell
+// whose NaN/Inf outputs pass p99.9 as losing every bit.)
+double FrontBits(double p999_bits) { return std::min(p999_bits, kAllBitsLost); }
 
 // Marks the front of each (convention, format) among `entries` and adds
 // them as rows of `source` at far/near `ratio`.
@@ -244,20 +279,22 @@ void AddFronts(const std::string& source, double ratio, const std::vector<FrontE
     for (std::size_t k = 0; k < members.size(); ++k) {
       const FrontEntry& e = entries[members[k]];
       rows.push_back({Columns(e.cell), source, RatioLabel(ratio), Shown(e.candidate.cost), Shown(e.candidate.spread),
-                      Shown(e.candidate.bits_lost), e.nonfinite, static_cast<bool>(on_front[k])});
+                      Shown(e.candidate.bits_lost), Shown(FrontBits(e.accuracy.p999_bits_low)),
+                      Shown(FrontBits(e.accuracy.p999_bits_high)), e.accuracy.nonfinite,
+                      static_cast<bool>(on_front[k])});
     }
   }
 }
 
-// On the front, bits lost stop at every bit: a relative error of 1 or more
-// leaves nothing of the position right. (AccuracyOf already counts a cell
-// whose NaN/Inf outputs pass p99.9 as losing every bit.)
-double FrontBits(double p999_bits) { return std::min(p999_bits, kAllBitsLost); }
+// Pixels of the frame a GPU cost is given for.
+constexpr double kFramePixels = 1920.0 * 1080.0;
+constexpr const char* kFrameName = "1920x1080";
 
 // The speed/accuracy front at the far/near ratios a scene typically has:
-// the cost from each speed file (GPU time per reconstruction) and from the
-// instruction mix (which always exists), the accuracy from this report's
-// sweep at that ratio on the GPU backend.
+// the cost from each speed file (GPU time per 1920x1080 frame, from the
+// ALU-bound time per reconstruction) and from the instruction mix (which
+// always exists), the accuracy from this report's sweep at that ratio on
+// the GPU backend, with its interval. Sources best first (CostKind).
 SpeedSection Speed(const ReportMeasurements& m) {
   SpeedSection section;
   if (!m.static_costs_status.ok()) {
@@ -273,7 +310,27 @@ SpeedSection Speed(const ReportMeasurements& m) {
   }
   const std::string accuracy = fmt::format(
       "this report's sweep at the chosen far/near (camera at the origin) on the {} backend ({})", backend, device);
-  const CostLookup& static_model = m.static_costs;
+  const auto source_name = [](const std::filesystem::path& path, const SpeedResults& speed) {
+    return fmt::format("{} ({})", speed.run.device.name, path.filename().string());
+  };
+  for (const auto& [path, speed] : m.speed) {
+    if (speed.gpu.empty()) continue;
+    FrontSource source;
+    source.source = source_name(path, speed);
+    source.kind = speed.run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    source.device = speed.run.device.name;
+    source.cost_unit =
+        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})", kFrameName,
+                    ResolutionName(speed.run.trade_resolution), speed.run.started_at);
+    source.cost_title = fmt::format("GPU time per {} frame (µs) on {}", kFrameName, speed.run.device.name);
+    source.accuracy = accuracy;
+    section.sources.push_back(std::move(source));
+  }
+  section.sources.push_back({"static cost model", CostKind::kStaticModel, "",
+                             std::string(kStaticCostUnit) + " of the compiled shader (docs/choosing.md)",
+                             fmt::format("static cost ({} of the compiled shader)", kStaticCostUnit), accuracy});
+  std::stable_sort(section.sources.begin(), section.sources.end(),
+                   [](const FrontSource& a, const FrontSource& b) { return a.kind < b.kind; });
 
   for (std::size_t k = 0; k < m.sweeps.ratios.size(); ++k) {
     const double ratio = m.sweeps.ratios[k];
@@ -282,45 +339,44 @@ SpeedSection Speed(const ReportMeasurements& m) {
       continue;
     }
     const Results& at = m.sweeps.results[k];
+    const auto accuracy_of = [&](const Cell& cell) -> std::optional<CellAccuracy> {
+      const CellResult* r = at.Find(cell, backend);
+      if (r == nullptr) return std::nullopt;
+      return AccuracyOf(r->stats);
+    };
     for (const auto& [path, speed] : m.speed) {
       if (speed.gpu.empty()) continue;
       std::vector<std::string> left_out;
       std::vector<FrontEntry> entries;
       for (const TradeFront& front : BuildTrade(speed, at, backend, speed.run.trade_resolution, left_out)) {
         for (const TradePoint& p : front.points) {
-          entries.push_back({Cell{p.variant, front.convention, front.format},
-                             {p.gpu_ns_per_reconstruction, p.gpu_spread_ns, FrontBits(p.p999_bits_lost)},
-                             p.nonfinite});
+          const Cell cell{p.variant, front.convention, front.format};
+          const std::optional<CellAccuracy> cell_accuracy = accuracy_of(cell);
+          if (!cell_accuracy) continue;
+          const double us_per_frame = kFramePixels * 1e-3;
+          entries.push_back({cell,
+                             {p.gpu_ns_per_reconstruction * us_per_frame, p.gpu_spread_ns * us_per_frame,
+                              FrontBits(p.p999_bits_lost)},
+                             *cell_accuracy});
         }
       }
-      AddFronts(fmt::format("{} ({})", speed.run.device.name, path.filename().string()), ratio, entries, rows);
+      AddFronts(source_name(path, speed), ratio, entries, rows);
     }
     std::vector<FrontEntry> entries;
     for (const CellResult& c : at.cells) {
-      const std::optional<CandidateCost> cost = c.backend == backend ? static_model(c.cell) : std::nullopt;
+      const std::optional<CandidateCost> cost = c.backend == backend ? m.static_costs(c.cell) : std::nullopt;
       if (!cost) continue;
       const CellAccuracy cell = AccuracyOf(c.stats);
-      entries.push_back({c.cell, {cost->value, 0.0, FrontBits(cell.p999_bits_lost)}, cell.nonfinite});
+      entries.push_back({c.cell, {cost->value, 0.0, FrontBits(cell.p999_bits_lost)}, cell});
     }
     AddFronts("static cost model", ratio, entries, rows);
   }
-  for (const auto& [path, speed] : m.speed) {
-    if (speed.gpu.empty()) continue;
-    section.sources.push_back({fmt::format("{} ({})", speed.run.device.name, path.filename().string()),
-                               fmt::format("GPU ns per reconstruction, ALU-bound, {} (measured {})",
-                                           ResolutionName(speed.run.trade_resolution), speed.run.started_at),
-                               accuracy});
-  }
-  section.sources.push_back(
-      {"static cost model", std::string(kStaticCostUnit) + " of the compiled shader (docs/choosing.md)", accuracy});
   return section;
 }
 
 // Two variants whose far-plane predictions are closer than this are tied:
 // the gate's tolerance at p99.9, below what the fits resolve.
 constexpr double kTieBits = 0.25;
-// Pixels of the frame a GPU cost is given for.
-constexpr double kFramePixels = 1920.0 * 1080.0;
 
 // The first screen, from the headline (fits), the precision points (their
 // intervals) and the speed section (costs): on the GPU backend where the
@@ -329,14 +385,21 @@ std::vector<RecommendationRow> Recommendations(const Report& report) {
   std::string backend;
   for (const HeadlineRow& h : report.headline)
     if (backend.empty() || h.cell.backend == "vulkan") backend = h.cell.backend;
-  // Costs: the first speed file's device, else the static model.
-  std::string source = report.speed.sources.empty() ? "" : report.speed.sources.front().source;
+  // Costs: the best source with a front (sources are best first: a GPU's
+  // time over a software rasteriser's over the static model).
+  const FrontSource* source = nullptr;
+  for (const FrontSource& s : report.speed.sources) {
+    const bool has_rows = std::any_of(report.speed.rows.begin(), report.speed.rows.end(),
+                                      [&](const FrontRow& r) { return r.source == s.source; });
+    if (has_rows && source == nullptr) source = &s;
+  }
   std::map<std::string, double> cost_of;  // variant/convention/format -> cost
   for (const FrontRow& r : report.speed.rows)
-    if (r.source == source && r.cost) cost_of.emplace(r.cell.Name(), *r.cost);
-  const bool measured = source != "static cost model" && !source.empty();
-  const std::string device = source.substr(0, source.find(" ("));
-  const std::string unit = measured ? "µs per 1920x1080 frame on " + device : kStaticCostUnit;
+    if (source != nullptr && r.source == source->source && r.cost) cost_of.emplace(r.cell.Name(), *r.cost);
+  const CostKind kind = source != nullptr ? source->kind : CostKind::kStaticModel;
+  const std::string unit = kind == CostKind::kStaticModel
+                               ? std::string(kStaticCostUnit)
+                               : fmt::format("µs per {} frame on {}", kFrameName, source->device);
 
   std::map<std::pair<std::string, std::string>, std::vector<const HeadlineRow*>> groups;
   std::vector<std::pair<std::string, std::string>> order;
@@ -360,7 +423,7 @@ std::vector<RecommendationRow> Recommendations(const Report& report) {
     const auto cost = [&](const HeadlineRow* h) -> std::optional<double> {
       auto it = cost_of.find(h->cell.Name());
       if (it == cost_of.end()) return std::nullopt;
-      return measured ? it->second * kFramePixels * 1e-3 : it->second;
+      return it->second;
     };
     double best = kAllBitsLost;
     for (const HeadlineRow* h : groups[key]) best = std::min(best, bits_of(h));
@@ -384,6 +447,7 @@ std::vector<RecommendationRow> Recommendations(const Report& report) {
       }
     }
     if (const std::optional<double> c = cost(&chosen)) row.cost = Shown(*c);
+    row.cost_kind = kind;
     row.cost_unit = unit;
     row.ratio_for_1e3 = chosen.ratio_for_1e3;
     row.ratio_for_1e6 = chosen.ratio_for_1e6;

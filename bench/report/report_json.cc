@@ -118,20 +118,23 @@ json Differences(const BackendDifferences& d) {
 }
 
 json Speed(const SpeedSection& s) {
-  json out = {
-      {"sources", Rows(s.sources,
-                       [](const FrontSource& f) {
-                         return json{{"source", f.source}, {"cost_unit", f.cost_unit}, {"accuracy", f.accuracy}};
-                       })},
-      {"rows", Rows(s.rows, [](const FrontRow& r) {
-         return CellRow(r.cell, {{"source", r.source},
-                                 {"ratio", r.ratio},
-                                 {"cost", Value(r.cost)},
-                                 {"spread", Value(r.spread)},
-                                 {"bits", Value(r.bits)},
-                                 {"nonfinite", r.nonfinite},
-                                 {"on_front", r.on_front}});
-       })}};
+  json out = {{"sources", Rows(s.sources,
+                               [](const FrontSource& f) {
+                                 return json{{"source", f.source},         {"kind", CostKindName(f.kind)},
+                                             {"device", f.device},         {"cost_unit", f.cost_unit},
+                                             {"cost_title", f.cost_title}, {"accuracy", f.accuracy}};
+                               })},
+              {"rows", Rows(s.rows, [](const FrontRow& r) {
+                 return CellRow(r.cell, {{"source", r.source},
+                                         {"ratio", r.ratio},
+                                         {"cost", Value(r.cost)},
+                                         {"spread", Value(r.spread)},
+                                         {"bits", Value(r.bits)},
+                                         {"bits_low", Value(r.bits_low)},
+                                         {"bits_high", Value(r.bits_high)},
+                                         {"nonfinite", r.nonfinite},
+                                         {"on_front", r.on_front}});
+               })}};
   if (s.error) out["error"] = *s.error;
   return out;
 }
@@ -173,54 +176,64 @@ json History(const std::optional<HistorySection>& h) {
 }  // namespace
 
 nlohmann::json ReportToJson(const Report& report) {
-  return WithSchema(kReportSchema, {{"environment", Environment(report.environment)},
-                                    {"recommendations", Rows(report.recommendations,
-                                                             [](const RecommendationRow& r) {
-                                                               return json{{"convention", r.convention},
-                                                                           {"format", r.format},
-                                                                           {"backend", r.backend},
-                                                                           {"ratio", r.ratio},
-                                                                           {"variants", r.variants},
-                                                                           {"bits", Value(r.bits)},
-                                                                           {"bits_low", Value(r.bits_low)},
-                                                                           {"bits_high", Value(r.bits_high)},
-                                                                           {"cost", Value(r.cost)},
-                                                                           {"cost_unit", r.cost_unit},
-                                                                           {"ratio_for_1e-3", Budget(r.ratio_for_1e3)},
-                                                                           {"ratio_for_1e-6", Budget(r.ratio_for_1e6)}};
-                                                             })},
-                                    {"headline", Rows(report.headline, Headline)},
-                                    {"precision_points", Rows(report.precision_points, ModelPoint)},
-                                    {"depth_points", Rows(report.depth_points, ModelPoint)},
-                                    {"split", Rows(report.split,
-                                                   [](const SplitRow& r) {
-                                                     return CellRow(r.cell, {{"ratio", r.ratio},
-                                                                             {"log10_ratio", Value(r.log10_ratio)},
-                                                                             {"total", Value(r.total)},
-                                                                             {"production", Value(r.production)},
-                                                                             {"storage", Value(r.storage)},
-                                                                             {"arith", Value(r.arith)}});
-                                                   })},
-                                    {"backend_differences", Differences(report.backend_differences)},
-                                    {"findings",
-                                     {{"nonfinite", Rows(report.nonfinite,
-                                                         [](const NonFiniteRow& r) {
-                                                           return CellRow(r.cell, {{"sweep", r.sweep},
-                                                                                   {"nan", r.nan},
-                                                                                   {"inf", r.inf},
-                                                                                   {"judged", r.judged},
-                                                                                   {"first_index", r.first_index},
-                                                                                   {"command", r.command}});
-                                                         })},
-                                      {"worst", Rows(report.worst,
-                                                     [](const WorstSampleRow& r) {
-                                                       return CellRow(r.cell, {{"bits", Value(r.bits)},
-                                                                               {"relative", Value(r.relative)},
-                                                                               {"index", r.index},
-                                                                               {"command", r.command}});
-                                                     })}}},
-                                    {"speed", Speed(report.speed)},
-                                    {"history", History(report.history)}});
+  return WithSchema(kReportSchema,
+                    {{"environment", Environment(report.environment)},
+                     {"recommendations", Rows(report.recommendations,
+                                              [](const RecommendationRow& r) {
+                                                return json{{"convention", r.convention},
+                                                            {"format", r.format},
+                                                            {"backend", r.backend},
+                                                            {"ratio", r.ratio},
+                                                            {"variants", r.variants},
+                                                            {"bits", Value(r.bits)},
+                                                            {"bits_low", Value(r.bits_low)},
+                                                            {"bits_high", Value(r.bits_high)},
+                                                            {"cost", Value(r.cost)},
+                                                            {"cost_kind", CostKindName(r.cost_kind)},
+                                                            {"cost_unit", r.cost_unit},
+                                                            {"ratio_for_1e-3", Budget(r.ratio_for_1e3)},
+                                                            {"ratio_for_1e-6", Budget(r.ratio_for_1e6)}};
+                                              })},
+                     {"headline", Rows(report.headline, Headline)},
+                     {"precision_points", Rows(report.precision_points, ModelPoint)},
+                     {"depth_points", Rows(report.depth_points, ModelPoint)},
+                     {"split", Rows(report.split,
+                                    [](const SplitRow& r) {
+                                      return CellRow(r.cell, {{"ratio", r.ratio},
+                                                              {"log10_ratio", Value(r.log10_ratio)},
+                                                              {"total", Value(r.total)},
+                                                              {"production", Value(r.production)},
+                                                              {"storage", Value(r.storage)},
+                                                              {"arith", Value(r.arith)}});
+                                    })},
+                     {"backend_differences", Differences(report.backend_differences)},
+                     {"findings",
+                      {{"nonfinite", Rows(report.nonfinite,
+                                          [](const NonFiniteRow& r) {
+                                            return CellRow(r.cell, {{"sweep", r.sweep},
+                                                                    {"kind", NonFiniteKindName(r.kind)},
+                                                                    {"nan", r.nan},
+                                                                    {"inf", r.inf},
+                                                                    {"judged", r.judged},
+                                                                    {"first_index", r.first_index},
+                                                                    {"command", r.command}});
+                                          })},
+                       {"groups", Rows(report.finding_groups,
+                                       [](const FindingGroup& g) {
+                                         return json{{"variant", g.variant},     {"kind", NonFiniteKindName(g.kind)},
+                                                     {"rows", g.rows},           {"outputs", g.outputs},
+                                                     {"encodings", g.encodings}, {"sweeps", g.sweeps},
+                                                     {"backends", g.backends},   {"command", g.command}};
+                                       })},
+                       {"worst", Rows(report.worst,
+                                      [](const WorstSampleRow& r) {
+                                        return CellRow(r.cell, {{"bits", Value(r.bits)},
+                                                                {"relative", Value(r.relative)},
+                                                                {"index", r.index},
+                                                                {"command", r.command}});
+                                      })}}},
+                     {"speed", Speed(report.speed)},
+                     {"history", History(report.history)}});
 }
 
 }  // namespace depthbench

@@ -15,6 +15,24 @@ Figure Shown(double x) {
 
 std::string CellColumns::Name() const { return fmt::format("{}/{}/{}", variant, convention, format); }
 
+const char* NonFiniteKindName(NonFiniteKind kind) {
+  switch (kind) {
+    case NonFiniteKind::kNaN: return "NaN";
+    case NonFiniteKind::kInf: return "Inf";
+    case NonFiniteKind::kNaNAndInf: return "NaN and Inf";
+  }
+  return "?";
+}
+
+const char* CostKindName(CostKind kind) {
+  switch (kind) {
+    case CostKind::kMeasuredGpu: return "measured on a GPU";
+    case CostKind::kMeasuredSoftware: return "measured on a software rasteriser";
+    case CostKind::kStaticModel: return "static cost model";
+  }
+  return "?";
+}
+
 std::size_t HistorySection::worse() const {
   return static_cast<std::size_t>(
       std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == "worse"; }));

@@ -115,11 +115,28 @@ struct BackendDifferences {
   std::vector<BackendDifferenceRow> rows;  // the largest, largest first
 };
 
+// What a non-finite output is: a NaN component, or an infinite one and
+// none NaN (stats.h counts them apart); a row can hold both.
+enum class NonFiniteKind { kNaN, kInf, kNaNAndInf };
+const char* NonFiniteKindName(NonFiniteKind kind);  // "NaN", "Inf", "NaN and Inf"
+
 struct NonFiniteRow {
   CellColumns cell;
   std::string sweep;  // "default domain", "f/n 1e4", "f/n inf"
+  NonFiniteKind kind = NonFiniteKind::kNaN;
   std::uint64_t nan = 0, inf = 0, judged = 0, first_index = 0;
   std::string command;  // replays the first
+};
+// The non-finite findings by cause: one formula (variant) returning one
+// kind of non-finite output, wherever it does so.
+struct FindingGroup {
+  std::string variant;
+  NonFiniteKind kind = NonFiniteKind::kNaN;
+  std::size_t rows = 0;                        // (cell, backend, sweep) rows of the group
+  std::uint64_t outputs = 0;                   // NaN and Inf outputs, all rows together
+  std::vector<std::string> encodings, sweeps;  // "standard/d16_unorm"; "f/n 1e7", in order of appearance
+  std::vector<std::string> backends;
+  std::string command;  // replays the group's first finding
 };
 struct WorstSampleRow {
   CellColumns cell;
@@ -132,11 +149,23 @@ struct FrontRow {
   CellColumns cell;  // without backend
   std::string source, ratio;
   Figure cost, spread, bits;
+  Figure bits_low, bits_high;  // the 95% sampling interval of the p99.9 (stats.h), at most every bit
   std::uint64_t nonfinite = 0;
   bool on_front = false;
 };
+// Where a front's costs come from, best first: GPU time measured on a
+// hardware GPU, GPU time measured on a software rasteriser (llvmpipe,
+// lavapipe: a CPU's timing of the shader), or the static cost model.
+enum class CostKind { kMeasuredGpu, kMeasuredSoftware, kStaticModel };
+const char* CostKindName(CostKind kind);  // "measured on a GPU", ...
+
 struct FrontSource {
-  std::string source, cost_unit, accuracy;
+  std::string source;  // the name its rows carry
+  CostKind kind = CostKind::kStaticModel;
+  std::string device;      // the measured device; empty for the static model
+  std::string cost_unit;   // what the cost is, in words
+  std::string cost_title;  // the cost axis: "GPU time per 1920x1080 frame (µs) on NVIDIA H100"
+  std::string accuracy;
 };
 struct SpeedSection {
   std::vector<FrontSource> sources;
@@ -182,7 +211,8 @@ struct RecommendationRow {
   std::vector<std::string> variants;  // the recommended first, then those tied with it
   Figure bits, bits_low, bits_high;   // p99.9 bits lost at the far plane, the model's 95% interval
   Figure cost;                        // none: no cost known
-  std::string cost_unit;              // "µs per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
+  CostKind cost_kind = CostKind::kStaticModel;
+  std::string cost_unit;  // "µs per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
   BudgetRatio ratio_for_1e3, ratio_for_1e6;
 };
 
@@ -195,6 +225,7 @@ struct Report {
   std::vector<SplitRow> split;
   BackendDifferences backend_differences;
   std::vector<NonFiniteRow> nonfinite;
+  std::vector<FindingGroup> finding_groups;  // the non-finite rows by cause, most rows first
   std::vector<WorstSampleRow> worst;
   SpeedSection speed;
   std::optional<HistorySection> history;  // none with --no-history

@@ -8,14 +8,17 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/base/text_table.h"
 #include "bench/report/report_json.h"
 
 namespace depthbench {
 namespace {
 
-constexpr std::size_t kWorstInSummary = 5;
-constexpr std::size_t kChangesInSummary = 20;
-constexpr std::size_t kFindingsInSummary = 5;
+// The summary is a CI job page: about 40 lines with nothing worse, the
+// detail is the page's.
+constexpr std::size_t kWorstInSummary = 3;
+constexpr std::size_t kChangesInSummary = 5;
+constexpr std::size_t kFindingsInSummary = 3;
 
 // Where the page's template takes the libraries and the document.
 constexpr std::string_view kLibrariesMark = "<!--DEPTHBENCH:LIBRARIES-->";
@@ -23,7 +26,7 @@ constexpr std::string_view kDataMark = "/*DEPTHBENCH:DATA*/null";
 
 // Bits lost; a figure that is not finite means every bit is lost.
 std::string Bits(const Figure& bits) { return bits ? fmt::format("{:.1f}", *bits) : "all"; }
-std::string Number(const Figure& x) { return x ? fmt::format("{:.3g}", *x) : "-"; }
+std::string Number(const Figure& x) { return x ? Readable(*x) : "-"; }
 
 std::string Budget(const BudgetRatio& b) {
   switch (b.kind) {
@@ -90,7 +93,7 @@ void Verdict(const Report& report, std::string& out) {
   std::size_t shown = 0;
   for (const auto& [key, bands] : worse) {
     if (shown++ == kChangesInSummary) {
-      out += fmt::format("- ... and {} more (see report.html)\n", worse.size() - kChangesInSummary);
+      out += fmt::format("- ... and {} more: see report.html\n", worse.size() - kChangesInSummary);
       break;
     }
     const std::size_t kBandsShown = 3;
@@ -106,11 +109,7 @@ void Verdict(const Report& report, std::string& out) {
 void WhatToUse(const Report& report, std::string& out) {
   if (report.recommendations.empty()) return;
   const RecommendationRow& first = report.recommendations.front();
-  out += fmt::format(
-      "## What to use ({})\n\nPer convention and format: the cheapest variant within 0.25 bit of the most precise "
-      "(tied ones in parentheses), p99.9 bits lost at the far plane with the model's 95% interval, cost in {}, and "
-      "the far/near up to which the far plane keeps 1e-3 and 1e-6.\n\n",
-      first.backend, first.cost_unit);
+  out += fmt::format("## What to use ({} backend; cost in {})\n\n", first.backend, first.cost_unit);
   out += "| convention | format | use | f/n | bits lost [95%] | cost | f/n for 1e-3 | f/n for 1e-6 |\n";
   out += "|---|---|---|---|---:|---:|---:|---:|\n";
   for (const RecommendationRow& r : report.recommendations) {
@@ -122,44 +121,46 @@ void WhatToUse(const Report& report, std::string& out) {
     const std::string interval =
         r.bits_low && r.bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r.bits_low, *r.bits_high) : "";
     out += fmt::format("| {} | {} | {} | {} | {}{} | {} | {} | {} |\n", r.convention, r.format, use, r.ratio,
-                       Bits(r.bits), interval,
-                       !r.cost            ? "-"
-                       : *r.cost >= 100.0 ? fmt::format("{:.0f}", *r.cost)
-                                          : fmt::format("{:.3g}", *r.cost),
-                       Budget(r.ratio_for_1e3), Budget(r.ratio_for_1e6));
+                       Bits(r.bits), interval, Number(r.cost), Budget(r.ratio_for_1e3), Budget(r.ratio_for_1e6));
   }
-  out += "\n";
-}
-
-void Worst(const Report& report, std::string& out) {
   out +=
-      "## Worst cells\n\nHighest p99.9 bits lost over the default domain (every projection, pose and depth the "
-      "sampler draws).\n\n";
-  out += "| cell | backend | p99.9 bits lost | max bits lost | NaN | Inf |\n|---|---|---:|---:|---:|---:|\n";
-  for (const HeadlineRow* row : WorstRows(report, kWorstInSummary)) {
-    out += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", row->cell.Name(), row->cell.backend,
-                       Bits(row->measured->p999_bits), Bits(row->measured->max_bits), row->measured->nan,
-                       row->measured->inf);
-  }
-  out += "\n";
+      "\nUse: the cheapest variant within 0.25 bit of the most precise (= tied ones); bits lost at p99.9 at the far "
+      "plane; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that relative error.\n\n";
 }
 
-void Findings(const Report& report, std::string& out) {
-  const std::vector<NonFiniteRow>& rows = report.nonfinite;
-  out += "## NaN and Inf\n\n";
-  if (rows.empty()) {
-    out += "No cell produced a NaN or an infinity where the true point is finite.\n\n";
-    return;
-  }
-  out += fmt::format("{} (cell, backend, sweep) with NaN or Inf outputs:\n\n", rows.size());
-  std::size_t shown = 0;
-  for (const NonFiniteRow& row : rows) {
-    if (shown++ == kFindingsInSummary) {
-      out += fmt::format("- ... and {} more (see report.html)\n", rows.size() - kFindingsInSummary);
-      break;
+// The worst cells over the default domain and the NaN/Inf findings by
+// cause, a few lines each: the page lists them all.
+void Problems(const Report& report, std::string& out) {
+  out += "## Worst cells and NaN/Inf findings\n\n";
+  // A cell as bad on every backend is one line.
+  std::vector<std::pair<const HeadlineRow*, std::vector<std::string>>> worst;
+  for (const HeadlineRow* row : WorstRows(report, report.headline.size())) {
+    auto same = std::find_if(worst.begin(), worst.end(), [&](const auto& w) {
+      return w.first->cell.Name() == row->cell.Name() && w.first->measured->p999_bits == row->measured->p999_bits &&
+             w.first->measured->max_bits == row->measured->max_bits;
+    });
+    if (same != worst.end()) {
+      same->second.push_back(row->cell.backend);
+    } else if (worst.size() < kWorstInSummary) {
+      worst.push_back({row, {row->cell.backend}});
     }
-    out += fmt::format("- `{}` on {}, {}: {} NaN, {} Inf of {}; first: `{}`\n", row.cell.Name(), row.cell.backend,
-                       row.sweep, row.nan, row.inf, row.judged, row.command);
+  }
+  for (const auto& [row, backends] : worst) {
+    out += fmt::format("- worst: `{}` on {}: {} bits lost at p99.9, {} at the maximum over the default domain\n",
+                       row->cell.Name(), fmt::join(backends, ", "), Bits(row->measured->p999_bits),
+                       Bits(row->measured->max_bits));
+  }
+  const std::vector<FindingGroup>& groups = report.finding_groups;
+  if (groups.empty()) out += "- no cell produced a NaN or an infinity where the true point is finite\n";
+  for (std::size_t i = 0; i < groups.size() && i < kFindingsInSummary; ++i) {
+    const FindingGroup& g = groups[i];
+    out += fmt::format("- cause: `{}` returns {}: {} outputs in {} (cell, backend, sweep) rows ({}; {}); first: `{}`\n",
+                       g.variant, NonFiniteKindName(g.kind), g.outputs, g.rows, fmt::join(g.sweeps, ", "),
+                       fmt::join(g.backends, ", "), g.command);
+  }
+  if (groups.size() > kFindingsInSummary) {
+    out += fmt::format("- ... and {} more causes of NaN/Inf outputs: see report.html\n",
+                       groups.size() - kFindingsInSummary);
   }
   out += "\n";
 }
@@ -216,18 +217,22 @@ Expected<std::string> RenderHtml(const Report& report, const std::filesystem::pa
 
 std::string RenderMarkdown(const Report& report) {
   const ReportEnvironment& env = report.environment;
-  std::string out = "# depthbench precision report\n\n";
+  std::string out;
+  Verdict(report, out);
   std::vector<std::string> devices;
   for (const auto& [name, device] : env.backends) devices.push_back(fmt::format("{} ({})", name, device.name));
-  out +=
-      fmt::format("{} · commit `{}` · {} · {} samples per far/near ratio, {} default-domain samples{} · {:.0f} s\n\n",
-                  env.started_at, env.commit.substr(0, 12), fmt::join(devices, ", "), env.fit_sweeps.samples_per_ratio,
-                  env.default_sweep.samples, env.quick ? " (quick)" : "", env.seconds.value_or(0.0));
-  Verdict(report, out);
+  out += fmt::format(
+      "depthbench precision report · {} · commit `{}` · {} · {} samples per far/near, {} default-domain{} · "
+      "{:.0f} s\n\n",
+      env.started_at, env.commit.substr(0, 12), fmt::join(devices, ", "),
+      ShortCount(static_cast<double>(env.fit_sweeps.samples_per_ratio)),
+      ShortCount(static_cast<double>(env.default_sweep.samples)), env.quick ? " (quick)" : "",
+      env.seconds.value_or(0.0));
   WhatToUse(report, out);
-  Worst(report, out);
-  Findings(report, out);
-  out += "The whole report, with plots: `report.html`; every figure it shows: `results.json`.\n";
+  Problems(report, out);
+  out +=
+      "Detail (plots of bits lost against far/near, the speed/accuracy front, GPU against CPU, every finding with its "
+      "replay command): `report.html` beside this file; every figure: `results.json`.\n";
   return out;
 }
 

@@ -14,13 +14,6 @@ namespace {
 using Align = TextTable::Align;
 
 // "2.41 ±0.031": the median and its spread, three significant digits.
-// Three significant digits, without an exponent from 1e-3 to 1e6.
-std::string Readable(double x, int digits) {
-  const double magnitude = std::fabs(x);
-  if (magnitude >= 1e6 || (magnitude < 1e-3 && magnitude > 0.0)) return fmt::format("{:.{}g}", x, digits);
-  const int exponent = magnitude > 0.0 ? static_cast<int>(std::floor(std::log10(magnitude))) : 0;
-  return fmt::format("{:.{}f}", x, std::max(0, digits - 1 - exponent));
-}
 std::string WithSpread(double value, double spread) {
   return fmt::format("{} ±{}", Readable(value, 3), Readable(spread, 2));
 }

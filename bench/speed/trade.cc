@@ -35,9 +35,12 @@ CellAccuracy AccuracyOf(const CellStats& stats) {
   accuracy.nonfinite = all.nan + all.inf;
   const std::uint64_t judged = all.judged();
   if (judged > 0 && static_cast<double>(accuracy.nonfinite) > kNonfiniteShareAtP999 * static_cast<double>(judged)) {
-    accuracy.p999_bits_lost = kAllBitsLost;
+    accuracy.p999_bits_lost = accuracy.p999_bits_low = accuracy.p999_bits_high = kAllBitsLost;
   } else {
-    accuracy.p999_bits_lost = BitsLost(Summarize(all, Metric::kTotal).p999);
+    const Summary summary = Summarize(all, Metric::kTotal);
+    accuracy.p999_bits_lost = BitsLost(summary.p999);
+    accuracy.p999_bits_low = BitsLost(summary.p999_interval.low);
+    accuracy.p999_bits_high = BitsLost(summary.p999_interval.high);
   }
   return accuracy;
 }

@@ -33,9 +33,11 @@ bool Dominates(const FrontCandidate& a, const FrontCandidate& b);
 // For each candidate, whether no other dominates it.
 std::vector<bool> ParetoFront(std::span<const FrontCandidate> candidates);
 
-// p99.9 bits lost of a cell's total error, and its NaN/Inf count.
+// p99.9 bits lost of a cell's total error with its 95% sampling interval
+// (MetricStats::LevelInterval), and its NaN/Inf count.
 struct CellAccuracy {
   double p999_bits_lost = 0.0;
+  double p999_bits_low = 0.0, p999_bits_high = 0.0;
   std::uint64_t nonfinite = 0;
 };
 CellAccuracy AccuracyOf(const CellStats& stats);
