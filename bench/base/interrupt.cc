@@ -57,6 +57,14 @@ Status InterruptedError(const std::string& what_was_kept) {
   return Status(StatusCode::kInterrupted, message);
 }
 
+namespace {
+std::atomic<bool> g_abandoned{false};
+}  // namespace
+
+void NoteAbandonedThread() { g_abandoned.store(true); }
+
+bool AbandonedThreads() { return g_abandoned.load(); }
+
 TemporaryFileGuard::TemporaryFileGuard(const std::filesystem::path& path) {
   const std::string& text = path.native();
   if (text.size() >= kPathMax) return;

@@ -26,6 +26,12 @@ int InterruptSignal();
 // SIGINT" and exit code 128 + signal.
 Status InterruptedError(const std::string& what_was_kept);
 
+// Work that cannot be stopped (a glslang compile past its time limit) is
+// given up on while its thread runs: the program must then end without
+// running static destructors under it (main does, when this was noted).
+void NoteAbandonedThread();
+bool AbandonedThreads();
+
 // A temporary file in the course of being written: while the guard lives, a
 // second signal removes the file before the process ends. At most a few are
 // live at once (one per writer); more are written but not guarded.

@@ -1,6 +1,8 @@
 #include "bench/cli/app.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -229,7 +231,14 @@ int RunDepthbench(int argc, const char* const* argv) {
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
   InstallInterruptHandlers();
-  return action ? ExitCode(action()) : kExitCannotRun;
+  const int code = action ? ExitCode(action()) : kExitCannotRun;
+  if (AbandonedThreads()) {
+    // A thread still runs work that cannot be stopped: end here, before
+    // the static objects it may use are destroyed.
+    std::fflush(nullptr);
+    std::_Exit(code);
+  }
+  return code;
 }
 
 }  // namespace depthbench::cli

@@ -1,10 +1,14 @@
 #include "bench/backends/vulkan/shader_compiler.h"
 
+#include <chrono>
+#include <cstdlib>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <memory>
 #include <regex>
 #include <sstream>
+#include <thread>
 #include <type_traits>
 #include <utility>
 
@@ -13,6 +17,8 @@
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
 #include <glslang/build_info.h>
+
+#include "bench/base/interrupt.h"
 
 namespace depthbench {
 namespace {
@@ -145,7 +151,17 @@ std::string GlslangVersion() {
                      GLSLANG_VERSION_FLAVOR);
 }
 
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path) {
+// How long a compile may take: our shaders take well under a second; a
+// shader whose macros expand exponentially never ends (and grows by about
+// 70 MB a second). DEPTHBENCH_COMPILE_SECONDS changes it.
+double CompileSeconds() {
+  const char* text = std::getenv("DEPTHBENCH_COMPILE_SECONDS");
+  char* end = nullptr;
+  const double value = text != nullptr ? std::strtod(text, &end) : 0.0;
+  return text != nullptr && end != text && *end == '\0' && value > 0.0 ? value : 30.0;
+}
+
+Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::path& path) {
   DB_ASSIGN_OR_RETURN(const std::string source, ReadSourceFile(path));
   const std::string name = path.string();
   DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path()));
@@ -157,6 +173,27 @@ Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem:
     return CompileError(fmt::format("{}: error: SPIR-V generation failed: {}", name, logger.getAllMessages()));
   }
   return spirv;
+}
+
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path) {
+  // glslang cannot be stopped, so the compile runs on a thread of its own
+  // that is given up on when it takes too long (the program then ends
+  // without waiting for it: base/interrupt.h).
+  using Words = Expected<std::vector<std::uint32_t>>;
+  std::packaged_task<Words()> task([path] { return CompileOnThisThread(path); });
+  std::future<Words> compiled = task.get_future();
+  std::thread compiler(std::move(task));
+  const double seconds = CompileSeconds();
+  if (compiled.wait_for(std::chrono::duration<double>(seconds)) == std::future_status::timeout) {
+    compiler.detach();
+    NoteAbandonedThread();
+    return CompileError(
+        fmt::format("{}: compiling did not finish within {:g} s (an #include or macro that expands without end?); "
+                    "DEPTHBENCH_COMPILE_SECONDS sets the limit",
+                    path.string(), seconds));
+  }
+  compiler.join();
+  return compiled.get();
 }
 
 Expected<std::vector<BufferMemberOffset>> ReflectBufferMembers(std::string_view source,
