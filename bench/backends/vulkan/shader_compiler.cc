@@ -53,8 +53,8 @@ Expected<std::string> ReadSourceFile(const std::filesystem::path& path) {
 // see real paths.
 class RelativeIncluder final : public glslang::TShader::Includer {
  public:
-  RelativeIncluder(std::string root_name, std::filesystem::path root_dir)
-      : root_name_(std::move(root_name)), root_dir_(std::move(root_dir)) {}
+  RelativeIncluder(std::string root_name, std::filesystem::path root_dir, std::vector<std::string>* sources)
+      : root_name_(std::move(root_name)), root_dir_(std::move(root_dir)), sources_(sources) {}
 
   IncludeResult* includeLocal(const char* header_name, const char* includer_name, size_t) override {
     const std::filesystem::path base =
@@ -63,6 +63,7 @@ class RelativeIncluder final : public glslang::TShader::Includer {
     Expected<std::string> text = ReadSourceFile(path);
     // A null result makes glslang report the directive's file and line.
     if (!text.ok()) return nullptr;
+    if (sources_ != nullptr) sources_->push_back(*text);
     auto* contents = new std::string(std::move(text).value());
     return new IncludeResult(path.string(), contents->data(), contents->size(), contents);
   }
@@ -76,6 +77,7 @@ class RelativeIncluder final : public glslang::TShader::Includer {
  private:
   std::string root_name_;
   std::filesystem::path root_dir_;
+  std::vector<std::string>* sources_;  // where to record what was read (may be null)
 };
 
 // glslang's info log says "ERROR: <file>:<line>: <message>"; compilers and
@@ -114,9 +116,11 @@ struct LinkedShader {
 };
 
 // `root_name` is what glslang reports for the source (its path, for a file);
-// includes in it resolve relative to `root_dir`.
+// includes in it resolve relative to `root_dir`; the text of every included
+// file is appended to `sources` when it is not null.
 Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, const std::string& root_name,
-                                                     const std::filesystem::path& root_dir) {
+                                                     const std::filesystem::path& root_dir,
+                                                     std::vector<std::string>* sources = nullptr) {
   EnsureGlslangInitialized();
   auto linked = std::make_unique<LinkedShader>();
   const char* text = source.data();
@@ -127,7 +131,7 @@ Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, 
   shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
-  RelativeIncluder includer(root_name, root_dir);
+  RelativeIncluder includer(root_name, root_dir, sources);
   if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, kMessages, includer)) {
     return CompileError(FormatInfoLog(shader.getInfoLog(), root_name));
   }
@@ -145,10 +149,12 @@ std::string GlslangVersion() {
                      GLSLANG_VERSION_FLAVOR);
 }
 
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path) {
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
+                                                          std::vector<std::string>* sources) {
   DB_ASSIGN_OR_RETURN(const std::string source, ReadSourceFile(path));
+  if (sources != nullptr) sources->push_back(source);
   const std::string name = path.string();
-  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path()));
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path(), sources));
   std::vector<std::uint32_t> spirv;
   spv::SpvBuildLogger logger;
   glslang::SpvOptions options;
