@@ -16,8 +16,9 @@
 //   no-stdout:               standard output must be empty
 //   check:  SHELL COMMAND    must succeed afterwards, run like setup
 //
-// In every value, @TMP@ is the case's temporary folder and @SOURCE@ the
-// source tree.
+// In every value, @TMP@ is the case's temporary folder, @SOURCE@ the
+// source tree and @DEPTHBENCH@ the program (for setup lines that make its
+// inputs, e.g. results files to merge).
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -39,7 +40,8 @@ struct Case {
 };
 
 std::string Substitute(std::string text, const std::string& tmp) {
-  const std::pair<std::string, std::string> names[] = {{"@TMP@", tmp}, {"@SOURCE@", DEPTHBENCH_SOURCE_DIR}};
+  const std::pair<std::string, std::string> names[] = {
+      {"@TMP@", tmp}, {"@SOURCE@", DEPTHBENCH_SOURCE_DIR}, {"@DEPTHBENCH@", DEPTHBENCH_BINARY_DIR "/bench/depthbench"}};
   for (const auto& [name, value] : names) {
     for (auto at = text.find(name); at != std::string::npos; at = text.find(name, at + value.size())) {
       text.replace(at, name.size(), value);

@@ -139,6 +139,20 @@ TEST_F(GateTest, PlantedInfFailsAndItsReproducerShowsTheInf) {
   EXPECT_NE(line.find("(inf, inf, inf)  Inf (a finding"), std::string::npos) << replay.out;
 }
 
+TEST_F(GateTest, AllNanCellsAreWorseOnceWithoutABitsFigure) {
+  // pq returns NaN for every sample: its cells have no finite output. They
+  // were listed as worse (NaN appeared) and better (bits lost "fell" to 0.0)
+  // at once; now they are worse, once, for having no finite output.
+  Edit("shared/variants/pq.h", "  return world_from_view(frame, view);",
+       "  return vec3(uintBitsToFloat(0x7fc00000u));");
+  const auto r = Gate();
+  ASSERT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("\nworse: pq/"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("all: no finite output ("), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("better: pq/"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("-> 0.00 bits"), std::string::npos) << r.out;
+}
+
 TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
   const std::string dir = testing::MakeTempDir("gate_inputs");
   std::ofstream(dir + "/broken.json") << "{ \"schema\": \"depthbench.baseline\", ";

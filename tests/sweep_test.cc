@@ -1,11 +1,13 @@
 // Determinism, shard additivity and the results file.
 #include <filesystem>
 #include <limits>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/results/results.h"
+#include "bench/results/results_table.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
@@ -120,6 +122,7 @@ class NonFinitePatternBackend final : public Backend {
  public:
   std::string name() const override { return "pattern"; }
   const DeviceInfo& device() const override { return device_; }
+  ProgramInfo program() const override { return {"none", "pattern"}; }
   bool concurrent() const override { return true; }
   Status Prepare(std::span<const CellPlan>, PassKind) override { return Status::Ok(); }
   Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
@@ -220,6 +223,71 @@ TEST(SweepTest, MergeRefusesOverlappingOrForeignShards) {
   auto merged = MergeResults({a, c});
   ASSERT_FALSE(merged.ok());
   EXPECT_NE(merged.status().message().find("same sweep"), std::string::npos);
+}
+
+TEST(SweepTest, MergeNamesTheFieldThatDiffersAndBothValues) {
+  const Results a = RunCpu(7, 2000, {1, 2});
+  Results b = RunCpu(7, 2000, {2, 2});
+  ASSERT_TRUE(MergeResults({a, b}).ok());
+  b.run.backends[0].program.hash = "depthbench 9.9.9";
+  auto merged = MergeResults({a, b}, {"a.json", "b.json"});
+  ASSERT_FALSE(merged.ok());
+  EXPECT_NE(merged.status().message().find("'b.json' is not a shard of the same sweep as 'a.json': "
+                                           "run.backends.program_hash differs: 'cpu=depthbench " +
+                                           a.run.version + "' in 'a.json', 'cpu=depthbench 9.9.9' in 'b.json'"),
+            std::string::npos)
+      << merged.status().message();
+  b = RunCpu(7, 2000, {2, 2});
+  b.run.cells.pop_back();
+  merged = MergeResults({a, b});
+  ASSERT_FALSE(merged.ok());
+  EXPECT_NE(merged.status().message().find("part 2 is not a shard of the same sweep as part 1: run.cells differs"),
+            std::string::npos)
+      << merged.status().message();
+  b = RunCpu(7, 2000, {2, 2});
+  b.run.version = "9.9.9";
+  EXPECT_NE(MergeResults({a, b}).status().message().find("run.version differs"), std::string::npos);
+}
+
+TEST(SweepTest, MergeCallsShardsOfDifferentSplitsSo) {
+  auto merged = MergeResults({RunCpu(7, 2000, {1, 2}), RunCpu(7, 2000, {2, 3})});
+  ASSERT_FALSE(merged.ok());
+  EXPECT_NE(merged.status().message().find("shards 1/2 and 2/3 are of different splits"), std::string::npos)
+      << merged.status().message();
+  EXPECT_EQ(merged.status().message().find("overlap"), std::string::npos) << merged.status().message();
+}
+
+TEST(SweepTest, MergeRefusesAPartialPartUnlessAllowed) {
+  const Results a = RunCpu(7, 2000, {1, 2});
+  Results b = RunCpu(7, 2000, {2, 2});
+  b.run.partial = true;
+  b.run.samples_judged = 500;
+  auto merged = MergeResults({a, b}, {"a.json", "b.json"});
+  ASSERT_FALSE(merged.ok());
+  EXPECT_NE(merged.status().message().find("'b.json' is partial: its sweep was interrupted after 500"),
+            std::string::npos)
+      << merged.status().message();
+  merged = MergeResults({a, b}, {}, /*allow_partial=*/true);
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  EXPECT_TRUE(merged->run.partial);
+  EXPECT_EQ(merged->run.samples_judged, 1000u + 500u);
+}
+
+TEST(SweepTest, AnAllNanCellShowsNoBitsFigure) {
+  // Bits lost of no finite output read 0.0, as if it were perfect.
+  Results results = RunCpu(7, 100, {});
+  CellResult& cell = results.cells.front();
+  cell.stats = CellStats{};
+  cell.stats.joint[JointBand(0, 0)].nan = 100;
+  results.cells.resize(1);
+  std::ostringstream out;
+  PrintResultsTable(results, out);
+  const std::string table = out.str();
+  const auto row = table.find(cell.cell.Name());
+  ASSERT_NE(row, std::string::npos) << table;
+  const std::string line = table.substr(row, table.find('\n', row) - row);
+  EXPECT_NE(line.find("none finite"), std::string::npos) << table;
+  EXPECT_EQ(line.find("0.0"), std::string::npos) << table;
 }
 
 TEST(SweepTest, ResultsSurviveTheJsonRoundTrip) {

@@ -34,6 +34,8 @@ class Backend {
 
   virtual std::string name() const = 0;  // "cpu", "vulkan"
   virtual const DeviceInfo& device() const = 0;
+  // What the prepared formulas were built from (known after Prepare).
+  virtual ProgramInfo program() const = 0;
 
   virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
 

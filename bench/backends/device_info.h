@@ -14,4 +14,13 @@ struct DeviceInfo {
   std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
 };
 
+// What a backend's formulas were built from: two runs ran the same program
+// exactly when `hash` is the same (results of different programs must not
+// be added up).
+struct ProgramInfo {
+  std::string shaders;  // the shader directory as given ("default": the installed one); "built-in" for the CPU
+  std::string hash;     // "fnv1a64:..." of every shader source compiled, includes too; the CPU: "depthbench VERSION"
+  friend bool operator==(const ProgramInfo&, const ProgramInfo&) = default;
+};
+
 }  // namespace depthbench

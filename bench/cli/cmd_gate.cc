@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/progress.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
@@ -19,7 +20,7 @@ struct GateFlags {
   std::vector<std::string> baselines;
   std::vector<std::string> new_backends;  // for --update of baselines that do not exist yet
   std::string device, shaders, junit, json;
-  bool update = false, validate = false;
+  bool update = false, validate = false, allow_uncovered = false;
   unsigned threads = 0;
 };
 
@@ -93,6 +94,12 @@ Expected<int> Gate(const GateFlags& f) {
   Progress progress("gate", StderrIsTerminal());
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
   DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
+  if (results.run.partial) {
+    // Figures of part of the plan compare with nothing: no verdict, report or baseline.
+    return InterruptedError(
+        fmt::format("the gate's sweep stopped after {} of its {} samples: no verdict was given and nothing was written",
+                    results.run.samples_judged, results.run.samples));
+  }
   progress.Finish(fmt::format("{} cells on {} backend(s)", results.cells.size(), backends.size()));
 
   const GateTolerance tolerance;
@@ -119,6 +126,24 @@ Expected<int> Gate(const GateFlags& f) {
       run.comparison.backend = s.baseline.backend;
     }
     runs.push_back(std::move(run));
+  }
+  if (!f.update) {
+    // Everything the run measured is compared, or the gate says what it did not compare.
+    for (const GateRun& r : runs) {
+      const std::string uncovered = r.comparison.Uncovered();
+      if (r.comparison.compared() == 0) {
+        return InvalidArgument(fmt::format(
+            "baseline '{}' covers none of the {} cells this gate ran ({}): nothing would be compared; make it again "
+            "with: depthbench gate --update --baseline {}",
+            r.baseline_path, r.current.cells.size(), uncovered, r.baseline_path));
+      }
+      if (!uncovered.empty() && !f.allow_uncovered) {
+        return InvalidArgument(fmt::format(
+            "baseline '{}' does not cover this run: {}; make it again with --update, or pass --allow-uncovered to "
+            "compare only what it covers",
+            r.baseline_path, uncovered));
+      }
+    }
   }
 
   PrintGateVerdict(runs, tolerance, std::cout);
@@ -148,7 +173,10 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
       "Runs every cell on the baselines' backends with seed {} and {} samples (camera at the world origin), "
       "compares each cell and band with the baseline, and exits 0 when nothing got worse, 1 when something did, "
       "2 when it cannot judge (no device, a shader that does not compile, a baseline that does not parse or was "
-      "made on another device or with another sample plan). Worse: the p99.9 or maximum bits lost of the total "
+      "made on another device or with another sample plan, or one that lacks cells or bands of the run: every cell "
+      "and band the run measures is compared unless --allow-uncovered, and then what was not compared is listed, and "
+      "skipped in JUnit), 130 when interrupted (nothing is written). A band with no finite output has no bits "
+      "figure: it counts as worse when it had one before. Worse: the p99.9 or maximum bits lost of the total "
       "or arithmetic error grew by more than 0.25 or 0.5 bit (the same seed and device give identical results; "
       "the tolerance absorbs driver and compiler updates), NaN or Inf appeared, or a cell disappeared.\n\n"
       "Examples:\n"
@@ -162,6 +190,8 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--shaders", flags->shaders, "shader directory to test (an edited copy of shaders/)");
   cmd->add_option("--device", flags->device, "Vulkan device (part of its name); default lavapipe");
   cmd->add_flag("--update", flags->update, "show what changes, then rewrite the baselines with this run");
+  cmd->add_flag("--allow-uncovered", flags->allow_uncovered,
+                "judge even when a baseline lacks cells or bands this run measures; they are listed as not compared");
   cmd->add_option("--junit", flags->junit, "write JUnit XML, one test case per cell");
   cmd->add_option("--json", flags->json, "write the full comparison as JSON");
   cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer");

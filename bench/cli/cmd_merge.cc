@@ -13,6 +13,7 @@ namespace {
 struct MergeFlags {
   std::vector<std::string> inputs;
   std::string output;
+  bool allow_partial = false;
 };
 
 Expected<int> Merge(const MergeFlags& f) {
@@ -22,15 +23,16 @@ Expected<int> Merge(const MergeFlags& f) {
     DB_ASSIGN_OR_RETURN(Results part, ReadResults(path));
     parts.push_back(std::move(part));
   }
-  DB_ASSIGN_OR_RETURN(const Results merged, MergeResults(parts));
-  std::uint64_t covered = 0;
-  for (const Shard& s : merged.run.shards) covered += s.End(merged.run.samples) - s.Begin(merged.run.samples);
+  DB_ASSIGN_OR_RETURN(const Results merged, MergeResults(parts, f.inputs, f.allow_partial));
+  const std::vector<Shard> missing = MissingShards(merged.run.shards);
+  if (!missing.empty() && !f.allow_partial) {
+    return InvalidArgument(fmt::format(
+        "missing shards {} (the inputs hold {} of {} shards): give every shard, or --allow-partial to write "
+        "a merge of the shards given",
+        ShardList(missing), merged.run.shards.size(), merged.run.shards.front().count));
+  }
   PrintRunHeader(merged, std::cout);
   PrintResultsTable(merged, std::cout);
-  if (covered != merged.run.samples) {
-    std::cout << fmt::format("\nnote: the merged shards cover {} of the sweep's {} samples\n", covered,
-                             merged.run.samples);
-  }
   DB_RETURN_IF_ERROR(WriteResults(f.output, merged));
   return kExitOk;
 }
@@ -41,13 +43,18 @@ void AddMergeCommand(CLI::App& app, CommandAction& action) {
   auto flags = std::make_shared<MergeFlags>();
   CLI::App* cmd = app.add_subcommand("merge", "Add up the results of the shards of one sweep (run --shard K/N)");
   cmd->footer(
-      "Shards of one sweep share seed, sample count and domain; their histograms add up exactly to "
-      "the results of running the whole sweep at once.\n\n"
+      "Shards of one sweep share what defines it: version, seed, sample count, domain, cells, backends and "
+      "devices, shader directories and the hash of the shader sources compiled; their histograms add up exactly to "
+      "the results of running the whole sweep at once. Exit 2 when the inputs differ in any of these (the message "
+      "names the field and both values), hold shards of different K/N splits or the same shard twice, when a shard "
+      "is missing, or when an input is partial (its run was interrupted), unless --allow-partial.\n\n"
       "Example:\n  depthbench merge part1.json part2.json --json all.json");
   cmd->add_option("inputs", flags->inputs, "results files of shards (depthbench run --shard K/N --json FILE)")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--json", flags->output, "where to write the merged results")->required();
+  cmd->add_flag("--allow-partial", flags->allow_partial,
+                "merge even when shards are missing or an input was interrupted; the header and the file say so");
   cmd->callback([flags, &action] { action = [flags] { return Merge(*flags); }; });
 }
 

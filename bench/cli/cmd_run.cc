@@ -144,7 +144,11 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--samples", flags->samples, "samples to draw, each run through every cell (default 1e6)");
   cmd->add_option("--seed", flags->seed, "random seed; the same seed gives the same samples anywhere (default 1)");
   cmd->add_option("--shard", flags->shard, "run shard K of N (1-based) of the sweep; shards merge exactly");
-  cmd->add_option("--json", flags->json, "write the results (schema depthbench.results v1) to FILE");
+  cmd->add_option(
+      "--json", flags->json,
+      fmt::format("write the results (schema {} v{}) to FILE; after an interrupt (exit 130) what was judged, "
+                  "marked partial",
+                  kResultsSchema.name, kResultsSchema.version));
   cmd->add_option("--index", flags->index,
                   "replay sample N alone and show everything about it (inputs, stored values, reference, each "
                   "backend's output and errors): what the gate and the fuzzer print to reproduce a finding");

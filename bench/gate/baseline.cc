@@ -18,8 +18,8 @@ BandFigures FiguresOf(const BandStats& band) {
   const Summary total = Summarize(band, Metric::kTotal);
   const Summary arith = Summarize(band, Metric::kArith);
   f.total_p999 = BitsLost(total.p999);
-  f.p999_interval_bits = std::max(f.total_p999 - BitsLost(total.p999_interval.low),
-                                  BitsLost(total.p999_interval.high) - f.total_p999);
+  f.p999_interval_bits =
+      std::max(f.total_p999 - BitsLost(total.p999_interval.low), BitsLost(total.p999_interval.high) - f.total_p999);
   f.total_max = BitsLost(total.max);
   f.arith_p999 = BitsLost(arith.p999);
   f.arith_max = BitsLost(arith.max);
@@ -126,7 +126,9 @@ Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
     if (!cell.ok()) return cells.Error(cell.status().message());
     DB_ASSIGN_OR_RETURN(JsonReader bands, cells.Field(name));
     if (!bands.json().is_object()) return bands.Error("expected an object of bands");
-    CellFigures& figures = b.cells[name];
+    // Keyed by the cell's own spelling, as the gate looks it up.
+    if (b.cells.contains(cell->Name())) return cells.Error(fmt::format("cell '{}' is given twice", cell->Name()));
+    CellFigures& figures = b.cells[cell->Name()];
     for (const auto& [band, unused] : bands_json.items()) {
       (void)unused;
       DB_ASSIGN_OR_RETURN(JsonReader r, bands.Field(band));

@@ -24,8 +24,33 @@ int GateComparison::failures() const {
 }
 
 int GateComparison::improvements() const {
+  return static_cast<int>(std::count_if(cells.begin(), cells.end(), [](const CellVerdict& c) { return c.improved(); }));
+}
+
+int GateComparison::compared() const {
   return static_cast<int>(
-      std::count_if(cells.begin(), cells.end(), [](const CellVerdict& c) { return !c.better.empty(); }));
+      std::count_if(cells.begin(), cells.end(), [](const CellVerdict& c) { return !c.appeared && !c.disappeared; }));
+}
+
+std::string GateComparison::Uncovered() const {
+  // Named up to a handful each; the counts say how many.
+  constexpr std::size_t kNamed = 5;
+  std::vector<std::string> missing_cells, missing_bands;
+  for (const CellVerdict& c : cells) {
+    if (c.appeared) missing_cells.push_back(c.cell);
+    for (const std::string& band : c.not_compared) missing_bands.push_back(c.cell + ": " + band);
+  }
+  const auto list = [&](const std::vector<std::string>& names, const char* what) {
+    std::string out = fmt::format("{} {} not in the baseline (", names.size(), what);
+    for (std::size_t k = 0; k < names.size() && k < kNamed; ++k) out += (k == 0 ? "" : ", ") + names[k];
+    return out + (names.size() > kNamed ? ", ...)" : ")");
+  };
+  std::string out;
+  if (!missing_cells.empty()) out = list(missing_cells, missing_cells.size() == 1 ? "cell" : "cells");
+  if (!missing_bands.empty()) {
+    out += (out.empty() ? "" : "; ") + list(missing_bands, missing_bands.size() == 1 ? "band" : "bands");
+  }
+  return out;
 }
 
 namespace {
@@ -98,6 +123,10 @@ Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Bas
     } else if (before == baseline.cells.end()) {
       verdict.appeared = true;
     } else {
+      for (const auto& [band, f] : after->second) {
+        (void)f;
+        if (!before->second.contains(band)) verdict.not_compared.push_back(band);
+      }
       for (const auto& [band, b] : before->second) {
         BandChange worse{band, b, {}, {}}, better{band, b, {}, {}};
         auto a = after->second.find(band);
@@ -106,21 +135,39 @@ Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Bas
         } else {
           worse.after = better.after = a->second;
           const BandFigures& f = a->second;
-          // A p99.9 needs enough samples to mean something; where it has
-          // them, it may move by its sampling interval (a driver update
-          // that shifts a few samples near the top) without failing.
-          if (b.judged >= MinimumSamples(Level::kP999) && f.judged >= MinimumSamples(Level::kP999)) {
-            const double p999_tolerance = std::max(tolerance.p999_bits, b.p999_interval_bits);
-            CompareBits("total p99.9", b.total_p999, f.total_p999, p999_tolerance, worse.reasons, better.reasons);
-            CompareBits("arith p99.9", b.arith_p999, f.arith_p999, p999_tolerance, worse.reasons, better.reasons);
+          if (b.judged == 0 || f.judged == 0) {
+            // Bits lost of no finite output read 0: compare nothing but
+            // whether there is output to measure.
+            if (b.judged > 0) {
+              worse.reasons.push_back(
+                  fmt::format("no finite output ({} NaN, {} Inf; was {} judged, total p99.9 {:.2f} bits)", f.nan, f.inf,
+                              b.judged, b.total_p999));
+            } else if (f.judged > 0) {
+              better.reasons.push_back(
+                  fmt::format("finite outputs again ({} judged, total p99.9 {:.2f} bits; was "
+                              "none: {} NaN, {} Inf)",
+                              f.judged, f.total_p999, b.nan, b.inf));
+            }
+          } else {
+            // A p99.9 needs enough samples to mean something; where it has
+            // them, it may move by its sampling interval (a driver update
+            // that shifts a few samples near the top) without failing.
+            if (b.judged >= MinimumSamples(Level::kP999) && f.judged >= MinimumSamples(Level::kP999)) {
+              const double p999_tolerance = std::max(tolerance.p999_bits, b.p999_interval_bits);
+              CompareBits("total p99.9", b.total_p999, f.total_p999, p999_tolerance, worse.reasons, better.reasons);
+              CompareBits("arith p99.9", b.arith_p999, f.arith_p999, p999_tolerance, worse.reasons, better.reasons);
+            }
+            CompareBits("total max", b.total_max, f.total_max, tolerance.max_bits, worse.reasons, better.reasons);
+            CompareBits("arith max", b.arith_max, f.arith_max, tolerance.max_bits, worse.reasons, better.reasons);
           }
-          CompareBits("total max", b.total_max, f.total_max, tolerance.max_bits, worse.reasons, better.reasons);
-          CompareBits("arith max", b.arith_max, f.arith_max, tolerance.max_bits, worse.reasons, better.reasons);
           CompareCount("NaN", b.nan, f.nan, worse.reasons, better.reasons);
           CompareCount("Inf", b.inf, f.inf, worse.reasons, better.reasons);
         }
-        if (!worse.reasons.empty()) verdict.worse.push_back(worse);
-        if (!better.reasons.empty()) verdict.better.push_back(better);
+        if (!worse.reasons.empty()) {
+          verdict.worse.push_back(worse);
+        } else if (!better.reasons.empty()) {
+          verdict.better.push_back(better);
+        }
       }
     }
     comparison.cells.push_back(std::move(verdict));

@@ -35,13 +35,21 @@ struct BandChange {
   std::vector<std::string> reasons;  // "total p99.9 +1.3 bits", "NaN appeared (0 -> 12)"
 };
 
+// Each band is classified once: worse when anything about it got worse
+// (what got better in it then goes unreported), else better or unchanged. A
+// band with no finite output on one side has no bits figure there: it is
+// worse or better for that, with the reason, and its bits are not compared.
 struct CellVerdict {
   std::string cell;
   std::vector<BandChange> worse;
   std::vector<BandChange> better;
-  bool disappeared = false;  // in the baseline, not in the run
-  bool appeared = false;     // in the run, not in the baseline
+  std::vector<std::string> not_compared;  // bands of the run that the baseline lacks
+  bool disappeared = false;               // in the baseline, not in the run
+  bool appeared = false;                  // in the run, not in the baseline: not compared
   bool failed() const { return disappeared || !worse.empty(); }
+  bool improved() const { return !failed() && !better.empty(); }
+  // Whether some of what the run measured in this cell was not compared.
+  bool uncovered() const { return appeared || !not_compared.empty(); }
 };
 
 struct GateComparison {
@@ -50,6 +58,11 @@ struct GateComparison {
   std::vector<std::string> notes;  // different driver or compiler versions
   int failures() const;
   int improvements() const;
+  int compared() const;  // cells in both
+  // What the baseline does not cover, for a message: "2 cells not in the
+  // baseline (a, b); 3 bands not in it (c: all, ...)"; empty when it covers
+  // every cell and band of the run.
+  std::string Uncovered() const;
 };
 
 // Why the two cannot be compared (another device, another sample plan), or

@@ -54,17 +54,24 @@ std::string DescribeWorse(const CellVerdict& v) {
 }  // namespace
 
 void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out) {
-  int failures = 0, improvements = 0, cells = 0;
+  int failures = 0, improvements = 0, cells = 0, compared = 0, not_compared = 0;
+  std::vector<std::string> uncovered;
   for (const GateRun& r : runs) {
     failures += r.comparison.failures();
     improvements += r.comparison.improvements();
     cells += static_cast<int>(r.comparison.cells.size());
+    compared += r.comparison.compared();
+    for (const CellVerdict& v : r.comparison.cells) not_compared += v.appeared;
+    const std::string what = r.comparison.Uncovered();
+    if (!what.empty()) uncovered.push_back(fmt::format("{} ({})", what, r.current.backend));
   }
   std::vector<std::string> backends;
   for (const GateRun& r : runs) backends.push_back(fmt::format("{} on {}", r.current.backend, r.current.device.name));
-  out << (failures == 0 ? fmt::format("PASS: no cell got worse ({} cells; {})", cells, Join(backends, ", "))
+  out << (failures == 0 ? fmt::format("PASS: no cell got worse ({} cells compared; {})", compared, Join(backends, ", "))
                         : fmt::format("FAIL: {} of {} cells got worse ({})", failures, cells, Join(backends, ", ")))
       << "\n";
+  // Only with --allow-uncovered: without it, a gate that does not cover its run gives no verdict.
+  for (const std::string& what : uncovered) out << "NOT COMPARED: " << what << "\n";
   if (improvements > 0) out << fmt::format("{} cells improved\n", improvements);
   out << fmt::format(
       "(tolerance: {} bit at p99.9, or its sampling interval where wider, {} bit at the maximum; NaN or Inf appearing "
@@ -85,6 +92,8 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
       std::vector<BandChange> bands = v.worse;
       std::stable_sort(bands.begin(), bands.end(), [](const BandChange& a, const BandChange& b) {
         auto growth = [](const BandChange& c) {
+          // No finite output is the largest loss there is.
+          if (c.after.judged == 0 && c.before.judged > 0) return std::numeric_limits<double>::infinity();
           return std::max(c.after.total_p999 - c.before.total_p999, c.after.arith_p999 - c.before.arith_p999);
         };
         return growth(a) > growth(b);
@@ -102,12 +111,17 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
   }
   for (const GateRun& r : runs) {
     for (const CellVerdict& v : r.comparison.cells) {
-      if (v.better.empty()) continue;
+      if (!v.improved()) continue;
       out << fmt::format("better: {} on {}: {}: {}\n", v.cell, r.current.backend, v.better.front().band,
                          Join(v.better.front().reasons, ", "));
     }
     for (const CellVerdict& v : r.comparison.cells) {
-      if (v.appeared) out << fmt::format("new cell (not in the baseline): {} on {}\n", v.cell, r.current.backend);
+      if (v.appeared) {
+        out << fmt::format("not compared: {} on {}: the cell is not in the baseline\n", v.cell, r.current.backend);
+      } else if (!v.not_compared.empty()) {
+        out << fmt::format("not compared: {} on {}: bands {} are not in the baseline\n", v.cell, r.current.backend,
+                           Join(v.not_compared, ", "));
+      }
     }
   }
   // The last line sums up; improvements beyond the tolerance are accepted
@@ -115,13 +129,13 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
   int unchanged = 0;
   std::vector<std::string> improved_baselines;
   for (const GateRun& r : runs) {
-    for (const CellVerdict& v : r.comparison.cells) unchanged += !v.failed() && v.better.empty() && !v.appeared;
+    for (const CellVerdict& v : r.comparison.cells) unchanged += !v.failed() && !v.improved() && !v.appeared;
     if (r.comparison.improvements() > 0 && !r.baseline_path.empty()) {
       improved_baselines.push_back("--baseline " + r.baseline_path);
     }
   }
-  out << fmt::format("\nsummary: {} cells worse, {} better, {} unchanged, of {}\n", failures, improvements, unchanged,
-                     cells);
+  out << fmt::format("\nsummary: {} cells worse, {} better, {} unchanged, {} not compared, of {}\n", failures,
+                     improvements, unchanged, not_compared, cells);
   if (failures == 0 && !improved_baselines.empty()) {
     out << fmt::format("to keep the improvements: depthbench gate --update {}{}\n", Join(improved_baselines, " "),
                        runs.front().shader_dir.empty() ? "" : " --shaders " + runs.front().shader_dir);
@@ -129,21 +143,37 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
 }
 
 std::string GateJUnit(const std::vector<GateRun>& runs) {
-  int tests = 0, failures = 0;
+  int tests = 0, failures = 0, skipped = 0;
+  const auto skipped_in = [](const GateComparison& c) {
+    return static_cast<int>(
+        std::count_if(c.cells.begin(), c.cells.end(), [](const CellVerdict& v) { return v.appeared; }));
+  };
   for (const GateRun& r : runs) {
     tests += static_cast<int>(r.comparison.cells.size());
     failures += r.comparison.failures();
+    skipped += skipped_in(r.comparison);
   }
   std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-  xml += fmt::format("<testsuites name=\"depthbench gate\" tests=\"{}\" failures=\"{}\">\n", tests, failures);
+  xml += fmt::format("<testsuites name=\"depthbench gate\" tests=\"{}\" failures=\"{}\" skipped=\"{}\">\n", tests,
+                     failures, skipped);
   for (const GateRun& r : runs) {
-    xml += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\">\n", XmlEscape(r.current.backend),
-                       r.comparison.cells.size(), r.comparison.failures());
+    xml += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" skipped=\"{}\">\n",
+                       XmlEscape(r.current.backend), r.comparison.cells.size(), r.comparison.failures(),
+                       skipped_in(r.comparison));
     for (const CellVerdict& v : r.comparison.cells) {
       xml += fmt::format("    <testcase classname=\"depthbench.gate.{}\" name=\"{}\"", XmlEscape(r.current.backend),
                          XmlEscape(v.cell));
+      if (v.appeared) {  // not compared: not a pass
+        xml += ">\n      <skipped message=\"not compared: the cell is not in the baseline\"/>\n    </testcase>\n";
+        continue;
+      }
       if (!v.failed()) {
-        xml += "/>\n";
+        xml += v.not_compared.empty()
+                   ? "/>\n"
+                   : fmt::format(
+                         ">\n      <system-out>not compared: bands {} are not in the baseline</system-out>\n"
+                         "    </testcase>\n",
+                         XmlEscape(Join(v.not_compared, ", ")));
         continue;
       }
       const std::string repro = v.disappeared ? "" : ReproFor(r, v.cell, v.worse.front());
@@ -158,10 +188,13 @@ std::string GateJUnit(const std::vector<GateRun>& runs) {
 
 nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
   auto figures = [](const BandFigures& f) {
-    return nlohmann::json{{"total_p999_bits", f.total_p999},
-                          {"total_max_bits", f.total_max},
-                          {"arith_p999_bits", f.arith_p999},
-                          {"arith_max_bits", f.arith_max},
+    // No finite output: no bits figure (null), not 0 bits lost.
+    const auto bits = [&](double value) { return f.judged == 0 ? nlohmann::json(nullptr) : JsonNumber(value); };
+    return nlohmann::json{{"total_p999_bits", bits(f.total_p999)},
+                          {"total_max_bits", bits(f.total_max)},
+                          {"arith_p999_bits", bits(f.arith_p999)},
+                          {"arith_max_bits", bits(f.arith_max)},
+                          {"judged", f.judged},
                           {"nan", f.nan},
                           {"inf", f.inf}};
   };
@@ -179,11 +212,13 @@ nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& t
     nlohmann::json cells = nlohmann::json::array();
     for (const CellVerdict& v : r.comparison.cells) {
       nlohmann::json cell = {{"cell", v.cell},
-                             {"verdict", v.failed()         ? "worse"
-                                         : v.better.empty() ? "same"
-                                                            : "better"},
+                             {"verdict", v.failed()     ? "worse"
+                                         : v.appeared   ? "not compared"
+                                         : v.improved() ? "better"
+                                                        : "same"},
                              {"disappeared", v.disappeared},
                              {"appeared", v.appeared},
+                             {"not_compared_bands", v.not_compared},
                              {"worse", changes(v.worse)},
                              {"better", changes(v.better)}};
       if (v.failed() && !v.disappeared) cell["reproduce"] = ReproFor(r, v.cell, v.worse.front());

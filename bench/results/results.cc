@@ -36,6 +36,25 @@ Expected<Shard> ParseShard(std::string_view text) {
   return shard;
 }
 
+std::vector<Shard> MissingShards(const std::vector<Shard>& held) {
+  if (held.empty()) return {};
+  const std::uint32_t count = held.front().count;
+  std::vector<Shard> missing;
+  for (const Shard& s : held)
+    if (s.count != count) return {};
+  for (std::uint32_t index = 1; index <= count; ++index) {
+    const Shard shard{index, count};
+    if (std::find(held.begin(), held.end(), shard) == held.end()) missing.push_back(shard);
+  }
+  return missing;
+}
+
+std::string ShardList(const std::vector<Shard>& shards) {
+  std::string out;
+  for (const Shard& s : shards) out += (out.empty() ? "" : ", ") + s.ToString();
+  return out;
+}
+
 const CellResult* Results::Find(const Cell& cell, const std::string& backend) const {
   for (const CellResult& c : cells)
     if (c.cell == cell && c.backend == backend) return &c;
@@ -135,7 +154,14 @@ json ToJson(const Results& results) {
   json shards = json::array();
   for (const Shard& s : run.shards) shards.push_back(s.ToString());
   json backends = json::array();
-  for (const auto& b : run.backends) backends.push_back({{"name", b.name}, {"device", DeviceToJson(b.device)}});
+  for (const auto& b : run.backends) {
+    backends.push_back({{"name", b.name},
+                        {"device", DeviceToJson(b.device)},
+                        {"shaders", b.program.shaders},
+                        {"program_hash", b.program.hash}});
+  }
+  json run_cells = json::array();
+  for (const Cell& c : run.cells) run_cells.push_back(c.Name());
 
   json cells = json::array();
   for (const CellResult& c : results.cells) {
@@ -189,6 +215,9 @@ json ToJson(const Results& results) {
                                        {"samples", run.samples},
                                        {"samples_per_frame", run.samples_per_frame},
                                        {"shards", shards},
+                                       {"partial", run.partial},
+                                       {"samples_judged", run.samples_judged},
+                                       {"cells", run_cells},
                                        {"domain", DomainToJson(run.domain)},
                                        {"backends", backends},
                                        {"seconds", run.seconds},
@@ -327,6 +356,15 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     run.shards.push_back(*shard);
     return Status::Ok();
   }));
+  DB_ASSIGN_OR_RETURN(run.partial, r.Bool("partial"));
+  DB_ASSIGN_OR_RETURN(run.samples_judged, r.Unsigned("samples_judged"));
+  DB_RETURN_IF_ERROR(r.ForEach("cells", [&](const JsonReader& c) -> Status {
+    DB_ASSIGN_OR_RETURN(std::string name, c.String());
+    Expected<Cell> cell = ParseCell(name);
+    if (!cell.ok()) return c.Error(cell.status().message());
+    run.cells.push_back(*cell);
+    return Status::Ok();
+  }));
   DB_ASSIGN_OR_RETURN(JsonReader domain, r.Field("domain"));
   DB_ASSIGN_OR_RETURN(run.domain, DomainFromJson(domain.json(), source));
   DB_RETURN_IF_ERROR(r.ForEach("backends", [&](const JsonReader& b) -> Status {
@@ -334,6 +372,8 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     DB_ASSIGN_OR_RETURN(record.name, b.String("name"));
     DB_ASSIGN_OR_RETURN(JsonReader device, b.Field("device"));
     DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
+    DB_ASSIGN_OR_RETURN(record.program.shaders, b.String("shaders"));
+    DB_ASSIGN_OR_RETURN(record.program.hash, b.String("program_hash"));
     run.backends.push_back(record);
     return Status::Ok();
   }));
@@ -378,29 +418,99 @@ Expected<Results> ReadResults(const std::filesystem::path& path) {
 
 // ---------------------------------------------------------------- merging
 
-Expected<Results> MergeResults(const std::vector<Results>& parts) {
+namespace {
+
+std::string Join(const std::vector<std::string>& parts) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : ",") + p;
+  return out;
+}
+
+std::string CellList(const std::vector<Cell>& cells) {
+  std::vector<std::string> names;
+  for (const Cell& c : cells) names.push_back(c.Name());
+  return Join(names);
+}
+
+std::string BackendList(const std::vector<BackendRecord>& backends, std::string (*what)(const BackendRecord&)) {
+  std::vector<std::string> out;
+  for (const BackendRecord& b : backends) out.push_back(b.name + "=" + what(b));
+  return Join(out);
+}
+
+// What defines a sweep, field by field, as text: two parts merge only when
+// every field reads the same. Names are those of the JSON (run.FIELD).
+std::vector<std::pair<std::string, std::string>> SweepIdentity(const RunInfo& run) {
+  std::vector<std::string> names;
+  for (const BackendRecord& b : run.backends) names.push_back(b.name);
+  return {
+      {"version", run.version},
+      {"seed", std::to_string(run.seed)},
+      {"samples", std::to_string(run.samples)},
+      {"samples_per_frame", std::to_string(run.samples_per_frame)},
+      {"domain", DomainToJson(run.domain).dump()},
+      {"cells", CellList(run.cells)},
+      {"backends", Join(names)},
+      {"backends.device", BackendList(run.backends,
+                                      [](const BackendRecord& b) {
+                                        return b.device.name + " [" + b.device.driver + "; " + b.device.compiler + "]";
+                                      })},
+      {"backends.shaders", BackendList(run.backends, [](const BackendRecord& b) { return b.program.shaders; })},
+      {"backends.program_hash", BackendList(run.backends, [](const BackendRecord& b) { return b.program.hash; })},
+  };
+}
+
+// A value in a message: long ones (the domain, every cell) cut short.
+std::string Quoted(const std::string& value) {
+  constexpr std::size_t kShown = 160;
+  return "'" + (value.size() <= kShown ? value : value.substr(0, kShown) + "...") + "'";
+}
+
+}  // namespace
+
+Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vector<std::string>& sources,
+                               bool allow_partial) {
   if (parts.empty()) return InvalidArgument("nothing to merge");
+  const auto name = [&](std::size_t p) {
+    return p < sources.size() ? fmt::format("'{}'", sources[p]) : fmt::format("part {}", p + 1);
+  };
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const RunInfo& run = parts[p].run;
+    if (run.partial && !allow_partial) {
+      return InvalidArgument(fmt::format(
+          "{} is partial: its sweep was interrupted after {} of its shards' samples; run it again, or merge with "
+          "--allow-partial to add up what it judged",
+          name(p), run.samples_judged));
+    }
+  }
+  const auto identity = SweepIdentity(parts.front().run);
   Results merged = parts.front();
   for (std::size_t p = 1; p < parts.size(); ++p) {
     const Results& part = parts[p];
-    const RunInfo& a = merged.run;
-    const RunInfo& b = part.run;
-    if (a.seed != b.seed || a.samples != b.samples || a.samples_per_frame != b.samples_per_frame ||
-        DomainToJson(a.domain) != DomainToJson(b.domain)) {
-      return InvalidArgument(fmt::format(
-          "part {} is not a shard of the same sweep (seed, sample count, plan and domain must match)", p + 1));
+    const auto other = SweepIdentity(part.run);
+    for (std::size_t f = 0; f < identity.size(); ++f) {
+      if (identity[f].second != other[f].second) {
+        return InvalidArgument(fmt::format(
+            "{} is not a shard of the same sweep as {}: run.{} differs: {} in {}, {} in {}", name(p), name(0),
+            identity[f].first, Quoted(identity[f].second), name(0), Quoted(other[f].second), name(p)));
+      }
     }
-    for (const Shard& s : b.shards) {
-      for (const Shard& held : a.shards) {
-        bool overlap = s.Begin(a.samples) < held.End(a.samples) && held.Begin(a.samples) < s.End(a.samples);
-        if (overlap) {
-          return InvalidArgument(fmt::format("shards {} and {} overlap", s.ToString(), held.ToString()));
+    for (const Shard& s : part.run.shards) {
+      for (const Shard& held : merged.run.shards) {
+        if (s.count != held.count) {
+          return InvalidArgument(fmt::format(
+              "shards {} and {} are of different splits (into {} and into {} shards): merge the shards of one "
+              "--shard K/N split",
+              held.ToString(), s.ToString(), held.count, s.count));
         }
+        if (s == held) return InvalidArgument(fmt::format("shard {} is given twice ({})", s.ToString(), name(p)));
       }
       merged.run.shards.push_back(s);
     }
-    merged.run.seconds += b.seconds;
-    merged.run.reconstructions += b.reconstructions;
+    merged.run.seconds += part.run.seconds;
+    merged.run.reconstructions += part.run.reconstructions;
+    merged.run.samples_judged += part.run.samples_judged;
+    merged.run.partial = merged.run.partial || part.run.partial;
     for (const CellResult& c : part.cells) {
       auto it = std::find_if(merged.cells.begin(), merged.cells.end(),
                              [&](const CellResult& m) { return m.cell == c.cell && m.backend == c.backend; });

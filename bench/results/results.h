@@ -22,8 +22,11 @@
 namespace depthbench {
 
 // Version 2: the production metric, non-finite outputs by cause, coverage
-// bands, the domain's name and production model.
-inline constexpr JsonSchema kResultsSchema{"depthbench.results", 2, "a results file of depthbench run --json"};
+// bands, the domain's name and production model. Version 3: what defines the
+// sweep (the cells run, each backend's shader sources and their hash) and
+// whether it was interrupted (run.partial, run.samples_judged). Older files
+// lack what merge must compare, so they are refused, not guessed at.
+inline constexpr JsonSchema kResultsSchema{"depthbench.results", 3, "a results file of depthbench run --json"};
 
 // Shard K of N (1-based, as "--shard K/N" spells it): samples
 // [total * (K-1) / N, total * K / N) of the sweep.
@@ -38,9 +41,15 @@ struct Shard {
 };
 Expected<Shard> ParseShard(std::string_view text);
 
+// The shards of a K/N split that `held` lacks, in order ("2/4", "3/4"); empty
+// when `held` is complete or mixes splits of different N.
+std::vector<Shard> MissingShards(const std::vector<Shard>& held);
+std::string ShardList(const std::vector<Shard>& shards);  // "2/4, 3/4"
+
 struct BackendRecord {
   std::string name;  // "cpu", "vulkan"
   DeviceInfo device;
+  ProgramInfo program;  // what its formulas were built from
 };
 
 struct RunInfo {
@@ -52,10 +61,15 @@ struct RunInfo {
   std::uint64_t samples = 0;  // of the whole sweep, every shard together
   std::uint32_t samples_per_frame = 0;
   std::vector<Shard> shards;  // the shards these results hold
+  std::vector<Cell> cells;    // the cells the sweep ran (the filter, after the domain's)
   Domain domain;
   std::vector<BackendRecord> backends;
   double seconds = 0.0;               // wall time (summed over merged shards)
   std::uint64_t reconstructions = 0;  // cell evaluations judged against the reference
+  // An interrupted sweep (SIGINT, SIGTERM) stops between batches: its
+  // figures are of the first samples_judged samples of its shards only.
+  bool partial = false;
+  std::uint64_t samples_judged = 0;  // of the shards held, summed over merged parts
 };
 
 struct CellResult {
@@ -77,9 +91,14 @@ Expected<Results> ResultsFromJson(const nlohmann::json& json, const std::string&
 Status WriteResults(const std::filesystem::path& path, const Results& results);
 Expected<Results> ReadResults(const std::filesystem::path& path);
 
-// Adds up the results of shards of one sweep. They must share seed, sample
-// count, plan and domain, and hold disjoint shards.
-Expected<Results> MergeResults(const std::vector<Results>& parts);
+// Adds up the results of shards of one sweep. They must share what defines
+// the sweep (version, seed, sample count, plan, domain, cells, backends with
+// their devices, shader directories and shader hashes) and hold disjoint
+// shards of one K/N split; a refusal names the field and both values.
+// `sources` names the parts in messages (file paths; "part K" when absent).
+// Partial (interrupted) parts are refused unless `allow_partial`.
+Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vector<std::string>& sources = {},
+                               bool allow_partial = false);
 
 nlohmann::json DomainToJson(const Domain& domain);
 Expected<Domain> DomainFromJson(const nlohmann::json& json, const std::string& source);

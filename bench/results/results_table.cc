@@ -18,6 +18,7 @@ std::string P999(const Summary& s) {
   const double spread = std::max(bits - BitsLost(s.p999_interval.low), BitsLost(s.p999_interval.high) - bits);
   return fmt::format("{:.1f}±{:.1f}", bits, spread);
 }
+constexpr const char* kNoFigure = "-";
 std::string Count(std::uint64_t n) { return n == 0 ? "0" : fmt::format("{}", n); }
 
 std::string SiCount(double x) {
@@ -33,16 +34,24 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   const RunInfo& run = results.run;
   out << fmt::format("depthbench {} (commit {}), seed {}, {} samples", run.version, run.commit, run.seed, run.samples);
   if (!(run.shards.size() == 1 && run.shards[0].count == 1)) {
-    std::string shards;
-    for (const Shard& s : run.shards) shards += (shards.empty() ? "" : ",") + s.ToString();
-    out << fmt::format(" (shards {})", shards);
+    out << fmt::format(" (shards {})", ShardList(run.shards));
   }
   out << "\n";
+  const std::vector<Shard> missing = MissingShards(run.shards);
+  if (!missing.empty()) {
+    out << fmt::format("PARTIAL: missing shards {}; these figures are of the other shards' samples only\n",
+                       ShardList(missing));
+  }
+  if (run.partial) {
+    out << fmt::format("PARTIAL: interrupted; {} of the shards' samples were judged, the figures are of those only\n",
+                       run.samples_judged);
+  }
   out << "domain: " << run.domain.Describe() << "\n";
   for (const auto& b : run.backends) {
     out << fmt::format("backend {}: {} [{}; {}; {}]", b.name, b.device.name, b.device.driver, b.device.api,
                        b.device.compiler);
     if (b.name == "vulkan" && b.device.kind == "cpu") out << " (software rasterizer on the CPU)";
+    if (b.name == "vulkan") out << fmt::format(", shaders {} ({})", b.program.shaders, b.program.hash);
     out << "\n";
   }
   if (run.seconds > 0) {
@@ -74,18 +83,28 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
     const BandStats all = c.stats.All();
     const Summary total = Summarize(all, Metric::kTotal);
     const Summary absolute = Summarize(all, Metric::kAbsolute);
-    table.AddRow({c.cell.Name(), c.backend, Count(all.finite), Bits(total.p50), Bits(total.p99), P999(total),
-                  Bits(total.max), Bits(Summarize(all, Metric::kProduction).p999),
-                  Bits(Summarize(all, Metric::kStorage).p999), Bits(Summarize(all, Metric::kArith).p999),
-                  fmt::format("{:.2g}", absolute.p999), fmt::format("{:.2g}", absolute.max), Count(all.nan),
-                  Count(all.inf), Count(all.stored_nonfinite)});
+    // A figure of no samples is no figure (an all-NaN cell lost every bit, not 0.0 of them).
+    const auto measured = [&](Metric m, std::string text) {
+      return all.metrics[static_cast<int>(m)].Count() == 0 ? std::string(kNoFigure) : text;
+    };
+    const bool no_output = all.finite == 0;
+    table.AddRow({c.cell.Name(), c.backend, no_output && all.nan + all.inf > 0 ? "none finite" : Count(all.finite),
+                  measured(Metric::kTotal, Bits(total.p50)), measured(Metric::kTotal, Bits(total.p99)),
+                  measured(Metric::kTotal, P999(total)), measured(Metric::kTotal, Bits(total.max)),
+                  measured(Metric::kProduction, Bits(Summarize(all, Metric::kProduction).p999)),
+                  measured(Metric::kStorage, Bits(Summarize(all, Metric::kStorage).p999)),
+                  measured(Metric::kArith, Bits(Summarize(all, Metric::kArith).p999)),
+                  measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.p999)),
+                  measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.max)), Count(all.nan), Count(all.inf),
+                  Count(all.stored_nonfinite)});
   }
   out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
          "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
          "three causes: prod (the depth the pipeline produced),\n"
          "stor (the format's rounding and fetch), shader (the variant's float32 arithmetic); the absolute error in\n"
          "world units; NaN and Inf outputs where exact arithmetic on the shader's inputs is finite (findings), and\n"
-         "'stored inf', non-finite outputs of stored values that denote infinity or the camera (expected)\n";
+         "'stored inf', non-finite outputs of stored values that denote infinity or the camera (expected); '-': no\n"
+         "sample to measure ('none finite': every output was NaN or Inf)\n";
   table.Print(out);
 }
 

@@ -114,7 +114,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   run.samples_per_frame = kSamplesPerFrame;
   run.shards = {options.shard};
   run.domain = options.domain;
-  for (Backend* backend : backends) run.backends.push_back({backend->name(), backend->device()});
+  run.cells = cells;
+  for (Backend* backend : backends) run.backends.push_back({backend->name(), backend->device(), backend->program()});
 
   const Sampler sampler(options.seed, options.domain);
   const BatchBuilder builder(sampler, layout.encodings, options.isa);
@@ -235,6 +236,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   run.reconstructions = progress.reconstructions_done;
+  run.samples_judged = progress.samples_done;
+  run.partial = progress.samples_done < progress.samples_total;
   return results;
 }
 

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/build_info.h"
 #include "bench/numerics/formulas.h"
 
 namespace depthbench {
@@ -116,6 +117,8 @@ class CpuBackend final : public Backend {
 
   std::string name() const override { return "cpu"; }
   const DeviceInfo& device() const override { return device_; }
+  // The formulas are compiled into the program: its version names them.
+  ProgramInfo program() const override { return {"built-in", std::string("depthbench ") + BuildVersion()}; }
   bool concurrent() const override { return true; }
 
   Status Prepare(std::span<const CellPlan> cells, PassKind) override {

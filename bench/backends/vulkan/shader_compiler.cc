@@ -59,8 +59,8 @@ Expected<std::string> ReadSourceFile(const std::filesystem::path& path) {
 // see real paths.
 class RelativeIncluder final : public glslang::TShader::Includer {
  public:
-  RelativeIncluder(std::string root_name, std::filesystem::path root_dir)
-      : root_name_(std::move(root_name)), root_dir_(std::move(root_dir)) {}
+  RelativeIncluder(std::string root_name, std::filesystem::path root_dir, std::vector<std::string>* sources)
+      : root_name_(std::move(root_name)), root_dir_(std::move(root_dir)), sources_(sources) {}
 
   IncludeResult* includeLocal(const char* header_name, const char* includer_name, size_t) override {
     const std::filesystem::path base =
@@ -69,6 +69,7 @@ class RelativeIncluder final : public glslang::TShader::Includer {
     Expected<std::string> text = ReadSourceFile(path);
     // A null result makes glslang report the directive's file and line.
     if (!text.ok()) return nullptr;
+    if (sources_ != nullptr) sources_->push_back(*text);
     auto* contents = new std::string(std::move(text).value());
     return new IncludeResult(path.string(), contents->data(), contents->size(), contents);
   }
@@ -82,6 +83,7 @@ class RelativeIncluder final : public glslang::TShader::Includer {
  private:
   std::string root_name_;
   std::filesystem::path root_dir_;
+  std::vector<std::string>* sources_;  // where to record what was read (may be null)
 };
 
 // glslang's info log says "ERROR: <file>:<line>: <message>"; compilers and
@@ -120,9 +122,11 @@ struct LinkedShader {
 };
 
 // `root_name` is what glslang reports for the source (its path, for a file);
-// includes in it resolve relative to `root_dir`.
+// includes in it resolve relative to `root_dir`; the text of every included
+// file is appended to `sources` when it is not null.
 Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, const std::string& root_name,
-                                                     const std::filesystem::path& root_dir) {
+                                                     const std::filesystem::path& root_dir,
+                                                     std::vector<std::string>* sources = nullptr) {
   EnsureGlslangInitialized();
   auto linked = std::make_unique<LinkedShader>();
   const char* text = source.data();
@@ -133,7 +137,7 @@ Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, 
   shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
-  RelativeIncluder includer(root_name, root_dir);
+  RelativeIncluder includer(root_name, root_dir, sources);
   if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, kMessages, includer)) {
     return CompileError(FormatInfoLog(shader.getInfoLog(), root_name));
   }
@@ -161,10 +165,12 @@ double CompileSeconds() {
   return text != nullptr && end != text && *end == '\0' && value > 0.0 ? value : 30.0;
 }
 
-Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::path& path) {
+Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::path& path,
+                                                         std::vector<std::string>* sources) {
   DB_ASSIGN_OR_RETURN(const std::string source, ReadSourceFile(path));
+  if (sources != nullptr) sources->push_back(source);
   const std::string name = path.string();
-  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path()));
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path(), sources));
   std::vector<std::uint32_t> spirv;
   spv::SpvBuildLogger logger;
   glslang::SpvOptions options;
@@ -175,12 +181,15 @@ Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::
   return spirv;
 }
 
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path) {
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
+                                                          std::vector<std::string>* sources) {
   // glslang cannot be stopped, so the compile runs on a thread of its own
   // that is given up on when it takes too long (the program then ends
-  // without waiting for it: base/interrupt.h).
+  // without waiting for it: base/interrupt.h). The thread owns what it
+  // writes until it is joined.
   using Words = Expected<std::vector<std::uint32_t>>;
-  std::packaged_task<Words()> task([path] { return CompileOnThisThread(path); });
+  auto read = std::make_shared<std::vector<std::string>>();
+  std::packaged_task<Words()> task([path, read] { return CompileOnThisThread(path, read.get()); });
   std::future<Words> compiled = task.get_future();
   std::thread compiler(std::move(task));
   const double seconds = CompileSeconds();
@@ -193,6 +202,7 @@ Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem:
                     path.string(), seconds));
   }
   compiler.join();
+  if (sources != nullptr) sources->insert(sources->end(), read->begin(), read->end());
   return compiled.get();
 }
 

@@ -20,8 +20,12 @@ std::string GlslangVersion();
 
 // SPIR-V words of the compute shader in `path`. NotFound when the file does
 // not exist, IoError when it cannot be read, CompileError with glslang's
-// messages as "<path>:<line>: error: <message>" lines otherwise.
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path);
+// messages as "<path>:<line>: error: <message>" lines otherwise. When
+// `sources` is not null, the text of the shader and of every file it
+// includes is appended to it in the order read (what results hash to say
+// which program ran).
+Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
+                                                          std::vector<std::string>* sources = nullptr);
 
 // One member of a buffer block as glslang lays it out: its reflected name
 // ("frame.camera_world" for member camera_world of a block member `frame`)

@@ -169,6 +169,21 @@ DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std
   return plan;
 }
 
+// FNV-1a (64 bits) of the sources' texts, each after its length, in the order
+// compiled: it changes with any edit to a shader or a file it includes, and
+// not with where the copy lies.
+std::string SourcesHash(const std::vector<std::string>& sources) {
+  std::uint64_t hash = 0xcbf29ce484222325u;
+  const auto add = [&](std::string_view bytes) {
+    for (const char c : bytes) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3u;
+  };
+  for (const std::string& text : sources) {
+    add(std::to_string(text.size()) + ":");
+    add(text);
+  }
+  return fmt::format("fnv1a64:{:016x}", hash);
+}
+
 class VulkanBackend final : public Backend {
  public:
   static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
@@ -176,6 +191,7 @@ class VulkanBackend final : public Backend {
 
   std::string name() const override { return "vulkan"; }
   const DeviceInfo& device() const override { return device_; }
+  ProgramInfo program() const override { return program_; }
   // One command buffer, one fence and one set of buffers: one Run at a time.
   bool concurrent() const override { return false; }
 
@@ -191,7 +207,9 @@ class VulkanBackend final : public Backend {
   std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
 
   Status PrepareOnDevice(std::span<const CellPlan> cells);
-  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape) const;
+  // `sources` collects the text of every source file compiled.
+  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape,
+                                                   std::vector<std::string>& sources) const;
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
@@ -210,6 +228,7 @@ class VulkanBackend final : public Backend {
   BackendOptions options_;                   // the requested pass shape (PassShapeFor)
   PassShape shape_{kSamplesPerFrame, 1, 1};  // of the prepared pipelines
   DeviceInfo device_;
+  ProgramInfo program_;  // of the prepared pipelines
   std::vector<CellPlan> cells_;
 
   std::unique_ptr<ComputePass> pass_;  // the storage buffers of compute_pass.glsl, PassConstants pushed
@@ -258,12 +277,14 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
   // Built aside so that a failure leaves the previous preparation intact.
   DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
   std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
+  std::vector<std::string> sources;
   for (const CellPlan& plan : cells) {
     DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
     if (pipeline.get() != VK_NULL_HANDLE) continue;
-    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape));
+    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape, sources));
   }
   pipelines_ = std::move(pipelines);
+  program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir, SourcesHash(sources)};
   shape_ = shape;
   cells_.assign(cells.begin(), cells.end());
   return Status::Ok();
@@ -286,9 +307,10 @@ std::uint64_t VulkanBackend::MaxBatchSamples() const {
   return most;
 }
 
-Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape) const {
+Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape,
+                                                                std::vector<std::string>& sources) const {
   const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path, &sources));
   const std::array<VkSpecializationMapEntry, 3> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
