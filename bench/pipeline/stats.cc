@@ -94,7 +94,8 @@ double MetricStats::Quantile(double q, int lowest_octave) const {
   std::uint64_t below = 0;
   for (const auto& [slot, count] : bins) {
     if (static_cast<double>(below + count) >= rank && count > 0) {
-      if (slot == 0) return std::ldexp(1.0, lowest_octave);
+      // Below the kept range: the edge is an upper bound, and so is the max.
+      if (slot == 0) return std::min(std::ldexp(1.0, lowest_octave), max());
       if (slot == kBinsKept + 1) return max();
       double fraction = std::clamp((rank - static_cast<double>(below)) / static_cast<double>(count), 0.0, 1.0);
       double log2_value = lowest_octave + (slot - 1 + fraction) / kBinsPerOctave;
@@ -103,6 +104,13 @@ double MetricStats::Quantile(double q, int lowest_octave) const {
     below += count;
   }
   return max();
+}
+
+bool MetricStats::BelowRange(double q) const {
+  const std::uint64_t n = Count();
+  const auto underflow = bins.find(0);
+  return n > 0 && underflow != bins.end() &&
+         static_cast<double>(underflow->second) >= std::clamp(q, 0.0, 1.0) * static_cast<double>(n);
 }
 
 const char* LevelName(Level level) {
@@ -188,6 +196,7 @@ Summary Summarize(const BandStats& band, Metric metric) {
   s.p50 = m.Quantile(0.5, low);
   s.p99 = m.Quantile(0.99, low);
   s.p999 = m.Quantile(0.999, low);
+  s.p999_below_range = m.Count() > 0 && m.BelowRange(0.999);
   s.p999_interval = m.LevelInterval(Level::kP999, metric);
   s.p999_supported = m.Count() >= MinimumSamples(Level::kP999);
   s.max = m.max();

@@ -115,8 +115,13 @@ struct MetricStats {
   void Merge(const MetricStats& other);
   void Merge(MetricStats&& other);  // takes other's bins whole where this has none
   // The q-quantile (q in [0, 1]) of the metric's value; 0 when empty.
-  // Underflow reads as the lowest kept edge, overflow as the exact max.
+  // Underflow reads as the lowest kept edge (or the max, when smaller): an
+  // upper bound, which BelowRange tells; overflow reads as the exact max.
   double Quantile(double q, int lowest_octave) const;
+  // Whether the q-quantile lies below the kept bins (the absolute error of
+  // a domain with a near plane far below 1e-6, say): Quantile is then only
+  // an upper bound.
+  bool BelowRange(double q) const;
   // The value at a level (a quantile, or the maximum) of metric `metric`.
   double AtLevel(Level level, Metric metric) const;
   // The 95% interval of the q-quantile: the values at the order-statistic
@@ -161,7 +166,8 @@ struct BandStats {
 struct Summary {
   double p50 = 0, p99 = 0, p999 = 0, max = 0;
   Interval p999_interval;
-  bool p999_supported = false;  // enough samples for a p99.9 (MinimumSamples)
+  bool p999_supported = false;    // enough samples for a p99.9 (MinimumSamples)
+  bool p999_below_range = false;  // p999 is an upper bound: the quantile lies below the histogram's bins
   std::uint64_t worst_index = 0;
 };
 Summary Summarize(const BandStats& band, Metric metric);

@@ -88,23 +88,24 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
       return all.metrics[static_cast<int>(m)].Count() == 0 ? std::string(kNoFigure) : text;
     };
     const bool no_output = all.finite == 0;
-    table.AddRow({c.cell.Name(), c.backend, no_output && all.nan + all.inf > 0 ? "none finite" : Count(all.finite),
-                  measured(Metric::kTotal, Bits(total.p50)), measured(Metric::kTotal, Bits(total.p99)),
-                  measured(Metric::kTotal, P999(total)), measured(Metric::kTotal, Bits(total.max)),
-                  measured(Metric::kProduction, Bits(Summarize(all, Metric::kProduction).p999)),
-                  measured(Metric::kStorage, Bits(Summarize(all, Metric::kStorage).p999)),
-                  measured(Metric::kArith, Bits(Summarize(all, Metric::kArith).p999)),
-                  measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.p999)),
-                  measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.max)), Count(all.nan), Count(all.inf),
-                  Count(all.stored_nonfinite)});
+    table.AddRow(
+        {c.cell.Name(), c.backend, no_output && all.nan + all.inf > 0 ? "none finite" : Count(all.finite),
+         measured(Metric::kTotal, Bits(total.p50)), measured(Metric::kTotal, Bits(total.p99)),
+         measured(Metric::kTotal, P999(total)), measured(Metric::kTotal, Bits(total.max)),
+         measured(Metric::kProduction, Bits(Summarize(all, Metric::kProduction).p999)),
+         measured(Metric::kStorage, Bits(Summarize(all, Metric::kStorage).p999)),
+         measured(Metric::kArith, Bits(Summarize(all, Metric::kArith).p999)),
+         measured(Metric::kAbsolute, fmt::format("{}{:.2g}", absolute.p999_below_range ? "<=" : "", absolute.p999)),
+         measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.max)), Count(all.nan), Count(all.inf),
+         Count(all.stored_nonfinite)});
   }
   out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
          "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
-         "three causes: prod (the depth the pipeline produced),\n"
-         "stor (the format's rounding and fetch), shader (the variant's float32 arithmetic); the absolute error in\n"
-         "world units; NaN and Inf outputs where exact arithmetic on the shader's inputs is finite (findings), and\n"
-         "'stored inf', non-finite outputs of stored values that denote infinity or the camera (expected); '-': no\n"
-         "sample to measure ('none finite': every output was NaN or Inf)\n";
+         "three causes: prod (the depth the pipeline produced), stor (the format's rounding and fetch), shader (the\n"
+         "variant's float32 arithmetic); the absolute error in world units ('<=': below the histogram's range of\n"
+         "2^-48, so only bounded); NaN and Inf outputs where exact arithmetic on the shader's inputs is finite\n"
+         "(findings), and 'stored inf', non-finite outputs of stored values that denote infinity or the camera\n"
+         "(expected); '-': no sample to measure ('none finite': every output was NaN or Inf)\n";
   table.Print(out);
 }
 
