@@ -203,5 +203,17 @@ TEST_F(BadInputTest, ASceneThatIsAFolder) {
   ExpectRefused({"choose", "--scene", dir_}, "'" + dir_ + "' is a directory, not a file");
 }
 
+// --json - writes the JSON to standard output (the tables go to stderr); a
+// standard output that cannot take it (a full disk: /dev/full) is an error,
+// exit 2, not a silent success.
+TEST_F(BadInputTest, JsonToAStandardOutputThatIsFullFails) {
+  const pid_t pid = testing::StartDepthbench({"run", "--backend", "cpu", "--samples", "1e3", "--json", "-"},
+                                             "/dev/full", dir_ + "/stderr");
+  EXPECT_EQ(testing::WaitForExit(pid, 0), 2);
+  EXPECT_NE(testing::ReadText(dir_ + "/stderr").find("cannot write to standard output ('-'): No space left on device"),
+            std::string::npos)
+      << testing::ReadText(dir_ + "/stderr");
+}
+
 }  // namespace
 }  // namespace depthbench

@@ -1,22 +1,21 @@
 #include "tests/command_runner.h"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 namespace depthbench::testing {
 
-CommandResult RunDepthbench(const std::vector<std::string>& args) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("depthbench_cmd_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const fs::path out_path = dir / "out", err_path = dir / "err";
+pid_t StartDepthbench(const std::vector<std::string>& args, const std::string& out_path, const std::string& err_path) {
   const std::string program = std::string(DEPTHBENCH_BINARY_DIR) + "/bench/depthbench";
-  CommandResult result;
   pid_t pid = ::fork();
   if (pid == 0) {
     std::freopen(out_path.c_str(), "w", stdout);
@@ -27,9 +26,32 @@ CommandResult RunDepthbench(const std::vector<std::string>& args) {
     ::execv(program.c_str(), argv.data());
     std::_Exit(127);
   }
+  return pid;
+}
+
+int WaitForExit(pid_t pid, double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   int status = 0;
-  ::waitpid(pid, &status, 0);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  while (true) {
+    const pid_t done = ::waitpid(pid, &status, seconds > 0 ? WNOHANG : 0);
+    if (done == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (done < 0) return -1;
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+CommandResult RunDepthbench(const std::vector<std::string>& args) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("depthbench_cmd_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path out_path = dir / "out", err_path = dir / "err";
+  CommandResult result;
+  result.exit_code = WaitForExit(StartDepthbench(args, out_path, err_path), 0);
   auto slurp = [](const fs::path& p) {
     std::ifstream in(p);
     std::stringstream s;

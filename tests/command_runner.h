@@ -2,6 +2,8 @@
 // captures its exit code and output.
 #pragma once
 
+#include <sys/types.h>
+
 #include <string>
 #include <vector>
 
@@ -15,6 +17,15 @@ struct CommandResult {
 
 // Runs `depthbench args...` (no shell: arguments are passed as they are).
 CommandResult RunDepthbench(const std::vector<std::string>& args);
+
+// Starts `depthbench args...` with stdout and stderr written to the files
+// given (which may be devices: /dev/full), and returns its process id.
+pid_t StartDepthbench(const std::vector<std::string>& args, const std::string& out_path, const std::string& err_path);
+
+// Waits for a process StartDepthbench started: its exit code (128 + signal
+// when a signal ended it), or -1 when it is still running after `seconds`
+// (it is then killed). 0 seconds: no limit.
+int WaitForExit(pid_t pid, double seconds);
 
 // A fresh empty directory under the system's temporary directory.
 std::string MakeTempDir(const std::string& name);

@@ -43,7 +43,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadSpeedInput{{"--resolution", "1920"}, "--resolution: '1920' is not WIDTHxHEIGHT"},
         BadSpeedInput{{"--accuracy-samples", "0"}, "--accuracy-samples: '0' is not a whole number"},
         BadSpeedInput{{"--device", "no-such-gpu"}, "no Vulkan device matches 'no-such-gpu'; available: llvmpipe"},
-        BadSpeedInput{{"--shaders", "/no/such/dir"}, "speed shader directory '/no/such/dir/speed' does not exist"},
+        BadSpeedInput{{"--shaders", "/no/such/dir"}, "shader directory '/no/such/dir' does not exist"},
         BadSpeedInput{{"--results", "/no/such/results.json"}, "--results: file '/no/such/results.json' does not exist"},
         BadSpeedInput{{"--compare", "/no/such/speed.json"}, "--compare: file '/no/such/speed.json' does not exist"},
         BadSpeedInput{{"--json", "/no/such/dir/speed.json"}, "cannot write '/no/such/dir/speed.json'"}),

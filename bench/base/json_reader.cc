@@ -58,7 +58,7 @@ Expected<nlohmann::json> JsonReader::Parse(const std::string& text, const std::s
 }
 
 Expected<nlohmann::json> ReadJsonFile(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(const std::string text, ReadFile(path));
+  DB_ASSIGN_OR_RETURN(const std::string text, ReadFile(path, kMaxJsonFileBytes));
   return JsonReader::Parse(text, path.string());
 }
 

@@ -289,7 +289,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
 }
 
 Expected<Scene> LoadScene(const std::filesystem::path& path) {
-  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path));
+  DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path, kMaxSourceFileBytes));
   return ParseScene(text, path.string());
 }
 

@@ -12,6 +12,7 @@
 #include <fmt/ranges.h>
 
 #include "bench/base/build_info.h"
+#include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/base/resources.h"
 #include "bench/base/suggest.h"
@@ -51,7 +52,7 @@ void NameOptionTypes(CLI::App& app) {
                                                          {"--shard", "K/N"},
                                                          {"--level", "LEVEL"},
                                                          {"--split", "BAND[,BAND]"},
-                                                         {"--json", "FILE"},
+                                                         {"--json", "FILE|-"},
                                                          {"--junit", "FILE"},
                                                          {"--scene", "FILE"},
                                                          {"--baseline", "FILE"},
@@ -85,6 +86,15 @@ void NameOptionTypes(CLI::App& app) {
         if (it != kTypes.end()) option->type_name(it->second);
       }
     }
+  }
+}
+
+// Every --json says that '-' is standard output.
+void DescribeStandardOutput(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands({})) {
+    CLI::Option* json = sub->get_option_no_throw("--json");
+    if (json == nullptr) continue;
+    json->description(json->get_description() + " ('-': standard output, and the tables go to standard error)");
   }
 }
 
@@ -140,6 +150,16 @@ void CheckWholeNumbers(CLI::App& app) {
   }
 }
 
+// Whether the chosen subcommand writes its JSON to standard output
+// (--json -).
+bool WritesJsonToStandardOutput(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands()) {
+    const CLI::Option* json = sub->get_option_no_throw("--json");
+    if (json != nullptr && json->count() > 0 && json->results().back() == kStandardOutputName) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
@@ -174,6 +194,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   AddReportCommand(*app, action);
   AddFuzzCommand(*app, action);
   NameOptionTypes(*app);
+  DescribeStandardOutput(*app);
   CheckWholeNumbers(*app);
   return app;
 }
@@ -225,13 +246,23 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
 
 int RunDepthbench(int argc, const char* const* argv) {
   // Lines for people fit 120 columns, unless --wide.
-  const WrappedOutput wrapped(std::cout);
+  std::streambuf* const standard_output = std::cout.rdbuf();
+  auto wrapped = std::make_unique<WrappedOutput>(std::cout);
   CommandAction action;
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
+  if (WritesJsonToStandardOutput(*app)) {
+    // Standard output carries the JSON alone (a user pipes it); what is
+    // printed for people goes to standard error instead.
+    wrapped.reset();
+    std::cout.rdbuf(std::cerr.rdbuf());
+    wrapped = std::make_unique<WrappedOutput>(std::cout);
+  }
   InstallInterruptHandlers();
   const int code = action ? ExitCode(action()) : kExitCannotRun;
+  wrapped.reset();
+  std::cout.rdbuf(standard_output);
   if (AbandonedThreads()) {
     // A thread still runs work that cannot be stopped: end here, before
     // the static objects it may use are destroyed.

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/factory.h"
+#include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
 
@@ -199,25 +200,30 @@ Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& w
 
 Status CheckWritable(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::path target = fs::absolute(path, ec);
-  if (ec || path.empty()) return InvalidArgument(fmt::format("{}: '{}' is not a usable path", what, path));
-  if (fs::is_directory(target, ec)) return IoError(fmt::format("{}: '{}' is a directory", what, path));
-  fs::path dir = target.parent_path();
-  if (!fs::is_directory(dir, ec)) {
-    return IoError(fmt::format("{}: cannot write '{}': directory '{}' does not exist", what, path, dir.string()));
+  const bool to_standard_output_allowed = what == "--json";
+  if (to_standard_output_allowed && path == kStandardOutputName) return Status::Ok();
+  Expected<fs::path> target = OutputTarget(path);
+  if (!target.ok()) {
+    const Status refused = target.status().WithContext(what);
+    if (!to_standard_output_allowed) return refused;
+    return Status(refused.code(), refused.message() + " (give - to write to standard output)");
   }
+  const fs::path dir = target->parent_path();
+  DB_RETURN_IF_ERROR(CheckDirectory(dir, "directory").WithContext(fmt::format("{}: cannot write '{}'", what, path)));
   // Create (and remove) a file beside the target: the only test that holds
   // for every case, including root (for whom access() says yes to any
   // directory) and pseudo or read-only file systems. The name is the one
-  // WriteFileAtomically uses for its temporary file, with another suffix.
-  const fs::path probe = dir / ("." + target.filename().string() + ".probe." + std::to_string(::getpid()));
+  // WriteFileAtomically uses for its temporary file, with another suffix;
+  // like that file, a second signal removes it.
+  const fs::path probe = dir / ("." + target->filename().string() + ".probe." + std::to_string(::getpid()));
+  const TemporaryFileGuard guard(probe);
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) {
     return IoError(fmt::format("{}: cannot write '{}': cannot create a file in directory '{}': {}", what, path,
                                dir.string(), std::strerror(errno)));
   }
   ::close(fd);
+  std::error_code ec;
   fs::remove(probe, ec);
   return Status::Ok();
 }

@@ -69,7 +69,10 @@ struct BackendFlags {
 Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& what);
 // Checks that an output file can be created, before a long run starts: the
 // path names a file (not a folder) in an existing folder where a file can be
-// created right now. The message names `what` (the flag) and the path.
+// created right now; symbolic links are followed to the file they name, and
+// a target that is not a regular file (a device, a FIFO) is refused. The
+// message names `what` (the flag) and the path. For --json, the data output
+// a user pipes, "-" (standard output) is accepted.
 Status CheckWritable(const std::string& path, const std::string& what);
 
 // True when stderr is a terminal (progress lines are shown only then).

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
 #include "bench/base/progress.h"
 #include "bench/base/resources.h"
 #include "bench/base/text_table.h"
@@ -230,6 +231,7 @@ Expected<int> Fuzz(const FuzzFlags& f) {
   if (!f.search && !f.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(f.out, ec);
+    DB_RETURN_IF_ERROR(CheckDirectory(f.out, "folder").WithContext("--out"));
     DB_RETURN_IF_ERROR(CheckWritable(f.out + "/.probe", "--out"));
   }
   BackendFlags backend_flags = f.backends;
@@ -249,8 +251,9 @@ void AddFuzzCommand(CLI::App& app, CommandAction& action) {
   cmd->footer(
       "Invariants: where the reference is finite the output must be finite, and the arithmetic error (from the "
       "value the texel holds) must stay within a first-order rounding bound (bench/fuzz/case_check.h). Findings "
-      "are deduplicated by cell, backend and kind, shrunk, and written to --out as reproducer files; exit 1 when "
-      "there are any.\n\n"
+      "are deduplicated by cell, backend and kind, written to --out as reproducer files as soon as they are found, "
+      "then shrunk and rewritten at the end; exit 1 when there are any. SIGINT or SIGTERM stops the campaign after "
+      "the batch or the file in hand (exit 130 or 143), keeping the reproducers written so far.\n\n"
       "The fuzz domain spans the extremes catalogue: near 1e-7 to 10, far/near 10 to 1e9 (and infinite far "
       "planes), fov 0.01 to 179.9 degrees, aspect 1e-3 to 1e3, cameras up to 1e7 from the origin; the domain "
       "flags narrow it.\n\n"

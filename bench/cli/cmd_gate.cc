@@ -44,7 +44,9 @@ Expected<int> Gate(const GateFlags& f) {
     if (f.update) {  // refused now, not after the sweep
       DB_RETURN_IF_ERROR(CheckWritable(path, "--baseline").WithContext("--update"));
     }
-    slot.exists = std::filesystem::exists(path);
+    // A link counts as there (a loop of links is then refused as one).
+    std::error_code ec;
+    slot.exists = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
     if (slot.exists) {
       DB_RETURN_IF_ERROR(StoreInto(ReadBaseline(path), slot.baseline).WithContext("the baseline does not parse"));
     } else if (!f.update) {

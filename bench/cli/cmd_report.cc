@@ -76,7 +76,7 @@ Expected<int> RunReport(const ReportFlags& f) {
   if (cells.size() != AllCells().size()) plan.cells = std::move(cells);
   DB_ASSIGN_OR_RETURN(plan.speed_files, SpeedFiles(f));
   for (const fs::path& file : plan.speed_files) {
-    if (!fs::is_regular_file(file)) return NotFound(fmt::format("--speed: {} does not exist", file.string()));
+    DB_RETURN_IF_ERROR(CheckReadableFile(file, kMaxJsonFileBytes).WithContext("--speed"));
   }
 
   // Everything that can be refused is refused before the sweeps run.
@@ -92,10 +92,8 @@ Expected<int> RunReport(const ReportFlags& f) {
     DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));
   fs::path page_template = f.page_template;
   if (page_template.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/report_template.html"), page_template));
+  DB_RETURN_IF_ERROR(CheckReadableFile(page_template, kMaxSourceFileBytes).WithContext("--template"));
   DB_RETURN_IF_ERROR(library.Check());
-  if (!fs::is_regular_file(page_template)) {
-    return NotFound(fmt::format("--template: {} does not exist", page_template.string()));
-  }
   std::optional<History> history;
   if (!f.no_history) {
     const fs::path path = f.history.empty() ? UserDataFolder() / "history.sqlite" : fs::path(f.history);

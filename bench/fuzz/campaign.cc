@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/base/interrupt.h"
 #include "bench/pipeline/stats.h"
 
 namespace depthbench {
@@ -137,6 +138,23 @@ Expected<FuzzCase> Shrink(CaseChecker& checker, FuzzCase c, FindingKind kind, co
   return c;
 }
 
+// Writes a finding's reproducer file: its case as found, or once shrunk.
+Status WriteFinding(const CampaignFinding& finding) {
+  ReproFile file;
+  file.fuzz_case = finding.shrunk;
+  file.cells = {finding.cell};
+  file.backends = {finding.backend};
+  const Judgement& j = finding.judgement;
+  file.finding = {{"signature", finding.signature},
+                  {"kind", FindingKindName(finding.kind)},
+                  {"hits", finding.hits},
+                  {"arith_error", JsonNumber(j.arith)},
+                  {"bound", JsonNumber(j.bound)},
+                  {"arith_bits_lost", JsonNumber(std::isfinite(j.arith) ? BitsLost(j.arith) : NAN)},
+                  {"bound_bits_lost", JsonNumber(BitsLost(j.bound))}};
+  return WriteReproFile(finding.file, file);
+}
+
 }  // namespace
 
 Expected<std::vector<FuzzPoint>> ReadCorpus(const std::vector<std::filesystem::path>& paths) {
@@ -149,13 +167,12 @@ Expected<std::vector<FuzzPoint>> ReadCorpus(const std::vector<std::filesystem::p
         if (entry.is_regular_file()) files.push_back(entry.path());
       }
       std::sort(files.begin(), files.end());
-    } else if (std::filesystem::is_regular_file(path, ec)) {
-      files.push_back(path);
     } else {
-      return NotFound(fmt::format("--corpus: '{}' is neither a file nor a folder", path.string()));
+      DB_RETURN_IF_ERROR(CheckReadableFile(path, kMaxSourceFileBytes).WithContext("--corpus"));
+      files.push_back(path);
     }
     for (const auto& file : files) {
-      DB_ASSIGN_OR_RETURN(std::string bytes, ReadFile(file));
+      DB_ASSIGN_OR_RETURN(std::string bytes, ReadFile(file, kMaxSourceFileBytes));
       points.push_back(DecodePoint({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}));
     }
   }
@@ -185,7 +202,8 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
   std::size_t corpus_next = 0;
   const std::uint32_t frames = std::max<std::uint32_t>(1, options.frames_per_batch);
 
-  while (true) {
+  // SIGINT or SIGTERM ends the campaign after the batch or the file in hand.
+  while (!Interrupted()) {
     const double t = elapsed();
     if (options.seconds > 0 && t >= options.seconds) break;
     if (options.cases > 0 && result.cases >= options.cases) break;
@@ -223,6 +241,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, count));
     result.cases += count;
 
+    const std::size_t findings_before = result.findings.size();
     for (std::size_t c = 0; c < checker.cells().size(); ++c) {
       for (std::size_t b = 0; b < backend_list.size(); ++b) {
         for (std::uint32_t i = 0; i < count; ++i) {
@@ -254,9 +273,21 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
           finding.kind = j.kind();
           finding.hits = 1;
           finding.first = batch.CaseOf(i);
+          finding.first.sample.index = 0;
+          // Until it is shrunk, the case as found is the reproducer.
+          finding.shrunk = finding.first;
+          finding.judgement = j;
           result.findings.push_back(std::move(finding));
         }
       }
+    }
+    // New findings are written at once, as found, so that a campaign
+    // stopped later keeps them; shrinking waits for the end (it prepares
+    // the shared backends for one cell at a time).
+    for (std::size_t k = findings_before; k < result.findings.size() && !options.out.empty(); ++k) {
+      CampaignFinding& finding = result.findings[k];
+      finding.file = options.out / (Sanitized(finding.signature) + ".json");
+      DB_RETURN_IF_ERROR(WriteFinding(finding));
     }
     // Keep the closest inputs only.
     if (elite.size() > 256) {
@@ -273,29 +304,17 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
   }
   result.seconds = elapsed();
 
-  // Shrink each finding on its own cell and backend, then write it.
+  // Shrink each finding on its own cell and backend, then rewrite its file
+  // with the shrunk case and the final hit count. A signal stops this after
+  // the file in hand; the findings not reached keep the case as found.
   for (CampaignFinding& finding : result.findings) {
+    if (Interrupted()) break;
     Backend* backend = *std::find_if(backend_list.begin(), backend_list.end(),
                                      [&](Backend* b) { return b->name() == finding.backend; });
     DB_ASSIGN_OR_RETURN(CaseChecker one, CaseChecker::Make({finding.cell}, {backend}, 1));
-    finding.first.sample.index = 0;
     DB_ASSIGN_OR_RETURN(finding.shrunk, Shrink(one, finding.first, finding.kind, options.domain));
     DB_ASSIGN_OR_RETURN(finding.judgement, CheckOne(one, finding.shrunk));
-    if (options.out.empty()) continue;
-    ReproFile file;
-    file.fuzz_case = finding.shrunk;
-    file.cells = {finding.cell};
-    file.backends = {finding.backend};
-    const Judgement& j = finding.judgement;
-    file.finding = {{"signature", finding.signature},
-                    {"kind", FindingKindName(finding.kind)},
-                    {"hits", finding.hits},
-                    {"arith_error", JsonNumber(j.arith)},
-                    {"bound", JsonNumber(j.bound)},
-                    {"arith_bits_lost", JsonNumber(std::isfinite(j.arith) ? BitsLost(j.arith) : NAN)},
-                    {"bound_bits_lost", JsonNumber(BitsLost(j.bound))}};
-    finding.file = options.out / (Sanitized(finding.signature) + ".json");
-    DB_RETURN_IF_ERROR(WriteReproFile(finding.file, file));
+    if (!options.out.empty()) DB_RETURN_IF_ERROR(WriteFinding(finding));
   }
   return result;
 }

@@ -5,7 +5,9 @@
 // from random points, and from mutations of the inputs that came closest to
 // their bound. Findings are deduplicated by signature (cell, backend, kind),
 // shrunk to the simplest case that still fails the same way, and written as
-// reproducer files that `depthbench run --repro FILE` replays.
+// reproducer files that `depthbench run --repro FILE` replays, each as soon
+// as it is found: SIGINT or SIGTERM ends the campaign after the batch or
+// the file in hand, and what was found is kept.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,10 @@ struct CampaignOptions {
   std::uint64_t seed = 1;
   std::vector<Cell> cells;
   std::vector<std::filesystem::path> corpus;  // files of FuzzPoint bytes, or folders of them
-  std::filesystem::path out;                  // where reproducer files go ("" = none written)
+  // Where reproducer files go ("" = none written). Each is written when its
+  // finding is first seen (the case as found, the hits so far), and
+  // rewritten at the end with the shrunk case and the campaign's count.
+  std::filesystem::path out;
   Domain domain = FuzzDomain();
   std::uint32_t frames_per_batch = 64;  // x 64 samples
   // Units held at a value in every input (index into the 18 units of a

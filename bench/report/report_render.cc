@@ -188,10 +188,10 @@ Status PlotLibrary::Check() const {
 Expected<std::string> RenderHtml(const Report& report, const std::filesystem::path& template_file,
                                  const PlotLibrary& library) {
   DB_RETURN_IF_ERROR(library.Check());
-  DB_ASSIGN_OR_RETURN(std::string page, ReadFile(template_file));
+  DB_ASSIGN_OR_RETURN(std::string page, ReadFile(template_file, kMaxSourceFileBytes));
   std::string scripts;
   for (const std::filesystem::path& bundle : library.Bundles()) {
-    DB_ASSIGN_OR_RETURN(std::string code, ReadFile(bundle));
+    DB_ASSIGN_OR_RETURN(std::string code, ReadFile(bundle, kMaxSourceFileBytes));
     // The page is offline: drop the pointer to a source map it cannot load.
     const std::size_t map = code.rfind("//# sourceMappingURL=");
     if (map != std::string::npos) code.erase(map);

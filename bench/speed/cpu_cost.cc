@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/encode.h"
 #include "bench/pipeline/shader_constants.h"
@@ -92,6 +93,9 @@ Expected<std::vector<CpuCost>> MeasureCpuCosts(std::span<const Cell> cells, cons
         static_cast<std::uint32_t>(std::clamp(std::ceil(options.min_repetition_ns / std::max(once, 1.0)), 1.0, 1e6));
     std::vector<double> per_reconstruction;
     for (std::uint32_t r = 0; r < options.repetitions; ++r) {
+      // A repetition lasts about min_repetition_ns: a signal stops the run
+      // between two of them.
+      if (Interrupted()) return InterruptedError("no speed results written");
       DB_ASSIGN_OR_RETURN(const double ns, TimeRuns(*backend, input.batch, k, runs, scratch));
       per_reconstruction.push_back(ns / (static_cast<double>(runs) * input.batch.count));
     }

@@ -9,6 +9,8 @@
 
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/files.h"
+#include "bench/base/interrupt.h"
 #include "bench/speed/timing_stats.h"
 
 namespace depthbench {
@@ -90,10 +92,8 @@ Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<Vul
     return Unavailable(fmt::format("Vulkan device '{}' reports timestampPeriod {}", properties.name,
                                    properties.limits.timestampPeriod));
   }
-  std::error_code error;
-  if (!std::filesystem::is_directory(shader_dir / "speed", error)) {
-    return NotFound(fmt::format("speed shader directory '{}' does not exist", (shader_dir / "speed").string()));
-  }
+  DB_RETURN_IF_ERROR(CheckDirectory(shader_dir, "shader directory"));
+  DB_RETURN_IF_ERROR(CheckDirectory(shader_dir / "speed", "speed shader directory"));
   std::unique_ptr<GpuPassTimer> timer(new GpuPassTimer(std::move(context), std::move(shader_dir)));
   const ValidationScope validation(*timer->context_);
   const std::array<VkDescriptorSetLayoutBinding, 3> bindings = {{
@@ -402,6 +402,9 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   const std::size_t count = variants.size();
   std::vector<VkPipeline> pipelines;
   for (const Variant variant : variants) {
+    // Compiling a pipeline takes seconds on a CPU implementation: a signal
+    // stops the timing between two (a submitted pass cannot be stopped).
+    if (Interrupted()) return InterruptedError("");
     DB_ASSIGN_OR_RETURN(const VkPipeline pipeline, Pipeline(variant, encoding_.convention, taps));
     pipelines.push_back(pipeline);
   }
@@ -436,6 +439,7 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
     }));
     for (PassTiming& timing : timings) timing.warmup_passes += rounds;
   }
+  if (Interrupted()) return InterruptedError("");
   // The timed rounds: one group of each variant per round.
   for (std::size_t v = 0; v < count; ++v) {
     timings[v].passes_per_repetition =

@@ -9,6 +9,7 @@
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/base/build_info.h"
 #include "bench/base/environment.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/thread_pool.h"
 #include "bench/speed/depth_image.h"
 #include "bench/speed/trade.h"
@@ -105,6 +106,9 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
       DB_ASSIGN_OR_RETURN(const DepthImage image, MakeDepthImage(encoding, resolution, pool));
       DB_RETURN_IF_ERROR(timer.LoadImage(image));
       for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
+        // A measurement takes up to a few seconds: a signal stops the run
+        // between two of them.
+        if (Interrupted()) return InterruptedError("no speed results written");
         const std::uint32_t taps = regime == Regime::kMemory ? 1 : options.alu_taps;
         if (options.progress) {
           options.progress(done, total,

@@ -2,9 +2,7 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <future>
-#include <iterator>
 #include <memory>
 #include <regex>
 #include <sstream>
@@ -18,6 +16,7 @@
 #include <glslang/SPIRV/GlslangToSpv.h>
 #include <glslang/build_info.h>
 
+#include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 
 namespace depthbench {
@@ -41,15 +40,7 @@ void EnsureGlslangInitialized() {
 }
 
 Expected<std::string> ReadSourceFile(const std::filesystem::path& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) {
-    return NotFound(fmt::format("shader source '{}' does not exist", path.string()));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return IoError(fmt::format("cannot open shader source '{}'", path.string()));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return IoError(fmt::format("cannot read shader source '{}'", path.string()));
-  return text;
+  return ReadFile(path, kMaxSourceFileBytes, "shader source");
 }
 
 // Resolves `#include "name"` relative to the directory of the including
@@ -67,11 +58,24 @@ class RelativeIncluder final : public glslang::TShader::Includer {
         root_name_ == includer_name ? root_dir_ : std::filesystem::path(includer_name).parent_path();
     const std::filesystem::path path = (base / header_name).lexically_normal();
     Expected<std::string> text = ReadSourceFile(path);
-    // A null result makes glslang report the directive's file and line.
-    if (!text.ok()) return nullptr;
+    if (!text.ok()) {
+      local_failure_ = text.status().message();
+      return nullptr;
+    }
     if (sources_ != nullptr) sources_->push_back(*text);
     auto* contents = new std::string(std::move(text).value());
     return new IncludeResult(path.string(), contents->data(), contents->size(), contents);
+  }
+
+  // glslang tries the system paths after a local include fails, and reports
+  // the failure that one returns (a result with no header name, whose text
+  // is the message) at the directive's file and line: here, why the local
+  // file could not be included (missing, a device, too large).
+  IncludeResult* includeSystem(const char*, const char*, size_t) override {
+    if (local_failure_.empty()) return nullptr;
+    auto* message = new std::string(std::move(local_failure_));
+    local_failure_.clear();
+    return new IncludeResult("", message->data(), message->size(), message);
   }
 
   void releaseInclude(IncludeResult* result) override {
@@ -84,6 +88,7 @@ class RelativeIncluder final : public glslang::TShader::Includer {
   std::string root_name_;
   std::filesystem::path root_dir_;
   std::vector<std::string>* sources_;  // where to record what was read (may be null)
+  std::string local_failure_;          // why the last local include failed
 };
 
 // glslang's info log says "ERROR: <file>:<line>: <message>"; compilers and

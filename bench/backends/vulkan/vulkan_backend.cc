@@ -14,6 +14,7 @@
 
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/base/files.h"
 #include "bench/base/resources.h"
 #include "bench/numerics/formulas.h"
 
@@ -270,10 +271,7 @@ Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
 }
 
 Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
-  std::error_code error;
-  if (!std::filesystem::is_directory(shader_dir_, error)) {
-    return NotFound(fmt::format("shader directory '{}' does not exist", shader_dir_.string()));
-  }
+  DB_RETURN_IF_ERROR(CheckDirectory(shader_dir_, "shader directory"));
   // Built aside so that a failure leaves the previous preparation intact.
   DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
   std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
