@@ -10,13 +10,16 @@
 
 namespace depthbench::testing {
 
-CommandResult RunDepthbench(const std::vector<std::string>& args) {
+StartedCommand StartDepthbench(const std::vector<std::string>& args) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("depthbench_cmd_" + std::to_string(::getpid()));
+  // One folder per command, so that commands running at once keep their
+  // outputs apart.
+  static int started = 0;
+  const fs::path dir = fs::temp_directory_path() /
+                       ("depthbench_cmd_" + std::to_string(::getpid()) + "_" + std::to_string(started++));
   fs::create_directories(dir);
   const fs::path out_path = dir / "out", err_path = dir / "err";
   const std::string program = std::string(DEPTHBENCH_BINARY_DIR) + "/bench/depthbench";
-  CommandResult result;
   pid_t pid = ::fork();
   if (pid == 0) {
     std::freopen(out_path.c_str(), "w", stdout);
@@ -27,20 +30,23 @@ CommandResult RunDepthbench(const std::vector<std::string>& args) {
     ::execv(program.c_str(), argv.data());
     std::_Exit(127);
   }
+  return {pid, dir.string()};
+}
+
+CommandResult FinishDepthbench(const StartedCommand& started) {
+  namespace fs = std::filesystem;
+  CommandResult result;
   int status = 0;
-  ::waitpid(pid, &status, 0);
+  ::waitpid(started.pid, &status, 0);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  auto slurp = [](const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  result.out = slurp(out_path);
-  result.err = slurp(err_path);
+  const fs::path dir = started.dir;
+  result.out = ReadText((dir / "out").string());
+  result.err = ReadText((dir / "err").string());
   fs::remove_all(dir);
   return result;
 }
+
+CommandResult RunDepthbench(const std::vector<std::string>& args) { return FinishDepthbench(StartDepthbench(args)); }
 
 std::string MakeTempDir(const std::string& name) {
   namespace fs = std::filesystem;

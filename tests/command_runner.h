@@ -16,6 +16,16 @@ struct CommandResult {
 // Runs `depthbench args...` (no shell: arguments are passed as they are).
 CommandResult RunDepthbench(const std::vector<std::string>& args);
 
+// The same, in two steps, for tests that run several at once: Start returns
+// as soon as the process is started, Finish waits for it and collects its
+// output. Every started command must be finished once.
+struct StartedCommand {
+  int pid = -1;
+  std::string dir;  // where its stdout and stderr go until Finish reads them
+};
+StartedCommand StartDepthbench(const std::vector<std::string>& args);
+CommandResult FinishDepthbench(const StartedCommand& started);
+
 // A fresh empty directory under the system's temporary directory.
 std::string MakeTempDir(const std::string& name);
 
