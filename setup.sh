@@ -23,8 +23,9 @@ packages=(
 if ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 if [[ "${1:-}" == "--tests" ]]; then
   # The report test opens the page in a real headless browser and checks
-  # results.json against its JSON Schema.
-  packages+=(chromium python3 python3-jsonschema)
+  # results.json against its JSON Schema; the scheduler files' test reads
+  # them as YAML.
+  packages+=(chromium python3 python3-jsonschema python3-yaml)
 elif [[ -n "${1:-}" ]]; then
   echo "setup: unknown option '$1'; allowed: --tests" >&2
   exit 2

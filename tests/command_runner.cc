@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <chrono>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -45,24 +44,29 @@ int WaitForExit(pid_t pid, double seconds) {
   }
 }
 
-CommandResult RunDepthbench(const std::vector<std::string>& args) {
+StartedCommand StartDepthbench(const std::vector<std::string>& args) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("depthbench_cmd_" + std::to_string(::getpid()));
+  // One folder per command, so that commands running at once keep their
+  // outputs apart.
+  static int started = 0;
+  const fs::path dir =
+      fs::temp_directory_path() / ("depthbench_cmd_" + std::to_string(::getpid()) + "_" + std::to_string(started++));
   fs::create_directories(dir);
-  const fs::path out_path = dir / "out", err_path = dir / "err";
+  return {StartDepthbench(args, (dir / "out").string(), (dir / "err").string()), dir.string()};
+}
+
+CommandResult FinishDepthbench(const StartedCommand& started) {
+  namespace fs = std::filesystem;
   CommandResult result;
-  result.exit_code = WaitForExit(StartDepthbench(args, out_path, err_path), 0);
-  auto slurp = [](const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  result.out = slurp(out_path);
-  result.err = slurp(err_path);
+  result.exit_code = WaitForExit(started.pid, 0);
+  const fs::path dir = started.dir;
+  result.out = ReadText((dir / "out").string());
+  result.err = ReadText((dir / "err").string());
   fs::remove_all(dir);
   return result;
 }
+
+CommandResult RunDepthbench(const std::vector<std::string>& args) { return FinishDepthbench(StartDepthbench(args)); }
 
 std::string MakeTempDir(const std::string& name) {
   namespace fs = std::filesystem;

@@ -27,6 +27,16 @@ pid_t StartDepthbench(const std::vector<std::string>& args, const std::string& o
 // (it is then killed). 0 seconds: no limit.
 int WaitForExit(pid_t pid, double seconds);
 
+// RunDepthbench in two steps, for tests that run several at once: Start
+// returns as soon as the process is started, Finish waits for it and
+// collects its output. Every started command must be finished once.
+struct StartedCommand {
+  pid_t pid = -1;
+  std::string dir;  // where its stdout and stderr go until Finish reads them
+};
+StartedCommand StartDepthbench(const std::vector<std::string>& args);
+CommandResult FinishDepthbench(const StartedCommand& started);
+
 // A fresh empty directory under the system's temporary directory.
 std::string MakeTempDir(const std::string& name);
 

@@ -50,8 +50,12 @@ std::vector<Shard> MissingShards(const std::vector<Shard>& held) {
 }
 
 std::string ShardList(const std::vector<Shard>& shards) {
+  // A shard of a sweep split a thousand ways lacks 999 others: its header
+  // and merge's message name the first few and count the rest.
+  constexpr std::size_t kNamed = 10;
   std::string out;
-  for (const Shard& s : shards) out += (out.empty() ? "" : ", ") + s.ToString();
+  for (std::size_t i = 0; i < shards.size() && i < kNamed; ++i) out += (i == 0 ? "" : ", ") + shards[i].ToString();
+  if (shards.size() > kNamed) out += fmt::format(" and {} more", shards.size() - kNamed);
   return out;
 }
 

@@ -44,7 +44,8 @@ Expected<Shard> ParseShard(std::string_view text);
 // The shards of a K/N split that `held` lacks, in order ("2/4", "3/4"); empty
 // when `held` is complete or mixes splits of different N.
 std::vector<Shard> MissingShards(const std::vector<Shard>& held);
-std::string ShardList(const std::vector<Shard>& shards);  // "2/4, 3/4"
+// "2/4, 3/4"; past ten shards, the first ten and "and N more".
+std::string ShardList(const std::vector<Shard>& shards);
 
 struct BackendRecord {
   std::string name;  // "cpu", "vulkan"
