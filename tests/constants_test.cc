@@ -147,9 +147,9 @@ TEST(ConstantsTest, Float32InverseViewProjectionLosesMoreAtFarNearAMillion) {
   // and each figure moved by at most 0.2 (a quarter-bit bin either way), so
   // 0.4 is two such moves below the smallest difference seen. Theory: the
   // float inverse's w row (1/B, -A/B, which cancel near the far plane) and
-  // its x, y entries carry 1 to 3 ulps from the cofactors and the
+  // its x, y entries carry about an ulp from the cofactors and the
   // determinant, against the half ulp of a single rounding: log2 of that
-  // ratio is about a bit at the maximum, less at p99.9.
+  // ratio is a bit at the maximum, less at p99.9.
   EXPECT_GT(engine[0] - exact[0], 0.4) << "inverse_vp: exact " << exact[0] << ", float32 " << engine[0];
   // divide reads A and B, the projection's own entries, with which the
   // pipeline also produced the depth: only the lens (tan * aspect in
