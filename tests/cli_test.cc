@@ -46,6 +46,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{{"run", "--ratio", "10:100,never"}, "--ratio: '10:100,never' is not understood"},
         BadInput{{"run", "--camera-distance", "-5"}, "--camera-distance: -5 is out of range"},
         BadInput{{"run", "--resolution", "1920*1080"}, "--resolution: '1920*1080' is not WIDTHxHEIGHT"},
+        BadInput{{"run", "--constants", "double"},
+                 "--constants: constants model 'double' is not one of exact, float32"},
         BadInput{{"run", "--samples", "1.5"}, "--samples: '1.5' is not a whole number"},
         BadInput{{"run", "--shard", "3/2"}, "--shard: '3/2' is not K/N with 1 <= K <= N"},
         BadInput{{"run", "--split", "colour"}, "--split: 'colour' is not one of ratio, depth, distance"},

@@ -73,6 +73,7 @@ void NameOptionTypes(CLI::App& app) {
                                                          {"--format", "NAME[,NAME]"},
                                                          {"--domain", "NAME|FILE"},
                                                          {"--production", "MODEL"},
+                                                         {"--constants", "MODEL"},
                                                          {"--resolution", "WxH[,WxH]"},
                                                          {"--corpus", "PATH"},
                                                          {"inputs", "FILE"}};

@@ -51,6 +51,13 @@ void DomainFlags::Add(CLI::App& app) {
                  "an engine uploads) or exact (the exact depth rounded once: the formats and variants alone)")
       ->type_name("MODEL")
       ->group("Domain");
+  app.add_option("--constants", constants,
+                 "how the per-frame shader constants are computed: exact (default: exactly, rounded once to "
+                 "float32) or float32 (as an engine does: float32 view and projection matrices, their product and "
+                 "its 4x4 inverse in float32, every other constant derived from them in float32; the projection's "
+                 "A and B also produce the depth)")
+      ->type_name("MODEL")
+      ->group("Domain");
 }
 
 Expected<Domain> DomainByName(const std::string& name_or_file) {
@@ -66,11 +73,15 @@ Expected<Domain> DomainByName(const std::string& name_or_file) {
 
 Expected<Domain> DomainFlags::Apply(Domain d) const {
   if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain), d));
-  const bool narrowed = !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() &&
-                          camera_distance.empty() && eye_depth.empty() && resolution.empty() && production.empty());
+  const bool narrowed =
+      !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() && camera_distance.empty() &&
+        eye_depth.empty() && resolution.empty() && production.empty() && constants.empty());
   if (narrowed) d.name += " (narrowed)";
   if (!production.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseProductionModel(production), d.production).WithContext("--production"));
+  }
+  if (!constants.empty()) {
+    DB_RETURN_IF_ERROR(StoreInto(ParseConstantsModel(constants), d.constants).WithContext("--constants"));
   }
   if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");

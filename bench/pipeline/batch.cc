@@ -44,7 +44,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   const std::size_t frames =
       count == 0 ? 0 : static_cast<std::size_t>((first + count - 1) / kSamplesPerFrame - first_frame + 1);
 
-  // Frames: exact parameters and the shader constants rounded from them.
+  // Frames: exact parameters and the shader constants computed from them.
   batch.frames.resize(frames);
   batch.distance_bands.resize(frames);
   batch.frame_params.resize(frames);
@@ -54,17 +54,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       Frame& frame = batch.frames[f];
       frame = sampler_.FrameAt(first_frame + f);
       batch.distance_bands[f] = static_cast<std::uint8_t>(DistanceBand(frame.camera_distance()));
-      hp::FrameParams exact = BuildFrameParams(frame);
-      batch.frame_params[f] = RoundToFloat(exact);
-      for (int c = 0; c < kHardwareConventionCount; ++c) {
-        const auto convention = static_cast<Convention>(c);
-        f32::DepthParams& out = batch.depth_params[f * kHardwareConventionCount + c];
-        // Conventions with a finite far plane have no constants on frames
-        // that have none (infinite-only domains); their cells do not run.
-        bool needs_far = (Info(convention).bits & f32::DB_CONVENTION_INFINITE) == 0u;
-        out = needs_far && !frame.finite() ? f32::DepthParams{}
-                                           : RoundToFloat(BuildDepthParams(frame, exact, convention));
-      }
+      BuildShaderConstants(frame, sampler_.constants(), batch.frame_params[f],
+                           std::span<f32::DepthParams, kHardwareConventionCount>(
+                               batch.depth_params.data() + f * kHardwareConventionCount, kHardwareConventionCount));
     }
   });
 

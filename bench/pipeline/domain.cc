@@ -106,11 +106,19 @@ Expected<ProductionModel> ParseProductionModel(std::string_view name) {
   return InvalidArgument(fmt::format("production model '{}' is not one of float32, exact", name));
 }
 
+const char* ConstantsModelName(ConstantsModel model) { return model == ConstantsModel::kFloat32 ? "float32" : "exact"; }
+
+Expected<ConstantsModel> ParseConstantsModel(std::string_view name) {
+  if (name == "exact") return ConstantsModel::kExact;
+  if (name == "float32") return ConstantsModel::kFloat32;
+  return InvalidArgument(fmt::format("constants model '{}' is not one of exact, float32", name));
+}
+
 bool operator==(const Domain& a, const Domain& b) {
   return a.fov_degrees == b.fov_degrees && a.aspect == b.aspect && a.near == b.near && a.ratio == b.ratio &&
          a.finite_far == b.finite_far && a.infinite_far == b.infinite_far && a.far == b.far &&
          a.camera_distance == b.camera_distance && a.eye_depth == b.eye_depth && a.resolutions == b.resolutions &&
-         a.production == b.production;
+         a.production == b.production && a.constants == b.constants;
 }
 
 Domain TypicalDomain() { return Domain{}; }
@@ -209,6 +217,7 @@ std::string Domain::ToFlags() const {
   }
   if (production != ProductionModel::kFloat32)
     flags += fmt::format(" --production {}", ProductionModelName(production));
+  if (constants != ConstantsModel::kExact) flags += fmt::format(" --constants {}", ConstantsModelName(constants));
   return flags;
 }
 
@@ -224,6 +233,7 @@ std::string Domain::Describe() const {
                                  aspect.ToString(), near.ToString(), far_text, camera_distance.ToString());
   if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
   if (production != ProductionModel::kFloat32) text += fmt::format(", {} production", ProductionModelName(production));
+  if (constants != ConstantsModel::kExact) text += fmt::format(", {} constants", ConstantsModelName(constants));
   return fmt::format("{}: {}", name, text);
 }
 

@@ -57,6 +57,21 @@ enum class ProductionModel : std::uint8_t { kFloat32, kExact };
 const char* ProductionModelName(ProductionModel model);  // "float32", "exact"
 Expected<ProductionModel> ParseProductionModel(std::string_view name);
 
+// How the per-frame constants the shaders receive (shared/params.h:
+// matrices, A and B, P and Q, lens, frustum corners) are computed
+// (bench/pipeline/shader_constants.h):
+//   kExact    exactly (double-double) from the frame, then rounded once to
+//             float32: the best an engine could upload;
+//   kFloat32  as an engine computes them: the view and projection matrices
+//             built in float32 from the float32 camera parameters, their
+//             product and its 4x4 inverse (glm::inverse) in float32, and
+//             every other constant derived from those floats in float32.
+// The projection's A and B are the ones the pipeline produces depth with
+// (kFloat32 production), so they follow this choice too; the truth does not.
+enum class ConstantsModel : std::uint8_t { kExact, kFloat32 };
+const char* ConstantsModelName(ConstantsModel model);  // "exact", "float32"
+Expected<ConstantsModel> ParseConstantsModel(std::string_view name);
+
 // The members' defaults are the `typical` domain (TypicalDomain).
 struct Domain {
   std::string name = "typical";    // the named domain or scene it started from ("custom" once narrowed)
@@ -78,6 +93,7 @@ struct Domain {
   std::optional<Range> eye_depth;  // absolute eye-depth range of interest (clipped to the frustum)
   std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}};
   ProductionModel production = ProductionModel::kFloat32;
+  ConstantsModel constants = ConstantsModel::kExact;
 
   // Far/near span used by frames whose far plane is infinite only.
   static constexpr double kInfiniteDepthSpan = 1e8;

@@ -21,7 +21,7 @@ inline constexpr std::uint32_t kSamplesPerFrame = 64;
 
 // One frame's exact parameters. They are the definition of the scene: the
 // reference evaluates them in double-double, the backends receive float32
-// constants rounded from them.
+// constants computed from them (shader_constants.h).
 struct Frame {
   std::uint64_t index = 0;
   double fov_y_degrees = 0.0;
@@ -79,6 +79,8 @@ class SampleSource {
   virtual PixelSample SampleAt(std::uint64_t index, const Frame& frame) const = 0;
   // How the pipeline produces its samples' stored depth.
   virtual ProductionModel production() const { return ProductionModel::kFloat32; }
+  // How the shaders' per-frame constants are computed.
+  virtual ConstantsModel constants() const { return ConstantsModel::kExact; }
 };
 
 // A point of the domain in unit coordinates: every random choice the
@@ -114,6 +116,7 @@ class Sampler : public SampleSource {
   Frame FrameAt(std::uint64_t frame_index) const override;
   PixelSample SampleAt(std::uint64_t index, const Frame& frame) const override;
   ProductionModel production() const override { return domain_.production; }
+  ConstantsModel constants() const override { return domain_.constants; }
   FrameUnits FrameUnitsAt(std::uint64_t frame_index) const;
   SampleUnits SampleUnitsAt(std::uint64_t index) const;
 

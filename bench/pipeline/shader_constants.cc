@@ -5,66 +5,88 @@ namespace {
 
 using DD = DoubleDouble;
 
-hp::vec3 Rotate(const glm::dmat3& r, const hp::vec3& v) {
-  hp::vec3 out;
+// The formulas below are written once for a `Real` that is DoubleDouble
+// (the exact constants: every conversion from double exact) or float (the
+// engine's: every conversion rounds, every operation rounds).
+template <class Real>
+glm::vec<3, Real> Rotate(const glm::dmat3& r, const glm::vec<3, Real>& v) {
+  glm::vec<3, Real> out;
   for (int row = 0; row < 3; ++row) {
-    out[row] = DD(r[0][row]) * v.x + DD(r[1][row]) * v.y + DD(r[2][row]) * v.z;
+    out[row] = Real(r[0][row]) * v.x + Real(r[1][row]) * v.y + Real(r[2][row]) * v.z;
   }
   return out;
 }
 
-hp::vec4 Vec4(const hp::vec3& v, DD w = DD(0.0)) { return hp::vec4(v.x, v.y, v.z, w); }
+template <class Real>
+glm::vec<4, Real> Vec4(const glm::vec<3, Real>& v, Real w = Real(0.0)) {
+  return glm::vec<4, Real>(v.x, v.y, v.z, w);
+}
 
 // The three corner values of an attribute that is `at(ndc)` at NDC point ndc
 // and linear in it: its value at uv (0, 0) and its steps along u and v.
-template <class At>
-void ScreenAttribute(At at, hp::vec4& origin, hp::vec4& du, hp::vec4& dv) {
-  hp::vec3 top_left = at(DD(-1.0), DD(1.0));
-  hp::vec3 top_right = at(DD(1.0), DD(1.0));
-  hp::vec3 bottom_left = at(DD(-1.0), DD(-1.0));
+template <class Real, class At>
+void ScreenAttribute(At at, glm::vec<4, Real>& origin, glm::vec<4, Real>& du, glm::vec<4, Real>& dv) {
+  const glm::vec<3, Real> top_left = at(Real(-1.0), Real(1.0));
+  const glm::vec<3, Real> top_right = at(Real(1.0), Real(1.0));
+  const glm::vec<3, Real> bottom_left = at(Real(-1.0), Real(-1.0));
   origin = Vec4(top_left);
-  du = Vec4(top_right - top_left);
-  dv = Vec4(bottom_left - top_left);
+  du = Vec4<Real>(top_right - top_left);
+  dv = Vec4<Real>(bottom_left - top_left);
+}
+
+// FrameParams (hp:: or f32::) from the frame's parameters, in that
+// instantiation's arithmetic.
+template <class Params>
+Params FrameParamsIn(const Frame& frame) {
+  using Real = typename decltype(Params::lens)::value_type;
+  using Vec3 = glm::vec<3, Real>;
+  using Vec4 = glm::vec<4, Real>;
+  const Real tan_y(frame.tan_half_fov_y);
+  const Real tan_x = Real(frame.aspect) * tan_y;
+  const Real far = frame.finite() ? Real(frame.far) : Real(0.0);
+  const glm::dmat3& r = frame.rotation;
+  const glm::dvec3& c = frame.camera_position;
+
+  Params p;
+  for (int col = 0; col < 3; ++col) {
+    p.camera_world[col] = Vec4(Real(r[col][0]), Real(r[col][1]), Real(r[col][2]), Real(0.0));
+  }
+  p.camera_world[3] = Vec4(Real(c.x), Real(c.y), Real(c.z), Real(1.0));
+  p.camera_position = Vec4(Real(c.x), Real(c.y), Real(c.z), far);
+  p.lens = Vec4(tan_x, tan_y, Real(1.0) / tan_x, Real(1.0) / tan_y);
+  p.resolution =
+      Vec4(Real(frame.width), Real(frame.height), Real(1.0) / Real(frame.width), Real(1.0) / Real(frame.height));
+
+  // View-space point of the pixel ray at eye depth `depth`.
+  auto view_at = [&](Real depth) {
+    return [=](Real ndc_x, Real ndc_y) { return Vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth); };
+  };
+  // Pettineo 2009: far-plane corners rotated to world space.
+  ScreenAttribute<Real>([&](Real x, Real y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin,
+                        p.frustum_ray_du, p.frustum_ray_dv);
+  // Pettineo 2009, light volume: the surface's view-space position.
+  ScreenAttribute<Real>(view_at(Real(frame.volume_depth)), p.volume_position_origin, p.volume_position_du,
+                        p.volume_position_dv);
+  // The eye-ray post 2011: the eye ray at w = 1 in view space and rotated to world space.
+  ScreenAttribute<Real>(view_at(Real(1.0)), p.eye_ray_view_origin, p.eye_ray_view_du, p.eye_ray_view_dv);
+  ScreenAttribute<Real>([&](Real x, Real y) { return Rotate(r, view_at(Real(1.0))(x, y)); }, p.eye_ray_world_origin,
+                        p.eye_ray_world_du, p.eye_ray_world_dv);
+  return p;
 }
 
 float Round(DD x) { return RoundToFloat(x); }
 glm::vec4 Round(const hp::vec4& v) { return {Round(v.x), Round(v.y), Round(v.z), Round(v.w)}; }
 glm::mat4 Round(const hp::mat4& m) { return glm::mat4(Round(m[0]), Round(m[1]), Round(m[2]), Round(m[3])); }
 
+bool HasConstants(const Frame& frame, Convention convention) {
+  // Conventions with a finite far plane have no constants on frames that
+  // have none (infinite-only domains).
+  return frame.finite() || (Info(convention).bits & f32::DB_CONVENTION_INFINITE) != 0u;
+}
+
 }  // namespace
 
-hp::FrameParams BuildFrameParams(const Frame& frame) {
-  const DD tan_y(frame.tan_half_fov_y);
-  const DD tan_x = DD(frame.aspect) * tan_y;
-  const DD far = frame.finite() ? DD(frame.far) : DD(0.0);
-  const glm::dmat3& r = frame.rotation;
-  const glm::dvec3& c = frame.camera_position;
-
-  hp::FrameParams p;
-  for (int col = 0; col < 3; ++col) {
-    p.camera_world[col] = hp::vec4(DD(r[col][0]), DD(r[col][1]), DD(r[col][2]), DD(0.0));
-  }
-  p.camera_world[3] = hp::vec4(DD(c.x), DD(c.y), DD(c.z), DD(1.0));
-  p.camera_position = hp::vec4(DD(c.x), DD(c.y), DD(c.z), far);
-  p.lens = hp::vec4(tan_x, tan_y, DD(1.0) / tan_x, DD(1.0) / tan_y);
-  p.resolution = hp::vec4(DD(frame.width), DD(frame.height), DD(1.0) / DD(frame.width), DD(1.0) / DD(frame.height));
-
-  // View-space point of the pixel ray at eye depth `depth`.
-  auto view_at = [&](DD depth) {
-    return [=](DD ndc_x, DD ndc_y) { return hp::vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth); };
-  };
-  // Pettineo 2009: far-plane corners rotated to world space.
-  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin, p.frustum_ray_du,
-                  p.frustum_ray_dv);
-  // Pettineo 2009, light volume: the surface's view-space position.
-  ScreenAttribute(view_at(DD(frame.volume_depth)), p.volume_position_origin, p.volume_position_du,
-                  p.volume_position_dv);
-  // The eye-ray post 2011: the eye ray at w = 1 in view space and rotated to world space.
-  ScreenAttribute(view_at(DD(1.0)), p.eye_ray_view_origin, p.eye_ray_view_du, p.eye_ray_view_dv);
-  ScreenAttribute([&](DD x, DD y) { return Rotate(r, view_at(DD(1.0))(x, y)); }, p.eye_ray_world_origin,
-                  p.eye_ray_world_du, p.eye_ray_world_dv);
-  return p;
-}
+hp::FrameParams BuildFrameParams(const Frame& frame) { return FrameParamsIn<hp::FrameParams>(frame); }
 
 hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
   const ConventionInfo& info = Info(convention);
@@ -118,6 +140,61 @@ f32::DepthParams RoundToFloat(const hp::DepthParams& p) {
   o.convention = p.convention;
   o.reserved0 = o.reserved1 = o.reserved2 = 0;
   return o;
+}
+
+glm::mat4 EngineViewMatrix(const Frame& frame) {
+  // The inverse of the camera's rigid transform, as glm::lookAt builds it:
+  // the transposed rotation and -dot(axis, eye) per row, in float32.
+  const glm::mat3 r(frame.rotation);
+  const glm::vec3 eye(frame.camera_position);
+  glm::mat4 view(1.0f);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 0; k < 3; ++k) view[k][axis] = r[axis][k];
+    view[3][axis] = -glm::dot(r[axis], eye);
+  }
+  return view;
+}
+
+glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention) {
+  // glm::perspective's layout (right-handed, w = -view.z) with the depth
+  // row of the convention: clip z = -A * view.z + B.
+  const float tan_y = static_cast<float>(frame.tan_half_fov_y);
+  const float tan_x = static_cast<float>(frame.aspect) * tan_y;
+  const float far = frame.finite() ? static_cast<float>(frame.far) : 0.0f;
+  const glm::vec2 ab = f32::ndc_depth_coefficients(static_cast<float>(frame.near), far, Info(convention).bits);
+  glm::mat4 projection(0.0f);
+  projection[0][0] = 1.0f / tan_x;
+  projection[1][1] = 1.0f / tan_y;
+  projection[2][2] = -ab.x;
+  projection[2][3] = -1.0f;
+  projection[3][2] = ab.y;
+  return projection;
+}
+
+f32::FrameParams EngineFrameParams(const Frame& frame) { return FrameParamsIn<f32::FrameParams>(frame); }
+
+f32::DepthParams EngineDepthParams(const Frame& frame, Convention convention) {
+  const glm::mat4 projection = EngineProjectionMatrix(frame, convention);
+  const float a = -projection[2][2], b = projection[3][2];
+  f32::DepthParams d;
+  d.inverse_view_projection = glm::inverse(projection * EngineViewMatrix(frame));
+  d.coefficients = glm::vec4(a, b, 1.0f / b, -a / b);
+  d.convention = Info(convention).bits;
+  d.reserved0 = d.reserved1 = d.reserved2 = 0;
+  return d;
+}
+
+void BuildShaderConstants(const Frame& frame, ConstantsModel model, f32::FrameParams& frame_params,
+                          std::span<f32::DepthParams, kHardwareConventionCount> depth_params) {
+  const bool exact = model == ConstantsModel::kExact;
+  const hp::FrameParams exact_params = exact ? BuildFrameParams(frame) : hp::FrameParams{};
+  frame_params = exact ? RoundToFloat(exact_params) : EngineFrameParams(frame);
+  for (int c = 0; c < kHardwareConventionCount; ++c) {
+    const auto convention = static_cast<Convention>(c);
+    depth_params[c] = !HasConstants(frame, convention) ? f32::DepthParams{}
+                      : exact                          ? RoundToFloat(BuildDepthParams(frame, exact_params, convention))
+                                                       : EngineDepthParams(frame, convention);
+  }
 }
 
 }  // namespace depthbench

@@ -1,9 +1,19 @@
 // Shader constants of a frame: the FrameParams and DepthParams of
-// shared/params.h, computed exactly (double-double) from the frame's
-// parameters and then rounded once to float32. That is the best an engine
-// can hand its shaders, so what remains is the error of the reconstruction
-// itself, not of a sloppy host-side matrix inverse.
+// shared/params.h, computed one of two ways (ConstantsModel, domain.h):
+//   exact    in double-double from the frame's parameters, then rounded
+//            once to float32: the best an engine can hand its shaders, so
+//            what remains is the error of the reconstruction itself;
+//   float32  as an engine computes them: the camera's parameters rounded
+//            to float32, the view and projection matrices built from them
+//            in float32, multiplied in float32, the view-projection
+//            inverted by a general float 4x4 inverse (glm::inverse, the
+//            cofactor expansion), and every other constant derived from
+//            those floats in float32.
+// The frame itself (the truth the reference judges against) is the same
+// either way.
 #pragma once
+
+#include <span>
 
 #include "bench/numerics/formulas.h"
 #include "bench/pipeline/cells.h"
@@ -18,5 +28,21 @@ hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& fram
 
 f32::FrameParams RoundToFloat(const hp::FrameParams& params);
 f32::DepthParams RoundToFloat(const hp::DepthParams& params);
+
+// The float32 path: the engine's view and projection matrices (right-handed
+// view looking down -Z; the projection maps view z to clip depth
+// A * z + B over w = z, so ndc = A + B / z), and the constants an engine
+// derives from them.
+glm::mat4 EngineViewMatrix(const Frame& frame);
+glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention);
+f32::FrameParams EngineFrameParams(const Frame& frame);
+f32::DepthParams EngineDepthParams(const Frame& frame, Convention convention);
+
+// What the shaders of `frame` receive under `model`: its FrameParams, and
+// in depth_params[c] the DepthParams of hardware convention c (zero for
+// the finite-far conventions when the frame has no finite far plane: their
+// cells do not run on it).
+void BuildShaderConstants(const Frame& frame, ConstantsModel model, f32::FrameParams& frame_params,
+                          std::span<f32::DepthParams, kHardwareConventionCount> depth_params);
 
 }  // namespace depthbench

@@ -149,7 +149,8 @@ json DomainToJson(const Domain& d) {
               {"eye_depth", d.eye_depth ? RangeToJson(*d.eye_depth) : json(nullptr)},
               {"resolutions", resolutions},
               {"name", d.name},
-              {"production", ProductionModelName(d.production)}};
+              {"production", ProductionModelName(d.production)},
+              {"constants", ConstantsModelName(d.constants)}};
   return out;
 }
 
@@ -286,6 +287,21 @@ Expected<int> BandIndex(const JsonReader& r, const std::string& key, int count) 
   return static_cast<int>(v);
 }
 
+// An optional field naming a model (ProductionModel, ConstantsModel):
+// `missing` for files written before the field existed.
+template <class Model>
+Status ReadModel(const JsonReader& r, const char* field, Expected<Model> (*parse)(std::string_view), Model missing,
+                 Model& out) {
+  out = missing;
+  if (!r.Has(field)) return Status::Ok();
+  DB_ASSIGN_OR_RETURN(const JsonReader value, r.Field(field));
+  DB_ASSIGN_OR_RETURN(const std::string name, value.String());
+  const Expected<Model> model = parse(name);
+  if (!model.ok()) return value.Error(model.status().message());
+  out = *model;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
@@ -324,14 +340,9 @@ Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
   // exactly, and their domain had no name.
   d.name = "custom";
   if (r.Has("name")) DB_RETURN_IF_ERROR(StoreInto(r.String("name"), d.name));
-  d.production = ProductionModel::kExact;
-  if (r.Has("production")) {
-    DB_ASSIGN_OR_RETURN(const JsonReader production, r.Field("production"));
-    DB_ASSIGN_OR_RETURN(const std::string name, production.String());
-    const Expected<ProductionModel> model = ParseProductionModel(name);
-    if (!model.ok()) return production.Error(model.status().message());
-    d.production = *model;
-  }
+  DB_RETURN_IF_ERROR(ReadModel(r, "production", ParseProductionModel, ProductionModel::kExact, d.production));
+  // Files written before --constants existed had exact constants.
+  DB_RETURN_IF_ERROR(ReadModel(r, "constants", ParseConstantsModel, ConstantsModel::kExact, d.constants));
   Status valid = d.Validate();
   if (!valid.ok()) return r.Error(valid.message());
   return d;

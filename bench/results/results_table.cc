@@ -32,7 +32,8 @@ std::string SiCount(double x) {
 
 void PrintRunHeader(const Results& results, std::ostream& out) {
   const RunInfo& run = results.run;
-  out << fmt::format("depthbench {} (commit {}), seed {}, {} samples", run.version, run.commit, run.seed, run.samples);
+  out << fmt::format("depthbench {} (commit {}), seed {}, {} samples, {} constants", run.version, run.commit, run.seed,
+                     run.samples, ConstantsModelName(run.domain.constants));
   if (!(run.shards.size() == 1 && run.shards[0].count == 1)) {
     out << fmt::format(" (shards {})", ShardList(run.shards));
   }
