@@ -103,6 +103,14 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
   }
   options.out = f.out;
   DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(FuzzDomain()));
+  // The campaign's cases (and the reproducers it writes) carry no pipeline
+  // model: they are produced as a GPU does, with exactly rounded constants.
+  const Domain defaults;
+  if (options.domain.production != defaults.production || options.domain.constants != defaults.constants) {
+    return InvalidArgument(
+        "--production and --constants apply to fuzz --search only: the campaign's cases and reproducers use float32 "
+        "production and exact constants");
+  }
   options.cells = CellsForDomain(cells, options.domain);
   Progress progress("fuzz", StderrIsTerminal() && !f.quiet);
   options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
