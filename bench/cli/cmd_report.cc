@@ -82,17 +82,29 @@ Expected<int> RunReport(const ReportFlags& f) {
   // Everything that can be refused is refused before the sweeps run.
   if (f.out.empty()) return InvalidArgument("--out: give the folder to write the report into");
   std::error_code ec;
+  const bool out_existed = fs::exists(f.out, ec);
   fs::create_directories(f.out, ec);
   if (ec || !fs::is_directory(f.out)) {
     return IoError(fmt::format("--out: cannot create folder '{}': {}", f.out, ec.message()));
   }
-  DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / "results.json").string(), "--out"));
+  // A folder made here and left empty by a failure is removed again.
+  struct RemoveIfLeftEmpty {
+    fs::path folder;
+    ~RemoveIfLeftEmpty() {
+      std::error_code ignored;
+      if (!folder.empty() && fs::is_empty(folder, ignored)) fs::remove(folder, ignored);
+    }
+  } made_out{out_existed ? fs::path() : fs::path(f.out)};
+  for (const char* name : {"results.json", "report.md", "report.html"}) {
+    DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / name).string(), "--out"));
+  }
   PlotLibrary library{f.plot_library};
   if (library.node_modules.empty())
     DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));
   fs::path page_template = f.page_template;
   if (page_template.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/report_template.html"), page_template));
   DB_RETURN_IF_ERROR(CheckReadableFile(page_template, kMaxSourceFileBytes).WithContext("--template"));
+  DB_RETURN_IF_ERROR(CheckReportTemplate(page_template).WithContext("--template"));
   DB_RETURN_IF_ERROR(library.Check());
   std::optional<History> history;
   if (!f.no_history) {
@@ -148,6 +160,8 @@ Expected<int> RunReport(const ReportFlags& f) {
         {"report.html", page}}) {
     DB_RETURN_IF_ERROR(WriteFileAtomically(out / name, text));
   }
+  // The run is kept in the history only now that its report is written.
+  if (history) DB_RETURN_IF_ERROR(history->Commit().WithContext("--history"));
   progress.end(fmt::format("{} (report.html, report.md, results.json)", out.string()));
 
   std::cout << markdown;

@@ -144,6 +144,17 @@ Expected<History> History::Open(const std::filesystem::path& path) {
     return InvalidArgument(fmt::format("{}: history schema version {}; this depthbench reads version {}", path.string(),
                                        version, kSchemaVersion));
   }
+  // Damage anywhere in the file, and a file that cannot be written (a
+  // read-only file or file system), are found now, not after the sweeps.
+  {
+    Statement check(db, "PRAGMA quick_check");
+    if (!check.ok() || check.Step() != SQLITE_ROW || check.Text(0) != "ok") {
+      return DbError(db, path, "the history database is damaged (PRAGMA quick_check); give --history another file");
+    }
+  }
+  if (sqlite3_db_readonly(db, "main") == 1 || !history.Exec("BEGIN IMMEDIATE").ok() || !history.Exec("ROLLBACK").ok()) {
+    return DbError(db, path, "the history database cannot be written");
+  }
   return history;
 }
 
@@ -210,9 +221,10 @@ Expected<std::int64_t> History::Record(HistoryRun run, std::span<const Baseline>
       }
     }
   }
-  DB_RETURN_IF_ERROR(Exec("COMMIT"));
   return run.id;
 }
+
+Status History::Commit() { return Exec("COMMIT"); }
 
 Expected<std::optional<std::pair<HistoryRun, Baseline>>> History::Previous(std::int64_t run_id, const Baseline& like) {
   Statement find(db_,

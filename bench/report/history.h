@@ -49,15 +49,18 @@ struct TrendPoint {
 class History {
  public:
   // Opens the database, creating it (and its folder) when missing. Refuses
-  // a file that is not a depthbench history, or one of a newer version.
+  // a file that is not a depthbench history, one of a newer version, a
+  // damaged one and one that cannot be written: all before any work.
   static Expected<History> Open(const std::filesystem::path& path);
   History(History&&) noexcept;
   History& operator=(History&&) noexcept;
   ~History();
 
-  // Records one run: one baseline per backend, all of one sample plan.
-  // Everything is written in one transaction, or nothing.
+  // Records one run: one baseline per backend, all of one sample plan, in
+  // a transaction that stays open: Commit() keeps the run (once the report
+  // it belongs to is written); without it, nothing is kept.
   Expected<std::int64_t> Record(HistoryRun run, std::span<const Baseline> baselines);
+  Status Commit();
 
   // The latest run before `run_id` with the same plan as `like` on the
   // same backend and device, as a baseline (nullopt when there is none).

@@ -511,6 +511,17 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
     if (progress.end) progress.end(summary);
   };
 
+  // The speed files first: a bad one is refused before the sweeps.
+  begin("speed files");
+  for (const std::filesystem::path& path : plan.speed_files) {
+    DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path));
+    m.speed.emplace_back(path, std::move(speed));
+  }
+  // A shader copy that does not compile leaves the front without its
+  // instruction counts, not the report without its other parts.
+  m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string()), m.static_costs);
+  end("speed files", fmt::format("{} read", m.speed.size()));
+
   FitPlan fit_plan = plan.fit;
   fit_plan.cells = plan.cells;
   begin("sweeps at fixed far/near");
@@ -532,15 +543,6 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   m.fits = FitPrecision(m.sweeps, fit_plan, metrics, kAllLevels, progress.fits);
   end("error models", fmt::format("{} fits", m.fits.size()));
 
-  begin("speed files");
-  for (const std::filesystem::path& path : plan.speed_files) {
-    DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path));
-    m.speed.emplace_back(path, std::move(speed));
-  }
-  // A shader copy that does not compile leaves the front without its
-  // instruction counts, not the report without its other parts.
-  m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string()), m.static_costs);
-  end("speed files", fmt::format("{} read", m.speed.size()));
   return m;
 }
 

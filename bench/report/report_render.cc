@@ -185,10 +185,33 @@ Status PlotLibrary::Check() const {
   return Status::Ok();
 }
 
+namespace {
+
+// Where the template takes the libraries and the data: the libraries' mark
+// first. An error names the file.
+Expected<std::pair<std::size_t, std::size_t>> TemplateMarks(const std::string& page,
+                                                            const std::filesystem::path& template_file) {
+  const std::size_t libraries_at = page.find(kLibrariesMark);
+  const std::size_t data_at = page.find(kDataMark);
+  if (libraries_at == std::string::npos || data_at == std::string::npos || data_at < libraries_at) {
+    return InvalidArgument(fmt::format("{}: not a report template (it lacks {} before {})", template_file.string(),
+                                       kLibrariesMark, kDataMark));
+  }
+  return std::pair{libraries_at, data_at};
+}
+
+}  // namespace
+
+Status CheckReportTemplate(const std::filesystem::path& template_file) {
+  DB_ASSIGN_OR_RETURN(const std::string page, ReadFile(template_file, kMaxSourceFileBytes));
+  return TemplateMarks(page, template_file).status();
+}
+
 Expected<std::string> RenderHtml(const Report& report, const std::filesystem::path& template_file,
                                  const PlotLibrary& library) {
   DB_RETURN_IF_ERROR(library.Check());
   DB_ASSIGN_OR_RETURN(std::string page, ReadFile(template_file, kMaxSourceFileBytes));
+  DB_ASSIGN_OR_RETURN(const auto marks, TemplateMarks(page, template_file));
   std::string scripts;
   for (const std::filesystem::path& bundle : library.Bundles()) {
     DB_ASSIGN_OR_RETURN(std::string code, ReadFile(bundle, kMaxSourceFileBytes));
@@ -204,14 +227,9 @@ Expected<std::string> RenderHtml(const Report& report, const std::filesystem::pa
   std::string data = ReportToJson(report).dump();
   for (std::size_t at = 0; (at = data.find("</", at)) != std::string::npos; at += 3) data.replace(at, 2, "<\\/");
 
-  const std::size_t libraries_at = page.find(kLibrariesMark);
-  const std::size_t data_at = page.find(kDataMark);
-  if (libraries_at == std::string::npos || data_at == std::string::npos || data_at < libraries_at) {
-    return InvalidArgument(fmt::format("{}: not a report template (it lacks {} before {})", template_file.string(),
-                                       kLibrariesMark, kDataMark));
-  }
-  page.replace(data_at, kDataMark.size(), data);
-  page.replace(libraries_at, kLibrariesMark.size(), scripts);
+  // The data first: it comes after the libraries' mark, which keeps its place.
+  page.replace(marks.second, kDataMark.size(), data);
+  page.replace(marks.first, kLibrariesMark.size(), scripts);
   return page;
 }
 

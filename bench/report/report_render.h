@@ -25,6 +25,10 @@ struct PlotLibrary {
 // The page: `template_file` (reports/report_template.html) with the
 // library bundles and the report's JSON document inlined, so that it opens
 // offline.
+// Whether `template_file` is a report template RenderHtml can fill: for
+// checking before the work.
+Status CheckReportTemplate(const std::filesystem::path& template_file);
+
 Expected<std::string> RenderHtml(const Report& report, const std::filesystem::path& template_file,
                                  const PlotLibrary& library);
 
