@@ -12,16 +12,11 @@
 
 #include "bench/base/json_reader.h"
 #include "bench/results/results.h"
+#include "fuzz/fuzz_support.h"
 
 namespace {
 
-// Aborts (a finding for libFuzzer) when a refusal has no message.
-template <class T>
-bool Accepted(const depthbench::Expected<T>& read) {
-  if (read.ok()) return true;
-  if (read.status().message().empty()) std::abort();
-  return false;
-}
+using depthbench::fuzzing::Accepted;
 
 depthbench::Expected<depthbench::Results> Read(const std::string& text, const std::string& name) {
   const depthbench::Expected<nlohmann::json> json = depthbench::JsonReader::Parse(text, name);

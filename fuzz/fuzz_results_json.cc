@@ -16,16 +16,11 @@
 #include "bench/gate/gate.h"
 #include "bench/results/results.h"
 #include "bench/speed/speed_results.h"
+#include "fuzz/fuzz_support.h"
 
 namespace {
 
-// Aborts (a finding for libFuzzer) when a refusal has no message.
-template <class T>
-bool Accepted(const depthbench::Expected<T>& read) {
-  if (read.ok()) return true;
-  if (read.status().message().empty()) std::abort();
-  return false;
-}
+using depthbench::fuzzing::Accepted;
 
 // The gate compares every cell and band of a run that the baseline holds,
 // and names every one that it lacks.

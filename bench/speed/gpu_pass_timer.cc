@@ -37,12 +37,8 @@ constexpr std::uint64_t kMaxExtraWarmupPasses = 65536;
 std::uint32_t GroupsFor(std::uint32_t pixels) { return (pixels + kWorkgroupSide - 1) / kWorkgroupSide; }
 
 void ComputeToComputeBarrier(VkCommandBuffer commands) {
-  VkMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                       &barrier, 0, nullptr, 0, nullptr);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 }  // namespace
@@ -462,20 +458,12 @@ Expected<std::vector<float>> GpuPassTimer::ReadResults() {
   DB_ASSIGN_OR_RETURN(VulkanBuffer readback, context_->CreateHostBuffer(result_bytes_, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                                                         HostAccess::kReadback));
   DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
-    VkMemoryBarrier to_transfer{};
-    to_transfer.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    to_transfer.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1,
-                         &to_transfer, 0, nullptr, 0, nullptr);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     const VkBufferCopy region{0, 0, result_bytes_};
     vkCmdCopyBuffer(commands, result_buffer_.get(), readback.handle(), 1, &region);
-    VkMemoryBarrier to_host{};
-    to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                         nullptr, 0, nullptr);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   }));
   DB_RETURN_IF_ERROR(readback.InvalidateForHostReads());
   std::vector<float> values(result_bytes_ / sizeof(float));

@@ -7,6 +7,15 @@
 
 namespace depthbench {
 
+void RecordMemoryBarrier(VkCommandBuffer commands, VkPipelineStageFlags from_stage, VkAccessFlags from_access,
+                         VkPipelineStageFlags to_stage, VkAccessFlags to_access) {
+  VkMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  barrier.srcAccessMask = from_access;
+  barrier.dstAccessMask = to_access;
+  vkCmdPipelineBarrier(commands, from_stage, to_stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+
 Expected<std::unique_ptr<ComputePass>> ComputePass::Create(std::shared_ptr<VulkanContext> context,
                                                            std::span<const VkDescriptorSetLayoutBinding> bindings,
                                                            std::uint32_t push_constant_bytes) {

@@ -24,6 +24,11 @@
 
 namespace depthbench {
 
+// Records a global memory barrier: writes of `from_access` in `from_stage`
+// made visible to `to_access` in `to_stage`.
+void RecordMemoryBarrier(VkCommandBuffer commands, VkPipelineStageFlags from_stage, VkAccessFlags from_access,
+                         VkPipelineStageFlags to_stage, VkAccessFlags to_access);
+
 class ComputePass {
  public:
   static Expected<std::unique_ptr<ComputePass>> Create(std::shared_ptr<VulkanContext> context,

@@ -480,12 +480,8 @@ void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, 
   const std::uint32_t groups = WorkgroupsFor(batch, shape_);
   // Every output starts as kUnwrittenBits; the shaders' writes come after.
   vkCmdFillBuffer(commands, buffers_[kPositions].handle(), 0, VK_WHOLE_SIZE, kUnwrittenBits);
-  VkMemoryBarrier filled{};
-  filled.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  filled.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  filled.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &filled, 0,
-                       nullptr, 0, nullptr);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
   for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
     pass_->Bind(commands, pipelines_[VariantIndex(dispatch.variant)].get());
@@ -494,12 +490,8 @@ void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, 
     vkCmdDispatch(commands, groups, dispatch.cells, 1);
   }
   // The host reads the positions once the fence signals.
-  VkMemoryBarrier to_host{};
-  to_host.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                       nullptr, 0, nullptr);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
 }  // namespace
