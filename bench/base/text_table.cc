@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 namespace depthbench {
 
@@ -117,7 +118,69 @@ WrappedOutput::~WrappedOutput() {
 std::size_t TextTable::MaxWidth() { return g_max_width; }
 void TextTable::SetMaxWidth(std::size_t columns) { g_max_width = columns; }
 
+namespace {
+TextTable::Format g_format = TextTable::Format::kText;
+std::ostream* g_sink = nullptr;
+
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// A Markdown table cell: '|' escaped.
+std::string MarkdownCell(const std::string& text) {
+  std::string cell;
+  for (char c : text) cell += c == '|' ? std::string("\\|") : std::string(1, c);
+  return cell;
+}
+}  // namespace
+
+void TextTable::SetFormat(Format format, std::ostream* sink) {
+  g_format = format;
+  g_sink = sink;
+}
+
+void TextTable::PrintForMachines(Format format, std::ostream& out) const {
+  std::vector<std::string> headers;
+  for (const Column& c : columns_) headers.push_back(c.header);
+  auto joined = [](const std::vector<std::string>& cells, auto field, const char* between) {
+    std::string line;
+    for (std::size_t c = 0; c < cells.size(); ++c) line += (c ? between : "") + field(cells[c]);
+    return line;
+  };
+  if (format == Format::kJson) {
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (const auto& row : rows_) {
+      if (row.empty()) continue;
+      nlohmann::ordered_json object = nlohmann::ordered_json::object();
+      for (std::size_t c = 0; c < row.size(); ++c) object[headers[c]] = row[c];
+      rows.push_back(std::move(object));
+    }
+    out << rows.dump() << "\n";
+    return;
+  }
+  if (format == Format::kCsv) {
+    out << joined(headers, CsvField, ",") << "\n";
+    for (const auto& row : rows_)
+      if (!row.empty()) out << joined(row, CsvField, ",") << "\n";
+  } else {
+    out << "| " << joined(headers, MarkdownCell, " | ") << " |\n|";
+    for (const Column& c : columns_) out << (c.align == Align::kRight ? " ---: |" : " --- |");
+    out << "\n";
+    for (const auto& row : rows_)
+      if (!row.empty()) out << "| " << joined(row, MarkdownCell, " | ") << " |\n";
+  }
+  out << "\n";  // a blank line between tables
+}
+
 void TextTable::Print(std::ostream& out) const {
+  if (g_format != Format::kText) {
+    PrintForMachines(g_format, g_sink != nullptr ? *g_sink : out);
+    return;
+  }
   const std::size_t n = columns_.size();
   std::vector<std::size_t> width(n);
   for (std::size_t c = 0; c < n; ++c) {

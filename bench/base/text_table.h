@@ -38,7 +38,17 @@ class TextTable {
   static std::size_t MaxWidth();
   static void SetMaxWidth(std::size_t columns);
 
+  // How every table is printed (--table-format): aligned text for people,
+  // or every column, whole, as CSV (RFC 4180), a Markdown table or one
+  // line of JSON (an array of objects keyed by header) per table. The
+  // machine formats go to `sink` (standard output), whatever stream Print
+  // is given, so that the lines for people can go elsewhere.
+  enum class Format { kText, kCsv, kMarkdown, kJson };
+  static void SetFormat(Format format, std::ostream* sink);
+
  private:
+  void PrintForMachines(Format format, std::ostream& out) const;
+
   std::vector<Column> columns_;
   std::vector<std::vector<std::string>> rows_;  // an empty row is a separator
 };

@@ -153,6 +153,9 @@ void CheckWholeNumbers(CLI::App& app) {
 
 // Whether the chosen subcommand writes its JSON to standard output
 // (--json -).
+// --table-format (one program-wide setting, as --wide).
+std::string g_table_format = "text";
+
 bool WritesJsonToStandardOutput(const CLI::App& app) {
   for (const CLI::App* sub : app.get_subcommands()) {
     const CLI::Option* json = sub->get_option_no_throw("--json");
@@ -176,6 +179,10 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
       "--wide", [] { TextTable::SetMaxWidth(0); },
       "print tables as wide as their contents; by default they fit 120 columns, leaving secondary columns out "
       "(a line after each table names them)");
+  app->add_option("--table-format", g_table_format,
+                  "how tables are printed: text (aligned, for people; the default), or csv, markdown or json (every "
+                  "column; the tables alone go to standard output, the lines around them to standard error)")
+      ->check(CLI::IsMember({"text", "csv", "markdown", "json"}));
   app->set_version_flag("--version", [] {
     const Expected<DataFolder> data = FindDataFolder();
     return fmt::format(
@@ -253,9 +260,17 @@ int RunDepthbench(int argc, const char* const* argv) {
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
-  if (WritesJsonToStandardOutput(*app)) {
-    // Standard output carries the JSON alone (a user pipes it); what is
-    // printed for people goes to standard error instead.
+  // Tables for machines: they alone on standard output.
+  std::ostream tables(standard_output);
+  if (g_table_format != "text") {
+    const std::map<std::string, TextTable::Format> formats{{"csv", TextTable::Format::kCsv},
+                                                           {"markdown", TextTable::Format::kMarkdown},
+                                                           {"json", TextTable::Format::kJson}};
+    TextTable::SetFormat(formats.at(g_table_format), &tables);
+  }
+  if (WritesJsonToStandardOutput(*app) || g_table_format != "text") {
+    // Standard output carries the JSON or the tables alone (a user pipes
+    // them); what is printed for people goes to standard error instead.
     wrapped.reset();
     std::cout.rdbuf(std::cerr.rdbuf());
     wrapped = std::make_unique<WrappedOutput>(std::cout);
