@@ -425,7 +425,8 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
   const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
   // The output is filled with kUnwrittenBits on the device before each run.
   const VkBufferUsageFlags usage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | (binding == kPositions ? VK_BUFFER_USAGE_TRANSFER_DST_BIT : 0u);
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+      (binding == kPositions ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT} : VkBufferUsageFlags{0});
   // The previous run has completed (Run waits), so the old buffer can go.
   buffer = VulkanBuffer();
   DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, usage, access));
