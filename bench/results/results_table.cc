@@ -39,7 +39,11 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   }
   out << "\n";
   const std::vector<Shard> missing = MissingShards(run.shards);
-  if (!missing.empty()) {
+  if (run.shards.size() == 1 && run.shards[0].count > 1) {
+    // One shard run on its own, as a scheduler's job does: expected.
+    out << fmt::format("shard {} of a sweep: the figures are of its samples; depthbench merge adds the shards up\n",
+                       run.shards[0].ToString());
+  } else if (!missing.empty()) {
     out << fmt::format("PARTIAL: missing shards {}; these figures are of the other shards' samples only\n",
                        ShardList(missing));
   }
