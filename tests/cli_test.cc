@@ -59,7 +59,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{{"run", "--samples", "10", "--json", "/no/such/dir/out.json"},
                  "cannot write '/no/such/dir/out.json': directory '/no/such/dir' does not exist"},
         BadInput{{"run", "--index", "-3"}, "--index: '-3' is not a sample index"},
-        BadInput{{"merge", "/no/such/file.json", "--json", "x.json"}, "File does not exist: /no/such/file.json"},
+        BadInput{{"merge", "/no/such/file.json", "--json", "x.json"},
+                 "results file '/no/such/file.json' does not exist"},
         BadInput{{"explode"}, "unknown subcommand 'explode'; available: list, run, merge"},
         // Near misses get the name they were probably meant to be.
         BadInput{{"rnu"}, "did you mean 'run'?"},

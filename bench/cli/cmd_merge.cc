@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/files.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/results/results_table.h"
@@ -18,6 +19,11 @@ struct MergeFlags {
 
 Expected<int> Merge(const MergeFlags& f) {
   DB_RETURN_IF_ERROR(CheckWritable(f.output, "--json"));
+  // Every input is looked at before any is read (a missing last shard is
+  // said at once).
+  for (const std::string& path : f.inputs) {
+    DB_RETURN_IF_ERROR(CheckReadableFile(path, kMaxJsonFileBytes, "results file"));
+  }
   std::vector<Results> parts;
   for (const std::string& path : f.inputs) {
     DB_ASSIGN_OR_RETURN(Results part, ReadResults(path));
@@ -50,8 +56,7 @@ void AddMergeCommand(CLI::App& app, CommandAction& action) {
       "is missing, or when an input is partial (its run was interrupted), unless --allow-partial.\n\n"
       "Example:\n  depthbench merge part1.json part2.json --json all.json");
   cmd->add_option("inputs", flags->inputs, "results files of shards (depthbench run --shard K/N --json FILE)")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   cmd->add_option("--json", flags->output, "where to write the merged results")->required();
   cmd->add_flag("--allow-partial", flags->allow_partial,
                 "merge even when shards are missing or an input was interrupted; the header and the file say so");
