@@ -65,8 +65,11 @@ std::vector<ModelPointRow> ModelAlongPoints(const PrecisionFit& fit, const FitSw
     auto [it, added] = deepest.try_emplace(p.ratio, p.depth_band);
     if (!added) it->second = std::max(it->second, p.depth_band);
   }
-  // Bits, or the relative error they stand for.
-  auto value = [relative](double b) { return Shown(relative ? std::ldexp(std::exp2(b), -24) : b); };
+  // Bits (0 to 24: a model and its interval say nothing past "nothing
+  // left"), or the relative error they stand for.
+  auto value = [relative](double b) {
+    return Shown(relative ? std::ldexp(std::exp2(b), -24) : std::clamp(b, 0.0, kAllBitsLost));
+  };
   std::vector<ModelPointRow> rows;
   for (const BandPoint& band : bands) {
     if (deepest_only && band.depth_band != deepest[band.ratio]) continue;
