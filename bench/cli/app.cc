@@ -253,6 +253,8 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
 }
 
 int RunDepthbench(int argc, const char* const* argv) {
+  // First of all: a signal that comes while the program starts is kept too.
+  InstallInterruptHandlers();
   // Lines for people fit 120 columns, unless --wide.
   std::streambuf* const standard_output = std::cout.rdbuf();
   auto wrapped = std::make_unique<WrappedOutput>(std::cout);
@@ -275,7 +277,6 @@ int RunDepthbench(int argc, const char* const* argv) {
     std::cout.rdbuf(std::cerr.rdbuf());
     wrapped = std::make_unique<WrappedOutput>(std::cout);
   }
-  InstallInterruptHandlers();
   const int code = action ? ExitCode(action()) : kExitCannotRun;
   wrapped.reset();
   std::cout.rdbuf(standard_output);
