@@ -1,8 +1,12 @@
-// The one file of shared/ that knows whether it is being compiled as GLSL 450
-// or as C++. Everything else in shared/ is written in the common subset:
+// The one file of shared/ that knows whether it is being compiled as GLSL 450,
+// as C++ or (for the programs around a user's HLSL function, shaders/user/)
+// as HLSL, which defines DB_HLSL first. Everything else in shared/ is written
+// in the common subset:
 //   - scalars are `real` (float in GLSL and in the CPU backend, a double-double
 //     in the high-precision reference) and `uint`;
 //   - vectors and matrices are vec2/vec3/vec4/mat4 (GLM types in C++);
+//   - a matrix times a vector or matrix is DB_MUL(m, v) (HLSL's `*` is
+//     element by element);
 //   - functions are declared with DB_FN, take their arguments by value and
 //     return one value (no out/inout), use no swizzles, and use only
 //     built-ins that GLM also has;
@@ -28,12 +32,26 @@
 #define DB_STATIC_ASSERT(condition, message) static_assert(condition, message);
 // A named integer constant: `const uint` in both languages.
 #define DB_CONST_UINT(name, value) [[maybe_unused]] constexpr std::uint32_t name = value;
+#define DB_MUL(m, v) ((m) * (v))
+
+#elif defined(DB_HLSL)
+
+#define DB_FN
+#define DB_STATIC_ASSERT(condition, message)
+#define DB_CONST_UINT(name, value) static const uint name = value;
+#define DB_MUL(m, v) mul(m, v)
+#define real float
+#define vec2 float2
+#define vec3 float3
+#define vec4 float4
+#define mat4 float4x4
 
 #else  // GLSL
 
 #define DB_FN
 #define DB_STATIC_ASSERT(condition, message)
 #define DB_CONST_UINT(name, value) const uint name = value;
+#define DB_MUL(m, v) ((m) * (v))
 #define real float
 
 #endif

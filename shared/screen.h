@@ -31,7 +31,7 @@ DB_FN vec3 interpolate_screen_attribute(vec4 origin, vec4 du, vec4 dv, vec2 uv) 
 // A view-space position taken to world space the way a shader does it: the
 // camera world matrix (inverse view), applied in the shader's precision.
 DB_FN vec3 world_from_view(FrameParams frame, vec3 view) {
-  return db_xyz(frame.camera_world * vec4(view.x, view.y, view.z, 1.0f));
+  return db_xyz(DB_MUL(frame.camera_world, vec4(view.x, view.y, view.z, 1.0f)));
 }
 
 // NDC depth read back from a stored window-space depth value: identical for

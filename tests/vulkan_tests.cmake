@@ -3,3 +3,4 @@
 depthbench_test(layout_test layout_test.cc LIBS depthbench_backends)
 depthbench_test(shader_compiler_test shader_compiler_test.cc LIBS depthbench_backends)
 depthbench_test(vulkan_backend_test vulkan_backend_test.cc LIBS depthbench_backends)
+depthbench_test(variant_file_test variant_file_test.cc LIBS depthbench_sweep depthbench_backends)

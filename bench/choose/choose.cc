@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/resources.h"
 #include "bench/base/text_table.h"
 #include "bench/speed/instruction_mix.h"
@@ -133,8 +133,8 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
   if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
   std::map<Variant, CandidateCost> by_variant;
   for (const VariantInfo& v : AllVariants()) {
-    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileComputeShader(dir / (std::string(v.name) + ".comp")));
-    DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, std::string(v.name) + "_world_position"));
+    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileVariant(v.id, VariantPass::kAccuracy, dir));
+    DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, VariantFunctionName(v.id)));
     by_variant[v.id] = {
         WeighedCost(mix), 0.0, kStaticCostUnit,
         "static model: the compiled shader's instructions, weighed per operation as choose --help lists"};

@@ -19,6 +19,7 @@
 #include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench::cli {
 namespace {
@@ -65,6 +66,7 @@ void NameOptionTypes(CLI::App& app) {
                                                          {"--template", "FILE"},
                                                          {"--plot-library", "FILE"},
                                                          {"--shaders", "DIR"},
+                                                         {"--variant-file", "FILE"},
                                                          {"--out", "DIR"},
                                                          {"--backend", "NAME[,NAME]"},
                                                          {"--device", "NAME"},
@@ -151,6 +153,22 @@ void CheckWholeNumbers(CLI::App& app) {
   }
 }
 
+// --variant-file, of every subcommand that runs variants: the files are
+// registered in the catalog once the command line is parsed, before the
+// command looks a variant up.
+std::vector<std::string> g_variant_files;
+void AddVariantFileOption(CLI::App& app) {
+  for (const char* name : {"run", "fit", "gate", "choose", "speed", "report"}) {
+    app.get_subcommand(name)
+        ->add_option("--variant-file", g_variant_files,
+                     "a reconstruction function of your own, in GLSL (.glsl) or HLSL (.hlsl), run as one more "
+                     "variant named after the file (repeatable). Its '// depthbench:' line declares what it reads "
+                     "and its conventions (docs/variant-files.md). It runs on Vulkan only: with it, the default "
+                     "--backend is vulkan")
+        ->group("Cells");
+  }
+}
+
 // Whether the chosen subcommand writes its JSON to standard output
 // (--json -).
 // --table-format (one program-wide setting, as --wide).
@@ -201,6 +219,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   AddChooseCommand(*app, action);
   AddReportCommand(*app, action);
   AddFuzzCommand(*app, action);
+  AddVariantFileOption(*app);
   NameOptionTypes(*app);
   DescribeStandardOutput(*app);
   CheckWholeNumbers(*app);
@@ -259,9 +278,11 @@ int RunDepthbench(int argc, const char* const* argv) {
   std::streambuf* const standard_output = std::cout.rdbuf();
   auto wrapped = std::make_unique<WrappedOutput>(std::cout);
   CommandAction action;
+  g_variant_files.clear();
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
+  if (Status registered = RegisterVariantFiles(g_variant_files); !registered.ok()) return ReportError(registered);
   // Tables for machines: they alone on standard output.
   std::ostream tables(standard_output);
   if (g_table_format != "text") {

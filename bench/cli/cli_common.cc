@@ -15,6 +15,7 @@
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench::cli {
 
@@ -167,6 +168,7 @@ void BackendFlags::Add(CLI::App& app, bool allow_several) {
                      allow_several ? "backends to run: cpu, vulkan (default both)" : "backend to run: cpu or vulkan");
   option->delimiter(',')->group("Backends");
   if (!allow_several) option->expected(1);
+  backend_option = option;
   app.add_option("--device", device,
                  "Vulkan device: a case-insensitive part of its name (default: Mesa lavapipe, 'llvmpipe'); "
                  "'depthbench list' shows the devices")
@@ -186,7 +188,13 @@ BackendSet::BackendSet(std::vector<std::unique_ptr<Backend>> owned) : owned_(std
 Expected<BackendSet> BackendFlags::Make() const {
   std::vector<std::unique_ptr<Backend>> out;
   BackendOptions options{device, shaders, validate};
-  for (const std::string& name : backends) {
+  std::vector<std::string> names = backends;
+  if (AnyUserVariant() && backend_option != nullptr && backend_option->count() == 0 && names.size() > 1) {
+    names = {"vulkan"};
+    std::cerr << "note: --variant-file: running on the vulkan backend alone (the cpu backend cannot run a "
+                 "shader file; --backend chooses)\n";
+  }
+  for (const std::string& name : names) {
     for (const auto& existing : out) {
       if (existing->name() == name) return InvalidArgument(fmt::format("--backend {} is given twice", name));
     }

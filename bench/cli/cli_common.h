@@ -61,6 +61,10 @@ struct BackendFlags {
   std::string device;
   std::string shaders;
   bool validate = false;
+  // Set by Add: whether --backend was given decides the default when a
+  // variant comes from a shader file (vulkan alone, the only backend that
+  // runs one).
+  const CLI::Option* backend_option = nullptr;
   void Add(CLI::App& app, bool allow_several = true);
   Expected<BackendSet> Make() const;
 };

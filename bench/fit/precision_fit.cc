@@ -300,7 +300,7 @@ void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std:
                    {"1e4"},
                    {"1e6", Align::kRight, true},
                    {"1e8"},
-                   {"inf"},
+                   {"inf", Align::kRight, true},
                    {"f/n 1e-3"},
                    {"f/n 1e-6"},
                    {"held-out miss", Align::kRight, true}});

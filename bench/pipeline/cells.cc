@@ -15,7 +15,6 @@ static_assert(catalog::kRev == f32::DB_CONVENTION_REVERSED && catalog::kInf == f
 namespace {
 using catalog::kConventions;
 using catalog::kFormats;
-using catalog::kVariants;
 
 std::string Lower(std::string_view s) {
   std::string out(s);
@@ -44,6 +43,31 @@ std::string Suggest(std::string_view word, const Catalogue& catalogue) {
 
 }  // namespace
 
+namespace {
+// The variants in Variant order: the built-in ones, then the user's
+// (user_variant.cc appends them before a command uses the catalog).
+std::vector<VariantInfo>& Variants() {
+  static std::vector<VariantInfo> variants(catalog::kVariants.begin(), catalog::kVariants.end());
+  return variants;
+}
+}  // namespace
+
+const VariantInfo& Info(Variant v) { return Variants()[static_cast<std::size_t>(v)]; }
+std::span<const VariantInfo> AllVariants() { return Variants(); }
+
+Variant AddVariant(const VariantInfo& info) {
+  std::vector<VariantInfo>& variants = Variants();
+  VariantInfo added = info;
+  added.id = static_cast<Variant>(variants.size());
+  variants.push_back(added);
+  return added.id;
+}
+
+void RemoveAddedVariants() {
+  std::vector<VariantInfo>& variants = Variants();
+  variants.erase(variants.begin() + kVariantCount, variants.end());
+}
+
 bool Reads(Variant v, Convention c, Format f) {
   DepthInput input = Info(v).input;
   return Info(f).stores == input && Info(c).hardware == (input == DepthInput::kHardware);
@@ -56,7 +80,7 @@ std::string Cell::Name() const {
 
 std::vector<Cell> AllCells() {
   std::vector<Cell> cells;
-  for (const auto& v : kVariants)
+  for (const auto& v : AllVariants())
     for (const auto& c : kConventions)
       for (const auto& f : kFormats)
         if (Reads(v.id, c.id, f.id)) cells.push_back({v.id, c.id, f.id});
@@ -67,7 +91,8 @@ std::vector<Encoding> AllEncodings() {
   std::vector<Encoding> encodings;
   for (const auto& c : kConventions)
     for (const auto& f : kFormats) {
-      bool read = std::any_of(kVariants.begin(), kVariants.end(),
+      const std::span<const VariantInfo> variants = AllVariants();
+      bool read = std::any_of(variants.begin(), variants.end(),
                               [&](const VariantInfo& v) { return Reads(v.id, c.id, f.id); });
       if (read) encodings.push_back({c.id, f.id});
     }
@@ -76,10 +101,12 @@ std::vector<Encoding> AllEncodings() {
 
 Expected<Variant> ParseVariant(std::string_view name) {
   std::string key = Lower(name);
-  for (const auto& v : kVariants)
+  const std::span<const VariantInfo> variants = AllVariants();
+  for (const auto& v : variants)
     if (v.name == key) return v.id;
-  return InvalidArgument("unknown variant '" + std::string(name) + "'; allowed: " +
-                         JoinNames(kVariants, [](const VariantInfo& v) { return v.name; }) + Suggest(name, kVariants));
+  return InvalidArgument("unknown variant '" + std::string(name) +
+                         "'; allowed: " + JoinNames(variants, [](const VariantInfo& v) { return v.name; }) +
+                         Suggest(name, variants) + " (a variant from a shader file needs its --variant-file)");
 }
 
 Expected<Convention> ParseConvention(std::string_view name) {

@@ -32,7 +32,11 @@ enum class Variant : std::uint8_t {
   kReciprocal,
   kPq,
 };
+// The built-in variants; variants from the user's shader files follow
+// them (user_variant.h), so that a Variant is an index into AllVariants().
 inline constexpr int kVariantCount = 8;
+
+struct UserShader;  // bench/pipeline/user_variant.h
 
 struct VariantInfo {
   Variant id;
@@ -40,6 +44,9 @@ struct VariantInfo {
   std::string_view source;  // the article it restates, by its short name in docs/sources.md
   DepthInput input;
   std::string_view idea;
+  // A variant from the user's shader file (--variant-file); null for the
+  // built-in ones. It runs on Vulkan only.
+  const UserShader* user = nullptr;
 };
 
 enum class Convention : std::uint8_t {
@@ -139,10 +146,16 @@ inline constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
 }};
 }  // namespace catalog
 
-inline const VariantInfo& Info(Variant v) { return catalog::kVariants[static_cast<int>(v)]; }
+// Built-in variants, then those registered from the user's files.
+const VariantInfo& Info(Variant v);
 inline const ConventionInfo& Info(Convention c) { return catalog::kConventions[static_cast<int>(c)]; }
 inline const FormatInfo& Info(Format f) { return catalog::kFormats[static_cast<int>(f)]; }
-inline std::span<const VariantInfo> AllVariants() { return catalog::kVariants; }
+std::span<const VariantInfo> AllVariants();
+// Appends a variant after the built-in ones and returns its id (how
+// user_variant.cc registers the user's shader files); RemoveAddedVariants
+// drops every appended one.
+Variant AddVariant(const VariantInfo& info);
+void RemoveAddedVariants();
 inline std::span<const ConventionInfo> AllConventions() { return catalog::kConventions; }
 inline std::span<const FormatInfo> AllFormats() { return catalog::kFormats; }
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/compute_pass.h"
-#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/speed/timing_stats.h"
@@ -130,8 +130,7 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
   if (auto found = pipelines_.find(key); found != pipelines_.end()) return found->second.get();
   auto compiled = spirv_.find(variant);
   if (compiled == spirv_.end()) {
-    const std::filesystem::path path = shader_dir_ / "speed" / (std::string(Info(variant).name) + ".comp");
-    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> words, CompileComputeShader(path));
+    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> words, CompileVariant(variant, VariantPass::kSpeed, shader_dir_));
     compiled = spirv_.emplace(variant, std::move(words)).first;
   }
   const std::vector<std::uint32_t>& spirv = compiled->second;

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
-#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/build_info.h"
 #include "bench/base/environment.h"
 #include "bench/base/interrupt.h"
@@ -147,11 +147,11 @@ Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path
     const bool selected =
         std::any_of(cells.begin(), cells.end(), [&](const Cell& c) { return c.variant == variant.id; });
     if (!selected) continue;
-    const std::filesystem::path path = shader_dir / "speed" / (std::string(variant.name) + ".comp");
-    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path));
-    const std::string function = std::string(variant.name) + "_world_position";
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
+                        CompileVariant(variant.id, VariantPass::kSpeed, shader_dir));
+    const std::string function = VariantFunctionName(variant.id);
     Expected<InstructionMix> mix = CountInstructionMix(spirv, function);
-    if (!mix.ok()) return mix.status().WithContext(path.string());
+    if (!mix.ok()) return mix.status().WithContext(VariantProgramName(variant.id, VariantPass::kSpeed, shader_dir));
     costs.push_back({variant.id, function, *mix});
   }
   return costs;
@@ -185,7 +185,21 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
   DB_ASSIGN_OR_RETURN(results.static_costs, MeasureStaticCosts(shader_dir, options.cells));
   DB_ASSIGN_OR_RETURN(results.gpu, TimeGpuPasses(timer, options, results.skipped));
   if (options.progress) options.progress(1, 1, "CPU backend");
-  DB_ASSIGN_OR_RETURN(results.cpu, MeasureCpuCosts(options.cells, options.cpu));
+  // The CPU backend runs the built-in formulas alone.
+  std::vector<Cell> cpu_cells;
+  std::vector<Variant> not_timed;
+  for (const Cell& cell : options.cells) {
+    if (Info(cell.variant).user == nullptr) {
+      cpu_cells.push_back(cell);
+    } else if (std::find(not_timed.begin(), not_timed.end(), cell.variant) == not_timed.end()) {
+      not_timed.push_back(cell.variant);
+      results.skipped.push_back(
+          fmt::format("cpu: {} not timed: a shader file runs on Vulkan only", Info(cell.variant).name));
+    }
+  }
+  if (!cpu_cells.empty()) {
+    DB_ASSIGN_OR_RETURN(results.cpu, MeasureCpuCosts(cpu_cells, options.cpu));
+  }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return results;
 }

@@ -8,6 +8,7 @@
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/stats.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench {
 namespace {
@@ -158,9 +159,10 @@ nlohmann::json ReproToJson(const Repro& repro) {
 
 std::string ReproCommand(std::uint64_t seed, std::uint64_t index, const Domain& domain, const Cell& cell,
                          const std::string& backend) {
-  return fmt::format("depthbench run --seed {} --index {} --backend {} --variant {} --convention {} --format {} {}",
-                     seed, index, backend, Info(cell.variant).name, Info(cell.convention).name, Info(cell.format).name,
-                     domain.ToFlags());
+  const UserShader* user = Info(cell.variant).user;
+  return fmt::format("depthbench run --seed {} --index {} --backend {} {}--variant {} --convention {} --format {} {}",
+                     seed, index, backend, user != nullptr ? "--variant-file " + user->path.string() + " " : "",
+                     Info(cell.variant).name, Info(cell.convention).name, Info(cell.format).name, domain.ToFlags());
 }
 
 }  // namespace depthbench

@@ -7,6 +7,7 @@
 
 #include "bench/base/build_info.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench {
 namespace {
@@ -97,6 +98,7 @@ CellRunner RunnerFor(Variant v) {
     case Variant::kDivide: return RunCell<f32x8::divide_world_position>;
     case Variant::kReciprocal: return RunCell<f32x8::reciprocal_world_position>;
     case Variant::kPq: return RunCell<f32x8::pq_world_position>;
+    default: break;
   }
   return nullptr;
 }
@@ -122,6 +124,15 @@ class CpuBackend final : public Backend {
   bool concurrent() const override { return true; }
 
   Status Prepare(std::span<const CellPlan> cells, PassKind) override {
+    for (const CellPlan& plan : cells) {
+      const VariantInfo& variant = Info(plan.cell.variant);
+      if (variant.user != nullptr) {
+        return Unavailable(fmt::format(
+            "the cpu backend cannot run '{}': its formula is a shader file ({}), which runs on Vulkan only; "
+            "use --backend vulkan",
+            variant.name, variant.user->path.string()));
+      }
+    }
     cells_.assign(cells.begin(), cells.end());
     return Status::Ok();
   }

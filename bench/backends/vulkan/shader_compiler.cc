@@ -131,7 +131,8 @@ struct LinkedShader {
 // file is appended to `sources` when it is not null.
 Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, const std::string& root_name,
                                                      const std::filesystem::path& root_dir,
-                                                     std::vector<std::string>* sources = nullptr) {
+                                                     std::vector<std::string>* sources = nullptr,
+                                                     ShaderLanguage language = ShaderLanguage::kGlsl) {
   EnsureGlslangInitialized();
   auto linked = std::make_unique<LinkedShader>();
   const char* text = source.data();
@@ -139,15 +140,19 @@ Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, 
   const char* name = root_name.c_str();
   glslang::TShader& shader = linked->shader;
   shader.setStringsWithLengthsAndNames(&text, &length, &name, 1);
-  shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+  const bool hlsl = language == ShaderLanguage::kHlsl;
+  shader.setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan,
+                     100);
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
+  if (hlsl) shader.setEntryPoint("main");
+  const auto messages = static_cast<EShMessages>(kMessages | (hlsl ? EShMsgReadHlsl : EShMsgDefault));
   RelativeIncluder includer(root_name, root_dir, sources);
-  if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, kMessages, includer)) {
+  if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, messages, includer)) {
     return CompileError(FormatInfoLog(shader.getInfoLog(), root_name));
   }
   linked->program.addShader(&shader);
-  if (!linked->program.link(kMessages)) {
+  if (!linked->program.link(messages)) {
     return CompileError(FormatInfoLog(linked->program.getInfoLog(), root_name));
   }
   return linked;
@@ -170,12 +175,11 @@ double CompileSeconds() {
   return text != nullptr && end != text && *end == '\0' && value > 0.0 ? value : 30.0;
 }
 
-Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::path& path,
-                                                         std::vector<std::string>* sources) {
-  DB_ASSIGN_OR_RETURN(const std::string source, ReadSourceFile(path));
+Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::string& source, const std::string& name,
+                                                         const std::filesystem::path& include_dir,
+                                                         ShaderLanguage language, std::vector<std::string>* sources) {
   if (sources != nullptr) sources->push_back(source);
-  const std::string name = path.string();
-  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, path.parent_path(), sources));
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, include_dir, sources, language));
   std::vector<std::uint32_t> spirv;
   spv::SpvBuildLogger logger;
   glslang::SpvOptions options;
@@ -188,13 +192,23 @@ Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::filesystem::
 
 Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
                                                           std::vector<std::string>* sources) {
+  DB_ASSIGN_OR_RETURN(std::string source, ReadSourceFile(path));
+  return CompileComputeSource(std::move(source), path.string(), path.parent_path(), ShaderLanguage::kGlsl, sources);
+}
+
+Expected<std::vector<std::uint32_t>> CompileComputeSource(std::string source, std::string name,
+                                                          std::filesystem::path include_dir, ShaderLanguage language,
+                                                          std::vector<std::string>* sources) {
   // glslang cannot be stopped, so the compile runs on a thread of its own
   // that is given up on when it takes too long (the program then ends
   // without waiting for it: base/interrupt.h). The thread owns what it
   // writes until it is joined.
   using Words = Expected<std::vector<std::uint32_t>>;
   auto read = std::make_shared<std::vector<std::string>>();
-  std::packaged_task<Words()> task([path, read] { return CompileOnThisThread(path, read.get()); });
+  std::packaged_task<Words()> task(
+      [source = std::move(source), name, include_dir = std::move(include_dir), language, read] {
+        return CompileOnThisThread(source, name, include_dir, language, read.get());
+      });
   std::future<Words> compiled = task.get_future();
   std::thread compiler(std::move(task));
   const double seconds = CompileSeconds();
@@ -204,7 +218,7 @@ Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem:
     return CompileError(
         fmt::format("{}: compiling did not finish within {:g} s (an #include or macro that expands without end?); "
                     "DEPTHBENCH_COMPILE_SECONDS sets the limit",
-                    path.string(), seconds));
+                    name, seconds));
   }
   compiler.join();
   if (sources != nullptr) sources->insert(sources->end(), read->begin(), read->end());

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bench/base/status.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench {
 
@@ -25,6 +26,14 @@ std::string GlslangVersion();
 // includes is appended to it in the order read (what results hash to say
 // which program ran).
 Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
+                                                          std::vector<std::string>* sources = nullptr);
+
+// The same for source text in `language` that glslang reports as `name`,
+// whose includes resolve relative to `include_dir` (absolute include paths
+// as they are): how a program generated around a user's function compiles.
+// HLSL's entry point is main().
+Expected<std::vector<std::uint32_t>> CompileComputeSource(std::string source, std::string name,
+                                                          std::filesystem::path include_dir, ShaderLanguage language,
                                                           std::vector<std::string>* sources = nullptr);
 
 // One member of a buffer block as glslang lays it out: its reflected name

@@ -14,6 +14,7 @@
 
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/files.h"
 #include "bench/base/resources.h"
 #include "bench/numerics/formulas.h"
@@ -154,7 +155,7 @@ struct DispatchPlan {
 DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std::uint32_t> which,
                             const SliceLayout& slices) {
   DispatchPlan plan;
-  for (std::size_t v = 0; v < kVariantCount; ++v) {
+  for (std::size_t v = 0; v < AllVariants().size(); ++v) {
     const auto first = static_cast<std::uint32_t>(plan.cell_slices.size());
     for (std::size_t k = 0; k < which.size(); ++k) {
       const CellPlan& cell = cells[which[k]];
@@ -234,7 +235,7 @@ class VulkanBackend final : public Backend {
 
   std::unique_ptr<ComputePass> pass_;  // the storage buffers of compute_pass.glsl, PassConstants pushed
   // Indexed by Variant; null for variants no prepared cell uses.
-  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines_;
+  std::vector<DeviceObject<VkPipeline>> pipelines_;
   std::array<VulkanBuffer, kBindingCount> buffers_;
 };
 
@@ -274,7 +275,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
   DB_RETURN_IF_ERROR(CheckDirectory(shader_dir_, "shader directory"));
   // Built aside so that a failure leaves the previous preparation intact.
   DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
-  std::array<DeviceObject<VkPipeline>, kVariantCount> pipelines;
+  std::vector<DeviceObject<VkPipeline>> pipelines(AllVariants().size());
   std::vector<std::string> sources;
   for (const CellPlan& plan : cells) {
     DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
@@ -307,8 +308,8 @@ std::uint64_t VulkanBackend::MaxBatchSamples() const {
 
 Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape,
                                                                 std::vector<std::string>& sources) const {
-  const std::filesystem::path path = shader_dir_ / (std::string(Info(variant).name) + ".comp");
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileComputeShader(path, &sources));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
+                      CompileVariant(variant, VariantPass::kAccuracy, shader_dir_, &sources));
   const std::array<VkSpecializationMapEntry, 3> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),
@@ -317,7 +318,8 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant,
                                sizeof(std::uint32_t)}};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(shape),
                                             &shape};
-  return pass_->CreatePipeline(spirv, specialization, fmt::format("'{}'", path.string()));
+  return pass_->CreatePipeline(spirv, specialization,
+                               fmt::format("'{}'", VariantProgramName(variant, VariantPass::kAccuracy, shader_dir_)));
 }
 
 // The positions stay in the mapped readback buffer when their slices are

@@ -1,0 +1,40 @@
+// The one place that says which program runs a variant: for a built-in
+// variant, its file in the shader directory (NAME.comp for the accuracy
+// pass, speed/NAME.comp for the timed pass); for a variant from the user's
+// file (--variant-file), a program generated around the user's function:
+// the pass of the same shader directory (GLSL, or shaders/user/'s HLSL
+// form), the contract of shaders/user/contract.inc, and the user's file,
+// included by its path so that compile errors name the user's file and
+// line.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench/base/status.h"
+#include "bench/pipeline/cells.h"
+
+namespace depthbench {
+
+enum class VariantPass : std::uint8_t {
+  kAccuracy,  // compute_pass.glsl: positions of the sweep's samples
+  kSpeed,     // speed/speed_pass.glsl: the timed full-screen pass
+};
+
+// SPIR-V of `variant`'s pass, from the programs in `shader_dir`. The text
+// of every source compiled is appended to `sources` when it is not null.
+Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass pass,
+                                                    const std::filesystem::path& shader_dir,
+                                                    std::vector<std::string>* sources = nullptr);
+
+// The function of the program that holds the variant's arithmetic (what a
+// static cost model counts): <name>_world_position, or the user's entry.
+std::string VariantFunctionName(Variant variant);
+
+// What compile messages call the program: its path, or for a user's
+// variant "<NAME's accuracy program>".
+std::string VariantProgramName(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir);
+
+}  // namespace depthbench
