@@ -113,8 +113,9 @@ TEST_F(ReportTest, PlantedRegressionIsFlaggedAndOnlyThere) {
   const std::string summary = ReadText(*root_ + "/night2/report.md");
   EXPECT_NE(summary.find("got worse"), std::string::npos) << summary;
   EXPECT_NE(summary.find("`divide/reversed/d32_sfloat` on vulkan"), std::string::npos) << summary;
-  // A CI job summary: the verdict, with counts, on the first line; about
-  // 40 lines in all (the worse cells add a line each), the page for detail.
+  // A CI job summary: the verdict, with counts, on the first line; at most
+  // 40 lines in all (tests/report_render_test.cc: however much got worse),
+  // the page for detail.
   const auto verdict = summary.find("**Verdict: ");
   EXPECT_EQ(verdict, 0u) << summary;
   EXPECT_NE(summary.find("cell(s) got worse** since", verdict), std::string::npos) << summary;
@@ -144,19 +145,48 @@ TEST_F(ReportTest, SummaryNamesTheWorstCells) {
   const std::string summary = ReadText(*root_ + "/night1/report.md");
   const auto section = summary.find("## Worst cells");
   ASSERT_NE(section, std::string::npos) << summary;
-  const std::string worst = summary.substr(section, summary.find("\n\n", summary.find("- ", section)) - section);
-  // Three lines; a cell with the same figures on both backends is one line
-  // that names both, so the three worst rows are all there.
+  const std::size_t line = summary.find("- worst ", section);
+  ASSERT_NE(line, std::string::npos) << summary;
+  const std::string worst = summary.substr(line, summary.find('\n', line) - line);
+  // One line of three; a cell with the same figures on both backends is
+  // one entry that names both, so the three worst rows are all there.
   for (std::size_t i = 0; i < 3; ++i) {
     bool named = false;
-    for (std::size_t at = worst.find("- worst: " + rows[i].name + " on "); at != std::string::npos;
-         at = worst.find("- worst: " + rows[i].name + " on ", at + 1)) {
-      named = named || worst.substr(at, worst.find('\n', at) - at).find(rows[i].backend) != std::string::npos;
+    for (std::size_t at = worst.find(rows[i].name + " on "); at != std::string::npos;
+         at = worst.find(rows[i].name + " on ", at + 1)) {
+      named = named || worst.substr(at, worst.find(')', at) - at).find(rows[i].backend) != std::string::npos;
     }
     EXPECT_TRUE(named) << rows[i].name << " on " << rows[i].backend << "\n" << worst;
   }
   // The best cell of all is not among the worst.
   EXPECT_EQ(worst.find(rows.back().name), std::string::npos) << rows.back().name;
+}
+
+// The first screen's interval is that of its point: the fit's model at the
+// far plane of the row's ratio, so it holds the point. Infinite-far rows
+// are where a band's interval once stood beside the model's point (24 bits
+// "in" [22.7, 23.7]): standard Z with D16 reaches every bit at the far end.
+TEST(ReportFirstScreenTest, EveryIntervalHoldsItsPoint) {
+  const std::string out = testing::MakeTempDir("report_first_screen");
+  const auto r = RunDepthbench({"report", "--samples", "1e5", "--default-samples", "1e4", "--variant", "divide,pq",
+                                "--convention", "standard,standard-inf,reversed-inf", "--format", "d16,d32f",
+                                "--backend", "cpu", "--no-speed", "--no-history", "--out", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json doc = json::parse(ReadText(out + "/results.json"));
+  std::size_t infinite = 0, with_interval = 0;
+  for (const json& row : doc["recommendations"]) {
+    const std::string name = row["convention"].get<std::string>() + "/" + row["format"].get<std::string>();
+    if (row["ratio"] == "inf") ++infinite;
+    // null: every bit lost, or no interval (a fit without a covariance).
+    if (row["bits"].is_null() || row["bits_low"].is_null() || row["bits_high"].is_null()) continue;
+    ++with_interval;
+    const double bits = row["bits"], low = row["bits_low"], high = row["bits_high"];
+    EXPECT_LE(low, bits) << name;
+    EXPECT_LE(bits, high) << name;
+  }
+  EXPECT_EQ(infinite, 4u) << "two infinite-far conventions, two formats";
+  EXPECT_EQ(with_interval, doc["recommendations"].size());
+  fs::remove_all(out);
 }
 
 TEST_F(ReportTest, RefusesAFileThatIsNotAHistory) {

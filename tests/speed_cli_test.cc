@@ -1,6 +1,7 @@
 // `depthbench speed` as a user runs it: bad input gets a message and exit
 // code 2; a small quick run prints its tables, says what lavapipe timings
-// are, and writes a speed file that reads back.
+// are, measures the memory-bound floor, and writes a speed file that reads
+// back.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -94,6 +95,19 @@ TEST(SpeedCliTest, QuickRunPrintsTheTradeAndWritesItsFile) {
   EXPECT_TRUE(any_on_front) << "a front is never empty";
   EXPECT_EQ(read->run.accuracy_backend, "vulkan");
   EXPECT_EQ(read->run.device_type, "cpu");
+  // The memory-bound floor, measured: a bandwidth, and the floor of the one
+  // format at the one resolution, below each memory-bound pass (on
+  // lavapipe a pass runs JIT-compiled per-pixel code besides moving its
+  // bytes: 8 to 14 times its floor in runs here).
+  EXPECT_NE(r.out.find("memory bandwidth: "), std::string::npos) << r.out;
+  ASSERT_TRUE(read->bandwidth.has_value());
+  EXPECT_GT(read->bandwidth->bytes_per_second(), 0.0);
+  ASSERT_EQ(read->floors.size(), 1u);
+  for (const GpuTiming& t : read->gpu) {
+    if (t.regime != Regime::kMemory) continue;
+    ASSERT_TRUE(read->TimesFloor(t).has_value()) << t.cell.Name();
+    EXPECT_GT(*read->TimesFloor(t), 1.0) << t.cell.Name();
+  }
 
   // The same run again, compared with the first: it reports how the two
   // rank the variants (exit 1 only if a ranking flipped).

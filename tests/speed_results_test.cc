@@ -1,6 +1,7 @@
 // The speed results file: it reads back what was written, refuses records of
 // cells that do not exist and files of another schema, ranks within groups,
 // and compares the rankings of two runs of one device only.
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -77,6 +78,15 @@ SpeedResults Example() {
   point.on_gpu_front = true;
   r.trade = {{Convention::kReversed, Format::kD32Sfloat, {point}}};
   r.skipped = {"nothing"};
+  BandwidthProbe probe;
+  probe.method = "a copy";
+  probe.bytes_read = probe.bytes_written = 1000;
+  probe.ns_per_pass = Summary(1.5, 2, 2.5);  // 2000 bytes in 2 ns: 1000 GB/s
+  probe.repetitions_ns = {0.5, 1.5, 2, 2.5, 3.5};
+  probe.passes_per_repetition = 4;
+  probe.warmup_passes = 9;
+  r.bandwidth = probe;
+  r.floors = MemoryFloors(probe, r.gpu);
   return r;
 }
 
@@ -90,6 +100,57 @@ TEST(SpeedResultsTest, ReadsBackWhatItWrote) {
   EXPECT_EQ(read->static_costs[0].mix, written.static_costs[0].mix);
   EXPECT_EQ(json["schema"], "depthbench.speed");
   EXPECT_EQ(json["schema_version"], 1);
+}
+
+// The floor: (texel bytes + 4 written) per pixel at the probe's rate, per
+// format and resolution; a memory-bound timing within 1.5 times it is
+// bandwidth-bound.
+TEST(SpeedResultsTest, FloorsAreBytesPerPixelOverTheMeasuredBandwidth) {
+  SpeedResults r = Example();
+  ASSERT_TRUE(r.bandwidth.has_value());
+  EXPECT_DOUBLE_EQ(r.bandwidth->bytes_per_second(), 1e12);
+  ASSERT_EQ(r.floors.size(), 1u);  // one format, one resolution
+  const MemoryFloor* floor = r.FindFloor(Format::kD32Sfloat, {1920, 1080});
+  ASSERT_NE(floor, nullptr);
+  EXPECT_EQ(floor->bytes_read_per_pixel, 4u);
+  EXPECT_EQ(floor->bytes_written_per_pixel, 4u);
+  EXPECT_DOUBLE_EQ(floor->ns_per_pass, 1920.0 * 1080.0 * 8.0 / 1000.0);  // 1000 bytes per ns
+  EXPECT_FALSE(r.TimesFloor(r.gpu[0]).has_value()) << "an ALU-bound timing has no floor";
+  // The memory-bound divide takes 10 ns against a floor of 16589 ns:
+  // below it, which only a cache could do; and at 1.5 times it, bound.
+  ASSERT_TRUE(r.TimesFloor(r.gpu[2]).has_value());
+  EXPECT_DOUBLE_EQ(*r.TimesFloor(r.gpu[2]), 10.0 / floor->ns_per_pass);
+  r.gpu[2].ns_per_pass = Summary(1.5 * floor->ns_per_pass - 1, 1.5 * floor->ns_per_pass, 1.5 * floor->ns_per_pass + 1);
+  const nlohmann::json json = ToJson(r);
+  EXPECT_EQ(json["gpu"][2]["bandwidth_bound"], true);
+  EXPECT_EQ(json["memory_floor"][0]["format"], "d32_sfloat");
+  EXPECT_EQ(json["bandwidth"]["bytes_per_second"], 1e12);
+  r.gpu[2].ns_per_pass = Summary(1.6 * floor->ns_per_pass - 1, 1.6 * floor->ns_per_pass, 1.6 * floor->ns_per_pass + 1);
+  EXPECT_EQ(ToJson(r)["gpu"][2]["bandwidth_bound"], false);
+  EXPECT_FALSE(ToJson(r)["gpu"][0].contains("bandwidth_bound"));
+}
+
+// Speed files made before the bandwidth probe still read, without floors;
+// every committed one among them.
+TEST(SpeedResultsTest, ReadsFilesWithoutABandwidthProbe) {
+  nlohmann::json json = ToJson(Example());
+  json.erase("bandwidth");
+  json.erase("memory_floor");
+  json.erase("bandwidth_bound_factor");
+  auto read = SpeedResultsFromJson(json, "old.json");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_FALSE(read->bandwidth.has_value());
+  EXPECT_TRUE(read->floors.empty());
+  EXPECT_FALSE(ToJson(*read).contains("memory_floor"));
+  const std::filesystem::path committed = std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "reports" / "speed";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(committed)) {
+    if (entry.path().extension() != ".json") continue;
+    ++files;
+    auto file = ReadSpeedResults(entry.path());
+    EXPECT_TRUE(file.ok()) << entry.path() << ": " << file.status().message();
+  }
+  EXPECT_GE(files, 4);
 }
 
 TEST(SpeedResultsTest, RefusesCellsThatDoNotExist) {

@@ -70,31 +70,77 @@ double DepthLimit(const Domain& d) {
   return d.finite_far ? d.far->max : d.near.max * Domain::kInfiniteDepthSpan;
 }
 
-// The error model over eye depth inside the scene (its far/near ratio is
-// fixed, so only depth can matter) and its prediction at the far end.
-std::pair<double, std::string> PredictAtFarEnd(const Scene& scene, const CellResult& cell, Level level) {
+// A band's figure of `metric` at `level`, as a fit point's b (log2 + 24);
+// nullopt when the band has too few samples or no positive finite figure.
+std::optional<double> BandB(const BandStats& band, Metric metric, Level level) {
+  if (band.finite < MinimumSamples(level)) return std::nullopt;
+  const double q = band[metric].AtLevel(level, metric);
+  if (!(q > 0.0) || !std::isfinite(q)) return std::nullopt;
+  return std::log2(q) + 24.0;
+}
+
+// The far end's error, predicted from two parts (docs/choosing.md):
+//   - the error with the camera at the world origin (what camera-relative
+//     rendering leaves: the depth's production and storage, the shader's
+//     arithmetic), modelled over eye depth on a sweep of the scene with its
+//     camera there, each depth decade's figure at its far edge (where
+//     errors grow with depth, a decade's high quantile is set by its
+//     deepest samples; docs/error-model.md), evaluated at the far end;
+//   - the error the scene's camera distance adds: float32 world
+//     coordinates a distance D from the origin are about 2^-24 D apart,
+//     an absolute error that does not depend on depth (in bits,
+//     log2(D / distance to the point) plus a constant: docs/error-model.md).
+//     It is taken from the scene's own samples: in the depth decade where
+//     the scene's figure stands furthest above the camera-at-origin one,
+//     A = sqrt(scene^2 - origin^2) in world units; relative to the far end
+//     it is A / far end.
+// The two add as independent errors do, in quadrature. A model over the
+// scene's samples alone mixed them: near decades, where the camera's
+// distance dominates and the error falls with depth, pulled the fit down
+// at the far end (open_world: 0.004 predicted, 0.015 measured).
+struct FarEndPrediction {
+  double value = std::nan("");  // in the requirement's unit
+  std::string model;            // "depth", "constant+camera", ...
+  double camera_term = 0.0;     // A, world units
+};
+
+FarEndPrediction PredictAtFarEnd(const Scene& scene, const CellResult& in_scene, const CellResult& at_origin,
+                                 Level level) {
   const Requirement& req = scene.requirement;
+  const Metric metric = MetricOf(req);
   const double near = scene.domain.near.min, far_end = DepthLimit(scene.domain);
   const double lowest = scene.domain.eye_depth ? scene.domain.eye_depth->min : near;
   std::vector<FitPoint> points;
+  // Differences within the histograms' quarter-octave bins are not resolved.
+  constexpr double kResolvedBits = 0.25;
+  double camera_term = 0.0, most_above = kResolvedBits;
   for (int d = 0; d < kDepthBands; ++d) {
-    const BandStats band = cell.stats.ForDepth(d);
-    if (band.finite < 100) continue;
-    const double q = band[Metric::kTotal].AtLevel(level, Metric::kTotal);
-    if (!(q > 0.0) || !std::isfinite(q)) continue;
     const double lo = std::max(lowest, near * DepthBandLow(d)), hi = std::min(far_end, near * DepthBandLow(d) * 10.0);
     if (!(hi > lo)) continue;
-    points.push_back({0.0, 0.5 * (std::log2(lo / near) + std::log2(hi / near)), std::log2(q) + 24.0});
+    const BandStats origin = at_origin.stats.ForDepth(d);
+    if (const std::optional<double> b = BandB(origin, metric, level)) points.push_back({0.0, std::log2(hi / near), *b});
+    const std::optional<double> scene_abs = BandB(in_scene.stats.ForDepth(d), Metric::kAbsolute, level);
+    const std::optional<double> origin_abs = BandB(origin, Metric::kAbsolute, level);
+    if (scene_abs && origin_abs && *scene_abs - *origin_abs > most_above) {
+      most_above = *scene_abs - *origin_abs;
+      camera_term = std::ldexp(std::sqrt(std::exp2(2.0 * *scene_abs) - std::exp2(2.0 * *origin_abs)), -24);
+    }
   }
   const ModelKind candidates[] = {ModelKind::kConstant, ModelKind::kDepth};
   const std::vector<FittedModel> ranked = FitAndRank(points, candidates);
-  if (ranked.empty()) return {std::nan(""), "none (too few depth bands)"};
-  const double b = ranked.front().Predict(0.0, std::log2(far_end / near));
-  const double relative = std::ldexp(1.0, -24) * std::exp2(b);
-  double value = relative;
-  if (req.kind == Requirement::Kind::kAbsolute) value = relative * far_end;
-  if (req.kind == Requirement::Kind::kBitsLost) value = std::max(0.0, b);
-  return {value, Info(ranked.front().kind).name};
+  FarEndPrediction p;
+  if (ranked.empty()) {
+    // Each depth decade needs the level's samples (4000 for a p99.9).
+    p.model = "too few samples";
+    return p;
+  }
+  const double at_far = std::ldexp(std::exp2(ranked.front().Predict(0.0, std::log2(far_end / near))), -24);
+  const double camera = metric == Metric::kAbsolute ? camera_term : camera_term / far_end;
+  const double value = std::hypot(at_far, camera);
+  p.value = req.kind == Requirement::Kind::kBitsLost ? BitsLost(value) : value;
+  p.model = std::string(Info(ranked.front().kind).name) + (camera_term > 0.0 ? "+camera" : "");
+  p.camera_term = camera_term;
+  return p;
 }
 
 // 5861 -> 5900: a sample count to suggest.
@@ -177,6 +223,16 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   whole.domain = scene.domain;
   whole.cells = cells;
   DB_ASSIGN_OR_RETURN(Results scene_results, RunSweep(whole, backends));
+  // The scene with its camera at the world origin, for the far-end model
+  // (PredictAtFarEnd); the scene itself when its camera never leaves it.
+  Results origin_results;
+  const Results* at_origin = &scene_results;
+  if (scene.domain.camera_distance.max > 0.0) {
+    SweepOptions origin = whole;
+    origin.domain.camera_distance = Range{0.0, 0.0};
+    DB_ASSIGN_OR_RETURN(origin_results, RunSweep(origin, backends));
+    at_origin = &origin_results;
+  }
   Results depth_results;
   const Results* judged = &scene_results;
   if (req.at_depth) {
@@ -214,7 +270,8 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   for (const Cell& cell : cells) {
     const CellResult* at_depth = judged->Find(cell, backend.name());
     const CellResult* in_scene = scene_results.Find(cell, backend.name());
-    if (at_depth == nullptr || in_scene == nullptr) continue;
+    const CellResult* origin = at_origin->Find(cell, backend.name());
+    if (at_depth == nullptr || in_scene == nullptr || origin == nullptr) continue;
     const BandStats band = at_depth->stats.All();
     const BandStats whole_band = in_scene->stats.All();
     CandidateVerdict v;
@@ -225,7 +282,10 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     v.measured_max = InUnit(req, band, Level::kMax);
     v.measured = req.level == Level::kMax ? v.measured_max : v.measured_p999;
     v.interval = InUnitInterval(req, band, req.level);
-    std::tie(v.predicted, v.model) = PredictAtFarEnd(scene, *in_scene, req.level);
+    const FarEndPrediction far_end = PredictAtFarEnd(scene, *in_scene, *origin, req.level);
+    v.predicted = far_end.value;
+    v.model = far_end.model;
+    v.camera_term = far_end.camera_term;
     // Findings only: outputs that are NaN or Inf where exact arithmetic on
     // the same inputs is finite, for samples inside the scene's ranges.
     v.nonfinite = band.nan + band.inf + whole_band.nan + whole_band.inf;
@@ -412,19 +472,21 @@ void PrintChoice(const ChooseResult& r, std::ostream& out) {
                    {"held back by", Align::kLeft, true},
                    {"cost"}});
   for (const CandidateVerdict& v : r.ranked) {
-    table.AddRow({fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
-                  v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
-                                               : fmt::format("{:.3g}", v.measured),
-                  fmt::format("{:.3g} ({})", v.predicted, v.model), std::to_string(v.nonfinite),
-                  v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
-                  v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
+    table.AddRow(
+        {fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
+         v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
+                                      : fmt::format("{:.3g}", v.measured),
+         std::isfinite(v.predicted) ? fmt::format("{:.3g} ({})", v.predicted, v.model) : fmt::format("- ({})", v.model),
+         std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+         v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
   }
   table.Print(out);
   out << fmt::format(
       "measured: at the requirement's level and depth, with the upper end of its 95% interval where it differs "
-      "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end; NaN/Inf: findings "
-      "inside the scene's "
-      "ranges;\nheld back by: the part of the error that dominates (production, storage or shader), or what else "
+      "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end (constant or depth: "
+      "over eye depth, camera at the world origin; +camera: with what the scene's camera distance adds; "
+      "docs/choosing.md); NaN/Inf: findings inside the scene's ranges;\nheld back by: the part of the error that "
+      "dominates (production, storage or shader), or what else "
       "fails it (interval: the measured value meets it, the upper end of its interval does not);\nrank: '=' marks "
       "costs that tie; exit status 0 when a candidate meets the requirement, 1 when none "
       "does\n");
@@ -447,6 +509,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"measured_max", JsonNumber(v.measured_max)},
                       {"predicted_far_end", JsonNumber(v.predicted)},
                       {"model", v.model},
+                      {"camera_term", JsonNumber(v.camera_term)},
                       {"nonfinite", v.nonfinite},
                       {"dominant_cause", MetricName(v.dominant)},
                       {"meets", v.meets},

@@ -65,8 +65,12 @@ struct CandidateVerdict {
   Interval interval;      // its 95% sampling interval; the verdict uses `high`
   bool supported = true;  // enough samples at the requirement's depth for the level
   std::uint64_t samples = 0;
-  double predicted = 0.0;       // the model's value at the scene's far end, same unit and level
-  std::string model;            // the error model used for the prediction
+  double predicted = 0.0;  // the model's value at the scene's far end, same unit and level
+  // The error model used for the prediction: over eye depth with the camera
+  // at the world origin ("constant", "depth"), "+camera" where the scene's
+  // camera distance adds its own (choose.cc PredictAtFarEnd).
+  std::string model;
+  double camera_term = 0.0;     // what the camera distance adds, in world units (0: nothing)
   std::uint64_t nonfinite = 0;  // NaN or Inf findings inside the scene's ranges
   // The cause with the largest p99.9 at the requirement's depth:
   // kProduction, kStorage or kArith (the shader's part).

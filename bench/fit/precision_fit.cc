@@ -33,6 +33,16 @@ bool InfiniteFar(const Cell& cell) {
 // saturate: 24 means nothing left, whatever the model's line says beyond.
 double FarPlane(const FittedModel& m, double x) { return std::clamp(m.Predict(x, x), 0.0, kAllBitsLost); }
 
+// What `m` says at (x, y) with its 95% interval, each held to 0..24 bits:
+// the interval is the unclamped prediction's, so that a prediction held at
+// 24 keeps the interval's lower end, and clamping (monotone) keeps the
+// value inside the interval.
+Estimate ClampedEstimate(const FittedModel& m, double x, double y) {
+  const Estimate e = EstimateOf(m, [x, y](const FittedModel& f) { return f.Predict(x, y); });
+  const auto clamp = [](double b) { return std::isnan(b) ? b : std::clamp(b, 0.0, kAllBitsLost); };
+  return {clamp(e.value), clamp(e.low), clamp(e.high)};
+}
+
 // Points at or above this carry no slope: the error has reached the
 // distance itself (a quarter bit below 24: the statistics' resolution).
 constexpr double kSaturatedBits = kAllBitsLost - 0.25;
@@ -197,7 +207,10 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
           }
           for (const auto& [name, ratio] : kPredictedRatios) {
             // No prediction past the data.
-            if (ratio <= highest_ratio * (1.0 + 1e-9)) fit.predicted[name] = FarPlane(m, std::log2(ratio));
+            if (ratio > highest_ratio * (1.0 + 1e-9)) continue;
+            const Estimate at = ClampedEstimate(m, std::log2(ratio), std::log2(ratio));
+            fit.predicted[name] = at.value;
+            fit.predicted_interval[name] = {at.low, at.high};
           }
           for (const auto& [name, budget] : kBudgets) {
             const double limit = 24.0 + std::log2(budget);
@@ -231,7 +244,9 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
             fit.holdout_points = static_cast<int>(test.size());
           }
         } else {
-          fit.predicted["inf"] = std::clamp(m.Predict(0.0, std::log2(kInfiniteSpan)), 0.0, kAllBitsLost);
+          const Estimate at = ClampedEstimate(m, 0.0, std::log2(kInfiniteSpan));
+          fit.predicted["inf"] = at.value;
+          fit.predicted_interval["inf"] = {at.low, at.high};
         }
         fits.push_back(std::move(fit));
       }
@@ -258,6 +273,10 @@ nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const 
                          {"converged", m.converged},
                          {"parameters", parameters}});
     }
+    nlohmann::json intervals = nlohmann::json::object();
+    for (const auto& [name, interval] : f.predicted_interval) {
+      intervals[name] = {JsonNumber(interval.first), JsonNumber(interval.second)};
+    }
     nlohmann::json budgets = nlohmann::json::object();
     for (const auto& [name, ratio] : f.budget_ratio) {
       budgets[name] = ratio ? JsonNumber(*ratio) : nlohmann::json("met throughout");
@@ -273,6 +292,7 @@ nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const 
          {"slope_bits_per_doubling", f.slope},
          {"slope_interval_95", {f.slope_low, f.slope_high}},
          {"predicted_bits_lost", f.predicted},
+         {"predicted_interval_95", intervals},
          {"last_ratio_meeting_budget", budgets},
          {"holdout",
           {{"points", f.holdout_points}, {"max_miss_bits", f.holdout_max_miss}, {"rms_miss_bits", f.holdout_rms_miss}}},

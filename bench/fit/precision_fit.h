@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -81,6 +82,10 @@ struct PrecisionFit {
   double slope = 0.0, slope_low = 0.0, slope_high = 0.0;
   // Predicted bits lost at the far plane (floored at 0), by ratio.
   std::map<std::string, double> predicted;  // "1e2" ... "1e8", "inf"
+  // Each prediction's 95% interval: the model's, at the same point, held
+  // to 0..24 bits as the prediction is (so it always holds the prediction;
+  // NaN where the fit has no covariance).
+  std::map<std::string, std::pair<double, double>> predicted_interval;
   // The largest far/near ratio at which the far plane still meets a
   // relative-error budget; nullopt when the budget is met throughout
   // [10, 1e12], 0 when it is not met even at 10.

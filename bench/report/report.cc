@@ -131,6 +131,9 @@ std::vector<HeadlineRow> HeadlineRows(const ReportMeasurements& m) {
       row.slope_high = Shown(f.slope_high);
     }
     for (const auto& [name, bits] : f.predicted) row.predicted_bits[name] = Shown(bits);
+    for (const auto& [name, interval] : f.predicted_interval) {
+      row.predicted_interval[name] = {Shown(interval.first), Shown(interval.second)};
+    }
     row.ratio_for_1e3 = Budget(f, "1e-3");
     row.ratio_for_1e6 = Budget(f, "1e-6");
     if (f.holdout_points > 0) row.holdout_max_miss = Shown(f.holdout_max_miss);
@@ -381,8 +384,8 @@ SpeedSection Speed(const ReportMeasurements& m) {
 // the gate's tolerance at p99.9, below what the fits resolve.
 constexpr double kTieBits = 0.25;
 
-// The first screen, from the headline (fits), the precision points (their
-// intervals) and the speed section (costs): on the GPU backend where the
+// The first screen, from the headline (fits: each prediction with its
+// interval) and the speed section (costs): on the GPU backend where the
 // report ran one, at far/near 1e4 for finite conventions.
 std::vector<RecommendationRow> Recommendations(const Report& report) {
   std::string backend;
@@ -442,12 +445,12 @@ std::vector<RecommendationRow> Recommendations(const Report& report) {
     const HeadlineRow& chosen = *tied.front();
     for (const HeadlineRow* h : tied) row.variants.push_back(h->cell.variant);
     row.bits = Shown(bits_of(&chosen));
-    for (const ModelPointRow& p : report.precision_points) {
-      if (p.cell.Name() == chosen.cell.Name() && p.cell.backend == backend && p.level == "p99.9" &&
-          p.ratio == row.ratio) {
-        row.bits_low = p.low;
-        row.bits_high = p.high;
-      }
+    // The interval of that very prediction (the fit's model at the far
+    // plane of the ratio), not of a band's point: a band can sit elsewhere
+    // (the infinite sweep's deepest band ends short of the span predicted).
+    if (auto it = chosen.predicted_interval.find(row.ratio); it != chosen.predicted_interval.end() && row.bits) {
+      row.bits_low = it->second.first;
+      row.bits_high = it->second.second;
     }
     if (const std::optional<double> c = cost(&chosen)) row.cost = Shown(*c);
     row.cost_kind = kind;

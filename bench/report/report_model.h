@@ -71,6 +71,8 @@ struct HeadlineRow {
   // infinite far plane.
   Figure slope, slope_low, slope_high;
   std::map<std::string, Figure> predicted_bits;  // "1e2" ... "1e8", "inf"
+  // The 95% interval of each prediction: the model's at the same point.
+  std::map<std::string, std::pair<Figure, Figure>> predicted_interval;
   BudgetRatio ratio_for_1e3, ratio_for_1e6;
   Figure holdout_max_miss;  // none without held-out points
   struct Measured {

@@ -9,15 +9,19 @@
 
 #include "bench/base/files.h"
 #include "bench/base/text_table.h"
+#include "bench/pipeline/cells.h"
 #include "bench/report/report_json.h"
 
 namespace depthbench {
 namespace {
 
-// The summary is a CI job page: about 40 lines with nothing worse, the
-// detail is the page's.
-constexpr std::size_t kWorstInSummary = 3;
-constexpr std::size_t kChangesInSummary = 5;
+// The summary is a CI job page: the verdict line, then at most 40 lines
+// in all, whatever changed (tests/report_render_test.cc holds the full set
+// of cells to that): the page has the detail. Its budget, at most:
+// verdict 2, changes and notes 5 + 1, the first screen 4 + 16 rows + 3,
+// worst cells and findings 3 + 3 + 1 + 1, the closing line 1.
+constexpr std::size_t kWorstInSummary = 3;  // on one line
+constexpr std::size_t kChangesInSummary = 3;
 constexpr std::size_t kFindingsInSummary = 3;
 
 // Where the page's template takes the libraries and the document.
@@ -101,31 +105,71 @@ void Verdict(const Report& report, std::string& out) {
     out += fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
                        bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
   }
-  if (!worse.empty()) out += "\n";
-  for (const std::string& note : h.notes) out += fmt::format("Note: {}\n\n", note);
+  // The comparison's notes, folded into one item of the same list.
+  if (!h.notes.empty()) out += fmt::format("- note: {}\n", Escape(fmt::format("{}", fmt::join(h.notes, "; "))));
+  if (!worse.empty() || !h.notes.empty()) out += "\n";
 }
 
-// What to use: the report's first screen (Report::recommendations).
+// What to use: the report's first screen (Report::recommendations), one
+// line per finite convention and format; a convention's infinite-far
+// form (standard-inf beside standard, ...) folds into its line, in the
+// last two columns. The page keeps one row each.
 void WhatToUse(const Report& report, std::string& out) {
   if (report.recommendations.empty()) return;
   const RecommendationRow& first = report.recommendations.front();
-  out += fmt::format("## What to use ({} backend; cost in {})\n\n", first.backend, first.cost_unit);
-  out += "| convention | format | use | f/n | bits lost [95%] | cost | f/n for 1e-3 | f/n for 1e-6 |\n";
-  out += "|---|---|---|---|---:|---:|---:|---:|\n";
-  for (const RecommendationRow& r : report.recommendations) {
-    std::string use = "`" + r.variants.front() + "`";
-    if (r.variants.size() > 1) {
-      use +=
-          fmt::format(" (= {})", fmt::join(std::vector<std::string>(r.variants.begin() + 1, r.variants.end()), ", "));
+  // The finite convention an infinite-far one is the limit of; itself for
+  // the others (and for a name not in the catalogue).
+  const auto finite_form = [](const std::string& convention) {
+    const Expected<Convention> parsed = ParseConvention(convention);
+    if (!parsed.ok() || (Info(*parsed).bits & catalog::kInf) == 0) return convention;
+    for (const ConventionInfo& c : AllConventions()) {
+      if (c.hardware && c.bits == (Info(*parsed).bits & ~catalog::kInf)) return std::string(c.name);
     }
+    return convention;
+  };
+  struct Line {
+    std::string convention, format;
+    const RecommendationRow *finite = nullptr, *infinite = nullptr;
+  };
+  std::vector<Line> lines;
+  for (const RecommendationRow& r : report.recommendations) {
+    const std::string convention = finite_form(r.convention);
+    const bool infinite = convention != r.convention;
+    auto it = std::find_if(lines.begin(), lines.end(),
+                           [&](const Line& l) { return l.convention == convention && l.format == r.format; });
+    if (it == lines.end()) it = lines.insert(lines.end(), Line{convention, r.format});
+    (infinite ? it->infinite : it->finite) = &r;
+  }
+  const auto use = [](const RecommendationRow* r) {
+    if (r == nullptr) return std::string("-");
+    std::string text = "`" + r->variants.front() + "`";
+    if (r->variants.size() > 1) {
+      text +=
+          fmt::format(" (= {})", fmt::join(std::vector<std::string>(r->variants.begin() + 1, r->variants.end()), ", "));
+    }
+    return text;
+  };
+  const auto bits = [](const RecommendationRow* r) {
+    if (r == nullptr) return std::string("-");
     const std::string interval =
-        r.bits_low && r.bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r.bits_low, *r.bits_high) : "";
-    out += fmt::format("| {} | {} | {} | {} | {}{} | {} | {} | {} |\n", r.convention, r.format, use, r.ratio,
-                       Bits(r.bits), interval, Number(r.cost), Budget(r.ratio_for_1e3), Budget(r.ratio_for_1e6));
+        r->bits_low && r->bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r->bits_low, *r->bits_high) : "";
+    return Bits(r->bits) + interval;
+  };
+  out += fmt::format("## What to use ({} backend; cost in {})\n\n", first.backend, first.cost_unit);
+  out +=
+      "| convention | format | use | f/n | bits lost [95%] | cost | f/n for 1e-3 | f/n for 1e-6 | infinite far: use | "
+      "bits lost [95%] |\n";
+  out += "|---|---|---|---|---:|---:|---:|---:|---|---:|\n";
+  for (const Line& l : lines) {
+    const RecommendationRow* f = l.finite;
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", l.convention, l.format, use(f),
+                       f ? f->ratio : "-", bits(f), f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
+                       f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite));
   }
   out +=
       "\nUse: the cheapest variant within 0.25 bit of the most precise (= tied ones); bits lost at p99.9 at the far "
-      "plane; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that relative error.\n\n";
+      "plane, the model's 95% interval; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that "
+      "relative error; infinite far: the convention's -inf form, at its far end.\n\n";
 }
 
 // The worst cells over the default domain and the NaN/Inf findings by
@@ -145,10 +189,14 @@ void Problems(const Report& report, std::string& out) {
       worst.push_back({row, {row->cell.backend}});
     }
   }
+  std::vector<std::string> worst_text;
   for (const auto& [row, backends] : worst) {
-    out += fmt::format("- worst: `{}` on {}: {} bits lost at p99.9, {} at the maximum over the default domain\n",
-                       row->cell.Name(), fmt::join(backends, ", "), Bits(row->measured->p999_bits),
-                       Bits(row->measured->max_bits));
+    worst_text.push_back(fmt::format("`{}` on {} ({}, {})", row->cell.Name(), fmt::join(backends, ", "),
+                                     Bits(row->measured->p999_bits), Bits(row->measured->max_bits)));
+  }
+  if (!worst_text.empty()) {
+    out += fmt::format("- worst (bits lost at p99.9 and at the maximum over the default domain): {}\n",
+                       fmt::join(worst_text, "; "));
   }
   const std::vector<FindingGroup>& groups = report.finding_groups;
   if (groups.empty()) out += "- no cell produced a NaN or an infinity where the true point is finite\n";
@@ -237,20 +285,18 @@ std::string RenderMarkdown(const Report& report) {
   const ReportEnvironment& env = report.environment;
   std::string out;
   Verdict(report, out);
+  WhatToUse(report, out);
+  Problems(report, out);
   std::vector<std::string> devices;
   for (const auto& [name, device] : env.backends) devices.push_back(fmt::format("{} ({})", name, device.name));
   out += fmt::format(
       "depthbench precision report · {} · commit `{}` · {} · {} samples per far/near, {} default-domain{} · "
-      "{:.0f} s\n\n",
+      "{:.0f} s. Detail (plots of bits lost against far/near, the speed/accuracy front, GPU against CPU, every "
+      "finding with its replay command): `report.html` beside this file; every figure: `results.json`.\n",
       env.started_at, env.commit.substr(0, 12), fmt::join(devices, ", "),
       ShortCount(static_cast<double>(env.fit_sweeps.samples_per_ratio)),
       ShortCount(static_cast<double>(env.default_sweep.samples)), env.quick ? " (quick)" : "",
       env.seconds.value_or(0.0));
-  WhatToUse(report, out);
-  Problems(report, out);
-  out +=
-      "Detail (plots of bits lost against far/near, the speed/accuracy front, GPU against CPU, every finding with its "
-      "replay command): `report.html` beside this file; every figure: `results.json`.\n";
   return out;
 }
 

@@ -34,6 +34,19 @@ struct PassConstants {
 // More warm-up passes than this are not needed on any device.
 constexpr std::uint64_t kMaxExtraWarmupPasses = 65536;
 
+// shaders/speed/bandwidth.comp: its bindings, element and workgroup size.
+enum ProbeBinding : std::uint32_t { kProbeSourceBinding = 0, kProbeDestinationBinding = 1 };
+constexpr VkDeviceSize kProbeElementBytes = 16;  // a uvec4
+constexpr std::uint32_t kProbeWorkgroupSize = 256;
+// The most workgroups of one probe dispatch: below every device's
+// maxComputeWorkGroupCount[0] (at least 65535), and 2^20 invocations,
+// several times the resident threads of any GPU (an H200: 132 SMs of 2048);
+// on a CPU device fewer, longer invocations copy faster (lavapipe: about
+// 1.5 times 32768 groups' rate, 4 times 512's).
+constexpr std::uint32_t kMaxProbeGroups = 4096;
+// A smaller probe fits in caches and would time them, not memory.
+constexpr std::uint64_t kMinProbeBytes = std::uint64_t{1} << 20;
+
 std::uint32_t GroupsFor(std::uint32_t pixels) { return (pixels + kWorkgroupSide - 1) / kWorkgroupSide; }
 
 void ComputeToComputeBarrier(VkCommandBuffer commands) {
@@ -329,7 +342,8 @@ void GpuPassTimer::RecordPasses(VkCommandBuffer commands, VkPipeline pipeline, s
   }
 }
 
-Expected<std::vector<double>> GpuPassTimer::TimeGroups(std::span<const Group> groups) {
+Expected<std::vector<double>> GpuPassTimer::TimeGroups(ComputePass& pass, std::span<const Group> groups,
+                                                       const Recorder& record) {
   const auto queries = static_cast<std::uint32_t>(2 * groups.size());
   if (queries > query_capacity_) {
     query_pool_.Reset();
@@ -344,12 +358,12 @@ Expected<std::vector<double>> GpuPassTimer::TimeGroups(std::span<const Group> gr
     query_capacity_ = queries;
   }
   const VkQueryPool pool = query_pool_.get();
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
+  DB_RETURN_IF_ERROR(pass.Submit([&](VkCommandBuffer commands) {
     vkCmdResetQueryPool(commands, pool, 0, queries);
     for (std::uint32_t g = 0; g < groups.size(); ++g) {
       // Bottom of pipe: written once everything recorded before has finished.
       vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g);
-      RecordPasses(commands, groups[g].pipeline, groups[g].passes);
+      record(commands, groups[g].pipeline, groups[g].passes);
       vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g + 1);
     }
   }));
@@ -394,7 +408,6 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
     return InvalidArgument("a timed pass needs at least one warm-up pass and one repetition");
   }
   const ValidationScope validation(*context_);
-  const std::size_t count = variants.size();
   std::vector<VkPipeline> pipelines;
   for (const Variant variant : variants) {
     // Compiling a pipeline takes seconds on a CPU implementation: a signal
@@ -403,13 +416,25 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
     DB_ASSIGN_OR_RETURN(const VkPipeline pipeline, Pipeline(variant, encoding_.convention, taps));
     pipelines.push_back(pipeline);
   }
+  const Recorder record = [this](VkCommandBuffer commands, VkPipeline pipeline, std::uint32_t passes) {
+    RecordPasses(commands, pipeline, passes);
+  };
+  DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimeInterleaved(*pass_, pipelines, record, warmup, repetitions));
+  DB_RETURN_IF_ERROR(validation.Check("the timing of passes"));
+  return timings;
+}
 
-  // Warm-up rounds, one pass of each variant: also each one's pass time.
+Expected<std::vector<PassTiming>> GpuPassTimer::TimeInterleaved(ComputePass& pass,
+                                                                std::span<const VkPipeline> pipelines,
+                                                                const Recorder& record, std::uint32_t warmup,
+                                                                std::uint32_t repetitions) {
+  const std::size_t count = pipelines.size();
+  // Warm-up rounds, one pass of each pipeline: also each one's pass time.
   std::vector<Group> schedule;
   for (std::uint32_t round = 0; round < warmup; ++round) {
     for (const VkPipeline pipeline : pipelines) schedule.push_back({pipeline, 1});
   }
-  DB_ASSIGN_OR_RETURN(const std::vector<double> first, TimeGroups(schedule));
+  DB_ASSIGN_OR_RETURN(const std::vector<double> first, TimeGroups(pass, schedule, record));
   std::vector<PassTiming> timings(count);
   std::vector<double> pass_ns(count);
   double warmed_ns = 0.0;
@@ -427,9 +452,9 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   if (warmed_ns < kMinWarmupNs) {
     const auto rounds = static_cast<std::uint32_t>(std::min<double>(
         std::ceil((kMinWarmupNs - warmed_ns) / round_ns), static_cast<double>(kMaxExtraWarmupPasses / count)));
-    DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
+    DB_RETURN_IF_ERROR(pass.Submit([&](VkCommandBuffer commands) {
       for (std::uint32_t round = 0; round < rounds; ++round) {
-        for (const VkPipeline pipeline : pipelines) RecordPasses(commands, pipeline, 1);
+        for (const VkPipeline pipeline : pipelines) record(commands, pipeline, 1);
       }
     }));
     for (PassTiming& timing : timings) timing.warmup_passes += rounds;
@@ -444,11 +469,10 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   for (std::uint32_t round = 0; round < repetitions; ++round) {
     for (std::size_t v = 0; v < count; ++v) schedule.push_back({pipelines[v], timings[v].passes_per_repetition});
   }
-  DB_ASSIGN_OR_RETURN(const std::vector<double> timed, TimeGroups(schedule));
+  DB_ASSIGN_OR_RETURN(const std::vector<double> timed, TimeGroups(pass, schedule, record));
   for (std::uint32_t round = 0; round < repetitions; ++round) {
     for (std::size_t v = 0; v < count; ++v) timings[v].ns_per_pass.push_back(timed[round * count + v]);
   }
-  DB_RETURN_IF_ERROR(validation.Check("the timing of passes"));
   return timings;
 }
 
@@ -468,6 +492,101 @@ Expected<std::vector<float>> GpuPassTimer::ReadResults() {
   std::vector<float> values(result_bytes_ / sizeof(float));
   std::memcpy(values.data(), readback.mapped(), result_bytes_);
   return values;
+}
+
+Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, std::uint32_t warmup,
+                                                         std::uint32_t repetitions) {
+  if (bytes < kMinProbeBytes) {
+    return InvalidArgument(
+        fmt::format("a bandwidth probe of {} bytes is too small to time (at least {})", bytes, kMinProbeBytes));
+  }
+  if (warmup == 0 || repetitions == 0) {
+    return InvalidArgument("a timed pass needs at least one warm-up pass and one repetition");
+  }
+  // As large as asked, as the device binds, and an eighth of its largest
+  // device-local heap (room for the two buffers beside everything else),
+  // whole workgroups of 16-byte elements.
+  VkPhysicalDeviceMemoryProperties memory{};
+  vkGetPhysicalDeviceMemoryProperties(context_->physical_device(), &memory);
+  VkDeviceSize heap = 0;
+  for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+    if ((memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0) {
+      heap = std::max(heap, memory.memoryHeaps[h].size);
+    }
+  }
+  constexpr VkDeviceSize kGroupBytes = kProbeElementBytes * kProbeWorkgroupSize;
+  VkDeviceSize size = std::min<VkDeviceSize>({bytes, device().limits.maxStorageBufferRange, heap / 8});
+  size -= size % kGroupBytes;
+  if (size < kMinProbeBytes) {
+    return Unavailable(
+        fmt::format("Vulkan device '{}' binds or holds too little for a bandwidth probe of {} bytes "
+                    "(maxStorageBufferRange {}, largest device-local heap {})",
+                    device().name, kMinProbeBytes, device().limits.maxStorageBufferRange, heap));
+  }
+  const ValidationScope validation(*context_);
+  const std::array<VkDescriptorSetLayoutBinding, 2> bindings = {{
+      {kProbeSourceBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+      {kProbeDestinationBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+  }};
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<ComputePass> probe,
+                      ComputePass::Create(context_, bindings, sizeof(std::uint32_t)));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
+                      CompileComputeShader(shader_dir_ / "speed" / "bandwidth.comp"));
+  DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
+                      probe->CreatePipeline(spirv, VkSpecializationInfo{}, "the bandwidth probe"));
+
+  // The two buffers; each buffer before its memory, so that it goes first.
+  DeviceObject<VkDeviceMemory> memories[2];
+  DeviceObject<VkBuffer> buffers[2];
+  for (int b = 0; b < 2; ++b) {
+    VkBufferCreateInfo buffer_info{};
+    buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    buffer_info.size = size;
+    buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer handle = VK_NULL_HANDLE;
+    DB_RETURN_IF_ERROR(CheckVk(vkCreateBuffer(vk_device(), &buffer_info, nullptr, &handle), "vkCreateBuffer"));
+    DeviceObject<VkBuffer> buffer(vk_device(), handle, vkDestroyBuffer);
+    VkMemoryRequirements requirements{};
+    vkGetBufferMemoryRequirements(vk_device(), handle, &requirements);
+    DB_ASSIGN_OR_RETURN(memories[b], AllocateDeviceLocal(requirements));
+    DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, memories[b].get(), 0), "vkBindBufferMemory"));
+    buffers[b] = std::move(buffer);
+  }
+  const VkDescriptorBufferInfo source_info{buffers[0].get(), 0, size};
+  const VkDescriptorBufferInfo destination_info{buffers[1].get(), 0, size};
+  std::array<VkWriteDescriptorSet, 2> writes{};
+  writes[0].dstBinding = kProbeSourceBinding;
+  writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  writes[0].pBufferInfo = &source_info;
+  writes[1].dstBinding = kProbeDestinationBinding;
+  writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  writes[1].pBufferInfo = &destination_info;
+  probe->WriteDescriptors(writes);
+  // Defined contents to copy (a device may skip pages never written).
+  DB_RETURN_IF_ERROR(probe->Submit([&](VkCommandBuffer commands) {
+    vkCmdFillBuffer(commands, buffers[0].get(), 0, size, 0x3f800000u);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  }));
+
+  const auto elements = static_cast<std::uint32_t>(size / kProbeElementBytes);
+  // Every invocation copies elements a whole dispatch apart (grid-stride),
+  // so that no dispatch exceeds any device's group-count limit (65535).
+  const std::uint32_t groups = std::min<std::uint32_t>(elements / kProbeWorkgroupSize, kMaxProbeGroups);
+  const Recorder record = [&](VkCommandBuffer commands, VkPipeline copy, std::uint32_t passes) {
+    probe->Bind(commands, copy);
+    probe->PushConstants(commands, &elements, sizeof(elements));
+    for (std::uint32_t p = 0; p < passes; ++p) {
+      vkCmdDispatch(commands, groups, 1, 1);
+      // Each copy waits for the one before, as the timed passes do.
+      ComputeToComputeBarrier(commands);
+    }
+  };
+  const VkPipeline pipelines[] = {pipeline.get()};
+  DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimeInterleaved(*probe, pipelines, record, warmup, repetitions));
+  DB_RETURN_IF_ERROR(validation.Check("the bandwidth probe"));
+  return BandwidthTiming{size, size, std::move(timings.front())};
 }
 
 }  // namespace depthbench

@@ -9,6 +9,9 @@
 //   3. TimePasses(variants, taps, ...) any number of times: the variants'
 //      passes over the loaded image, taps reconstructions per pixel, timed.
 // Pipelines are built on first use, one per (variant, convention, taps).
+// MeasureBandwidth, at any time, times the device's memory bandwidth with
+// the same machinery (shaders/speed/bandwidth.comp): what a memory-bound
+// pass can at best reach, for the memory-bound floor.
 //
 // How passes are timed: the variants that compete (those reading the
 // loaded image) are timed together, interleaved, so that a slow drift of
@@ -29,6 +32,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <span>
@@ -61,12 +65,22 @@ struct PassTiming {
   std::uint32_t warmup_passes = 0;
 };
 
+// A timed copy between two device-local storage buffers: every pass reads
+// `bytes_read` and writes as many.
+struct BandwidthTiming {
+  std::uint64_t bytes_read = 0, bytes_written = 0;  // per pass
+  PassTiming timing;
+};
+
 class GpuPassTimer {
  public:
   static constexpr double kMinWarmupNs = 20e6;
   static constexpr double kMinGroupNs = 1e6;
   static constexpr std::uint32_t kMaxPassesPerGroup = 4096;
   static constexpr std::uint32_t kMaxTaps = 64;
+  // The bandwidth probe's buffers: each far larger than any GPU's last-level
+  // cache (50 MB on an H100 or H200), so that the copy runs from memory.
+  static constexpr std::uint64_t kBandwidthProbeBytes = std::uint64_t{256} << 20;
 
   static Expected<std::unique_ptr<GpuPassTimer>> Create(std::shared_ptr<VulkanContext> context,
                                                         std::filesystem::path shader_dir);
@@ -91,6 +105,13 @@ class GpuPassTimer {
   // The values the last pass wrote, one per pixel (for tests).
   Expected<std::vector<float>> ReadResults();
 
+  // The device's memory bandwidth: a copy of `bytes` (at most; fewer where
+  // the device binds or holds less, see the result) from one device-local
+  // storage buffer to another, timed as TimePasses times one variant. The
+  // buffers live for the call only. InvalidArgument when bytes is below
+  // 1 MiB or warmup or repetitions is 0.
+  Expected<BandwidthTiming> MeasureBandwidth(std::uint64_t bytes, std::uint32_t warmup, std::uint32_t repetitions);
+
  private:
   explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
   VkDevice vk_device() const { return context_->device(); }
@@ -103,13 +124,21 @@ class GpuPassTimer {
   void WriteDescriptors();
   // `passes` passes of `pipeline` with barriers between them.
   void RecordPasses(VkCommandBuffer commands, VkPipeline pipeline, std::uint32_t passes) const;
+  // Records `passes` passes of a pipeline of some compute pass.
+  using Recorder = std::function<void(VkCommandBuffer, VkPipeline, std::uint32_t)>;
   // A group: `passes` back-to-back passes of one pipeline.
   struct Group {
     VkPipeline pipeline;
     std::uint32_t passes;
   };
-  // Times the groups in order, in one submission; ns per pass per group.
-  Expected<std::vector<double>> TimeGroups(std::span<const Group> groups);
+  // Times the groups in order, in one submission of `pass`; ns per pass per
+  // group.
+  Expected<std::vector<double>> TimeGroups(ComputePass& pass, std::span<const Group> groups, const Recorder& record);
+  // The schedule of TimePasses (see the top of this file) for `pipelines`
+  // of `pass`, recorded by `record`.
+  Expected<std::vector<PassTiming>> TimeInterleaved(ComputePass& pass, std::span<const VkPipeline> pipelines,
+                                                    const Recorder& record, std::uint32_t warmup,
+                                                    std::uint32_t repetitions);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -11,6 +12,7 @@
 #include "bench/base/files.h"
 #include "bench/base/json_reader.h"
 #include "bench/results/results.h"
+#include "bench/speed/depth_image.h"
 
 namespace depthbench {
 
@@ -80,6 +82,41 @@ const GpuTiming* SpeedResults::FindGpu(const Cell& cell, Resolution resolution, 
   return nullptr;
 }
 
+std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::vector<GpuTiming>& timings) {
+  std::vector<MemoryFloor> floors;
+  const double bytes_per_ns = probe.bytes_per_second() * 1e-9;
+  if (!(bytes_per_ns > 0.0) || !std::isfinite(bytes_per_ns)) return floors;
+  for (const GpuTiming& t : timings) {
+    const bool known = std::any_of(floors.begin(), floors.end(), [&](const MemoryFloor& f) {
+      return f.format == t.cell.format && f.resolution == t.resolution;
+    });
+    if (known) continue;
+    MemoryFloor floor;
+    floor.format = t.cell.format;
+    floor.resolution = t.resolution;
+    // One reconstruction per pixel: its texel read (as Vulkan stores the
+    // format), one float32 written (shaders/speed/speed_pass.glsl).
+    floor.bytes_read_per_pixel = TexelBytes(t.cell.format);
+    floor.bytes_written_per_pixel = sizeof(float);
+    floor.ns_per_pass = t.pixels() * (floor.bytes_read_per_pixel + floor.bytes_written_per_pixel) / bytes_per_ns;
+    floors.push_back(floor);
+  }
+  return floors;
+}
+
+const MemoryFloor* SpeedResults::FindFloor(Format format, Resolution resolution) const {
+  for (const MemoryFloor& f : floors)
+    if (f.format == format && f.resolution == resolution) return &f;
+  return nullptr;
+}
+
+std::optional<double> SpeedResults::TimesFloor(const GpuTiming& timing) const {
+  if (timing.regime != Regime::kMemory) return std::nullopt;
+  const MemoryFloor* floor = FindFloor(timing.cell.format, timing.resolution);
+  if (floor == nullptr || !(floor->ns_per_pass > 0.0)) return std::nullopt;
+  return timing.ns_per_pass.median / floor->ns_per_pass;
+}
+
 const CpuCost* SpeedResults::FindCpu(const Cell& cell) const {
   for (const CpuCost& c : cpu)
     if (c.cell == cell) return &c;
@@ -144,12 +181,23 @@ json RunToJson(const SpeedRunInfo& run) {
           {"seconds", run.seconds}};
 }
 
+json BandwidthToJson(const BandwidthProbe& b) {
+  return {{"method", b.method},
+          {"bytes_read", b.bytes_read},
+          {"bytes_written", b.bytes_written},
+          {"ns_per_pass", SummaryToJson(b.ns_per_pass)},
+          {"repetitions_ns", b.repetitions_ns},
+          {"passes_per_repetition", b.passes_per_repetition},
+          {"warmup_passes", b.warmup_passes},
+          {"bytes_per_second", b.bytes_per_second()}};
+}
+
 }  // namespace
 
 json ToJson(const SpeedResults& results) {
   json gpu = json::array();
   for (const GpuTiming& t : results.gpu) {
-    gpu.push_back({{"cell", t.cell.Name()},
+    json timing = {{"cell", t.cell.Name()},
                    {"resolution", ResolutionName(t.resolution)},
                    {"regime", RegimeName(t.regime)},
                    {"taps", t.taps},
@@ -161,7 +209,21 @@ json ToJson(const SpeedResults& results) {
                    {"passes_per_repetition", t.passes_per_repetition},
                    {"warmup_passes", t.warmup_passes},
                    {"rank", t.rank},
-                   {"indistinguishable_from", VariantNames(t.indistinguishable_from)}});
+                   {"indistinguishable_from", VariantNames(t.indistinguishable_from)}};
+    // Memory-bound timings against their floor (derived; not read back).
+    if (const std::optional<double> times = results.TimesFloor(t)) {
+      timing["times_floor"] = *times;
+      timing["bandwidth_bound"] = *times <= kBandwidthBoundFactor;
+    }
+    gpu.push_back(std::move(timing));
+  }
+  json floors = json::array();
+  for (const MemoryFloor& f : results.floors) {
+    floors.push_back({{"format", Info(f.format).name},
+                      {"resolution", ResolutionName(f.resolution)},
+                      {"bytes_read_per_pixel", f.bytes_read_per_pixel},
+                      {"bytes_written_per_pixel", f.bytes_written_per_pixel},
+                      {"ns_per_pass", f.ns_per_pass}});
   }
   json static_costs = json::array();
   for (const StaticCost& s : results.static_costs) {
@@ -192,12 +254,16 @@ json ToJson(const SpeedResults& results) {
     trade.push_back(
         {{"convention", Info(front.convention).name}, {"format", Info(front.format).name}, {"points", points}});
   }
-  return WithSchema(kSpeedSchema, {{"run", RunToJson(results.run)},
-                                   {"gpu", gpu},
-                                   {"static", static_costs},
-                                   {"cpu", cpu},
-                                   {"trade", trade},
-                                   {"skipped", results.skipped}});
+  json document = {
+      {"run", RunToJson(results.run)}, {"gpu", gpu}, {"static", static_costs}, {"cpu", cpu}, {"trade", trade},
+      {"skipped", results.skipped}};
+  // Absent where no probe ran (files made before it), as a reader expects.
+  if (results.bandwidth) {
+    document["bandwidth"] = BandwidthToJson(*results.bandwidth);
+    document["memory_floor"] = floors;
+    document["bandwidth_bound_factor"] = kBandwidthBoundFactor;
+  }
+  return WithSchema(kSpeedSchema, std::move(document));
 }
 
 Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results) {
@@ -345,6 +411,41 @@ Expected<GpuTiming> ReadGpuTiming(const JsonReader& r) {
   return t;
 }
 
+Expected<BandwidthProbe> ReadBandwidth(const JsonReader& r) {
+  BandwidthProbe b;
+  DB_ASSIGN_OR_RETURN(b.method, r.String("method"));
+  DB_ASSIGN_OR_RETURN(b.bytes_read, r.Unsigned("bytes_read"));
+  DB_ASSIGN_OR_RETURN(b.bytes_written, r.Unsigned("bytes_written"));
+  if (b.bytes_read + b.bytes_written == 0) return r.Error("a bandwidth probe that moved no bytes");
+  DB_ASSIGN_OR_RETURN(JsonReader summary, r.Field("ns_per_pass"));
+  DB_ASSIGN_OR_RETURN(b.ns_per_pass, ReadSummary(summary));
+  if (!(b.ns_per_pass.median > 0.0)) return summary.Error("the median must be above 0 ns");
+  DB_RETURN_IF_ERROR(r.ForEach("repetitions_ns", [&](const JsonReader& element) -> Status {
+    DB_ASSIGN_OR_RETURN(const double ns, element.Number());
+    b.repetitions_ns.push_back(ns);
+    return Status::Ok();
+  }));
+  DB_ASSIGN_OR_RETURN(b.passes_per_repetition, ReadU32(r, "passes_per_repetition"));
+  DB_ASSIGN_OR_RETURN(b.warmup_passes, ReadU32(r, "warmup_passes"));
+  return b;
+}
+
+Expected<MemoryFloor> ReadFloor(const JsonReader& r) {
+  MemoryFloor f;
+  DB_ASSIGN_OR_RETURN(JsonReader format_field, r.Field("format"));
+  DB_ASSIGN_OR_RETURN(const std::string format, format_field.String());
+  Expected<Format> parsed = ParseFormat(format);
+  if (!parsed.ok()) return format_field.Error(parsed.status().message());
+  f.format = *parsed;
+  DB_ASSIGN_OR_RETURN(JsonReader resolution, r.Field("resolution"));
+  DB_ASSIGN_OR_RETURN(f.resolution, ReadResolution(resolution));
+  DB_ASSIGN_OR_RETURN(f.bytes_read_per_pixel, ReadU32(r, "bytes_read_per_pixel"));
+  DB_ASSIGN_OR_RETURN(f.bytes_written_per_pixel, ReadU32(r, "bytes_written_per_pixel"));
+  DB_ASSIGN_OR_RETURN(f.ns_per_pass, r.Number("ns_per_pass"));
+  if (!(f.ns_per_pass > 0.0) || !std::isfinite(f.ns_per_pass)) return r.Error("ns_per_pass must be above 0");
+  return f;
+}
+
 Expected<TradeFront> ReadFront(const JsonReader& r) {
   TradeFront front;
   DB_ASSIGN_OR_RETURN(JsonReader convention_field, r.Field("convention"));
@@ -387,6 +488,16 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
   SpeedResults results;
   DB_ASSIGN_OR_RETURN(JsonReader run, top.Field("run"));
   DB_ASSIGN_OR_RETURN(results.run, ReadRun(run));
+  // Files made before the bandwidth probe have neither part.
+  if (top.Has("bandwidth")) {
+    DB_ASSIGN_OR_RETURN(JsonReader bandwidth, top.Field("bandwidth"));
+    DB_ASSIGN_OR_RETURN(results.bandwidth, ReadBandwidth(bandwidth));
+    DB_RETURN_IF_ERROR(top.ForEach("memory_floor", [&](const JsonReader& r) -> Status {
+      DB_ASSIGN_OR_RETURN(MemoryFloor floor, ReadFloor(r));
+      results.floors.push_back(floor);
+      return Status::Ok();
+    }));
+  }
   DB_RETURN_IF_ERROR(top.ForEach("gpu", [&](const JsonReader& r) -> Status {
     DB_ASSIGN_OR_RETURN(GpuTiming timing, ReadGpuTiming(r));
     results.gpu.push_back(std::move(timing));

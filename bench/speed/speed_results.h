@@ -2,11 +2,14 @@
 // speed/accuracy trade made from it. Saved as versioned JSON (schema
 // "depthbench.speed", version 1) for the report and for `choose`. Results
 // are kept per device: every file names the device it was measured on,
-// and rankings of different devices are never mixed.
+// and rankings of different devices are never mixed. The bandwidth probe
+// and the memory-bound floors came later: files without them still read
+// (no floor is then known).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +64,40 @@ bool SameGroup(const GpuTiming& a, const GpuTiming& b);
 // and the variants it is indistinguishable from.
 void RankGpuTimings(std::vector<GpuTiming>& timings);
 
+// The device's memory bandwidth as the probe measured it
+// (GpuPassTimer::MeasureBandwidth): a copy between two device-local
+// buffers, timed as the passes are.
+struct BandwidthProbe {
+  std::string method;                               // what was copied, in words
+  std::uint64_t bytes_read = 0, bytes_written = 0;  // per pass
+  TimingSummary ns_per_pass;
+  std::vector<double> repetitions_ns;
+  std::uint32_t passes_per_repetition = 1;
+  std::uint32_t warmup_passes = 0;
+
+  // Bytes moved (read and written) per second, at the median.
+  double bytes_per_second() const { return static_cast<double>(bytes_read + bytes_written) / ns_per_pass.median * 1e9; }
+};
+
+// The memory-bound floor of a full-screen pass over one format at one
+// resolution: the bytes it must move, one reconstruction per pixel (the
+// texel read, the float written), over the measured bandwidth. No pass can
+// be faster without caches holding the image; a pass within
+// kBandwidthBoundFactor of it is bound by memory bandwidth.
+struct MemoryFloor {
+  Format format;
+  Resolution resolution{0, 0};
+  std::uint32_t bytes_read_per_pixel = 0, bytes_written_per_pixel = 0;
+  double ns_per_pass = 0.0;
+};
+// Within this factor of its floor, a memory-bound pass is said to be
+// bandwidth-bound: it moves its bytes at two thirds or more of the rate a
+// plain copy reaches on the device.
+inline constexpr double kBandwidthBoundFactor = 1.5;
+
+// The floors of every format and resolution of `timings`, from `probe`.
+std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::vector<GpuTiming>& timings);
+
 struct StaticCost {
   Variant variant;
   std::string function;  // the SPIR-V function counted, "<variant>_world_position"
@@ -111,6 +148,8 @@ struct SpeedRunInfo {
 
 struct SpeedResults {
   SpeedRunInfo run;
+  std::optional<BandwidthProbe> bandwidth;  // none in files made before the probe, or when it failed
+  std::vector<MemoryFloor> floors;          // per format and resolution timed; empty without a probe
   std::vector<GpuTiming> gpu;
   std::vector<StaticCost> static_costs;
   std::vector<CpuCost> cpu;
@@ -118,6 +157,10 @@ struct SpeedResults {
   std::vector<std::string> skipped;  // cells not timed on this device, with the reason
 
   const GpuTiming* FindGpu(const Cell& cell, Resolution resolution, Regime regime) const;
+  const MemoryFloor* FindFloor(Format format, Resolution resolution) const;
+  // A memory-bound timing's median over its floor; nullopt for an ALU-bound
+  // timing or where no floor is known.
+  std::optional<double> TimesFloor(const GpuTiming& timing) const;
   const CpuCost* FindCpu(const Cell& cell) const;
 };
 

@@ -157,6 +157,23 @@ Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path
   return costs;
 }
 
+Expected<BandwidthProbe> ProbeBandwidth(GpuPassTimer& timer, const SpeedOptions& options) {
+  DB_ASSIGN_OR_RETURN(const BandwidthTiming measured,
+                      timer.MeasureBandwidth(options.bandwidth_bytes, options.warmup, options.repetitions));
+  BandwidthProbe probe;
+  probe.method = fmt::format(
+      "a copy of {} MiB between two device-local storage buffers, 16 bytes per invocation "
+      "(shaders/speed/bandwidth.comp), timed as the passes are",
+      measured.bytes_read >> 20);
+  probe.bytes_read = measured.bytes_read;
+  probe.bytes_written = measured.bytes_written;
+  DB_ASSIGN_OR_RETURN(probe.ns_per_pass, SummarizeTimings(measured.timing.ns_per_pass));
+  probe.repetitions_ns = measured.timing.ns_per_pass;
+  probe.passes_per_repetition = measured.timing.passes_per_repetition;
+  probe.warmup_passes = measured.timing.warmup_passes;
+  return probe;
+}
+
 Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path& shader_dir,
                                 const SpeedOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -184,6 +201,20 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
 
   DB_ASSIGN_OR_RETURN(results.static_costs, MeasureStaticCosts(shader_dir, options.cells));
   DB_ASSIGN_OR_RETURN(results.gpu, TimeGpuPasses(timer, options, results.skipped));
+  if (!results.gpu.empty()) {
+    if (Interrupted()) return InterruptedError("no speed results written");
+    if (options.progress) options.progress(1, 1, "memory bandwidth");
+    Expected<BandwidthProbe> probe = ProbeBandwidth(timer, options);
+    if (probe.ok()) {
+      results.bandwidth = std::move(probe).value();
+      results.floors = MemoryFloors(*results.bandwidth, results.gpu);
+    } else if (probe.status().code() == StatusCode::kInterrupted) {
+      return probe.status();
+    } else {
+      // The timings stand without it; only the floors are missing.
+      results.skipped.push_back("memory-bound floors: the bandwidth probe failed: " + probe.status().message());
+    }
+  }
   if (options.progress) options.progress(1, 1, "CPU backend");
   // The CPU backend runs the built-in formulas alone.
   std::vector<Cell> cpu_cells;

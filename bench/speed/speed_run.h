@@ -26,6 +26,9 @@ struct SpeedOptions {
   std::uint32_t alu_taps = 16;  // reconstructions per pixel in the ALU-bound regime
   std::uint32_t warmup = 2;     // warm-up passes per measurement (at least; see gpu_pass_timer.h)
   std::uint32_t repetitions = 10;
+  // Bytes of each buffer of the bandwidth probe (GpuPassTimer::
+  // MeasureBandwidth), timed with the same warm-up and repetitions.
+  std::uint64_t bandwidth_bytes = GpuPassTimer::kBandwidthProbeBytes;
   // A cell whose format the device cannot sample: refused (true), or left
   // out and listed in SpeedResults::skipped (false).
   bool refuse_unsupported = false;
@@ -57,7 +60,13 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
 Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path& shader_dir,
                                                      std::span<const Cell> cells);
 
-// Everything but the trade, on `timer`'s device; run info filled in.
+// The device's memory bandwidth (GpuPassTimer::MeasureBandwidth) as the
+// results keep it.
+Expected<BandwidthProbe> ProbeBandwidth(GpuPassTimer& timer, const SpeedOptions& options);
+
+// Everything but the trade, on `timer`'s device; run info filled in; the
+// memory-bound floors from the bandwidth probe, or, where the probe could
+// not run, a line in SpeedResults::skipped saying why.
 Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path& shader_dir,
                                 const SpeedOptions& options);
 

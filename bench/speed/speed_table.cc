@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -44,61 +45,93 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
       "repetitions; ALU-bound regime: {} taps per pixel\n",
       run.timestamp_period_ns, run.timestamp_valid_bits, run.warmup, run.repetitions, run.alu_taps);
   out << "note: " << run.note << "\n";
+  if (const std::optional<BandwidthProbe>& b = results.bandwidth) {
+    out << fmt::format("memory bandwidth: {} GB/s ±{} (read and written; {}; median of {})\n",
+                       Readable(b->bytes_per_second() * 1e-9, 3),
+                       Readable(b->bytes_per_second() * 1e-9 * b->ns_per_pass.spread() / b->ns_per_pass.median, 2),
+                       b->method, b->ns_per_pass.count);
+  }
   out << "figures are medians ±spread (interquartile range); a rank is 1 + the variants of the same convention, "
          "format, resolution and regime that are faster by more than the spread; '=' marks a rank shared with "
          "an indistinguishable variant\n\n";
 }
 
 void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
-  std::vector<TextTable::Column> columns = {
-      {"variant", Align::kLeft}, {"convention", Align::kLeft}, {"format", Align::kLeft}};
-  for (const Resolution& r : results.run.resolutions) {
-    columns.push_back({fmt::format("{} µs/frame", ResolutionName(r))});
-    columns.push_back({"rank", Align::kRight, true});
-    columns.push_back({fmt::format("{} G recon/s", ResolutionName(r))});
-    columns.push_back({"rank", Align::kRight, true});
-  }
-  TextTable table(columns);
   std::vector<Cell> cells;
   for (const GpuTiming& t : results.gpu) {
     if (std::find(cells.begin(), cells.end(), t.cell) == cells.end()) cells.push_back(t.cell);
   }
-  Encoding previous{};
-  bool first = true;
-  for (const Cell& cell : cells) {
-    if (!first && cell.encoding() != previous) table.AddSeparator();
-    first = false;
-    previous = cell.encoding();
-    std::vector<std::string> row = {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
-                                    std::string(Info(cell.format).short_name)};
+  // One table per regime: the memory-bound one with each pass's floor
+  // beside it, the ALU-bound one in reconstructions per second.
+  for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
+    const bool memory = regime == Regime::kMemory;
+    std::vector<TextTable::Column> columns = {
+        {"variant", Align::kLeft}, {"convention", Align::kLeft}, {"format", Align::kLeft}};
     for (const Resolution& r : results.run.resolutions) {
-      for (const Regime regime : {Regime::kMemory, Regime::kAlu}) {
+      if (memory) {
+        columns.push_back({fmt::format("{} µs/frame", ResolutionName(r))});
+        columns.push_back({"floor"});
+        columns.push_back({"bound", Align::kLeft});
+      } else {
+        columns.push_back({fmt::format("{} G recon/s", ResolutionName(r))});
+      }
+      columns.push_back({"rank", Align::kRight, true});
+    }
+    TextTable table(columns);
+    Encoding previous{};
+    bool first = true;
+    for (const Cell& cell : cells) {
+      if (!first && cell.encoding() != previous) table.AddSeparator();
+      first = false;
+      previous = cell.encoding();
+      std::vector<std::string> row = {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
+                                      std::string(Info(cell.format).short_name)};
+      for (const Resolution& r : results.run.resolutions) {
         const GpuTiming* t = results.FindGpu(cell, r, regime);
         if (t == nullptr) {
-          row.insert(row.end(), {"-", "-"});
+          row.insert(row.end(), memory ? 4 : 2, "-");
           continue;
         }
-        // Memory-bound: a whole frame, one reconstruction per pixel, in
-        // microseconds. ALU-bound: reconstructions per second, 10^9 (the
-        // spread carried over to first order: d(1/x) = dx / x^2).
-        const double pixels = static_cast<double>(r.width) * r.height;
-        const double ns = t->ns_per_reconstruction(), spread = t->spread_ns_per_pixel() / t->taps;
-        row.push_back(regime == Regime::kMemory
-                          ? WithSpread(t->ns_per_pixel() * pixels * 1e-3, t->spread_ns_per_pixel() * pixels * 1e-3)
-                          : WithSpread(1.0 / ns, spread / (ns * ns)));
+        if (memory) {
+          // A whole frame, one reconstruction per pixel, in microseconds,
+          // beside the floor of its format and resolution.
+          row.push_back(WithSpread(t->ns_per_pass.median * 1e-3, t->ns_per_pass.spread() * 1e-3));
+          const MemoryFloor* floor = results.FindFloor(cell.format, r);
+          row.push_back(floor != nullptr ? Readable(floor->ns_per_pass * 1e-3, 3) : "-");
+          const std::optional<double> times = results.TimesFloor(*t);
+          row.push_back(!times                            ? "-"
+                        : *times <= kBandwidthBoundFactor ? "bandwidth"
+                                                          : fmt::format("{}x floor", Readable(*times, 2)));
+        } else {
+          // 10^9 reconstructions per second (the spread carried over to
+          // first order: d(1/x) = dx / x^2).
+          const double ns = t->ns_per_reconstruction(), spread = t->spread_ns_per_pixel() / t->taps;
+          row.push_back(WithSpread(1.0 / ns, spread / (ns * ns)));
+        }
         row.push_back(RankText(results, *t));
       }
+      table.AddRow(row);
     }
-    table.AddRow(row);
+    if (memory) {
+      out << "GPU time of a whole frame, memory-bound (one reconstruction per pixel: reading the depth image and "
+             "writing positions), in µs";
+      if (results.bandwidth) {
+        out << fmt::format(
+            "; floor: the least time the pass's bytes take at the device's measured bandwidth ({} GB/s, see "
+            "above): (bytes of a texel + 4 written) per pixel; bound: 'bandwidth' where the pass takes at most "
+            "{}x its floor (it is bound by memory bandwidth), else how many times its floor it takes (bound by "
+            "something else: arithmetic, latency, the texture path, or on a CPU device the code itself)\n",
+            Readable(results.bandwidth->bytes_per_second() * 1e-9, 3), Readable(kBandwidthBoundFactor, 2));
+      } else {
+        out << "; no floor: the device's bandwidth was not measured\n";
+      }
+    } else {
+      out << "Reconstructions per second when ALU-bound (" << results.run.alu_taps
+          << " per pixel), in 10^9: where the variants' arithmetic differs\n";
+    }
+    table.Print(out);
+    out << "\n";
   }
-  out << "GPU time of a whole frame, memory-bound (one reconstruction per pixel: reading the depth image "
-         "and writing positions), in µs; and reconstructions per second when ALU-bound ("
-      << results.run.alu_taps
-      << " per pixel), in 10^9. On a real GPU the memory-bound figures of all variants are "
-         "nearly equal: the pass is bound by memory bandwidth, not by the variant's arithmetic; the ALU-bound "
-         "figures are where variants differ\n";
-  table.Print(out);
-  out << "\n";
 }
 
 void PrintStaticTable(const SpeedResults& results, std::ostream& out) {

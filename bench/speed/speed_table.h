@@ -10,8 +10,10 @@ namespace depthbench {
 
 // Device, driver, timestamp period, settings, and what the figures mean.
 void PrintSpeedHeader(const SpeedResults& results, std::ostream& out);
-// One row per cell: per resolution, the memory-bound ns per pixel and the
-// ALU-bound ns per reconstruction, each with its spread and rank.
+// Two tables, one row per cell: per resolution, the memory-bound µs per
+// frame with its memory-bound floor and whether it is bandwidth-bound;
+// then the ALU-bound reconstructions per second; each with its spread and
+// rank.
 void PrintGpuTable(const SpeedResults& results, std::ostream& out);
 // One row per variant: the instruction mix of its reconstruction.
 void PrintStaticTable(const SpeedResults& results, std::ostream& out);
