@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"

@@ -244,7 +244,7 @@ json ToJson(const SpeedResults& results) {
                         {"gpu_ns_per_reconstruction", p.gpu_ns_per_reconstruction},
                         {"gpu_spread_ns", p.gpu_spread_ns},
                         {"gpu_memory_ns_per_pixel", p.gpu_memory_ns_per_pixel},
-                        {"cpu_ns_per_reconstruction", p.cpu_ns_per_reconstruction},
+                        {"cpu_ns_per_reconstruction", JsonNumber(p.cpu_ns_per_reconstruction)},
                         {"cpu_spread_ns", p.cpu_spread_ns},
                         {"p999_bits_lost", p.p999_bits_lost},
                         {"nonfinite", p.nonfinite},

@@ -7,8 +7,10 @@
 // (no floor is then known).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -110,12 +112,13 @@ struct TradePoint {
   double gpu_ns_per_reconstruction = 0.0;  // ALU-bound regime at the trade's resolution
   double gpu_spread_ns = 0.0;              // its spread, in the same unit
   double gpu_memory_ns_per_pixel = 0.0;    // memory-bound regime, for reference
-  double cpu_ns_per_reconstruction = 0.0;
+  double cpu_ns_per_reconstruction = std::numeric_limits<double>::quiet_NaN();  // NaN: not timed (a shader file)
   double cpu_spread_ns = 0.0;
   double p999_bits_lost = 0.0;  // total error, from the accuracy results
   std::uint64_t nonfinite = 0;  // NaN or Inf outputs in the accuracy results
   bool on_gpu_front = false;
   bool on_cpu_front = false;
+  bool has_cpu_cost() const { return !std::isnan(cpu_ns_per_reconstruction); }
 };
 
 struct TradeFront {

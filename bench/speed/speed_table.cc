@@ -192,7 +192,8 @@ void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
       table.AddRow({std::string(Info(front.convention).name), std::string(Info(front.format).short_name),
                     std::string(Info(p.variant).name), fmt::format("{:.1f}", p.p999_bits_lost),
                     WithSpread(p.gpu_ns_per_reconstruction * pixels * 1e-3, p.gpu_spread_ns * pixels * 1e-3),
-                    p.on_gpu_front ? "*" : "", WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns),
+                    p.on_gpu_front ? "*" : "",
+                    p.has_cpu_cost() ? WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns) : "-",
                     p.on_cpu_front ? "*" : "", fmt::format("{}", p.nonfinite)});
     }
   }

@@ -63,10 +63,8 @@ std::vector<TradeFront> BuildTrade(const SpeedResults& speed, const Results& acc
     const Cell& cell = alu.cell;
     const CellResult* errors = accuracy.Find(cell, backend);
     const CpuCost* cpu = speed.FindCpu(cell);
-    if (errors == nullptr || cpu == nullptr) {
-      left_out.push_back(
-          fmt::format("{}: no {} in the trade", cell.Name(),
-                      errors == nullptr ? "accuracy result of the " + backend + " backend" : std::string("CPU cost")));
+    if (errors == nullptr) {
+      left_out.push_back(fmt::format("{}: no accuracy result of the {} backend in the trade", cell.Name(), backend));
       continue;
     }
     TradePoint point;
@@ -76,8 +74,12 @@ std::vector<TradeFront> BuildTrade(const SpeedResults& speed, const Results& acc
     if (const GpuTiming* memory = speed.FindGpu(cell, resolution, Regime::kMemory)) {
       point.gpu_memory_ns_per_pixel = memory->ns_per_pixel();
     }
-    point.cpu_ns_per_reconstruction = cpu->ns_per_reconstruction.median;
-    point.cpu_spread_ns = cpu->ns_per_reconstruction.spread();
+    // A variant from a shader file has no CPU cost: it is on the GPU side
+    // of the trade alone.
+    if (cpu != nullptr) {
+      point.cpu_ns_per_reconstruction = cpu->ns_per_reconstruction.median;
+      point.cpu_spread_ns = cpu->ns_per_reconstruction.spread();
+    }
     const CellAccuracy cell_accuracy = AccuracyOf(errors->stats);
     point.p999_bits_lost = cell_accuracy.p999_bits_lost;
     point.nonfinite = cell_accuracy.nonfinite;
@@ -89,15 +91,17 @@ std::vector<TradeFront> BuildTrade(const SpeedResults& speed, const Results& acc
   std::vector<TradeFront> out;
   for (auto& [key, front] : fronts) {
     std::vector<FrontCandidate> gpu, cpu;
-    for (const TradePoint& p : front.points) {
+    std::vector<std::size_t> with_cpu;  // the points that have a CPU cost
+    for (std::size_t i = 0; i < front.points.size(); ++i) {
+      const TradePoint& p = front.points[i];
       gpu.push_back({p.gpu_ns_per_reconstruction, p.gpu_spread_ns, p.p999_bits_lost});
+      if (!p.has_cpu_cost()) continue;
       cpu.push_back({p.cpu_ns_per_reconstruction, p.cpu_spread_ns, p.p999_bits_lost});
+      with_cpu.push_back(i);
     }
     const std::vector<bool> on_gpu = ParetoFront(gpu), on_cpu = ParetoFront(cpu);
-    for (std::size_t i = 0; i < front.points.size(); ++i) {
-      front.points[i].on_gpu_front = on_gpu[i];
-      front.points[i].on_cpu_front = on_cpu[i];
-    }
+    for (std::size_t i = 0; i < front.points.size(); ++i) front.points[i].on_gpu_front = on_gpu[i];
+    for (std::size_t k = 0; k < with_cpu.size(); ++k) front.points[with_cpu[k]].on_cpu_front = on_cpu[k];
     out.push_back(std::move(front));
   }
   return out;
