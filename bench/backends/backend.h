@@ -66,6 +66,10 @@ struct BackendOptions {
   // device type: 8 and 8 on a CPU device, 1 and 1 on a GPU.
   std::uint32_t samples_per_invocation = 0;
   std::uint32_t frames_per_workgroup = 0;
+  // Vulkan: ArithmeticProbe bits (backends/vulkan/arithmetic_probe.h)
+  // applied to every compiled shader; the backend is then named
+  // "vulkan:<probes>".
+  std::uint32_t arithmetic_probes = 0;
 };
 
 }  // namespace depthbench

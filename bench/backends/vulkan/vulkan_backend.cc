@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/backends/vulkan/arithmetic_probe.h"
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/backends/vulkan/variant_program.h"
@@ -191,7 +192,9 @@ class VulkanBackend final : public Backend {
   static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
                                                    const BackendOptions& options);
 
-  std::string name() const override { return "vulkan"; }
+  std::string name() const override {
+    return options_.arithmetic_probes == 0 ? "vulkan" : "vulkan:" + ArithmeticProbesName(options_.arithmetic_probes);
+  }
   const DeviceInfo& device() const override { return device_; }
   ProgramInfo program() const override { return program_; }
   // One command buffer, one fence and one set of buffers: one Run at a time.
@@ -251,6 +254,10 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
   if (context == nullptr) return InvalidArgument("the Vulkan backend needs a Vulkan context");
   std::filesystem::path shader_dir = options.shader_dir;
   if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
+  if ((options.arithmetic_probes & kExactDivision) != 0 && !context->shader_float64()) {
+    return Unavailable(fmt::format("the exact-division probe divides in float64, which Vulkan device '{}' lacks",
+                                   context->properties().name));
+  }
   std::unique_ptr<VulkanBackend> backend(new VulkanBackend(std::move(context), std::move(shader_dir), options));
   const ValidationScope validation(*backend->context_);
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
@@ -283,7 +290,10 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
     DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape, sources));
   }
   pipelines_ = std::move(pipelines);
-  program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir, SourcesHash(sources)};
+  // The probes change the program as much as an edit would.
+  const std::string probes = ArithmeticProbesName(options_.arithmetic_probes);
+  program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir,
+              SourcesHash(sources) + (probes.empty() ? "" : " " + probes)};
   shape_ = shape;
   cells_.assign(cells.begin(), cells.end());
   return Status::Ok();
@@ -308,8 +318,10 @@ std::uint64_t VulkanBackend::MaxBatchSamples() const {
 
 Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape,
                                                                 std::vector<std::string>& sources) const {
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compiled,
                       CompileVariant(variant, VariantPass::kAccuracy, shader_dir_, &sources));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
+                      ApplyArithmeticProbes(compiled, options_.arithmetic_probes));
   const std::array<VkSpecializationMapEntry, 3> entries = {
       VkSpecializationMapEntry{kWorkgroupSizeConstant, offsetof(PassShape, workgroup_size), sizeof(std::uint32_t)},
       VkSpecializationMapEntry{kSamplesPerInvocationConstant, offsetof(PassShape, samples_per_invocation),

@@ -403,6 +403,14 @@ Status VulkanContext::CreateDevice() {
   device_info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   device_info.queueCreateInfoCount = 1;
   device_info.pQueueCreateInfos = &queue_info;
+  // float64 arithmetic, where the device has it: the exact-division probe
+  // (arithmetic_probe.h) divides in float64.
+  VkPhysicalDeviceFeatures supported{};
+  vkGetPhysicalDeviceFeatures(physical_device_, &supported);
+  VkPhysicalDeviceFeatures enabled{};
+  enabled.shaderFloat64 = supported.shaderFloat64;
+  shader_float64_ = supported.shaderFloat64 == VK_TRUE;
+  device_info.pEnabledFeatures = &enabled;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateDevice(physical_device_, &device_info, nullptr, &device_), "vkCreateDevice"));
   vkGetDeviceQueue(device_, properties_.queue_family, 0, &queue_);
 

@@ -175,6 +175,8 @@ class VulkanContext {
   VkQueue queue() const { return queue_; }
   VkCommandPool command_pool() const { return command_pool_; }
   const VulkanDeviceProperties& properties() const { return properties_; }
+  // Whether shaders may use float64 (enabled wherever the device has it).
+  bool shader_float64() const { return shader_float64_; }
 
   bool validation_enabled() const { return validation_enabled_; }
   // The validation layer's warnings and errors since the last call.
@@ -204,6 +206,7 @@ class VulkanContext {
   VkPhysicalDeviceMemoryProperties memory_properties_{};
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
+  bool shader_float64_ = false;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
 };
 

@@ -1,0 +1,41 @@
+// Probes of a GPU's float32 arithmetic: rewrites of a compiled SPIR-V
+// module that take one freedom away from the driver's compiler, so that a
+// run with and without the rewrite measures what that freedom costs.
+//
+//   no-contraction: every floating-point arithmetic result is decorated
+//     NoContraction (what GLSL's `precise` does), so a multiply and an add
+//     stay two roundings instead of becoming one fused multiply-add;
+//   exact-division: every float32 division becomes a float64 division of
+//     the widened operands, rounded once to float32: the correctly rounded
+//     quotient (Vulkan lets a float32 division be off by 2.5 ulp; a float64
+//     quotient rounded to float32 is wrong only when the exact quotient lies
+//     within about 2^-29 ulp of a rounding midpoint).
+//
+// The Vulkan backend applies them when its name says so
+// ("vulkan:no-contraction", "vulkan:exact-division", or both joined by '+').
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/base/status.h"
+
+namespace depthbench {
+
+enum ArithmeticProbe : std::uint32_t {
+  kNoContraction = 1u << 0,
+  kExactDivision = 1u << 1,
+};
+
+// "no-contraction+exact-division" <-> bits; "" for none.
+Expected<std::uint32_t> ParseArithmeticProbes(std::string_view text);
+std::string ArithmeticProbesName(std::uint32_t probes);
+
+// The module with the probes applied. InvalidArgument when the words are not
+// a SPIR-V module.
+Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::uint32_t> spirv, std::uint32_t probes);
+
+}  // namespace depthbench
