@@ -268,21 +268,30 @@ Status GpuPassTimer::CreateResultBuffer(VkDeviceSize bytes) {
   result_buffer_.Reset();
   result_memory_.Reset();
   result_bytes_ = 0;
+  DB_ASSIGN_OR_RETURN(BoundBuffer bound,
+                      CreateBoundBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  result_memory_ = std::move(bound.memory);
+  result_buffer_ = std::move(bound.buffer);
+  result_bytes_ = bytes;
+  return Status::Ok();
+}
+
+Expected<GpuPassTimer::BoundBuffer> GpuPassTimer::CreateBoundBuffer(VkDeviceSize bytes,
+                                                                    VkBufferUsageFlags usage) const {
   VkBufferCreateInfo buffer_info{};
   buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   buffer_info.size = bytes;
-  buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  buffer_info.usage = usage;
   buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   VkBuffer handle = VK_NULL_HANDLE;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateBuffer(vk_device(), &buffer_info, nullptr, &handle), "vkCreateBuffer"));
-  DeviceObject<VkBuffer> buffer(vk_device(), handle, vkDestroyBuffer);
+  BoundBuffer bound;
+  bound.buffer = DeviceObject<VkBuffer>(vk_device(), handle, vkDestroyBuffer);
   VkMemoryRequirements requirements{};
   vkGetBufferMemoryRequirements(vk_device(), handle, &requirements);
-  DB_ASSIGN_OR_RETURN(result_memory_, AllocateDeviceLocal(requirements));
-  DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, result_memory_.get(), 0), "vkBindBufferMemory"));
-  result_buffer_ = std::move(buffer);
-  result_bytes_ = bytes;
-  return Status::Ok();
+  DB_ASSIGN_OR_RETURN(bound.memory, AllocateDeviceLocal(requirements));
+  DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, bound.memory.get(), 0), "vkBindBufferMemory"));
+  return bound;
 }
 
 void GpuPassTimer::WriteDescriptors() {
@@ -536,26 +545,14 @@ Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, st
   DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
                       probe->CreatePipeline(spirv, VkSpecializationInfo{}, "the bandwidth probe"));
 
-  // The two buffers; each buffer before its memory, so that it goes first.
-  DeviceObject<VkDeviceMemory> memories[2];
-  DeviceObject<VkBuffer> buffers[2];
-  for (int b = 0; b < 2; ++b) {
-    VkBufferCreateInfo buffer_info{};
-    buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-    buffer_info.size = size;
-    buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    VkBuffer handle = VK_NULL_HANDLE;
-    DB_RETURN_IF_ERROR(CheckVk(vkCreateBuffer(vk_device(), &buffer_info, nullptr, &handle), "vkCreateBuffer"));
-    DeviceObject<VkBuffer> buffer(vk_device(), handle, vkDestroyBuffer);
-    VkMemoryRequirements requirements{};
-    vkGetBufferMemoryRequirements(vk_device(), handle, &requirements);
-    DB_ASSIGN_OR_RETURN(memories[b], AllocateDeviceLocal(requirements));
-    DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, memories[b].get(), 0), "vkBindBufferMemory"));
-    buffers[b] = std::move(buffer);
+  // The source and the destination.
+  BoundBuffer bound[2];
+  for (BoundBuffer& b : bound) {
+    DB_ASSIGN_OR_RETURN(b,
+                        CreateBoundBuffer(size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT));
   }
-  const VkDescriptorBufferInfo source_info{buffers[0].get(), 0, size};
-  const VkDescriptorBufferInfo destination_info{buffers[1].get(), 0, size};
+  const VkDescriptorBufferInfo source_info{bound[0].buffer.get(), 0, size};
+  const VkDescriptorBufferInfo destination_info{bound[1].buffer.get(), 0, size};
   std::array<VkWriteDescriptorSet, 2> writes{};
   writes[0].dstBinding = kProbeSourceBinding;
   writes[0].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -566,7 +563,7 @@ Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, st
   probe->WriteDescriptors(writes);
   // Defined contents to copy (a device may skip pages never written).
   DB_RETURN_IF_ERROR(probe->Submit([&](VkCommandBuffer commands) {
-    vkCmdFillBuffer(commands, buffers[0].get(), 0, size, 0x3f800000u);
+    vkCmdFillBuffer(commands, bound[0].buffer.get(), 0, size, 0x3f800000u);
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }));

@@ -119,6 +119,13 @@ class GpuPassTimer {
   Status CreateSampler();
   Expected<VkPipeline> Pipeline(Variant variant, Convention convention, std::uint32_t taps);
   Expected<DeviceObject<VkDeviceMemory>> AllocateDeviceLocal(const VkMemoryRequirements& requirements) const;
+  // A buffer of `bytes` in device-local memory, bound to it; the buffer is
+  // declared after its memory, so that it is destroyed first.
+  struct BoundBuffer {
+    DeviceObject<VkDeviceMemory> memory;
+    DeviceObject<VkBuffer> buffer;
+  };
+  Expected<BoundBuffer> CreateBoundBuffer(VkDeviceSize bytes, VkBufferUsageFlags usage) const;
   Status CreateImage(const DepthImage& image);
   Status CreateResultBuffer(VkDeviceSize bytes);
   void WriteDescriptors();
