@@ -163,9 +163,12 @@ Expected<std::vector<Cell>> CellFlags::Select() const {
 }
 
 void BackendFlags::Add(CLI::App& app, bool allow_several) {
-  auto* option =
-      app.add_option("--backend", backends,
-                     allow_several ? "backends to run: cpu, vulkan (default both)" : "backend to run: cpu or vulkan");
+  auto* option = app.add_option(
+      "--backend", backends,
+      allow_several ? "backends to run: cpu, vulkan (default both); vulkan:no-contraction, vulkan:exact-division "
+                      "or vulkan:no-contraction+exact-division run the Vulkan backend with fused "
+                      "multiply-adds forbidden or divisions correctly rounded (reports/gpu-probes)"
+                    : "backend to run: cpu or vulkan");
   option->delimiter(',')->group("Backends");
   if (!allow_several) option->expected(1);
   backend_option = option;
