@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "bench/backends/factory.h"
+#include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/stats.h"
@@ -170,6 +171,21 @@ TEST_F(VariantFileTest, SubtractFirstExampleBeatsDivideNearTheFarPlane) {
   EXPECT_GT(divide_shader, 12.0);
   EXPECT_LT(edit_shader, divide_shader - 8.0);
   EXPECT_LE(bits(options.cells[1], Metric::kTotal), bits(options.cells[0], Metric::kTotal));
+}
+
+TEST_F(VariantFileTest, CompileErrorsNameTheUsersLineAndNothingGenerated) {
+  // A missing ';' on line 2 makes glslang stumble again in the generated
+  // lines after the user's file; that follow-on message is left out.
+  const std::string path = WriteShader(
+      "broken.hlsl",
+      "// depthbench: input=hardware\nfloat3 reconstruct(float2 uv, float depth) { return float3(uv, depth) }\n");
+  auto variant = RegisterVariantFile(path);
+  ASSERT_TRUE(variant.ok()) << variant.status().message();
+  auto compiled = CompileVariant(*variant, VariantPass::kAccuracy, fs::path(DEPTHBENCH_SOURCE_DIR) / "shaders");
+  ASSERT_FALSE(compiled.ok());
+  const std::string& message = compiled.status().message();
+  EXPECT_NE(message.find("broken.hlsl:2: error:"), std::string::npos) << message;
+  EXPECT_EQ(message.find("program>"), std::string::npos) << message;
 }
 
 TEST_F(VariantFileTest, CpuBackendSaysItCannotRunAShaderFile) {

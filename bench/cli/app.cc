@@ -158,7 +158,7 @@ void CheckWholeNumbers(CLI::App& app) {
 // command looks a variant up.
 std::vector<std::string> g_variant_files;
 void AddVariantFileOption(CLI::App& app) {
-  for (const char* name : {"run", "fit", "gate", "choose", "speed", "report"}) {
+  for (const char* name : {"list", "run", "fit", "gate", "choose", "speed", "report"}) {
     app.get_subcommand(name)
         ->add_option("--variant-file", g_variant_files,
                      "a reconstruction function of your own, in GLSL (.glsl) or HLSL (.hlsl), run as one more "

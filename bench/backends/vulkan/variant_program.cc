@@ -50,8 +50,24 @@ Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass
   const UserShader* user = Info(variant).user;
   if (user == nullptr) return CompileComputeShader(BuiltInProgram(variant, pass, shader_dir), sources);
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
-  return CompileComputeSource(UserProgram(*user, pass, dir), VariantProgramName(variant, pass, shader_dir), dir,
-                              user->language, sources);
+  const std::string program = VariantProgramName(variant, pass, shader_dir);
+  Expected<std::vector<std::uint32_t>> compiled =
+      CompileComputeSource(UserProgram(*user, pass, dir), program, dir, user->language, sources);
+  if (compiled.ok() || compiled.status().code() != StatusCode::kCompileError) return compiled;
+  // A mistake in the user's file often makes the parser stumble again in
+  // the generated lines after it: those follow-on messages only confuse.
+  const std::string& log = compiled.status().message();
+  if (log.find(user->path.string() + ":") == std::string::npos) return compiled;
+  std::string kept;
+  std::size_t begin = 0;
+  while (begin < log.size()) {
+    const std::size_t end = std::min(log.find('\n', begin), log.size());
+    const std::string_view line(log.data() + begin, end - begin);
+    if (!line.starts_with(program + ":")) kept += std::string(line) + "\n";
+    begin = end + 1;
+  }
+  if (!kept.empty()) kept.pop_back();
+  return CompileError(kept);
 }
 
 }  // namespace depthbench
