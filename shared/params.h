@@ -38,12 +38,14 @@ struct FrameParams {
   vec4 eye_ray_world_origin;  // the eye-ray post 2011: the same ray rotated by the inverse view matrix
   vec4 eye_ray_world_du;
   vec4 eye_ray_world_dv;
+  mat4 world_view;  // world space -> view space (the view matrix): the raster pipeline's light volumes
 };
 
 // What one depth convention adds to a frame: the mapping between eye depth
 // z (= -view.z > 0) and NDC depth, which is  ndc_z = A + B / z.
 struct DepthParams {
   mat4 inverse_view_projection;  // Unity URP: NDC (x, y, ndc_z, 1) -> homogeneous world position
+  mat4 view_projection;          // world position -> clip space: what the raster pipeline draws with
   vec4 coefficients;             // x: A, y: B, z: P = 1/B, w: Q = -A/B (the engine shader notes)
   uint convention;               // DB_CONVENTION_* bits
   uint reserved0;
@@ -66,6 +68,18 @@ struct PassConstants {
   uint first_cell;      // the dispatch's first entry in the CellSlice buffer
   uint reserved0;
   uint reserved1;
+};
+
+// The geometry the raster pipeline draws for one sample
+// (bench/pipeline/raster_model.h): a small triangle facing the camera
+// through the sample's point, which produces its depth, and a light volume
+// around the point, which the bounding-volume ray variant draws. A sample
+// with nothing to draw has all four zero (no area, no coverage).
+struct RasterSample {
+  vec4 triangle0;  // xyz: a world-space corner, float32 as a vertex buffer holds it; w: 1
+  vec4 triangle1;
+  vec4 triangle2;
+  vec4 volume;  // xyz: world-space centre of an axis-aligned cube around the point; w: half its edge
 };
 
 // Where one cell's inputs and outputs lie in the batch's buffers.

@@ -26,11 +26,13 @@ layout(std430, binding = 0) buffer FrameBlock { FrameParams frame; uint frame_en
 layout(std430, binding = 1) buffer DepthBlock { DepthParams depth; uint depth_end; };
 layout(std430, binding = 2) buffer PassBlock { PassConstants pass; uint pass_end; };
 layout(std430, binding = 3) buffer CellBlock { CellSlice cell; uint cell_end; };
+layout(std430, binding = 4) buffer RasterBlock { RasterSample raster; uint raster_end; };
 void main() {
   frame_end = 0u;
   depth_end = 0u;
   pass_end = 0u;
   cell_end = 0u;
+  raster_end = 0u;
 }
 )";
 
@@ -79,18 +81,20 @@ TEST_F(LayoutTest, FrameParamsMatchesStd430) {
   EXPECT_MEMBER_AT(frame, FrameParams, eye_ray_world_origin);
   EXPECT_MEMBER_AT(frame, FrameParams, eye_ray_world_du);
   EXPECT_MEMBER_AT(frame, FrameParams, eye_ray_world_dv);
-  EXPECT_EQ(MembersOf("frame"), 16) << "a FrameParams member is not listed above";
+  EXPECT_MEMBER_AT(frame, FrameParams, world_view);
+  EXPECT_EQ(MembersOf("frame"), 17) << "a FrameParams member is not listed above";
   EXPECT_EQ(Offset("frame_end"), static_cast<int>(sizeof(f32::FrameParams)));
 }
 
 TEST_F(LayoutTest, DepthParamsMatchesStd430) {
   EXPECT_MEMBER_AT(depth, DepthParams, inverse_view_projection);
+  EXPECT_MEMBER_AT(depth, DepthParams, view_projection);
   EXPECT_MEMBER_AT(depth, DepthParams, coefficients);
   EXPECT_MEMBER_AT(depth, DepthParams, convention);
   EXPECT_MEMBER_AT(depth, DepthParams, reserved0);
   EXPECT_MEMBER_AT(depth, DepthParams, reserved1);
   EXPECT_MEMBER_AT(depth, DepthParams, reserved2);
-  EXPECT_EQ(MembersOf("depth"), 6) << "a DepthParams member is not listed above";
+  EXPECT_EQ(MembersOf("depth"), 7) << "a DepthParams member is not listed above";
   EXPECT_EQ(Offset("depth_end"), static_cast<int>(sizeof(f32::DepthParams)));
 }
 
@@ -114,6 +118,15 @@ TEST_F(LayoutTest, CellSliceMatchesStd430) {
   EXPECT_MEMBER_AT(cell, CellSlice, reserved);
   EXPECT_EQ(MembersOf("cell"), 4) << "a CellSlice member is not listed above";
   EXPECT_EQ(Offset("cell_end"), static_cast<int>(sizeof(f32::CellSlice)));
+}
+
+TEST_F(LayoutTest, RasterSampleMatchesStd430) {
+  EXPECT_MEMBER_AT(raster, RasterSample, triangle0);
+  EXPECT_MEMBER_AT(raster, RasterSample, triangle1);
+  EXPECT_MEMBER_AT(raster, RasterSample, triangle2);
+  EXPECT_MEMBER_AT(raster, RasterSample, volume);
+  EXPECT_EQ(MembersOf("raster"), 4) << "a RasterSample member is not listed above";
+  EXPECT_EQ(Offset("raster_end"), static_cast<int>(sizeof(f32::RasterSample)));
 }
 
 }  // namespace

@@ -8,10 +8,11 @@
 //      backend compiles the shaders and builds pipelines here);
 //   3. Run(batch, which, scratch) any number of times: the listed cells'
 //      world positions for every sample of the batch.
-// Every backend today runs the compute form (the rasterizer's interpolation
-// computed per pixel); PassKind leaves room for a raster mode that draws
-// real vertex/fragment passes, and for an on-device mode that samples and
-// judges on the GPU, without changing this interface's callers.
+// PassKind picks the form: compute (the rasterizer's interpolation computed
+// per pixel from the frame's constants, the stored depths as the batch
+// gives them) or raster (the batch's RasterSample geometry drawn: depth
+// produced by a rasterizer into a real depth or G-buffer target, fetched
+// by texel, rays interpolated from the vertex stage).
 #pragma once
 
 #include <cstdint>
@@ -26,7 +27,21 @@
 
 namespace depthbench {
 
-enum class PassKind { kCompute };
+enum class PassKind { kCompute, kRaster };
+// The raster production model is produced by the raster form.
+inline PassKind PassKindOf(ProductionModel production) {
+  return production == ProductionModel::kRaster ? PassKind::kRaster : PassKind::kCompute;
+}
+
+// How the depths a raster backend produced compare with the batch's (the
+// host's model of a rasterizer, bench/pipeline/raster_model.h), over the
+// samples that have geometry, since Prepare: one per depth slot.
+struct RasterAgreement {
+  std::uint64_t texels = 0;     // samples with geometry
+  std::uint64_t differing = 0;  // whose texel bits differ from the batch's code
+  std::uint64_t uncovered = 0;  // that the device left uncovered (nothing written)
+  std::uint32_t max_code_distance = 0;  // the largest |device code - batch code| (ulps for float formats)
+};
 
 class Backend {
  public:
@@ -38,6 +53,9 @@ class Backend {
   virtual ProgramInfo program() const = 0;
 
   virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
+  // Raster backends that produce their own depths: how those agreed with
+  // the batch's, per depth slot of the prepared cells (empty otherwise).
+  virtual std::vector<RasterAgreement> raster_agreement() const { return {}; }
 
   // World positions of the prepared cells listed in `which` (indices into
   // Prepare's list) for every sample of `batch`, component by component:

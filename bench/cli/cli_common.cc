@@ -52,6 +52,14 @@ void DomainFlags::Add(CLI::App& app) {
                  "an engine uploads) or exact (the exact depth rounded once: the formats and variants alone)")
       ->type_name("MODEL")
       ->group("Domain");
+  app.add_option("--pipeline", pipeline,
+                 "compute (default: a compute shader reads the stored depths the host produced, and computes the "
+                 "interpolated rays per pixel) or raster (a graphics pipeline draws geometry through every sample's "
+                 "point into a real depth or G-buffer target with the float32 view-projection matrix, then a "
+                 "full-screen or light-volume pass fetches the texel and gets its rays from the vertex stage; on "
+                 "the CPU backend, the host's model of the same)")
+      ->type_name("PIPELINE")
+      ->group("Domain");
   app.add_option("--constants", constants,
                  "how the per-frame shader constants are computed: exact (default: exactly, rounded once to "
                  "float32) or float32 (as an engine does: float32 view and projection matrices, their product and "
@@ -76,13 +84,23 @@ Expected<Domain> DomainFlags::Apply(Domain d) const {
   if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain), d));
   const bool narrowed =
       !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() && camera_distance.empty() &&
-        eye_depth.empty() && resolution.empty() && production.empty() && constants.empty());
+        eye_depth.empty() && resolution.empty() && production.empty() && constants.empty() && pipeline.empty());
   if (narrowed) d.name += " (narrowed)";
   if (!production.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseProductionModel(production), d.production).WithContext("--production"));
   }
   if (!constants.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseConstantsModel(constants), d.constants).WithContext("--constants"));
+  }
+  if (pipeline == "raster") {
+    if (!production.empty() && d.production != ProductionModel::kRaster) {
+      return InvalidArgument("--pipeline raster produces depth as the rasterizer does; it takes no --production");
+    }
+    d.production = ProductionModel::kRaster;
+  } else if (pipeline == "compute") {
+    if (d.production == ProductionModel::kRaster) d.production = ProductionModel::kFloat32;
+  } else if (!pipeline.empty()) {
+    return InvalidArgument(fmt::format("--pipeline: '{}' is not one of compute, raster", pipeline));
   }
   if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");

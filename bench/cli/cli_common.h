@@ -32,7 +32,7 @@ inline constexpr const char* kDomainHelp =
 
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
-  std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants;
+  std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;
   void Add(CLI::App& app);
   // The domain --domain names (or `base`), narrowed by the range flags.
   Expected<Domain> Apply(Domain base) const;

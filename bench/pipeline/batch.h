@@ -27,7 +27,6 @@ struct Batch : ShaderInputs {
   std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
   SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
   ReferenceArrays reference;                 // [depth slot * count + sample]
-  std::vector<std::uint32_t> codes;          // [depth slot * count + sample]: stored texel bits
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 };

@@ -97,13 +97,19 @@ Status ParseRatioInto(std::string_view text, Domain& domain) {
 }
 
 const char* ProductionModelName(ProductionModel model) {
-  return model == ProductionModel::kExact ? "exact" : "float32";
+  switch (model) {
+    case ProductionModel::kExact: return "exact";
+    case ProductionModel::kRaster: return "raster";
+    case ProductionModel::kFloat32: break;
+  }
+  return "float32";
 }
 
 Expected<ProductionModel> ParseProductionModel(std::string_view name) {
   if (name == "float32") return ProductionModel::kFloat32;
   if (name == "exact") return ProductionModel::kExact;
-  return InvalidArgument(fmt::format("production model '{}' is not one of float32, exact", name));
+  if (name == "raster") return ProductionModel::kRaster;
+  return InvalidArgument(fmt::format("production model '{}' is not one of float32, exact, raster", name));
 }
 
 const char* ConstantsModelName(ConstantsModel model) { return model == ConstantsModel::kFloat32 ? "float32" : "exact"; }
@@ -215,8 +221,11 @@ std::string Domain::ToFlags() const {
       sizes += fmt::format("{}{}x{}", sizes.empty() ? "" : ",", r.width, r.height);
     flags += " --resolution " + sizes;
   }
-  if (production != ProductionModel::kFloat32)
+  if (production == ProductionModel::kRaster) {
+    flags += " --pipeline raster";
+  } else if (production != ProductionModel::kFloat32) {
     flags += fmt::format(" --production {}", ProductionModelName(production));
+  }
   if (constants != ConstantsModel::kExact) flags += fmt::format(" --constants {}", ConstantsModelName(constants));
   return flags;
 }

@@ -52,9 +52,14 @@ struct Resolution {
 //             transform;
 //   kExact    the exact value, correctly rounded to float32 once: the best
 //             any pipeline could do, to measure the formats and the
-//             variants alone.
-enum class ProductionModel : std::uint8_t { kFloat32, kExact };
-const char* ProductionModelName(ProductionModel model);  // "float32", "exact"
+//             variants alone;
+//   kRaster   the raster pipeline (`--pipeline raster`): geometry through
+//             the sample's point drawn with the float32 view-projection
+//             matrix, the depth a rasterizer interpolates at the pixel
+//             centre (bench/pipeline/raster_model.h models it on the host;
+//             a raster backend renders its own). Decoded like kFloat32.
+enum class ProductionModel : std::uint8_t { kFloat32, kExact, kRaster };
+const char* ProductionModelName(ProductionModel model);  // "float32", "exact", "raster"
 Expected<ProductionModel> ParseProductionModel(std::string_view name);
 
 // How the per-frame constants the shaders receive (shared/params.h:

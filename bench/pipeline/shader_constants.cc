@@ -53,6 +53,14 @@ Params FrameParamsIn(const Frame& frame) {
   }
   p.camera_world[3] = Vec4(Real(c.x), Real(c.y), Real(c.z), Real(1.0));
   p.camera_position = Vec4(Real(c.x), Real(c.y), Real(c.z), far);
+  // The view matrix: the transposed rotation, and -dot(axis, eye) per row.
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 0; k < 3; ++k) p.world_view[k][axis] = Real(r[axis][k]);
+    p.world_view[3][axis] =
+        -(Real(r[axis][0]) * Real(c.x) + Real(r[axis][1]) * Real(c.y) + Real(r[axis][2]) * Real(c.z));
+    p.world_view[axis][3] = Real(0.0);
+  }
+  p.world_view[3][3] = Real(1.0);
   p.lens = Vec4(tan_x, tan_y, Real(1.0) / tan_x, Real(1.0) / tan_y);
   p.resolution =
       Vec4(Real(frame.width), Real(frame.height), Real(1.0) / Real(frame.width), Real(1.0) / Real(frame.height));
@@ -109,6 +117,14 @@ hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, C
   inverse_projection[2] = hp::vec4(zero, zero, zero, d.coefficients.z);
   inverse_projection[3] = hp::vec4(zero, zero, DD(-1.0), d.coefficients.w);
   d.inverse_view_projection = f.camera_world * inverse_projection;
+  // The projection itself (EngineProjectionMatrix's layout), times the view.
+  hp::mat4 projection(zero);
+  projection[0][0] = f.lens.z;
+  projection[1][1] = f.lens.w;
+  projection[2][2] = -a;
+  projection[2][3] = DD(-1.0);
+  projection[3][2] = b;
+  d.view_projection = projection * f.world_view;
   return d;
 }
 
@@ -130,12 +146,14 @@ f32::FrameParams RoundToFloat(const hp::FrameParams& p) {
   o.eye_ray_world_origin = Round(p.eye_ray_world_origin);
   o.eye_ray_world_du = Round(p.eye_ray_world_du);
   o.eye_ray_world_dv = Round(p.eye_ray_world_dv);
+  o.world_view = Round(p.world_view);
   return o;
 }
 
 f32::DepthParams RoundToFloat(const hp::DepthParams& p) {
   f32::DepthParams o;
   o.inverse_view_projection = Round(p.inverse_view_projection);
+  o.view_projection = Round(p.view_projection);
   o.coefficients = Round(p.coefficients);
   o.convention = p.convention;
   o.reserved0 = o.reserved1 = o.reserved2 = 0;
@@ -171,13 +189,18 @@ glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention) {
   return projection;
 }
 
-f32::FrameParams EngineFrameParams(const Frame& frame) { return FrameParamsIn<f32::FrameParams>(frame); }
+f32::FrameParams EngineFrameParams(const Frame& frame) {
+  f32::FrameParams p = FrameParamsIn<f32::FrameParams>(frame);
+  p.world_view = EngineViewMatrix(frame);
+  return p;
+}
 
 f32::DepthParams EngineDepthParams(const Frame& frame, Convention convention) {
   const glm::mat4 projection = EngineProjectionMatrix(frame, convention);
   const float a = -projection[2][2], b = projection[3][2];
   f32::DepthParams d;
-  d.inverse_view_projection = glm::inverse(projection * EngineViewMatrix(frame));
+  d.view_projection = projection * EngineViewMatrix(frame);
+  d.inverse_view_projection = glm::inverse(d.view_projection);
   d.coefficients = glm::vec4(a, b, 1.0f / b, -a / b);
   d.convention = Info(convention).bits;
   d.reserved0 = d.reserved1 = d.reserved2 = 0;

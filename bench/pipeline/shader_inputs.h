@@ -24,6 +24,10 @@ struct ShaderInputs {
   std::vector<f32::DepthParams> depth_params;  // [frame * kHardwareConventionCount + convention]
   std::vector<std::uint32_t> pixels;           // [sample]: x | y << 16
   std::vector<float> depths;                   // [depth slot * count + sample]: fetched values
+  std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: the texel bits fetched
+  // The raster pipeline's geometry (empty unless the domain's production
+  // is ProductionModel::kRaster): [sample].
+  std::vector<f32::RasterSample> raster;
 
   std::uint32_t FrameOf(std::uint32_t sample) const { return (sample + first_offset) / kSamplesPerFrame; }
   std::size_t frame_count() const { return frame_params.size(); }

@@ -73,7 +73,7 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
   for (std::uint32_t c = 0; c < every.size(); ++c) every[c] = c;
   std::vector<float> scratch;
   for (std::size_t b = 0; b < backends.size(); ++b) {
-    DB_RETURN_IF_ERROR(backends[b]->Prepare(layout.cells));
+    DB_RETURN_IF_ERROR(backends[b]->Prepare(layout.cells, PassKindOf(sampler.production())));
     DB_ASSIGN_OR_RETURN(std::span<const float> out, backends[b]->Run(batch, every, scratch));
     outputs[b].assign(out.begin(), out.end());
   }

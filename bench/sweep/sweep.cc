@@ -96,7 +96,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   }
   const RunLayout layout = MakeRunLayout(cells);
   for (Backend* backend : backends) {
-    DB_RETURN_IF_ERROR(backend->Prepare(layout.cells).WithContext("preparing the " + backend->name() + " backend"));
+    DB_RETURN_IF_ERROR(backend->Prepare(layout.cells, PassKindOf(options.domain.production))
+                           .WithContext("preparing the " + backend->name() + " backend"));
   }
   // A batch no backend can take whole is cut to what the smallest takes.
   std::uint64_t batch_size = options.batch_size;
