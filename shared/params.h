@@ -82,6 +82,21 @@ struct RasterSample {
   vec4 volume;  // xyz: world-space centre of an axis-aligned cube around the point; w: half its edge
 };
 
+// Push constants of the raster form's draws (shaders/raster/): how the
+// batch's samples lie in the atlas, where sample i is texel
+// (i % atlas_width, i / atlas_width), and what the draw renders: a depth
+// slot (pass 1) or a cell (pass 2).
+struct RasterConstants {
+  uint sample_count;       // samples in the batch: the length of a position slice
+  uint atlas_width;        // texels per atlas row
+  uint samples_per_frame;  // sample i belongs to frame (i + first_in_frame) / samples_per_frame
+  uint first_in_frame;     // position within its frame of the batch's first sample
+  uint conventions_per_frame;
+  uint convention_slot;  // the slot's or cell's convention within a frame's DepthParams
+  uint output_offset;    // pass 2: first float of the cell's positions: slices of x, then y, then z
+  uint reserved0;
+};
+
 // Where one cell's inputs and outputs lie in the batch's buffers.
 struct CellSlice {
   uint convention_slot;  // index of the cell's convention within a frame's DepthParams

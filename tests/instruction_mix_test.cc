@@ -20,7 +20,7 @@ namespace {
 std::vector<std::uint32_t> CompileText(const std::string& name, const std::string& source) {
   const std::filesystem::path path = std::filesystem::path(testing::MakeTempDir("instruction_mix")) / name;
   std::ofstream(path) << source;
-  auto spirv = CompileComputeShader(path);
+  auto spirv = CompileShader(path);
   EXPECT_TRUE(spirv.ok()) << spirv.status().message();
   return spirv.ok() ? *spirv : std::vector<std::uint32_t>{};
 }
@@ -94,7 +94,7 @@ InstructionMix VariantMix(Variant variant) {
   const std::string name(Info(variant).name);
   const std::filesystem::path path =
       std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "shaders" / "speed" / (name + ".comp");
-  auto spirv = CompileComputeShader(path);
+  auto spirv = CompileShader(path);
   EXPECT_TRUE(spirv.ok()) << spirv.status().message();
   if (!spirv.ok()) return {};
   return MixOf(*spirv, name + "_world_position");

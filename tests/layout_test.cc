@@ -27,12 +27,14 @@ layout(std430, binding = 1) buffer DepthBlock { DepthParams depth; uint depth_en
 layout(std430, binding = 2) buffer PassBlock { PassConstants pass; uint pass_end; };
 layout(std430, binding = 3) buffer CellBlock { CellSlice cell; uint cell_end; };
 layout(std430, binding = 4) buffer RasterBlock { RasterSample raster; uint raster_end; };
+layout(std430, binding = 5) buffer DrawBlock { RasterConstants draw; uint draw_end; };
 void main() {
   frame_end = 0u;
   depth_end = 0u;
   pass_end = 0u;
   cell_end = 0u;
   raster_end = 0u;
+  draw_end = 0u;
 }
 )";
 
@@ -127,6 +129,19 @@ TEST_F(LayoutTest, RasterSampleMatchesStd430) {
   EXPECT_MEMBER_AT(raster, RasterSample, volume);
   EXPECT_EQ(MembersOf("raster"), 4) << "a RasterSample member is not listed above";
   EXPECT_EQ(Offset("raster_end"), static_cast<int>(sizeof(f32::RasterSample)));
+}
+
+TEST_F(LayoutTest, RasterConstantsMatchesStd430) {
+  EXPECT_MEMBER_AT(draw, RasterConstants, sample_count);
+  EXPECT_MEMBER_AT(draw, RasterConstants, atlas_width);
+  EXPECT_MEMBER_AT(draw, RasterConstants, samples_per_frame);
+  EXPECT_MEMBER_AT(draw, RasterConstants, first_in_frame);
+  EXPECT_MEMBER_AT(draw, RasterConstants, conventions_per_frame);
+  EXPECT_MEMBER_AT(draw, RasterConstants, convention_slot);
+  EXPECT_MEMBER_AT(draw, RasterConstants, output_offset);
+  EXPECT_MEMBER_AT(draw, RasterConstants, reserved0);
+  EXPECT_EQ(MembersOf("draw"), 8) << "a RasterConstants member is not listed above";
+  EXPECT_EQ(Offset("draw_end"), static_cast<int>(sizeof(f32::RasterConstants)));
 }
 
 }  // namespace

@@ -78,7 +78,7 @@ TEST_F(ShaderCompilerTest, EveryShaderCompiles) {
   int compiled = 0;
   for (const fs::directory_entry& entry : fs::directory_iterator(kSourceDir / "shaders")) {
     if (entry.path().extension() != ".comp") continue;
-    auto spirv = CompileComputeShader(entry.path());
+    auto spirv = CompileShader(entry.path());
     ASSERT_TRUE(spirv.ok()) << spirv.status().message();
     ASSERT_FALSE(spirv->empty());
     EXPECT_EQ(spirv->front(), kSpirvMagic) << entry.path();
@@ -95,7 +95,7 @@ TEST_F(ShaderCompilerTest, ErrorInIncludedFileNamesThatFileAndLine) {
   const int line = ReplaceLine(header, "real ndc_z =", "  real ndc_z = undeclared_depth;");
   ASSERT_GT(line, 0);
 
-  auto spirv = CompileComputeShader(copy_ / "shaders" / "divide.comp");
+  auto spirv = CompileShader(copy_ / "shaders" / "divide.comp");
   ASSERT_FALSE(spirv.ok());
   EXPECT_EQ(spirv.status().code(), StatusCode::kCompileError);
   const std::string location = header.lexically_normal().string() + ":" + std::to_string(line) + ": error: ";
@@ -108,7 +108,7 @@ TEST_F(ShaderCompilerTest, ErrorAfterIncludesNamesTheShaderAndLine) {
   WriteFile(shader, ReadFile(shader) + "int broken = ;\n");
   const int line = LineCount(shader);
 
-  auto spirv = CompileComputeShader(shader);
+  auto spirv = CompileShader(shader);
   ASSERT_FALSE(spirv.ok());
   EXPECT_EQ(spirv.status().code(), StatusCode::kCompileError);
   EXPECT_NE(spirv.status().message().find(shader.string() + ":" + std::to_string(line) + ": error: "),
@@ -118,18 +118,18 @@ TEST_F(ShaderCompilerTest, ErrorAfterIncludesNamesTheShaderAndLine) {
 
 TEST_F(ShaderCompilerTest, MissingFileIsNotFound) {
   const fs::path missing = copy_ / "shaders" / "no_such_variant.comp";
-  auto spirv = CompileComputeShader(missing);
+  auto spirv = CompileShader(missing);
   ASSERT_FALSE(spirv.ok());
   EXPECT_EQ(spirv.status().code(), StatusCode::kNotFound);
   EXPECT_NE(spirv.status().message().find(missing.string()), std::string::npos) << spirv.status().message();
 }
 
 TEST_F(ShaderCompilerTest, EditedCopyCompilesFromTheCopy) {
-  auto original = CompileComputeShader(kSourceDir / "shaders" / "reciprocal.comp");
+  auto original = CompileShader(kSourceDir / "shaders" / "reciprocal.comp");
   ASSERT_TRUE(original.ok()) << original.status().message();
   // An untouched copy gives the same words: the SPIR-V does not depend on
   // where the sources live, so a difference below comes from the edit.
-  auto unchanged = CompileComputeShader(copy_ / "shaders" / "reciprocal.comp");
+  auto unchanged = CompileShader(copy_ / "shaders" / "reciprocal.comp");
   ASSERT_TRUE(unchanged.ok()) << unchanged.status().message();
   EXPECT_EQ(*unchanged, *original);
 
@@ -137,7 +137,7 @@ TEST_F(ShaderCompilerTest, EditedCopyCompilesFromTheCopy) {
   ASSERT_GT(ReplaceLine(header, "real inverse_w =",
                         "  real inverse_w = depth.coefficients.y / (ndc_z + depth.coefficients.x);"),
             0);
-  auto edited = CompileComputeShader(copy_ / "shaders" / "reciprocal.comp");
+  auto edited = CompileShader(copy_ / "shaders" / "reciprocal.comp");
   ASSERT_TRUE(edited.ok()) << edited.status().message();
   EXPECT_NE(*edited, *original);
 }

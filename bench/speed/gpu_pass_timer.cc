@@ -57,21 +57,6 @@ void ComputeToComputeBarrier(VkCommandBuffer commands) {
 
 }  // namespace
 
-VkFormat VulkanFormatOf(Format format) {
-  switch (format) {
-    case Format::kD16Unorm: return VK_FORMAT_D16_UNORM;
-    case Format::kX8D24Unorm: return VK_FORMAT_X8_D24_UNORM_PACK32;
-    case Format::kD32Sfloat: return VK_FORMAT_D32_SFLOAT;
-    case Format::kR32Sfloat: return VK_FORMAT_R32_SFLOAT;
-    case Format::kR16Sfloat: return VK_FORMAT_R16_SFLOAT;
-    case Format::kR16Unorm: return VK_FORMAT_R16_UNORM;
-    case Format::kR32SfloatViewZ: return VK_FORMAT_R32_SFLOAT;
-  }
-  return VK_FORMAT_UNDEFINED;
-}
-
-bool IsDepthFormat(Format format) { return Info(format).stores == DepthInput::kHardware; }
-
 Status CheckFormatFeatures(Format format, VkFormatFeatureFlags features, const std::string& device_name) {
   std::string missing;
   if ((features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT) == 0) missing = "sampled images";
@@ -112,25 +97,9 @@ Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<Vul
       {kResultsBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
   }};
   DB_ASSIGN_OR_RETURN(timer->pass_, ComputePass::Create(timer->context_, bindings, sizeof(PassSize)));
-  DB_RETURN_IF_ERROR(timer->CreateSampler());
+  DB_ASSIGN_OR_RETURN(timer->sampler_, timer->context_->CreateTexelSampler());
   DB_RETURN_IF_ERROR(validation.Check("the creation of the GPU pass timer"));
   return timer;
-}
-
-Status GpuPassTimer::CreateSampler() {
-  // texelFetch ignores filtering and addressing; the sampler only has to exist.
-  VkSamplerCreateInfo sampler_info{};
-  sampler_info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
-  sampler_info.magFilter = VK_FILTER_NEAREST;
-  sampler_info.minFilter = VK_FILTER_NEAREST;
-  sampler_info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  sampler_info.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  sampler_info.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  sampler_info.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  VkSampler sampler = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateSampler(vk_device(), &sampler_info, nullptr, &sampler), "vkCreateSampler"));
-  sampler_ = DeviceObject<VkSampler>(vk_device(), sampler, vkDestroySampler);
-  return Status::Ok();
 }
 
 Status GpuPassTimer::CheckFormat(Format format) const {
@@ -163,59 +132,14 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
   return stored.get();
 }
 
-Expected<DeviceObject<VkDeviceMemory>> GpuPassTimer::AllocateDeviceLocal(
-    const VkMemoryRequirements& requirements) const {
-  // Device-local first, as an engine places its render targets; a device
-  // without it (none known) still runs.
-  DB_ASSIGN_OR_RETURN(const std::uint32_t type,
-                      context_->FindMemoryType(requirements.memoryTypeBits,
-                                               {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VkMemoryPropertyFlags{0}}));
-  VkMemoryAllocateInfo allocate_info{};
-  allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  allocate_info.allocationSize = requirements.size;
-  allocate_info.memoryTypeIndex = type;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(vk_device(), &allocate_info, nullptr, &memory),
-                             fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
-  return DeviceObject<VkDeviceMemory>(vk_device(), memory, vkFreeMemory);
-}
-
 Status GpuPassTimer::CreateImage(const DepthImage& image) {
   const Format format = image.encoding.format;
   DB_RETURN_IF_ERROR(CheckFormat(format));
-  const VkFormat vk_format = VulkanFormatOf(format);
-  VkImageCreateInfo image_info{};
-  image_info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-  image_info.imageType = VK_IMAGE_TYPE_2D;
-  image_info.format = vk_format;
-  image_info.extent = {image.resolution.width, image.resolution.height, 1};
-  image_info.mipLevels = 1;
-  image_info.arrayLayers = 1;
-  image_info.samples = VK_SAMPLE_COUNT_1_BIT;
-  image_info.tiling = VK_IMAGE_TILING_OPTIMAL;
-  image_info.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  image_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  image_info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  VkImage handle = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateImage(vk_device(), &image_info, nullptr, &handle),
-                             fmt::format("vkCreateImage of {} {}x{}", Info(format).vulkan_name, image.resolution.width,
-                                         image.resolution.height)));
-  DeviceObject<VkImage> new_image(vk_device(), handle, vkDestroyImage);
-  VkMemoryRequirements requirements{};
-  vkGetImageMemoryRequirements(vk_device(), handle, &requirements);
-  DB_ASSIGN_OR_RETURN(DeviceObject<VkDeviceMemory> memory, AllocateDeviceLocal(requirements));
-  DB_RETURN_IF_ERROR(CheckVk(vkBindImageMemory(vk_device(), handle, memory.get(), 0), "vkBindImageMemory"));
-
   const VkImageAspectFlags aspect = IsDepthFormat(format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
-  VkImageViewCreateInfo view_info{};
-  view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
-  view_info.image = handle;
-  view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
-  view_info.format = vk_format;
-  view_info.subresourceRange = {aspect, 0, 1, 0, 1};
-  VkImageView view = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateImageView(vk_device(), &view_info, nullptr, &view), "vkCreateImageView"));
-  DeviceObject<VkImageView> new_view(vk_device(), view, vkDestroyImageView);
+  DB_ASSIGN_OR_RETURN(VulkanImage new_image,
+                      context_->CreateImage(VulkanFormatOf(format), {image.resolution.width, image.resolution.height},
+                                            VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, aspect));
+  const VkImage handle = new_image.image.get();
 
   // The texels travel through a staging buffer, as an engine uploads.
   DB_ASSIGN_OR_RETURN(
@@ -248,11 +172,8 @@ Status GpuPassTimer::CreateImage(const DepthImage& image) {
     vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr,
                          0, nullptr, 1, &to_shader);
   }));
-  image_view_.Reset();
   image_.Reset();
-  image_memory_ = std::move(memory);
   image_ = std::move(new_image);
-  image_view_ = std::move(new_view);
   return Status::Ok();
 }
 
@@ -289,14 +210,14 @@ Expected<GpuPassTimer::BoundBuffer> GpuPassTimer::CreateBoundBuffer(VkDeviceSize
   bound.buffer = DeviceObject<VkBuffer>(vk_device(), handle, vkDestroyBuffer);
   VkMemoryRequirements requirements{};
   vkGetBufferMemoryRequirements(vk_device(), handle, &requirements);
-  DB_ASSIGN_OR_RETURN(bound.memory, AllocateDeviceLocal(requirements));
+  DB_ASSIGN_OR_RETURN(bound.memory, context_->AllocateDeviceLocal(requirements));
   DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(vk_device(), handle, bound.memory.get(), 0), "vkBindBufferMemory"));
   return bound;
 }
 
 void GpuPassTimer::WriteDescriptors() {
   const VkDescriptorBufferInfo constants_info{constants_.handle(), 0, sizeof(PassConstants)};
-  const VkDescriptorImageInfo image_info{sampler_.get(), image_view_.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const VkDescriptorImageInfo image_info{sampler_.get(), image_.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   const VkDescriptorBufferInfo results_info{result_buffer_.get(), 0, result_bytes_};
   std::array<VkWriteDescriptorSet, 3> writes{};
   writes[0].dstBinding = kConstantsBinding;
@@ -541,7 +462,7 @@ Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, st
   DB_ASSIGN_OR_RETURN(std::unique_ptr<ComputePass> probe,
                       ComputePass::Create(context_, bindings, sizeof(std::uint32_t)));
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
-                      CompileComputeShader(shader_dir_ / "speed" / "bandwidth.comp"));
+                      CompileShader(shader_dir_ / "speed" / "bandwidth.comp"));
   DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
                       probe->CreatePipeline(spirv, VkSpecializationInfo{}, "the bandwidth probe"));
 

@@ -43,6 +43,7 @@
 #include <vulkan/vulkan.h>
 
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/vulkan_formats.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
@@ -50,10 +51,6 @@
 
 namespace depthbench {
 
-// The Vulkan format a bench format is stored in, and whether it is a depth
-// format (sampled through the depth aspect).
-VkFormat VulkanFormatOf(Format format);
-bool IsDepthFormat(Format format);
 // Ok when `features` (the device's optimal-tiling features of the format)
 // allow sampling the image and copying into it; otherwise Unavailable,
 // naming the format, the device and what is missing.
@@ -116,9 +113,7 @@ class GpuPassTimer {
   explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
   VkDevice vk_device() const { return context_->device(); }
 
-  Status CreateSampler();
   Expected<VkPipeline> Pipeline(Variant variant, Convention convention, std::uint32_t taps);
-  Expected<DeviceObject<VkDeviceMemory>> AllocateDeviceLocal(const VkMemoryRequirements& requirements) const;
   // A buffer of `bytes` in device-local memory, bound to it; the buffer is
   // declared after its memory, so that it is destroyed first.
   struct BoundBuffer {
@@ -165,9 +160,7 @@ class GpuPassTimer {
   bool loaded_ = false;
   Encoding encoding_{};
   Resolution resolution_{0, 0};
-  DeviceObject<VkDeviceMemory> image_memory_;
-  DeviceObject<VkImage> image_;
-  DeviceObject<VkImageView> image_view_;
+  VulkanImage image_;
   VulkanBuffer constants_;
   DeviceObject<VkDeviceMemory> result_memory_;
   DeviceObject<VkBuffer> result_buffer_;

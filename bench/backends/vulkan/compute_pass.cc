@@ -16,12 +16,25 @@ void RecordMemoryBarrier(VkCommandBuffer commands, VkPipelineStageFlags from_sta
   vkCmdPipelineBarrier(commands, from_stage, to_stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
 }
 
+Expected<DeviceObject<VkShaderModule>> CreateShaderModule(VkDevice device, std::span<const std::uint32_t> spirv,
+                                                          const std::string& what) {
+  VkShaderModuleCreateInfo module_info{};
+  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
+  module_info.pCode = spirv.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(
+      CheckVk(vkCreateShaderModule(device, &module_info, nullptr, &module), "vkCreateShaderModule for " + what));
+  return DeviceObject<VkShaderModule>(device, module, vkDestroyShaderModule);
+}
+
 Expected<std::unique_ptr<ComputePass>> ComputePass::Create(std::shared_ptr<VulkanContext> context,
                                                            std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                                           std::uint32_t push_constant_bytes) {
+                                                           std::uint32_t push_constant_bytes,
+                                                           VkShaderStageFlags stages, std::uint32_t sets) {
   if (context == nullptr) return InvalidArgument("a compute pass needs a Vulkan context");
-  std::unique_ptr<ComputePass> pass(new ComputePass(std::move(context)));
-  DB_RETURN_IF_ERROR(pass->CreateLayout(bindings, push_constant_bytes));
+  std::unique_ptr<ComputePass> pass(new ComputePass(std::move(context), stages));
+  DB_RETURN_IF_ERROR(pass->CreateLayout(bindings, push_constant_bytes, sets));
   DB_RETURN_IF_ERROR(pass->CreateCommandObjects());
   return pass;
 }
@@ -32,7 +45,7 @@ ComputePass::~ComputePass() {
 }
 
 Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                 std::uint32_t push_constant_bytes) {
+                                 std::uint32_t push_constant_bytes, std::uint32_t sets) {
   push_constant_bytes_ = push_constant_bytes;
   VkDescriptorSetLayoutCreateInfo set_layout_info{};
   set_layout_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
@@ -43,7 +56,7 @@ Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> b
                              "vkCreateDescriptorSetLayout"));
   set_layout_ = DeviceObject<VkDescriptorSetLayout>(device(), set_layout, vkDestroyDescriptorSetLayout);
 
-  const VkPushConstantRange push_constants{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes};
+  const VkPushConstantRange push_constants{stages_, 0, push_constant_bytes};
   VkPipelineLayoutCreateInfo pipeline_layout_info{};
   pipeline_layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pipeline_layout_info.setLayoutCount = 1;
@@ -55,31 +68,33 @@ Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> b
                              "vkCreatePipelineLayout"));
   pipeline_layout_ = DeviceObject<VkPipelineLayout>(device(), pipeline_layout, vkDestroyPipelineLayout);
 
-  // The pool holds exactly what the one set needs, type by type.
+  // The pool holds exactly what the sets need, type by type.
   std::vector<VkDescriptorPoolSize> sizes;
   for (const VkDescriptorSetLayoutBinding& b : bindings) {
     auto it = std::find_if(sizes.begin(), sizes.end(), [&](const auto& s) { return s.type == b.descriptorType; });
     if (it == sizes.end()) {
-      sizes.push_back({b.descriptorType, b.descriptorCount});
+      sizes.push_back({b.descriptorType, b.descriptorCount * sets});
     } else {
-      it->descriptorCount += b.descriptorCount;
+      it->descriptorCount += b.descriptorCount * sets;
     }
   }
   VkDescriptorPoolCreateInfo pool_info{};
   pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.maxSets = 1;
+  pool_info.maxSets = sets;
   pool_info.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
   pool_info.pPoolSizes = sizes.data();
   VkDescriptorPool pool = VK_NULL_HANDLE;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateDescriptorPool(device(), &pool_info, nullptr, &pool), "vkCreateDescriptorPool"));
   pool_ = DeviceObject<VkDescriptorPool>(device(), pool, vkDestroyDescriptorPool);
 
+  const std::vector<VkDescriptorSetLayout> layouts(sets, set_layout);
+  sets_.resize(sets);
   VkDescriptorSetAllocateInfo set_info{};
   set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
   set_info.descriptorPool = pool;
-  set_info.descriptorSetCount = 1;
-  set_info.pSetLayouts = &set_layout;
-  DB_RETURN_IF_ERROR(CheckVk(vkAllocateDescriptorSets(device(), &set_info, &set_), "vkAllocateDescriptorSets"));
+  set_info.descriptorSetCount = sets;
+  set_info.pSetLayouts = layouts.data();
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateDescriptorSets(device(), &set_info, sets_.data()), "vkAllocateDescriptorSets"));
   return Status::Ok();
 }
 
@@ -102,21 +117,14 @@ Status ComputePass::CreateCommandObjects() {
 Expected<DeviceObject<VkPipeline>> ComputePass::CreatePipeline(std::span<const std::uint32_t> spirv,
                                                                const VkSpecializationInfo& specialization,
                                                                const std::string& what) const {
-  VkShaderModuleCreateInfo module_info{};
-  module_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  module_info.codeSize = spirv.size() * sizeof(std::uint32_t);
-  module_info.pCode = spirv.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateShaderModule(device(), &module_info, nullptr, &module), "vkCreateShaderModule for " + what));
   // The pipeline keeps what it needs; the module goes when this returns.
-  const DeviceObject<VkShaderModule> module_owner(device(), module, vkDestroyShaderModule);
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> module, CreateShaderModule(device(), spirv, what));
 
   VkComputePipelineCreateInfo pipeline_info{};
   pipeline_info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
   pipeline_info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
   pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pipeline_info.stage.module = module;
+  pipeline_info.stage.module = module.get();
   pipeline_info.stage.pName = "main";
   pipeline_info.stage.pSpecializationInfo = &specialization;
   pipeline_info.layout = pipeline_layout_.get();
@@ -126,22 +134,23 @@ Expected<DeviceObject<VkPipeline>> ComputePass::CreatePipeline(std::span<const s
   return DeviceObject<VkPipeline>(device(), pipeline, vkDestroyPipeline);
 }
 
-void ComputePass::WriteDescriptors(std::span<VkWriteDescriptorSet> writes) const {
+void ComputePass::WriteDescriptors(std::span<VkWriteDescriptorSet> writes, std::uint32_t set) const {
   for (VkWriteDescriptorSet& write : writes) {
     write.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    write.dstSet = set_;
+    write.dstSet = sets_[set];
     if (write.descriptorCount == 0) write.descriptorCount = 1;
   }
   vkUpdateDescriptorSets(device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
 }
 
-void ComputePass::Bind(VkCommandBuffer commands, VkPipeline pipeline) const {
-  if (pipeline != VK_NULL_HANDLE) vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-  vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_.get(), 0, 1, &set_, 0, nullptr);
+void ComputePass::Bind(VkCommandBuffer commands, VkPipeline pipeline, VkPipelineBindPoint bind_point,
+                       std::uint32_t set) const {
+  if (pipeline != VK_NULL_HANDLE) vkCmdBindPipeline(commands, bind_point, pipeline);
+  vkCmdBindDescriptorSets(commands, bind_point, pipeline_layout_.get(), 0, 1, &sets_[set], 0, nullptr);
 }
 
 void ComputePass::PushConstants(VkCommandBuffer commands, const void* data, std::uint32_t bytes) const {
-  vkCmdPushConstants(commands, pipeline_layout_.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
+  vkCmdPushConstants(commands, pipeline_layout_.get(), stages_, 0,
                      std::min(bytes, push_constant_bytes_), data);
 }
 

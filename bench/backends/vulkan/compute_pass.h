@@ -1,12 +1,14 @@
-// ComputePass: what every compute pass of the bench owns and does the same
-// way, the backend's reconstruction pass and the speed timer's timed passes
-// alike: one descriptor set with its layouts and push constants, compute
-// pipelines over that layout, and a command buffer that is recorded,
-// submitted and waited for.
+// ComputePass: what every pass of the bench owns and does the same way, the
+// backend's reconstruction pass, its raster form and the speed timer's timed
+// passes alike: a descriptor set (or several of one layout) with its
+// layouts and push constants,
+// pipelines over that layout (compute pipelines made here; the raster form
+// makes graphics pipelines over the same layout), and a command buffer that
+// is recorded, submitted and waited for.
 //
-// Lifecycle: Create(context, bindings, push-constant bytes); point the set
-// at resources with WriteDescriptors; CreatePipeline once per shader; then
-// Submit(record) any number of times. Submit returns only when the device
+// Lifecycle: Create(context, bindings, push-constant bytes, stages); point
+// the set at resources with WriteDescriptors; CreatePipeline once per
+// shader; then Submit(record) any number of times. Submit returns only when the device
 // has finished (or failed) the work, so no work is in flight when the pass
 // or the resources its commands used are destroyed.
 #pragma once
@@ -16,6 +18,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <vulkan/vulkan.h>
 
@@ -29,11 +32,18 @@ namespace depthbench {
 void RecordMemoryBarrier(VkCommandBuffer commands, VkPipelineStageFlags from_stage, VkAccessFlags from_access,
                          VkPipelineStageFlags to_stage, VkAccessFlags to_access);
 
+// A shader module of `spirv`; `what` names the shader in errors.
+Expected<DeviceObject<VkShaderModule>> CreateShaderModule(VkDevice device, std::span<const std::uint32_t> spirv,
+                                                          const std::string& what);
+
 class ComputePass {
  public:
-  static Expected<std::unique_ptr<ComputePass>> Create(std::shared_ptr<VulkanContext> context,
-                                                       std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                                       std::uint32_t push_constant_bytes);
+  // `stages`: those that read the push constants. `sets`: how many sets of
+  // the layout to hold (a pass that binds different resources per draw).
+  static Expected<std::unique_ptr<ComputePass>> Create(
+      std::shared_ptr<VulkanContext> context, std::span<const VkDescriptorSetLayoutBinding> bindings,
+      std::uint32_t push_constant_bytes, VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT,
+      std::uint32_t sets = 1);
   ~ComputePass();
   ComputePass(const ComputePass&) = delete;
   ComputePass& operator=(const ComputePass&) = delete;
@@ -48,12 +58,14 @@ class ComputePass {
                                                     const VkSpecializationInfo& specialization,
                                                     const std::string& what) const;
 
-  // Points bindings of the set at resources: each write names its binding,
-  // type and resource; the set is filled in here.
-  void WriteDescriptors(std::span<VkWriteDescriptorSet> writes) const;
+  // Points bindings of set `set` at resources: each write names its
+  // binding, type and resource; the set is filled in here.
+  void WriteDescriptors(std::span<VkWriteDescriptorSet> writes, std::uint32_t set = 0) const;
 
-  // Binds the set, and `pipeline` unless it is null, for dispatches.
-  void Bind(VkCommandBuffer commands, VkPipeline pipeline) const;
+  // Binds the set, and `pipeline` unless it is null, for dispatches (or for
+  // draws, with the graphics bind point).
+  void Bind(VkCommandBuffer commands, VkPipeline pipeline,
+            VkPipelineBindPoint bind_point = VK_PIPELINE_BIND_POINT_COMPUTE, std::uint32_t set = 0) const;
   // Pushes `bytes` of push constants (at most what Create reserved).
   void PushConstants(VkCommandBuffer commands, const void* data, std::uint32_t bytes) const;
 
@@ -62,17 +74,20 @@ class ComputePass {
   Status Submit(const std::function<void(VkCommandBuffer)>& record);
 
  private:
-  explicit ComputePass(std::shared_ptr<VulkanContext> context) : context_(std::move(context)) {}
-  Status CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings, std::uint32_t push_constant_bytes);
+  ComputePass(std::shared_ptr<VulkanContext> context, VkShaderStageFlags stages)
+      : context_(std::move(context)), stages_(stages) {}
+  Status CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings, std::uint32_t push_constant_bytes,
+                      std::uint32_t sets);
   Status CreateCommandObjects();
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   DeviceObject<VkDescriptorSetLayout> set_layout_;
   DeviceObject<VkPipelineLayout> pipeline_layout_;
   DeviceObject<VkDescriptorPool> pool_;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;  // freed with the pool
+  std::vector<VkDescriptorSet> sets_;  // freed with the pool
   DeviceObject<VkFence> fence_;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // from the context's pool; freed by the destructor
+  VkShaderStageFlags stages_;
   std::uint32_t push_constant_bytes_ = 0;
 };
 

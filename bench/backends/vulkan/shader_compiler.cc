@@ -119,10 +119,20 @@ std::string FormatInfoLog(const std::string& log, const std::string& source_name
   return formatted.empty() ? fmt::format("{}: error: glslang failed without a message", source_name) : formatted;
 }
 
-// A parsed and linked compute shader. The program refers to the shader, so
-// it is declared after it and destroyed before it.
+EShLanguage LanguageOf(ShaderStage stage) {
+  switch (stage) {
+    case ShaderStage::kVertex: return EShLangVertex;
+    case ShaderStage::kFragment: return EShLangFragment;
+    case ShaderStage::kCompute: break;
+  }
+  return EShLangCompute;
+}
+
+// A parsed and linked shader. The program refers to the shader, so it is
+// declared after it and destroyed before it.
 struct LinkedShader {
-  glslang::TShader shader{EShLangCompute};
+  explicit LinkedShader(EShLanguage stage) : shader(stage) {}
+  glslang::TShader shader;
   glslang::TProgram program;
 };
 
@@ -132,19 +142,24 @@ struct LinkedShader {
 Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, const std::string& root_name,
                                                      const std::filesystem::path& root_dir,
                                                      std::vector<std::string>* sources = nullptr,
-                                                     ShaderLanguage language = ShaderLanguage::kGlsl) {
+                                                     ShaderLanguage language = ShaderLanguage::kGlsl,
+                                                     EShLanguage stage = EShLangCompute) {
   EnsureGlslangInitialized();
-  auto linked = std::make_unique<LinkedShader>();
+  auto linked = std::make_unique<LinkedShader>(stage);
   const char* text = source.data();
   const int length = static_cast<int>(source.size());
   const char* name = root_name.c_str();
   glslang::TShader& shader = linked->shader;
   shader.setStringsWithLengthsAndNames(&text, &length, &name, 1);
   const bool hlsl = language == ShaderLanguage::kHlsl;
-  shader.setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan,
+  shader.setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, stage, glslang::EShClientVulkan,
                      100);
-  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_1);
-  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_3);
+  // The raster form's stages need Vulkan 1.3 anyway; under 1.2 rules a
+  // vertex stage's gl_ViewportIndex is the core capability
+  // (shaderOutputViewportIndex), not an extension's.
+  const bool graphics = stage != EShLangCompute;
+  shader.setEnvClient(glslang::EShClientVulkan, graphics ? glslang::EShTargetVulkan_1_2 : glslang::EShTargetVulkan_1_1);
+  shader.setEnvTarget(glslang::EShTargetSpv, graphics ? glslang::EShTargetSpv_1_5 : glslang::EShTargetSpv_1_3);
   if (hlsl) shader.setEntryPoint("main");
   const auto messages = static_cast<EShMessages>(kMessages | (hlsl ? EShMsgReadHlsl : EShMsgDefault));
   RelativeIncluder includer(root_name, root_dir, sources);
@@ -177,28 +192,31 @@ double CompileSeconds() {
 
 Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::string& source, const std::string& name,
                                                          const std::filesystem::path& include_dir,
-                                                         ShaderLanguage language, std::vector<std::string>* sources) {
+                                                         ShaderLanguage language, ShaderStage stage,
+                                                         std::vector<std::string>* sources) {
   if (sources != nullptr) sources->push_back(source);
-  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked, ParseAndLink(source, name, include_dir, sources, language));
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked,
+                      ParseAndLink(source, name, include_dir, sources, language, LanguageOf(stage)));
   std::vector<std::uint32_t> spirv;
   spv::SpvBuildLogger logger;
   glslang::SpvOptions options;
-  glslang::GlslangToSpv(*linked->program.getIntermediate(EShLangCompute), spirv, &logger, &options);
+  glslang::GlslangToSpv(*linked->program.getIntermediate(LanguageOf(stage)), spirv, &logger, &options);
   if (spirv.empty()) {
     return CompileError(fmt::format("{}: error: SPIR-V generation failed: {}", name, logger.getAllMessages()));
   }
   return spirv;
 }
 
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
-                                                          std::vector<std::string>* sources) {
+Expected<std::vector<std::uint32_t>> CompileShader(const std::filesystem::path& path, ShaderStage stage,
+                                                   std::vector<std::string>* sources) {
   DB_ASSIGN_OR_RETURN(std::string source, ReadSourceFile(path));
-  return CompileComputeSource(std::move(source), path.string(), path.parent_path(), ShaderLanguage::kGlsl, sources);
+  return CompileShaderSource(std::move(source), path.string(), path.parent_path(), ShaderLanguage::kGlsl, stage,
+                             sources);
 }
 
-Expected<std::vector<std::uint32_t>> CompileComputeSource(std::string source, std::string name,
-                                                          std::filesystem::path include_dir, ShaderLanguage language,
-                                                          std::vector<std::string>* sources) {
+Expected<std::vector<std::uint32_t>> CompileShaderSource(std::string source, std::string name,
+                                                         std::filesystem::path include_dir, ShaderLanguage language,
+                                                         ShaderStage stage, std::vector<std::string>* sources) {
   // glslang cannot be stopped, so the compile runs on a thread of its own
   // that is given up on when it takes too long (the program then ends
   // without waiting for it: base/interrupt.h). The thread owns what it
@@ -206,8 +224,8 @@ Expected<std::vector<std::uint32_t>> CompileComputeSource(std::string source, st
   using Words = Expected<std::vector<std::uint32_t>>;
   auto read = std::make_shared<std::vector<std::string>>();
   std::packaged_task<Words()> task(
-      [source = std::move(source), name, include_dir = std::move(include_dir), language, read] {
-        return CompileOnThisThread(source, name, include_dir, language, read.get());
+      [source = std::move(source), name, include_dir = std::move(include_dir), language, stage, read] {
+        return CompileOnThisThread(source, name, include_dir, language, stage, read.get());
       });
   std::future<Words> compiled = task.get_future();
   std::thread compiler(std::move(task));

@@ -1,5 +1,6 @@
-// GLSL compute shaders to SPIR-V through glslang's C++ API, for Vulkan 1.1
-// (SPIR-V 1.3). `#include "..."` (GL_GOOGLE_include_directive) resolves
+// GLSL (and HLSL) shaders to SPIR-V through glslang's C++ API: compute
+// shaders for Vulkan 1.1 (SPIR-V 1.3), vertex and fragment shaders for
+// Vulkan 1.2 (SPIR-V 1.5). `#include "..."` (GL_GOOGLE_include_directive) resolves
 // relative to the directory of the including file, so a copy of shaders/ and
 // shared/ compiles from the copy. Compile errors name the real path and line
 // of the file they occur in, included files too.
@@ -19,22 +20,27 @@ namespace depthbench {
 // "glslang 12.0.0": the compiler the Vulkan backend's formulas go through.
 std::string GlslangVersion();
 
-// SPIR-V words of the compute shader in `path`. NotFound when the file does
+// The pipeline stage a shader is compiled for.
+enum class ShaderStage : std::uint8_t { kCompute, kVertex, kFragment };
+
+// SPIR-V words of the `stage` shader in `path`. NotFound when the file does
 // not exist, IoError when it cannot be read, CompileError with glslang's
 // messages as "<path>:<line>: error: <message>" lines otherwise. When
 // `sources` is not null, the text of the shader and of every file it
 // includes is appended to it in the order read (what results hash to say
 // which program ran).
-Expected<std::vector<std::uint32_t>> CompileComputeShader(const std::filesystem::path& path,
-                                                          std::vector<std::string>* sources = nullptr);
+Expected<std::vector<std::uint32_t>> CompileShader(const std::filesystem::path& path,
+                                                   ShaderStage stage = ShaderStage::kCompute,
+                                                   std::vector<std::string>* sources = nullptr);
 
 // The same for source text in `language` that glslang reports as `name`,
 // whose includes resolve relative to `include_dir` (absolute include paths
 // as they are): how a program generated around a user's function compiles.
 // HLSL's entry point is main().
-Expected<std::vector<std::uint32_t>> CompileComputeSource(std::string source, std::string name,
-                                                          std::filesystem::path include_dir, ShaderLanguage language,
-                                                          std::vector<std::string>* sources = nullptr);
+Expected<std::vector<std::uint32_t>> CompileShaderSource(std::string source, std::string name,
+                                                         std::filesystem::path include_dir, ShaderLanguage language,
+                                                         ShaderStage stage = ShaderStage::kCompute,
+                                                         std::vector<std::string>* sources = nullptr);
 
 // One member of a buffer block as glslang lays it out: its reflected name
 // ("frame.camera_world" for member camera_world of a block member `frame`)

@@ -13,22 +13,50 @@ std::filesystem::path BuiltInProgram(Variant variant, VariantPass pass, const st
   return pass == VariantPass::kSpeed ? shader_dir / "speed" / file : shader_dir / file;
 }
 
-// The program around a user's function: the contract's settings, the
-// shared headers, the contract, the user's file, then the pass.
-std::string UserProgram(const UserShader& user, VariantPass pass, const std::filesystem::path& dir) {
-  const bool hlsl = user.language == ShaderLanguage::kHlsl;
+const char* PassName(VariantPass pass) {
+  switch (pass) {
+    case VariantPass::kSpeed: return "speed";
+    case VariantPass::kRaster: return "raster";
+    case VariantPass::kAccuracy: break;
+  }
+  return "accuracy";
+}
+
+// Whether the program is generated around the variant's function rather
+// than read from a file of the shader directory.
+bool Generated(Variant variant, VariantPass pass) {
+  return Info(variant).user != nullptr || pass == VariantPass::kRaster;
+}
+
+// The program around a variant's function: for a user's, the contract's
+// settings, the shared headers, the contract, the user's file; for a
+// built-in one, the shared headers and its shared/variants/ header; then
+// the pass.
+std::string GeneratedProgram(Variant variant, VariantPass pass, const std::filesystem::path& dir) {
+  const UserShader* user = Info(variant).user;
+  const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
   auto include = [](const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); };
   std::string text = hlsl ? "" : "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
-  text +=
-      fmt::format("#define DB_USER_ENTRY {}\n#define DB_USER_UV_BOTTOM_LEFT {}\n#define DB_USER_VIEW_LEFT_HANDED {}\n",
-                  user.entry, user.uv_bottom_left ? 1 : 0, user.view_left_handed ? 1 : 0);
-  text += include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
-  text += include(dir / "user" / "contract.inc");
-  text += include(user.path);
-  text += "#define RECONSTRUCT db_user_world_position\n";
-  const bool speed = pass == VariantPass::kSpeed;
-  text += include(hlsl ? dir / "user" / (speed ? "speed_pass.hlsl" : "compute_pass.hlsl")
-                       : (speed ? dir / "speed" / "speed_pass.glsl" : dir / "compute_pass.glsl"));
+  if (user == nullptr) {
+    text += include(dir / "common.glsl");
+    text += include(dir.parent_path() / "shared" / "variants" / (std::string(Info(variant).name) + ".h"));
+    text += fmt::format("#define RECONSTRUCT {}\n", VariantFunctionName(variant));
+  } else {
+    text += fmt::format(
+        "#define DB_USER_ENTRY {}\n#define DB_USER_UV_BOTTOM_LEFT {}\n#define DB_USER_VIEW_LEFT_HANDED {}\n",
+        user->entry, user->uv_bottom_left ? 1 : 0, user->view_left_handed ? 1 : 0);
+    text += include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
+    text += include(dir / "user" / "contract.inc");
+    text += include(user->path);
+    text += "#define RECONSTRUCT db_user_world_position\n";
+  }
+  switch (pass) {
+    case VariantPass::kAccuracy: text += include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
+    case VariantPass::kSpeed:
+      text += include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
+      break;
+    case VariantPass::kRaster: text += include(dir / "raster" / "raster_pass.glsl"); break;
+  }
   return text;
 }
 
@@ -40,20 +68,29 @@ std::string VariantFunctionName(Variant variant) {
 }
 
 std::string VariantProgramName(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir) {
-  if (Info(variant).user == nullptr) return BuiltInProgram(variant, pass, shader_dir).string();
-  return fmt::format("<{}'s {} program>", Info(variant).name, pass == VariantPass::kSpeed ? "speed" : "accuracy");
+  if (!Generated(variant, pass)) return BuiltInProgram(variant, pass, shader_dir).string();
+  return fmt::format("<{}'s {} program>", Info(variant).name, PassName(pass));
 }
 
 Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources) {
   const UserShader* user = Info(variant).user;
-  if (user == nullptr) return CompileComputeShader(BuiltInProgram(variant, pass, shader_dir), sources);
+  if (!Generated(variant, pass)) return CompileShader(BuiltInProgram(variant, pass, shader_dir), ShaderStage::kCompute, sources);
+  const bool raster = pass == VariantPass::kRaster;
+  if (raster && user != nullptr && user->language == ShaderLanguage::kHlsl) {
+    return Unavailable(fmt::format(
+        "{}: the raster form has no HLSL fragment program yet; HLSL variant files run in the compute form only "
+        "(--pipeline compute), or write the function in GLSL",
+        user->path.string()));
+  }
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
   const std::string program = VariantProgramName(variant, pass, shader_dir);
   Expected<std::vector<std::uint32_t>> compiled =
-      CompileComputeSource(UserProgram(*user, pass, dir), program, dir, user->language, sources);
-  if (compiled.ok() || compiled.status().code() != StatusCode::kCompileError) return compiled;
+      CompileShaderSource(GeneratedProgram(variant, pass, dir), program, dir,
+                          user != nullptr ? user->language : ShaderLanguage::kGlsl,
+                          raster ? ShaderStage::kFragment : ShaderStage::kCompute, sources);
+  if (user == nullptr || compiled.ok() || compiled.status().code() != StatusCode::kCompileError) return compiled;
   // A mistake in the user's file often makes the parser stumble again in
   // the generated lines after it: those follow-on messages only confuse.
   const std::string& log = compiled.status().message();

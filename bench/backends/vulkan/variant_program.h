@@ -5,7 +5,9 @@
 // the pass of the same shader directory (GLSL, or shaders/user/'s HLSL
 // form), the contract of shaders/user/contract.inc, and the user's file,
 // included by its path so that compile errors name the user's file and
-// line.
+// line. The raster form's fragment program is generated for every variant
+// the same way, around its function: shared/variants/NAME.h for a built-in
+// one, the contract and the user's file for the user's.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +23,7 @@ namespace depthbench {
 enum class VariantPass : std::uint8_t {
   kAccuracy,  // compute_pass.glsl: positions of the sweep's samples
   kSpeed,     // speed/speed_pass.glsl: the timed full-screen pass
+  kRaster,    // raster/raster_pass.glsl: the raster form's reconstruction, a fragment program
 };
 
 // SPIR-V of `variant`'s pass, from the programs in `shader_dir`. The text
@@ -33,8 +36,8 @@ Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass
 // static cost model counts): <name>_world_position, or the user's entry.
 std::string VariantFunctionName(Variant variant);
 
-// What compile messages call the program: its path, or for a user's
-// variant "<NAME's accuracy program>".
+// What compile messages call the program: its path, or for a generated
+// one "<NAME's accuracy program>" (speed, raster).
 std::string VariantProgramName(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir);
 
 }  // namespace depthbench

@@ -14,6 +14,7 @@
 
 #include "bench/backends/vulkan/arithmetic_probe.h"
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/raster_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/files.h"
@@ -204,6 +205,12 @@ class VulkanBackend final : public Backend {
   Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override;
   std::uint64_t MaxBatchSamples() const override;
+  std::vector<RasterAgreement> raster_agreement() const override {
+    return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
+  }
+  std::vector<std::uint32_t> raster_texels() const {
+    return raster_ != nullptr ? raster_->texels() : std::vector<std::uint32_t>{};
+  }
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -211,13 +218,16 @@ class VulkanBackend final : public Backend {
 
   std::string DeviceContext() const { return fmt::format("Vulkan device '{}'", device_.name); }
 
-  Status PrepareOnDevice(std::span<const CellPlan> cells);
+  Status PrepareOnDevice(std::span<const CellPlan> cells, PassKind pass);
   // `sources` collects the text of every source file compiled.
   Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape,
                                                    std::vector<std::string>& sources) const;
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
+  // What either form would read out of bounds.
+  Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
+  // What the compute form's device cannot address or dispatch.
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
                                  std::span<const std::uint32_t> which, const SliceLayout& slices) const;
@@ -240,6 +250,7 @@ class VulkanBackend final : public Backend {
   // Indexed by Variant; null for variants no prepared cell uses.
   std::vector<DeviceObject<VkPipeline>> pipelines_;
   std::array<VulkanBuffer, kBindingCount> buffers_;
+  std::unique_ptr<RasterPass> raster_;  // the raster form, when prepared for it
 };
 
 VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -271,25 +282,32 @@ Expected<std::unique_ptr<Backend>> VulkanBackend::Create(std::shared_ptr<VulkanC
   return std::unique_ptr<Backend>(std::move(backend));
 }
 
-Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind) {
+Status VulkanBackend::Prepare(std::span<const CellPlan> cells, PassKind pass) {
   const ValidationScope validation(*context_);
-  Status status = PrepareOnDevice(cells);
+  Status status = PrepareOnDevice(cells, pass);
   if (status.ok()) status = validation.Check("Prepare");
   return status.WithContext(DeviceContext());
 }
 
-Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
+Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind pass) {
   DB_RETURN_IF_ERROR(CheckDirectory(shader_dir_, "shader directory"));
   // Built aside so that a failure leaves the previous preparation intact.
   DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
   std::vector<DeviceObject<VkPipeline>> pipelines(AllVariants().size());
   std::vector<std::string> sources;
-  for (const CellPlan& plan : cells) {
-    DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
-    if (pipeline.get() != VK_NULL_HANDLE) continue;
-    DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape, sources));
+  std::unique_ptr<RasterPass> raster;
+  if (pass == PassKind::kRaster) {
+    DB_ASSIGN_OR_RETURN(raster,
+                        RasterPass::Create(context_, cells, shader_dir_, options_.arithmetic_probes, sources));
+  } else {
+    for (const CellPlan& plan : cells) {
+      DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
+      if (pipeline.get() != VK_NULL_HANDLE) continue;
+      DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape, sources));
+    }
   }
   pipelines_ = std::move(pipelines);
+  raster_ = std::move(raster);
   // The probes change the program as much as an edit would.
   const std::string probes = ArithmeticProbesName(options_.arithmetic_probes);
   program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir,
@@ -301,6 +319,11 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells) {
 
 std::uint64_t VulkanBackend::MaxBatchSamples() const {
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  if (raster_ != nullptr) {
+    // The positions of every cell, in one storage buffer.
+    const std::uint64_t positions = limits.maxStorageBufferRange / (sizeof(float) * 3 * std::max<std::size_t>(cells_.size(), 1));
+    return std::min(raster_->MaxBatchSamples(), positions);
+  }
   std::uint64_t slots = 1;
   for (const CellPlan& plan : cells_) slots = std::max<std::uint64_t>(slots, plan.depth_slot + 1u);
   // The widest per-sample binding (every cell's positions, or every slot's
@@ -348,6 +371,19 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
                                                             std::vector<float>& scratch) {
   const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
   if (output_floats == 0) return std::span<const float>();
+  DB_RETURN_IF_ERROR(CheckBatch(batch, which));
+  if (raster_ != nullptr) {
+    if (output_floats * sizeof(float) > context_->properties().limits.maxStorageBufferRange) {
+      return InvalidArgument(fmt::format("{} cells of {} samples write {} bytes; the device binds at most {}",
+                                         which.size(), batch.count, output_floats * sizeof(float),
+                                         context_->properties().limits.maxStorageBufferRange));
+    }
+    const ValidationScope validation(*context_);
+    DB_ASSIGN_OR_RETURN(const float* positions, raster_->Run(batch, which, kUnwrittenBits));
+    DB_RETURN_IF_ERROR(validation.Check("Run"));
+    DB_RETURN_IF_ERROR(CheckEveryOutputWritten(positions, batch, which, SliceLayout{0, batch.count}));
+    return std::span<const float>(positions, output_floats);
+  }
   const SliceLayout slices = SliceLayoutFor(batch, shape_);
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
@@ -385,10 +421,7 @@ Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const Shad
   return Status::Ok();
 }
 
-// What the shaders would otherwise read or write out of bounds, and what
-// the device cannot address or dispatch.
-Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                               const BindingBytes& bytes) const {
+Status VulkanBackend::CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const {
   const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
   if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
       batch.pixels.size() < batch.count || batch.depths.size() % batch.count != 0) {
@@ -408,6 +441,11 @@ Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::u
                                          depths_needed, batch.depths.size()));
     }
   }
+  return Status::Ok();
+}
+
+Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                               const BindingBytes& bytes) const {
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
   const std::uint32_t groups = WorkgroupsFor(batch, shape_);
   if (groups > limits.maxComputeWorkGroupCount[0]) {
@@ -432,19 +470,13 @@ Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::u
 }
 
 Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
-  VulkanBuffer& buffer = buffers_[binding];
-  if (buffer.size() >= bytes) return Status::Ok();
-  // Growing geometrically keeps reallocations rare when batches vary a little.
-  const VkDeviceSize size = std::max(bytes, buffer.size() + buffer.size() / 2);
   const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
   // The output is filled with kUnwrittenBits on the device before each run.
   const VkBufferUsageFlags usage =
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
       (binding == kPositions ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT} : VkBufferUsageFlags{0});
   // The previous run has completed (Run waits), so the old buffer can go.
-  buffer = VulkanBuffer();
-  DB_ASSIGN_OR_RETURN(buffer, context_->CreateHostBuffer(size, usage, access));
-  return Status::Ok();
+  return context_->GrowHostBuffer(buffers_[binding], bytes, usage, access);
 }
 
 Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
@@ -510,6 +542,11 @@ void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, 
 }
 
 }  // namespace
+
+std::vector<std::uint32_t> RasterTexels(const Backend& backend) {
+  const auto* vulkan = dynamic_cast<const VulkanBackend*>(&backend);
+  return vulkan != nullptr ? vulkan->raster_texels() : std::vector<std::uint32_t>{};
+}
 
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {
   VulkanContextOptions context_options;

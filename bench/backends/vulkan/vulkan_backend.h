@@ -1,10 +1,13 @@
 // The Vulkan backend: the shaders/ compute shaders, compiled with glslang at
 // Prepare time; a Run dispatches once per variant, each of the variant's
 // cells in a row of workgroups. Inputs go up and positions come back
-// through host-visible buffers; Run waits for the device.
+// through host-visible buffers; Run waits for the device. Prepared with
+// PassKind::kRaster it draws instead (raster_pass.h).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "bench/backends/backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
@@ -20,5 +23,11 @@ Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& optio
 // options.device and options.validation do not apply (the context decided).
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanContext> context,
                                                      const BackendOptions& options);
+
+// The texel bits the raster form of a Vulkan backend produced in its last
+// Run, laid out as ShaderInputs::codes (0 where it drew nothing); empty for
+// any other backend or form. What the device stored, for tests that compare
+// the forms on the same stored depths.
+std::vector<std::uint32_t> RasterTexels(const Backend& backend);
 
 }  // namespace depthbench

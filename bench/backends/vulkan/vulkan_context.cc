@@ -18,9 +18,10 @@ namespace {
 constexpr char kValidationLayer[] = "VK_LAYER_KHRONOS_validation";
 constexpr char kValidationEnvironment[] = "DEPTHBENCH_VALIDATION";
 // The SPIR-V the shaders compile to (1.3) needs Vulkan 1.1. The instance asks
-// for 1.2 so that devices that have it report their driver's name.
+// for 1.3 so that devices that have it report their driver's name and can
+// render without render passes (the raster form, dynamic rendering).
 constexpr std::uint32_t kMinimumDeviceApi = VK_API_VERSION_1_1;
-constexpr std::uint32_t kInstanceApi = VK_API_VERSION_1_2;
+constexpr std::uint32_t kInstanceApi = VK_API_VERSION_1_3;
 constexpr char kDriverHint[] =
     "install mesa-vulkan-drivers for lavapipe (Mesa's CPU implementation), or point VK_ICD_FILENAMES "
     "at a driver's ICD manifest (e.g. /usr/share/vulkan/icd.d/lvp_icd.x86_64.json)";
@@ -133,15 +134,30 @@ std::vector<VkQueueFamilyProperties> QueueFamilies(VkPhysicalDevice device) {
 }
 
 // The queue family the context uses: the first that can run compute,
-// preferring one that can also write timestamps.
+// preferring one that can also draw (the raster form) and then one that can
+// write timestamps.
 std::optional<std::uint32_t> ChooseComputeQueueFamily(const std::vector<VkQueueFamilyProperties>& families) {
   std::optional<std::uint32_t> chosen;
+  int best = -1;
   for (std::uint32_t i = 0; i < families.size(); ++i) {
     if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
-    if (families[i].timestampValidBits > 0) return i;
-    if (!chosen) chosen = i;
+    const int score = ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0 ? 2 : 0) +
+                      (families[i].timestampValidBits > 0 ? 1 : 0);
+    if (score > best) {
+      best = score;
+      chosen = i;
+    }
   }
   return chosen;
+}
+
+bool HasDeviceExtension(VkPhysicalDevice device, std::string_view name) {
+  std::uint32_t count = 0;
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkExtensionProperties> extensions(count);
+  if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data()) != VK_SUCCESS) return false;
+  return std::any_of(extensions.begin(), extensions.end(),
+                     [&](const VkExtensionProperties& e) { return name == e.extensionName; });
 }
 
 struct DeviceCandidate {
@@ -179,6 +195,7 @@ DeviceCandidate DescribeDevice(VkPhysicalDevice device) {
     candidate.has_compute_queue = true;
     properties.queue_family = *family;
     properties.queue_timestamp_valid_bits = families[*family].timestampValidBits;
+    properties.queue_graphics = (families[*family].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0;
   }
   return candidate;
 }
@@ -404,13 +421,66 @@ Status VulkanContext::CreateDevice() {
   device_info.queueCreateInfoCount = 1;
   device_info.pQueueCreateInfos = &queue_info;
   // float64 arithmetic, where the device has it: the exact-division probe
-  // (arithmetic_probe.h) divides in float64.
-  VkPhysicalDeviceFeatures supported{};
-  vkGetPhysicalDeviceFeatures(physical_device_, &supported);
-  VkPhysicalDeviceFeatures enabled{};
-  enabled.shaderFloat64 = supported.shaderFloat64;
-  shader_float64_ = supported.shaderFloat64 == VK_TRUE;
-  device_info.pEnabledFeatures = &enabled;
+  // (arithmetic_probe.h) divides in float64. What the raster form draws
+  // with, where the device has it; the raster form checks what it lacks
+  // when it is prepared (RasterFeatures).
+  VkPhysicalDeviceDepthClipControlFeaturesEXT clip_control{};
+  clip_control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DEPTH_CLIP_CONTROL_FEATURES_EXT;
+  VkPhysicalDeviceVulkan13Features features13{};
+  features13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+  VkPhysicalDeviceVulkan12Features features12{};
+  features12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  VkPhysicalDeviceFeatures2 supported{};
+  supported.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  const bool api12 = properties_.api_version >= VK_API_VERSION_1_2;
+  const bool api13 = properties_.api_version >= VK_API_VERSION_1_3;
+  const bool has_clip_control = HasDeviceExtension(physical_device_, VK_EXT_DEPTH_CLIP_CONTROL_EXTENSION_NAME);
+  // Only structures the device knows go into the chain.
+  void** next = &supported.pNext;
+  const auto chain = [&next](auto& features) {
+    *next = &features;
+    next = &features.pNext;
+  };
+  if (api12) chain(features12);
+  if (api13) chain(features13);
+  if (has_clip_control) chain(clip_control);
+  vkGetPhysicalDeviceFeatures2(physical_device_, &supported);
+  const VkPhysicalDeviceFeatures& core = supported.features;
+  shader_float64_ = core.shaderFloat64 == VK_TRUE;
+  raster_features_ = {.graphics_queue = properties_.queue_graphics,
+                      .dynamic_rendering = api13 && features13.dynamicRendering == VK_TRUE,
+                      .multi_viewport = core.multiViewport == VK_TRUE,
+                      .viewport_index = api12 && features12.shaderOutputViewportIndex == VK_TRUE,
+                      .depth_clamp = core.depthClamp == VK_TRUE,
+                      .fragment_stores = core.fragmentStoresAndAtomics == VK_TRUE,
+                      .depth_clip_control = has_clip_control && clip_control.depthClipControl == VK_TRUE};
+  // Enabling is the same chain with only what is wanted left on.
+  VkPhysicalDeviceFeatures2 enabled{};
+  enabled.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  enabled.pNext = supported.pNext;
+  enabled.features.shaderFloat64 = core.shaderFloat64;
+  enabled.features.multiViewport = core.multiViewport;
+  enabled.features.depthClamp = core.depthClamp;
+  enabled.features.fragmentStoresAndAtomics = core.fragmentStoresAndAtomics;
+  // Of the 1.2 and 1.3 features, only these two are wanted.
+  const VkBool32 viewport_index = features12.shaderOutputViewportIndex;
+  void* const after12 = features12.pNext;
+  features12 = VkPhysicalDeviceVulkan12Features{};
+  features12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  features12.pNext = after12;
+  features12.shaderOutputViewportIndex = viewport_index;
+  const VkBool32 dynamic_rendering = features13.dynamicRendering;
+  void* const after13 = features13.pNext;
+  features13 = VkPhysicalDeviceVulkan13Features{};
+  features13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+  features13.pNext = after13;
+  features13.dynamicRendering = dynamic_rendering;
+  const char* const extensions[] = {VK_EXT_DEPTH_CLIP_CONTROL_EXTENSION_NAME};
+  if (has_clip_control) {
+    device_info.enabledExtensionCount = 1;
+    device_info.ppEnabledExtensionNames = extensions;
+  }
+  device_info.pNext = &enabled;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateDevice(physical_device_, &device_info, nullptr, &device_), "vkCreateDevice"));
   vkGetDeviceQueue(device_, properties_.queue_family, 0, &queue_);
 
@@ -473,6 +543,84 @@ Expected<VulkanBuffer> VulkanContext::CreateHostBuffer(VkDeviceSize size, VkBuff
   DB_RETURN_IF_ERROR(CheckVk(vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped_), "vkMapMemory"));
   buffer.coherent_ = (memory_properties_.memoryTypes[memory_type].propertyFlags & kCoherent) != 0;
   return buffer;
+}
+
+Status VulkanContext::GrowHostBuffer(VulkanBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                                     HostAccess access) const {
+  if (buffer.size() >= bytes) return Status::Ok();
+  const VkDeviceSize size = std::max(bytes, buffer.size() + buffer.size() / 2);
+  buffer = VulkanBuffer();
+  DB_ASSIGN_OR_RETURN(buffer, CreateHostBuffer(size, usage, access));
+  return Status::Ok();
+}
+
+Expected<DeviceObject<VkDeviceMemory>> VulkanContext::AllocateDeviceLocal(
+    const VkMemoryRequirements& requirements) const {
+  // Device-local first, as an engine places its render targets; a device
+  // without it (none known) still runs.
+  DB_ASSIGN_OR_RETURN(const std::uint32_t type,
+                      FindMemoryType(requirements.memoryTypeBits,
+                                     {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VkMemoryPropertyFlags{0}}));
+  VkMemoryAllocateInfo allocate_info{};
+  allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  allocate_info.allocationSize = requirements.size;
+  allocate_info.memoryTypeIndex = type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(device_, &allocate_info, nullptr, &memory),
+                             fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
+  return DeviceObject<VkDeviceMemory>(device_, memory, vkFreeMemory);
+}
+
+Expected<DeviceObject<VkSampler>> VulkanContext::CreateTexelSampler() const {
+  VkSamplerCreateInfo sampler_info{};
+  sampler_info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+  sampler_info.magFilter = VK_FILTER_NEAREST;
+  sampler_info.minFilter = VK_FILTER_NEAREST;
+  sampler_info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  sampler_info.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  sampler_info.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  sampler_info.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  VkSampler sampler = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateSampler(device_, &sampler_info, nullptr, &sampler), "vkCreateSampler"));
+  return DeviceObject<VkSampler>(device_, sampler, vkDestroySampler);
+}
+
+Expected<VulkanImage> VulkanContext::CreateImage(VkFormat format, VkExtent2D extent, VkImageUsageFlags usage,
+                                                 VkImageAspectFlags aspect) const {
+  VkImageCreateInfo image_info{};
+  image_info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+  image_info.imageType = VK_IMAGE_TYPE_2D;
+  image_info.format = format;
+  image_info.extent = {extent.width, extent.height, 1};
+  image_info.mipLevels = 1;
+  image_info.arrayLayers = 1;
+  image_info.samples = VK_SAMPLE_COUNT_1_BIT;
+  image_info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  image_info.usage = usage;
+  image_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  image_info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImage handle = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateImage(device_, &image_info, nullptr, &handle),
+                             fmt::format("vkCreateImage of format {} {}x{}", static_cast<int>(format), extent.width,
+                                         extent.height)));
+  VulkanImage image;
+  image.extent = extent;
+  image.aspect = aspect;
+  image.image = DeviceObject<VkImage>(device_, handle, vkDestroyImage);
+  VkMemoryRequirements requirements{};
+  vkGetImageMemoryRequirements(device_, handle, &requirements);
+  DB_ASSIGN_OR_RETURN(image.memory, AllocateDeviceLocal(requirements));
+  DB_RETURN_IF_ERROR(CheckVk(vkBindImageMemory(device_, handle, image.memory.get(), 0), "vkBindImageMemory"));
+  VkImageViewCreateInfo view_info{};
+  view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+  view_info.image = handle;
+  view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view_info.format = format;
+  view_info.subresourceRange = {aspect, 0, 1, 0, 1};
+  VkImageView view = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateImageView(device_, &view_info, nullptr, &view), "vkCreateImageView"));
+  image.view = DeviceObject<VkImageView>(device_, view, vkDestroyImageView);
+  return image;
 }
 
 DeviceInfo DeviceInfoOf(const VulkanDeviceProperties& properties) {

@@ -1,7 +1,9 @@
-// VulkanContext: one Vulkan device ready for compute work. It owns the
-// instance, the validation messenger (when validation is on), the chosen
-// physical device, a logical device with one compute-capable queue, and a
-// command pool for that queue, and it hands out host-visible buffers.
+// VulkanContext: one Vulkan device ready for compute work, and for drawing
+// where the device can. It owns the instance, the validation messenger (when
+// validation is on), the chosen physical device, a logical device with one
+// compute-capable queue (that can also draw, where one can), and a command
+// pool for that queue, and it hands out host-visible buffers and
+// device-local images.
 #pragma once
 
 #include <cstdint>
@@ -62,6 +64,7 @@ struct VulkanDeviceProperties {
   VkPhysicalDeviceLimits limits{};  // timestampPeriod, timestampComputeAndGraphics, dispatch and buffer limits
   std::uint32_t queue_family = 0;
   std::uint32_t queue_timestamp_valid_bits = 0;  // 0: the queue cannot write timestamps
+  bool queue_graphics = false;                   // the queue can also draw
 
   // "<driverName> <driverInfo>", or the driver version where the device
   // does not report its driver.
@@ -156,6 +159,35 @@ class VulkanBuffer {
   bool coherent_ = false;
 };
 
+// A 2D image of one mip level and layer in device-local memory, with a
+// view of its whole `aspect`. Members are destroyed view first; Reset an
+// image before assigning another to it (a move assigns the memory first).
+struct VulkanImage {
+  DeviceObject<VkDeviceMemory> memory;
+  DeviceObject<VkImage> image;
+  DeviceObject<VkImageView> view;
+  VkExtent2D extent{};
+  VkImageAspectFlags aspect = 0;
+
+  void Reset() {
+    view.Reset();
+    image.Reset();
+    memory.Reset();
+  }
+};
+
+// What the raster form of the backend draws with, as the device offers it
+// (each is enabled on the context's device where offered).
+struct RasterFeatures {
+  bool graphics_queue = false;          // the chosen queue can draw
+  bool dynamic_rendering = false;       // Vulkan 1.3: drawing without render pass objects
+  bool multi_viewport = false;          // every sample its own viewport
+  bool viewport_index = false;          // shaderOutputViewportIndex: the vertex stage picks it
+  bool depth_clamp = false;             // light volumes drawn without near and far clipping
+  bool fragment_stores = false;         // fragmentStoresAndAtomics: positions written from the fragment stage
+  bool depth_clip_control = false;      // VK_EXT_depth_clip_control: GL-style clip depth [-1, 1]
+};
+
 // How the host uses a buffer, which decides the memory type it lives in.
 enum class HostAccess {
   kUpload,    // written by the host, read by shaders: coherent write-combined memory is best
@@ -177,6 +209,7 @@ class VulkanContext {
   const VulkanDeviceProperties& properties() const { return properties_; }
   // Whether shaders may use float64 (enabled wherever the device has it).
   bool shader_float64() const { return shader_float64_; }
+  const RasterFeatures& raster_features() const { return raster_features_; }
 
   bool validation_enabled() const { return validation_enabled_; }
   // The validation layer's warnings and errors since the last call.
@@ -189,6 +222,19 @@ class VulkanContext {
                                          std::initializer_list<VkMemoryPropertyFlags> candidates) const;
   // A mapped buffer of `size` bytes (> 0) in memory suited to `access`.
   Expected<VulkanBuffer> CreateHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage, HostAccess access) const;
+  // Makes `buffer` hold at least `bytes`: a larger one replaces it when it
+  // holds fewer (its contents are lost), grown geometrically so that
+  // batches that vary a little rarely reallocate. The device must not be
+  // using the old buffer.
+  Status GrowHostBuffer(VulkanBuffer& buffer, VkDeviceSize bytes, VkBufferUsageFlags usage, HostAccess access) const;
+  // Memory for `requirements`, device-local where the device has it.
+  Expected<DeviceObject<VkDeviceMemory>> AllocateDeviceLocal(const VkMemoryRequirements& requirements) const;
+  // A sampler for texelFetch, which ignores filtering and addressing: it
+  // only has to exist.
+  Expected<DeviceObject<VkSampler>> CreateTexelSampler() const;
+  // An optimally tiled image (layout undefined) and its view.
+  Expected<VulkanImage> CreateImage(VkFormat format, VkExtent2D extent, VkImageUsageFlags usage,
+                                    VkImageAspectFlags aspect) const;
 
  private:
   VulkanContext() = default;
@@ -207,6 +253,7 @@ class VulkanContext {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   bool shader_float64_ = false;
+  RasterFeatures raster_features_;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
 };
 

@@ -1,0 +1,691 @@
+#include "bench/backends/vulkan/raster_pass.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "bench/backends/vulkan/arithmetic_probe.h"
+#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/variant_program.h"
+#include "bench/backends/vulkan/vulkan_formats.h"
+
+namespace depthbench {
+
+struct RasterPass::Slot {
+  Encoding encoding{};
+  std::uint32_t convention_slot = 0;
+  std::optional<std::uint32_t> atlas;  // none when no prepared cell reads the slot
+  DeviceObject<VkPipeline> production;
+};
+
+namespace {
+
+// shaders/raster/raster_common.glsl's VIEWPORTS_PER_DRAW. Every device with
+// multiViewport has at least 16 viewports (the minimum of maxViewports).
+constexpr std::uint32_t kViewportsPerDraw = 16;
+constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
+constexpr std::uint32_t kTriangleVertices = 3;
+constexpr std::uint32_t kCubeVertices = 36;  // shaders/raster/light_volume.vert's kCubeCorners
+
+// The descriptor set both passes draw with (shaders/raster/): the batch's
+// inputs first.
+enum Binding : std::uint32_t { kFrames, kDepthParams, kPixels, kGeometry, kAtlases, kPositions, kBindingCount };
+constexpr std::size_t kInputBindings = kGeometry + 1;
+
+// The bytes of the batch's inputs, binding by binding.
+std::array<VkDeviceSize, kInputBindings> InputBytes(const ShaderInputs& batch) {
+  const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
+  return {frames * sizeof(f32::FrameParams), frames * kHardwareConventionCount * sizeof(f32::DepthParams),
+          std::size_t{batch.count} * sizeof(std::uint32_t), std::size_t{batch.count} * sizeof(f32::RasterSample)};
+}
+constexpr VkShaderStageFlags kDrawStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
+// gbuffer.frag's specialization constant VIEW_Z.
+constexpr std::uint32_t kViewZConstant = 0;
+
+bool ClipMinusOne(Convention convention) { return (Info(convention).bits & catalog::kGl) != 0; }
+bool ReversedDepth(Convention convention) { return (Info(convention).bits & catalog::kRev) != 0; }
+
+// Bytes of a texel as a copy to a buffer packs it.
+std::uint32_t TexelBytesOf(Format format) { return Info(format).bits <= 16 ? 2 : 4; }
+VkDeviceSize AlignedTo4(VkDeviceSize bytes) { return (bytes + 3) / 4 * 4; }
+
+bool IsZero(const glm::vec4& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f; }
+// All zero: the host has nothing for the sample to draw.
+bool HasGeometry(const f32::RasterSample& sample) {
+  return !(IsZero(sample.triangle0) && IsZero(sample.triangle1) && IsZero(sample.triangle2));
+}
+
+// A texel's bits as ShaderInputs::codes holds them: X8_D24 keeps its depth
+// in the low 24 bits of the word, the other 8 are undefined.
+std::uint32_t CodeOf(Format format, const std::byte* texel) {
+  if (TexelBytesOf(format) == 2) {
+    std::uint16_t half = 0;
+    std::memcpy(&half, texel, sizeof(half));
+    return half;
+  }
+  std::uint32_t word = 0;
+  std::memcpy(&word, texel, sizeof(word));
+  return format == Format::kX8D24Unorm ? word & 0x00ff'ffffu : word;
+}
+
+// What one graphics pipeline of the raster form differs in.
+struct DrawState {
+  VkShaderModule vertex = VK_NULL_HANDLE;
+  VkShaderModule fragment = VK_NULL_HANDLE;
+  const VkSpecializationInfo* fragment_constants = nullptr;
+  std::vector<VkFormat> colors;
+  VkFormat depth = VK_FORMAT_UNDEFINED;  // a depth attachment, tested ALWAYS and written
+  bool clip_minus_one = false;           // GL-style clip depth (VK_EXT_depth_clip_control)
+  bool light_volume = false;             // back faces only, depth clamped rather than clipped
+};
+
+Expected<DeviceObject<VkPipeline>> CreateGraphicsPipeline(VkDevice device, VkPipelineLayout layout,
+                                                          const DrawState& state, const std::string& what) {
+  std::array<VkPipelineShaderStageCreateInfo, 2> stages{};
+  for (VkPipelineShaderStageCreateInfo& stage : stages) {
+    stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    stage.pName = "main";
+  }
+  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  stages[0].module = state.vertex;
+  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  stages[1].module = state.fragment;
+  stages[1].pSpecializationInfo = state.fragment_constants;
+
+  VkPipelineVertexInputStateCreateInfo vertex_input{};  // the shaders fetch their own vertices
+  vertex_input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
+  VkPipelineInputAssemblyStateCreateInfo assembly{};
+  assembly.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
+  assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+
+  VkPipelineViewportDepthClipControlCreateInfoEXT clip_control{};
+  clip_control.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_DEPTH_CLIP_CONTROL_CREATE_INFO_EXT;
+  clip_control.negativeOneToOne = VK_TRUE;
+  VkPipelineViewportStateCreateInfo viewport{};
+  viewport.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
+  viewport.pNext = state.clip_minus_one ? &clip_control : nullptr;
+  viewport.viewportCount = kViewportsPerDraw;
+  viewport.scissorCount = kViewportsPerDraw;
+
+  VkPipelineRasterizationStateCreateInfo rasterization{};
+  rasterization.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
+  rasterization.depthClampEnable = state.light_volume ? VK_TRUE : VK_FALSE;
+  rasterization.polygonMode = VK_POLYGON_MODE_FILL;
+  // The cube's faces are counter-clockwise seen from outside, in NDC with y
+  // up; the viewport's negative height keeps that counter-clockwise in
+  // framebuffer coordinates, so culling front faces leaves the back ones.
+  rasterization.cullMode = state.light_volume ? VK_CULL_MODE_FRONT_BIT : VK_CULL_MODE_NONE;
+  rasterization.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  rasterization.lineWidth = 1.0f;
+
+  VkPipelineMultisampleStateCreateInfo multisample{};
+  multisample.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
+  multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+
+  const bool has_depth = state.depth != VK_FORMAT_UNDEFINED;
+  VkPipelineDepthStencilStateCreateInfo depth{};
+  depth.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+  depth.depthTestEnable = has_depth ? VK_TRUE : VK_FALSE;
+  depth.depthWriteEnable = has_depth ? VK_TRUE : VK_FALSE;
+  depth.depthCompareOp = VK_COMPARE_OP_ALWAYS;  // one triangle a texel: whatever it rasterizes is stored
+
+  std::vector<VkPipelineColorBlendAttachmentState> attachments(state.colors.size());
+  for (VkPipelineColorBlendAttachmentState& attachment : attachments) {
+    attachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT;
+  }
+  VkPipelineColorBlendStateCreateInfo blend{};
+  blend.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
+  blend.attachmentCount = static_cast<std::uint32_t>(attachments.size());
+  blend.pAttachments = attachments.data();
+
+  // Every draw places its samples' viewports and scissors.
+  const std::array<VkDynamicState, 2> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dynamic{};
+  dynamic.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
+  dynamic.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states.size());
+  dynamic.pDynamicStates = dynamic_states.data();
+
+  VkPipelineRenderingCreateInfo rendering{};
+  rendering.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO;
+  rendering.colorAttachmentCount = static_cast<std::uint32_t>(state.colors.size());
+  rendering.pColorAttachmentFormats = state.colors.data();
+  rendering.depthAttachmentFormat = state.depth;
+
+  VkGraphicsPipelineCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
+  info.pNext = &rendering;
+  info.stageCount = static_cast<std::uint32_t>(stages.size());
+  info.pStages = stages.data();
+  info.pVertexInputState = &vertex_input;
+  info.pInputAssemblyState = &assembly;
+  info.pViewportState = &viewport;
+  info.pRasterizationState = &rasterization;
+  info.pMultisampleState = &multisample;
+  info.pDepthStencilState = &depth;
+  info.pColorBlendState = &blend;
+  info.pDynamicState = &dynamic;
+  info.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
+                             "vkCreateGraphicsPipelines for " + what));
+  return DeviceObject<VkPipeline>(device, pipeline, vkDestroyPipeline);
+}
+
+void RecordImageBarrier(VkCommandBuffer commands, const VulkanImage& image, VkImageLayout from, VkImageLayout to,
+                        VkPipelineStageFlags from_stage, VkAccessFlags from_access, VkPipelineStageFlags to_stage,
+                        VkAccessFlags to_access) {
+  VkImageMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+  barrier.srcAccessMask = from_access;
+  barrier.dstAccessMask = to_access;
+  barrier.oldLayout = from;
+  barrier.newLayout = to;
+  barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image.image.get();
+  barrier.subresourceRange = {image.aspect, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(commands, from_stage, to_stage, 0, 0, nullptr, 0, nullptr, 1, &barrier);
+}
+
+VkRenderingAttachmentInfo ClearedAttachment(const VulkanImage& image, VkImageLayout layout, VkClearValue clear) {
+  VkRenderingAttachmentInfo attachment{};
+  attachment.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+  attachment.imageView = image.view.get();
+  attachment.imageLayout = layout;
+  attachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  attachment.clearValue = clear;
+  return attachment;
+}
+
+// Ok when the device can use `format` for everything `needed` says.
+Status CheckFormat(VkPhysicalDevice physical_device, VkFormat format, std::string_view name,
+                   VkFormatFeatureFlags needed, const std::string& device_name) {
+  VkFormatProperties properties{};
+  vkGetPhysicalDeviceFormatProperties(physical_device, format, &properties);
+  if ((properties.optimalTilingFeatures & needed) == needed) return Status::Ok();
+  return Unavailable(fmt::format(
+      "the raster form renders into {} and copies it back{}; Vulkan device '{}' cannot (format features {:#x} of "
+      "{:#x})",
+      name, (needed & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT) != 0 ? " and samples it" : "", device_name,
+      properties.optimalTilingFeatures & needed, needed));
+}
+
+}  // namespace
+
+Status CheckRasterFeatures(const RasterFeatures& features, std::span<const CellPlan> cells,
+                           const std::string& device_name) {
+  std::vector<std::string> missing;
+  const auto need = [&](bool has, std::string_view what) {
+    if (!has) missing.emplace_back(what);
+  };
+  need(features.graphics_queue, "a queue that can both compute and draw");
+  need(features.dynamic_rendering, "dynamicRendering (Vulkan 1.3)");
+  need(features.multi_viewport, "multiViewport");
+  need(features.viewport_index, "shaderOutputViewportIndex (Vulkan 1.2)");
+  need(features.fragment_stores, "fragmentStoresAndAtomics");
+  const bool volumes = std::any_of(cells.begin(), cells.end(),
+                                   [](const CellPlan& plan) { return plan.cell.variant == Variant::kVolumeRay; });
+  if (volumes) need(features.depth_clamp, "depthClamp (volume_ray draws its light volumes unclipped)");
+  std::vector<std::string_view> gl_conventions;
+  for (const CellPlan& plan : cells) {
+    const Convention convention = plan.cell.convention;
+    if (!Info(convention).hardware || !ClipMinusOne(convention)) continue;
+    if (std::find(gl_conventions.begin(), gl_conventions.end(), Info(convention).name) == gl_conventions.end()) {
+      gl_conventions.push_back(Info(convention).name);
+    }
+  }
+  if (!gl_conventions.empty() && !features.depth_clip_control) {
+    missing.push_back(fmt::format("VK_EXT_depth_clip_control (GL-style clip depth, for the conventions {})",
+                                  fmt::join(gl_conventions, ", ")));
+  }
+  if (missing.empty()) return Status::Ok();
+  return Unavailable(fmt::format("the raster form (--pipeline raster) needs what Vulkan device '{}' lacks: {}",
+                                 device_name, fmt::join(missing, "; ")));
+}
+
+RasterPass::RasterPass(std::shared_ptr<VulkanContext> context) : context_(std::move(context)) {}
+RasterPass::~RasterPass() = default;
+
+Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanContext> context,
+                                                         std::span<const CellPlan> cells,
+                                                         const std::filesystem::path& shader_dir,
+                                                         std::uint32_t arithmetic_probes,
+                                                         std::vector<std::string>& sources) {
+  if (context == nullptr) return InvalidArgument("the raster form needs a Vulkan context");
+  const std::string& device_name = context->properties().name;
+  DB_RETURN_IF_ERROR(CheckRasterFeatures(context->raster_features(), cells, device_name));
+  std::unique_ptr<RasterPass> pass(new RasterPass(std::move(context)));
+  pass->cells_.assign(cells.begin(), cells.end());
+
+  std::uint32_t slot_count = 0;
+  for (const CellPlan& plan : cells) slot_count = std::max(slot_count, plan.depth_slot + 1);
+  pass->slots_.resize(slot_count);
+  std::uint32_t atlases = 0;
+  for (const CellPlan& plan : cells) {
+    Slot& slot = pass->slots_[plan.depth_slot];
+    if (slot.atlas) continue;
+    slot.encoding = plan.cell.encoding();
+    slot.convention_slot = plan.convention_slot;
+    slot.atlas = atlases++;
+    const Format format = slot.encoding.format;
+    const VkFormatFeatureFlags use =
+        VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT |
+        (IsDepthFormat(format) ? VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT : VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT);
+    DB_RETURN_IF_ERROR(CheckFormat(pass->context_->physical_device(), VulkanFormatOf(format), Info(format).vulkan_name,
+                                   use, device_name));
+  }
+  DB_RETURN_IF_ERROR(CheckFormat(pass->context_->physical_device(), kCoverageFormat, "VK_FORMAT_R8_UINT",
+                                 VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT,
+                                 device_name));
+  pass->atlases_.resize(atlases);
+  pass->agreement_.assign(slot_count, RasterAgreement{});
+
+  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+  for (std::uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kDrawStages, nullptr};
+  }
+  bindings[kAtlases].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  // A set per atlas: the sets differ in the atlas alone, and a cell's draws
+  // bind its slot's.
+  DB_ASSIGN_OR_RETURN(pass->pass_, ComputePass::Create(pass->context_, bindings, sizeof(f32::RasterConstants),
+                                                       kDrawStages, std::max(atlases, 1u)));
+  DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
+  DB_RETURN_IF_ERROR(pass->BuildPipelines(cells, shader_dir, arithmetic_probes, sources));
+  return pass;
+}
+
+Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::filesystem::path& shader_dir,
+                                  std::uint32_t arithmetic_probes, std::vector<std::string>& sources) {
+  const auto module = [&](Expected<std::vector<std::uint32_t>> compiled,
+                          const std::string& what) -> Expected<DeviceObject<VkShaderModule>> {
+    if (!compiled.ok()) return compiled.status();
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, ApplyArithmeticProbes(*compiled, arithmetic_probes));
+    return CreateShaderModule(device(), spirv, what);
+  };
+  const auto stage = [&](std::string_view file, ShaderStage kind) {
+    const std::filesystem::path path = shader_dir / "raster" / file;
+    return module(CompileShader(path, kind, &sources), path.string());
+  };
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> triangle, stage("sample_triangle.vert", ShaderStage::kVertex));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> coverage, stage("coverage.frag", ShaderStage::kFragment));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> gbuffer, stage("gbuffer.frag", ShaderStage::kFragment));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> full_screen, stage("full_screen.vert", ShaderStage::kVertex));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> light_volume,
+                      stage("light_volume.vert", ShaderStage::kVertex));
+  const VkPipelineLayout layout = pass_->pipeline_layout();
+
+  for (Slot& slot : slots_) {
+    if (!slot.atlas) continue;
+    const Format format = slot.encoding.format;
+    const VkBool32 view_z = Info(format).stores == DepthInput::kViewZ ? VK_TRUE : VK_FALSE;
+    const VkSpecializationMapEntry entry{kViewZConstant, 0, sizeof(VkBool32)};
+    const VkSpecializationInfo constants{1, &entry, sizeof(view_z), &view_z};
+    DrawState state;
+    state.vertex = triangle.get();
+    state.colors = {kCoverageFormat};
+    if (IsDepthFormat(format)) {
+      state.fragment = coverage.get();
+      state.depth = VulkanFormatOf(format);
+      state.clip_minus_one = ClipMinusOne(slot.encoding.convention);
+    } else {
+      state.fragment = gbuffer.get();
+      state.fragment_constants = &constants;
+      state.colors.push_back(VulkanFormatOf(format));
+    }
+    DB_ASSIGN_OR_RETURN(slot.production,
+                        CreateGraphicsPipeline(device(), layout, state,
+                                               fmt::format("the raster form's {}/{} depth pass",
+                                                           Info(slot.encoding.convention).name, Info(format).name)));
+  }
+
+  reconstruction_.clear();
+  reconstruction_.resize(AllVariants().size());
+  for (const CellPlan& plan : cells) {
+    const Variant variant = plan.cell.variant;
+    DeviceObject<VkPipeline>& pipeline = reconstruction_[static_cast<std::size_t>(variant)];
+    if (pipeline.get() != VK_NULL_HANDLE) continue;
+    const std::string name = VariantProgramName(variant, VariantPass::kRaster, shader_dir);
+    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> fragment,
+                        module(CompileVariant(variant, VariantPass::kRaster, shader_dir, &sources), name));
+    DrawState state;
+    state.light_volume = variant == Variant::kVolumeRay;
+    state.vertex = state.light_volume ? light_volume.get() : full_screen.get();
+    state.fragment = fragment.get();
+    DB_ASSIGN_OR_RETURN(pipeline, CreateGraphicsPipeline(device(), layout, state, name));
+  }
+  return Status::Ok();
+}
+
+std::uint64_t RasterPass::MaxBatchSamples() const {
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  const std::uint32_t rows = std::min(limits.maxImageDimension2D, limits.maxFramebufferHeight);
+  return std::uint64_t{kAtlasWidth} * rows;
+}
+
+Status RasterPass::CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which) const {
+  if (batch.raster.size() < batch.count) {
+    return InvalidArgument(fmt::format(
+        "the raster form draws the batch's geometry, and a batch of {} samples has it for {}: its domain's "
+        "production must be the raster pipeline's (--pipeline raster)",
+        batch.count, batch.raster.size()));
+  }
+  for (const std::uint32_t index : which) {
+    const std::size_t codes_needed = (std::size_t{cells_[index].depth_slot} + 1) * batch.count;
+    if (batch.codes.size() < codes_needed) {
+      return InvalidArgument(fmt::format("cell {} compares {} texel codes; the batch has {}",
+                                         cells_[index].cell.Name(), codes_needed, batch.codes.size()));
+    }
+  }
+  const std::uint64_t rows = (std::uint64_t{batch.count} + kAtlasWidth - 1) / kAtlasWidth;
+  if (std::uint64_t{batch.count} > MaxBatchSamples()) {
+    return InvalidArgument(fmt::format("a batch of {} samples needs an atlas of {} rows; the device renders at most {}",
+                                       batch.count, rows, MaxBatchSamples() / kAtlasWidth));
+  }
+  // A sample's viewport lies up to a frame's size beyond the atlas.
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  for (const f32::FrameParams& frame : batch.frame_params) {
+    const float width = frame.resolution.x;
+    const float height = frame.resolution.y;
+    if (width > static_cast<float>(limits.maxViewportDimensions[0]) ||
+        height > static_cast<float>(limits.maxViewportDimensions[1]) ||
+        -width < limits.viewportBoundsRange[0] ||
+        static_cast<float>(rows) + height > limits.viewportBoundsRange[1]) {
+      return InvalidArgument(fmt::format(
+          "a {}x{} frame's viewports reach beyond what the device allows (at most {}x{}, within [{}, {}]) with an "
+          "atlas of {} rows; run fewer samples at once",
+          width, height, limits.maxViewportDimensions[0], limits.maxViewportDimensions[1],
+          limits.viewportBoundsRange[0], limits.viewportBoundsRange[1], rows));
+    }
+  }
+  return Status::Ok();
+}
+
+// The atlases only grow, so that batches of varying sizes do not recreate
+// them; a new one is made readable at once, so that pass 2's descriptors
+// are valid for every atlas whether or not the run draws it.
+Status RasterPass::EnsureAtlases(std::uint32_t rows) {
+  if (rows <= atlas_rows_) return Status::Ok();
+  const std::uint32_t most = static_cast<std::uint32_t>(MaxBatchSamples() / kAtlasWidth);
+  const std::uint32_t grown = std::min(std::max(rows, atlas_rows_ + atlas_rows_ / 2), most);
+  for (Atlas& atlas : atlases_) {
+    atlas.value.Reset();
+    atlas.coverage.Reset();
+  }
+  atlas_rows_ = 0;
+  for (const Slot& slot : slots_) {
+    if (!slot.atlas) continue;
+    const Format format = slot.encoding.format;
+    const bool depth = IsDepthFormat(format);
+    Atlas& atlas = atlases_[*slot.atlas];
+    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                  (depth ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
+                                         : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
+    DB_ASSIGN_OR_RETURN(atlas.value,
+                        context_->CreateImage(VulkanFormatOf(format), {kAtlasWidth, grown}, use,
+                                              depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT));
+    DB_ASSIGN_OR_RETURN(atlas.coverage,
+                        context_->CreateImage(kCoverageFormat, {kAtlasWidth, grown},
+                                              VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                              VK_IMAGE_ASPECT_COLOR_BIT));
+  }
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) {
+    for (const Atlas& atlas : atlases_) {
+      RecordImageBarrier(commands, atlas.value, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                         VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, 0, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                         VK_ACCESS_SHADER_READ_BIT);
+    }
+  }));
+  atlas_rows_ = grown;
+  return Status::Ok();
+}
+
+Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
+  const std::array<VkDeviceSize, kInputBindings> bytes = InputBytes(batch);
+  const std::array<const void*, kInputBindings> data = {batch.frame_params.data(), batch.depth_params.data(),
+                                                        batch.pixels.data(), batch.raster.data()};
+  const std::array<VulkanBuffer*, kInputBindings> buffers = {&frames_, &depth_params_, &pixels_, &geometry_};
+  for (std::size_t binding = 0; binding < kInputBindings; ++binding) {
+    VulkanBuffer& buffer = *buffers[binding];
+    DB_RETURN_IF_ERROR(context_->GrowHostBuffer(buffer, bytes[binding], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                                HostAccess::kUpload));
+    std::memcpy(buffer.mapped(), data[binding], bytes[binding]);
+    DB_RETURN_IF_ERROR(buffer.FlushHostWrites());
+  }
+
+  // Pass 1's texels and coverage, slot after slot, each at a multiple of 4
+  // bytes as copies of depth aspects require.
+  texel_offsets_.assign(slots_.size(), 0);
+  coverage_offsets_.assign(slots_.size(), 0);
+  VkDeviceSize readback_bytes = 0;
+  const VkDeviceSize texels = VkDeviceSize{kAtlasWidth} * rows;
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (!slots_[s].atlas) continue;
+    texel_offsets_[s] = readback_bytes;
+    readback_bytes += AlignedTo4(texels * TexelBytesOf(slots_[s].encoding.format));
+    coverage_offsets_[s] = readback_bytes;
+    readback_bytes += AlignedTo4(texels);
+  }
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(readback_, readback_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                              HostAccess::kReadback));
+  return Status::Ok();
+}
+
+Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                       std::uint32_t unwritten_bits) {
+  DB_RETURN_IF_ERROR(CheckRun(batch, which));
+  const std::uint32_t count = batch.count;
+  const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
+  DB_RETURN_IF_ERROR(EnsureAtlases(rows));
+  DB_RETURN_IF_ERROR(Upload(batch, rows));
+  const VkDeviceSize position_bytes = VkDeviceSize{3} * count * which.size() * sizeof(float);
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(
+      positions_, position_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+      HostAccess::kReadback));
+
+  // Points the sets at this run's buffers (they may have been reallocated)
+  // and each at its atlas.
+  const std::array<VkDeviceSize, kInputBindings> input_bytes = InputBytes(batch);
+  const std::array<VkDescriptorBufferInfo, kBindingCount> infos = {{
+      {frames_.handle(), 0, input_bytes[kFrames]},
+      {depth_params_.handle(), 0, input_bytes[kDepthParams]},
+      {pixels_.handle(), 0, input_bytes[kPixels]},
+      {geometry_.handle(), 0, input_bytes[kGeometry]},
+      {},
+      {positions_.handle(), 0, position_bytes},
+  }};
+  for (std::uint32_t set = 0; set < atlases_.size(); ++set) {
+    const VkDescriptorImageInfo image{sampler_.get(), atlases_[set].value.view.get(),
+                                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+    for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
+      writes[binding].dstBinding = binding;
+      writes[binding].descriptorType =
+          binding == kAtlases ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes[binding].pBufferInfo = &infos[binding];
+    }
+    writes[kAtlases].pBufferInfo = nullptr;
+    writes[kAtlases].pImageInfo = &image;
+    pass_->WriteDescriptors(writes, set);
+  }
+
+  // Sample i's viewport puts its frame's pixel on texel i; the scissor
+  // keeps that texel alone. Whole draws: the last one's unused viewports
+  // repeat its last sample's.
+  const std::uint32_t padded = (count + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
+  viewports_.resize(padded);
+  scissors_.resize(padded);
+  for (std::uint32_t i = 0; i < padded; ++i) {
+    const std::uint32_t sample = std::min(i, count - 1);
+    const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
+    const std::uint32_t x = sample % kAtlasWidth, y = sample / kAtlasWidth;
+    const auto pixel_x = static_cast<float>(batch.pixels[sample] & 0xffffu);
+    const auto pixel_y = static_cast<float>(batch.pixels[sample] >> 16);
+    // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
+    viewports_[i] = {static_cast<float>(x) - pixel_x, static_cast<float>(y) - pixel_y + resolution.y, resolution.x,
+                     -resolution.y, 0.0f, 1.0f};
+    scissors_[i] = {{static_cast<std::int32_t>(x), static_cast<std::int32_t>(y)}, {1, 1}};
+  }
+
+  std::vector<bool> drawn(slots_.size(), false);
+  for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
+  DB_RETURN_IF_ERROR(
+      pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, which, drawn, rows, unwritten_bits); }));
+  DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+  CompareTexels(batch, drawn);
+
+  // Nothing was drawn for a sample without geometry: it has no position.
+  auto* positions = static_cast<float*>(positions_.mapped());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (HasGeometry(batch.raster[i])) continue;
+    for (std::size_t slice = 0; slice < 3 * which.size(); ++slice) {
+      positions[slice * count + i] = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  return positions;
+}
+
+void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                        const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const {
+  vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    if (drawn[slot]) RecordProduction(commands, batch, slot, rows);
+  }
+
+  // Pass 2 has no attachments: its fragments write the positions.
+  VkRenderingInfo rendering{};
+  rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+  rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
+  rendering.layerCount = 1;
+  vkCmdBeginRendering(commands, &rendering);
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const CellPlan& plan = cells_[which[k]];
+    const Variant variant = plan.cell.variant;
+    pass_->Bind(commands, reconstruction_[static_cast<std::size_t>(variant)].get(), VK_PIPELINE_BIND_POINT_GRAPHICS,
+                *slots_[plan.depth_slot].atlas);
+    const f32::RasterConstants constants = {.sample_count = batch.count,
+                                            .atlas_width = kAtlasWidth,
+                                            .samples_per_frame = kSamplesPerFrame,
+                                            .first_in_frame = batch.first_offset,
+                                            .conventions_per_frame = kHardwareConventionCount,
+                                            .convention_slot = plan.convention_slot,
+                                            .output_offset = static_cast<std::uint32_t>(k * 3 * batch.count),
+                                            .reserved0 = 0};
+    pass_->PushConstants(commands, &constants, sizeof(constants));
+    RecordDraws(commands, batch.count, variant == Variant::kVolumeRay ? kCubeVertices : kTriangleVertices);
+  }
+  vkCmdEndRendering(commands);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                      VK_ACCESS_HOST_READ_BIT);
+}
+
+void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot_index,
+                                  std::uint32_t rows) const {
+  const Slot& slot = slots_[slot_index];
+  const Atlas& atlas = atlases_[*slot.atlas];
+  const bool depth = IsDepthFormat(slot.encoding.format);
+  constexpr VkPipelineStageFlags kAttachmentStages = VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                                     VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
+                                                     VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+  constexpr VkAccessFlags kAttachmentWrites =
+      VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  const VkImageLayout value_layout =
+      depth ? VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  // What the atlases held is cleared: the old contents need not survive.
+  RecordImageBarrier(commands, atlas.value, VK_IMAGE_LAYOUT_UNDEFINED, value_layout,
+                     VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, kAttachmentStages, kAttachmentWrites);
+  RecordImageBarrier(commands, atlas.coverage, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                     VK_PIPELINE_STAGE_TRANSFER_BIT, 0, kAttachmentStages, kAttachmentWrites);
+
+  VkClearValue uncovered{};
+  uncovered.color.uint32[0] = 0;
+  VkClearValue far{};  // what a depth buffer holds where nothing was drawn
+  far.depthStencil.depth = ReversedDepth(slot.encoding.convention) ? 0.0f : 1.0f;
+  VkClearValue nothing{};
+  nothing.color.float32[0] = 0.0f;
+  std::vector<VkRenderingAttachmentInfo> colors = {
+      ClearedAttachment(atlas.coverage, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, uncovered)};
+  if (!depth) colors.push_back(ClearedAttachment(atlas.value, value_layout, nothing));
+  const VkRenderingAttachmentInfo depth_attachment = ClearedAttachment(atlas.value, value_layout, far);
+  VkRenderingInfo rendering{};
+  rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+  rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
+  rendering.layerCount = 1;
+  rendering.colorAttachmentCount = static_cast<std::uint32_t>(colors.size());
+  rendering.pColorAttachments = colors.data();
+  rendering.pDepthAttachment = depth ? &depth_attachment : nullptr;
+  vkCmdBeginRendering(commands, &rendering);
+  pass_->Bind(commands, slot.production.get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
+  f32::RasterConstants constants{};
+  constants.sample_count = batch.count;
+  constants.atlas_width = kAtlasWidth;
+  constants.samples_per_frame = kSamplesPerFrame;
+  constants.first_in_frame = batch.first_offset;
+  constants.conventions_per_frame = kHardwareConventionCount;
+  constants.convention_slot = slot.convention_slot;
+  pass_->PushConstants(commands, &constants, sizeof(constants));
+  RecordDraws(commands, batch.count, kTriangleVertices);
+  vkCmdEndRendering(commands);
+
+  // The texels and the coverage go to the host; the texels then to pass 2.
+  for (const VulkanImage* image : {&atlas.value, &atlas.coverage}) {
+    RecordImageBarrier(commands, *image, image == &atlas.value ? value_layout : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kAttachmentStages, kAttachmentWrites,
+                       VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferImageCopy region{};
+    region.bufferOffset = image == &atlas.value ? texel_offsets_[slot_index] : coverage_offsets_[slot_index];
+    region.imageSubresource = {image->aspect, 0, 0, 1};
+    region.imageExtent = {kAtlasWidth, rows, 1};
+    vkCmdCopyImageToBuffer(commands, image->image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1,
+                           &region);
+  }
+  RecordImageBarrier(commands, atlas.value, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                     VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+}
+
+// Instances are samples, kViewportsPerDraw to a draw: instance i takes
+// viewport i % kViewportsPerDraw, which the draw has just set.
+void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const {
+  for (std::uint32_t first = 0; first < count; first += kViewportsPerDraw) {
+    vkCmdSetViewport(commands, 0, kViewportsPerDraw, viewports_.data() + first);
+    vkCmdSetScissor(commands, 0, kViewportsPerDraw, scissors_.data() + first);
+    vkCmdDraw(commands, vertices, std::min(kViewportsPerDraw, count - first), 0, first);
+  }
+}
+
+void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn) {
+  const std::size_t count = batch.count;
+  texels_.assign(slots_.size() * count, 0);
+  const auto* readback = static_cast<const std::byte*>(readback_.mapped());
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (!drawn[s]) continue;
+    const Format format = slots_[s].encoding.format;
+    const std::uint32_t bytes = TexelBytesOf(format);
+    const std::byte* texels = readback + texel_offsets_[s];
+    const std::byte* coverage = readback + coverage_offsets_[s];
+    RasterAgreement& agreement = agreement_[s];
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!HasGeometry(batch.raster[i])) continue;
+      const std::uint32_t device = CodeOf(format, texels + i * bytes);
+      const std::uint32_t host = batch.codes[s * count + i];
+      texels_[s * count + i] = device;
+      ++agreement.texels;
+      agreement.differing += device != host ? 1 : 0;
+      agreement.uncovered += coverage[i] == std::byte{0} ? 1 : 0;
+      agreement.max_code_distance = std::max(agreement.max_code_distance, device > host ? device - host : host - device);
+    }
+  }
+}
+
+}  // namespace depthbench

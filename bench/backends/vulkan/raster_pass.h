@@ -1,0 +1,127 @@
+// RasterPass: the raster form of the Vulkan backend (PassKind::kRaster). A
+// run records two passes into one command buffer, with dynamic rendering:
+//
+//   1. depth production, per depth slot: every sample's small triangle
+//      (ShaderInputs::raster) drawn into the slot's atlas, a depth
+//      attachment for the hardware formats, a G-buffer colour channel for
+//      the linear and view-z ones, with an R8_UINT coverage attachment
+//      beside it. The texels are copied back and compared with the batch's
+//      codes (agreement());
+//   2. reconstruction, per cell: the variant's fragment program
+//      (shaders/raster/raster_pass.glsl around its function) reads the
+//      slot's atlas by texel, its rays interpolated from the vertex stage:
+//      a full-screen triangle per sample, or for volume_ray the back faces
+//      of the sample's light volume.
+//
+// Sample i is texel (i % kAtlasWidth, i / kAtlasWidth) of every atlas, and
+// is drawn through a viewport of its own, offset by whole pixels so that
+// its frame's pixel lands on that texel: its geometry rasterizes as at its
+// real pixel. Instances are samples, 16 to a draw, each picking its
+// viewport (gl_ViewportIndex).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "bench/backends/backend.h"
+#include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/status.h"
+#include "bench/pipeline/shader_inputs.h"
+
+namespace depthbench {
+
+// Ok when a device with `features` can draw the raster form of `cells`;
+// otherwise Unavailable, naming the device and everything it lacks (and,
+// for VK_EXT_depth_clip_control, the cells' conventions that need it).
+Status CheckRasterFeatures(const RasterFeatures& features, std::span<const CellPlan> cells,
+                           const std::string& device_name);
+
+class RasterPass {
+ public:
+  // Texels per atlas row: a power of two, so that a sample's texel is a
+  // shift and a mask away, and narrow enough that a small batch is a few
+  // rows of lavapipe's 64-texel tiles.
+  static constexpr std::uint32_t kAtlasWidth = 256;
+
+  // Compiles the programs of `cells` from `shader_dir` with
+  // `arithmetic_probes` applied to each (the text of every source goes to
+  // `sources`) and builds their pipelines.
+  static Expected<std::unique_ptr<RasterPass>> Create(std::shared_ptr<VulkanContext> context,
+                                                      std::span<const CellPlan> cells,
+                                                      const std::filesystem::path& shader_dir,
+                                                      std::uint32_t arithmetic_probes,
+                                                      std::vector<std::string>& sources);
+  ~RasterPass();
+  RasterPass(const RasterPass&) = delete;
+  RasterPass& operator=(const RasterPass&) = delete;
+
+  // Draws both passes for the prepared cells listed in `which` (count > 0,
+  // at least one cell). Returns their positions as the compute form lays
+  // them out (cell k's component c of sample i at (k * 3 + c) * count + i),
+  // in mapped memory valid until the next Run. Every position starts as
+  // `unwritten_bits`; a sample with no geometry gets quiet NaNs (nothing
+  // was drawn for it), so whatever else still holds `unwritten_bits` is a
+  // sample the program did not write.
+  Expected<const float*> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                             std::uint32_t unwritten_bits);
+
+  // Per depth slot, since Create: RasterAgreement (backend.h).
+  const std::vector<RasterAgreement>& agreement() const { return agreement_; }
+  // The texel bits pass 1 produced in the last Run, laid out as
+  // ShaderInputs::codes; 0 for slots it did not draw and for samples with
+  // no geometry.
+  const std::vector<std::uint32_t>& texels() const { return texels_; }
+  // The most samples the atlas holds.
+  std::uint64_t MaxBatchSamples() const;
+
+ private:
+  struct Slot;  // what pass 1 draws for one depth slot
+  struct Atlas {
+    VulkanImage value;     // the depth attachment or the G-buffer channel
+    VulkanImage coverage;  // R8_UINT: 1 where pass 1 drew
+  };
+
+  explicit RasterPass(std::shared_ptr<VulkanContext> context);
+  VkDevice device() const { return context_->device(); }
+
+  Status BuildPipelines(std::span<const CellPlan> cells, const std::filesystem::path& shader_dir,
+                        std::uint32_t arithmetic_probes, std::vector<std::string>& sources);
+  Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
+  Status EnsureAtlases(std::uint32_t rows);
+  Status Upload(const ShaderInputs& batch, std::uint32_t rows);
+  // `drawn`: per depth slot, whether the run draws it (a listed cell reads it).
+  void Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
+              const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const;
+  void RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot,
+                        std::uint32_t rows) const;
+  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const;
+  void CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn);
+
+  std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
+  std::vector<CellPlan> cells_;
+  std::vector<Slot> slots_;
+  // The descriptor sets of both passes, one per atlas: the batch's buffers,
+  // the atlas (sampled by pass 2) and the positions.
+  std::unique_ptr<ComputePass> pass_;
+  DeviceObject<VkSampler> sampler_;
+  std::vector<DeviceObject<VkPipeline>> reconstruction_;  // indexed by Variant; null where no cell uses it
+
+  std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), atlas_rows_ rows each
+  std::uint32_t atlas_rows_ = 0;
+  std::vector<VkViewport> viewports_;  // per sample of the run, padded to whole draws
+  std::vector<VkRect2D> scissors_;
+  VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
+  std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
+
+  std::vector<RasterAgreement> agreement_;
+  std::vector<std::uint32_t> texels_;
+};
+
+}  // namespace depthbench
