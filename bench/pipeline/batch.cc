@@ -5,6 +5,7 @@
 
 #include "bench/pipeline/bands.h"
 #include "bench/pipeline/encode.h"
+#include "bench/pipeline/raster_model.h"
 #include "bench/pipeline/shader_constants.h"
 
 namespace depthbench {
@@ -60,7 +61,10 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
     }
   });
 
-  // Samples: pixel, ray and depth pick.
+  // Samples: pixel, ray and depth pick; for the raster pipeline, the
+  // geometry drawn, whose point under the pixel is the truth.
+  const bool raster = model_ == ProductionModel::kRaster;
+  batch.raster.assign(raster ? count : 0, f32::RasterSample{});
   batch.pixels.resize(count);
   for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
   batch.samples.Resize(count);
@@ -69,7 +73,12 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       [&](std::size_t begin, std::size_t end, unsigned) {
         for (std::size_t i = begin; i < end; ++i) {
           const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
-          const PixelSample sample = sampler_.SampleAt(first + i, frame);
+          PixelSample sample = sampler_.SampleAt(first + i, frame);
+          if (raster) {
+            const RasterGeometry geometry = MakeRasterGeometry(frame, sample);
+            batch.raster[i] = geometry.sample;
+            if (geometry.rendered_depth) sample.eye_depth = *geometry.rendered_depth;
+          }
           batch.pixels[i] = sample.x | (sample.y << 16);
           const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);
           batch.ray_x[i] = ray.x;
@@ -117,6 +126,19 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       const DepthMappings mapping = mapping_of(k).At(lo);
       float* floats = pipeline_floats_.data() + k * count + lo;
       PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
+      if (raster) {
+        // The host's model of the rasterizer, where there is geometry (the
+        // rest keeps the compute form's float: it is not judged).
+        for (std::size_t i = lo; i < lo + n; ++i) {
+          const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
+          const std::size_t drawn_with = stores == DepthInput::kHardware ? convention : 0;
+          const float value = RasterPipelineFloat(
+              encoding, batch.frame_params[frame],
+              batch.depth_params[frame * kHardwareConventionCount + drawn_with], batch.pixels[i] & 0xffffu,
+              batch.pixels[i] >> 16, batch.raster[i]);
+          if (value == value) floats[i - lo] = value;
+        }
+      }
       DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);
     }
   });
@@ -156,6 +178,13 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
                       nullptr, isa_);
       References(encoding, samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo, batch.reference,
                  at, isa_);
+      // Raster samples with nothing drawn have no point to judge.
+      for (std::size_t i = lo; raster && i < lo + n; ++i) {
+        if (batch.raster[i].triangle0.w == 0.0f) {
+          batch.reference.status[s * count + i] = ReferenceStatus::kDegenerate;
+          batch.reference.inverse_distance_sq[s * count + i] = 0.0;
+        }
+      }
     }
   });
 }

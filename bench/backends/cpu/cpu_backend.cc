@@ -7,6 +7,7 @@
 
 #include "bench/base/build_info.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/raster_model.h"
 #include "bench/pipeline/user_variant.h"
 
 namespace depthbench {
@@ -23,6 +24,14 @@ void BroadcastFloats(const Narrow& narrow, Wide& wide, std::size_t floats) {
   for (std::size_t k = 0; k < floats; ++k) to[k] = Float8(from[k]);
 }
 
+// Lane `lane` of the wide block set to the narrow one's floats.
+template <class Wide, class Narrow>
+void SetLaneFloats(const Narrow& narrow, Wide& wide, std::size_t floats, int lane) {
+  const auto* from = reinterpret_cast<const float*>(&narrow);
+  auto* to = reinterpret_cast<float*>(&wide);
+  for (std::size_t k = 0; k < floats; ++k) to[k * Float8::kLanes + static_cast<std::size_t>(lane)] = from[k];
+}
+
 f32x8::FrameParams Widen(const f32::FrameParams& narrow) {
   f32x8::FrameParams wide;
   BroadcastFloats(narrow, wide, sizeof(narrow) / sizeof(float));
@@ -37,21 +46,41 @@ f32x8::DepthParams Widen(const f32::DepthParams& narrow) {
   return wide;
 }
 
+// The FrameParams the variant reads in each lane: the frame's, or in the
+// raster form the sample's own, with the screen attributes a rasterizer
+// interpolates at its pixel (bench/pipeline/raster_model.h).
+f32x8::FrameParams RasterLaneFrames(const ShaderInputs& batch, std::uint32_t frame_index, std::uint32_t first, int n) {
+  const f32::FrameParams& frame = batch.frame_params[frame_index];
+  const f32::DepthParams& standard = batch.depth_params[frame_index * kHardwareConventionCount];
+  f32x8::FrameParams wide;
+  for (int lane = 0; lane < Float8::kLanes; ++lane) {
+    const std::uint32_t k = first + static_cast<std::uint32_t>(lane < n ? lane : n - 1);
+    const std::uint32_t pixel = batch.pixels[k];
+    SetLaneFloats(RasterFrameParams(frame, standard, pixel & 0xffffu, pixel >> 16, batch.raster[k]), wide,
+                  sizeof(frame) / sizeof(float), lane);
+  }
+  return wide;
+}
+
 // Frame by frame (the frame's constants are uniform), eight samples at a
 // time in the lanes of the f32x8 instantiation.
 template <f32x8::WorldPositionFn Reconstruct>
 void RunCell(const ShaderInputs& batch, const CellPlan& plan, float* out) {
+  const bool raster = !batch.raster.empty();
   constexpr int kLanes = Float8::kLanes;
   const float* depths = batch.depths.data() + static_cast<std::size_t>(plan.depth_slot) * batch.count;
   for (std::uint32_t begin = 0; begin < batch.count;) {
     const std::uint32_t frame_index = batch.FrameOf(begin);
     const std::uint32_t end =
         std::min<std::uint32_t>(batch.count, (frame_index + 1) * kSamplesPerFrame - batch.first_offset);
-    const f32x8::FrameParams frame = Widen(batch.frame_params[frame_index]);
+    const f32x8::FrameParams uniform_frame = Widen(batch.frame_params[frame_index]);
+    f32x8::FrameParams lane_frames;
     const f32x8::DepthParams depth =
         Widen(batch.depth_params[frame_index * kHardwareConventionCount + plan.convention_slot]);
     for (std::uint32_t i = begin; i < end; i += kLanes) {
       const int n = static_cast<int>(std::min<std::uint32_t>(kLanes, end - i));
+      const f32x8::FrameParams& frame =
+          raster ? (lane_frames = RasterLaneFrames(batch, frame_index, i, n)) : uniform_frame;
       using Words = std::uint32_t __attribute__((vector_size(32)));
       Words pixels;
       Float8::Lanes stored;

@@ -1,0 +1,275 @@
+#include "bench/pipeline/raster_model.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace depthbench {
+namespace {
+
+using L = long double;
+using LVec3 = glm::vec<3, L>;
+
+// The pixel's centre in NDC (y up), as PixelRay takes it.
+glm::vec<2, L> PixelNdc(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+  return {(static_cast<L>(x) + 0.5L) * 2.0L / frame.width - 1.0L,
+          1.0L - (static_cast<L>(y) + 0.5L) * 2.0L / frame.height};
+}
+
+LVec3 ToLong(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+LVec3 Rotate(const glm::dmat3& r, const LVec3& v) {
+  return ToLong(r[0]) * v.x + ToLong(r[1]) * v.y + ToLong(r[2]) * v.z;
+}
+// The transpose: world directions into the camera's axes.
+LVec3 Unrotate(const glm::dmat3& r, const LVec3& v) {
+  return {glm::dot(ToLong(r[0]), v), glm::dot(ToLong(r[1]), v), glm::dot(ToLong(r[2]), v)};
+}
+glm::vec4 ToFloat4(const LVec3& v, float w) {
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), w};
+}
+LVec3 Xyz(const glm::vec4& v) { return {v.x, v.y, v.z}; }
+
+// Where the exact camera puts world point q on the screen, in pixels (x
+// right, y down), or nothing when q is not in front of the camera.
+std::optional<glm::vec<2, L>> ExactScreen(const Frame& frame, const LVec3& q) {
+  const LVec3 view = Unrotate(frame.rotation, q - ToLong(frame.camera_position));
+  if (!(view.z < 0.0L)) return std::nullopt;
+  const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
+  const L ndc_x = view.x / (-view.z * tan_x), ndc_y = view.y / (-view.z * tan_y);
+  return glm::vec<2, L>((ndc_x + 1.0L) * frame.width / 2.0L, (1.0L - ndc_y) * frame.height / 2.0L);
+}
+
+// Signed distance, in pixels, of p from the line a->b; positive on the
+// left of a->b in a y-down frame for a clockwise-on-screen triangle.
+L EdgeDistance(const glm::vec<2, L>& a, const glm::vec<2, L>& b, const glm::vec<2, L>& p) {
+  const glm::vec<2, L> e = b - a;
+  return (e.x * (p.y - a.y) - e.y * (p.x - a.x)) / std::sqrt(e.x * e.x + e.y * e.y);
+}
+
+// GLSL's mat4 * vec4, in float32, one product and sum at a time in the
+// order a shader compiler emits them (glm pairs the sums instead).
+glm::vec4 Transform(const glm::mat4& m, const glm::vec4& v) {
+  glm::vec4 out;
+  for (int row = 0; row < 4; ++row) {
+    float sum = m[0][row] * v.x;
+    sum = sum + m[1][row] * v.y;
+    sum = sum + m[2][row] * v.z;
+    sum = sum + m[3][row] * v.w;
+    out[row] = sum;
+  }
+  return out;
+}
+
+// A vertex after the vertex stage: its position on the frame's screen in
+// pixels (the float NDC taken exactly), its clip w, and the attribute.
+struct ScreenVertex {
+  glm::dvec2 screen;
+  double w;
+};
+ScreenVertex ToScreen(const glm::vec4& clip, const f32::FrameParams& frame) {
+  const double x = static_cast<double>(clip.x) / clip.w, y = static_cast<double>(clip.y) / clip.w;
+  return {{(x + 1.0) * frame.resolution.x / 2.0, (1.0 - y) * frame.resolution.y / 2.0}, clip.w};
+}
+
+// Screen-space barycentrics of p in the triangle, or nothing when p lies
+// outside it (or the triangle has no area).
+std::optional<glm::dvec3> Barycentrics(const std::array<ScreenVertex, 3>& v, const glm::dvec2& p) {
+  const auto cross = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  };
+  const double area = cross(v[0].screen, v[1].screen, v[2].screen);
+  if (area == 0.0 || !std::isfinite(area)) return std::nullopt;
+  const glm::dvec3 b(cross(p, v[1].screen, v[2].screen) / area, cross(v[0].screen, p, v[2].screen) / area,
+                     cross(v[0].screen, v[1].screen, p) / area);
+  if (b.x < 0.0 || b.y < 0.0 || b.z < 0.0) return std::nullopt;
+  return b;
+}
+
+// The attribute at barycentrics b, interpolated exactly: linearly in
+// screen space, or perspective-correctly (weights b_k / w_k).
+template <class T>
+T Interpolate(const std::array<ScreenVertex, 3>& v, const glm::dvec3& b, const std::array<T, 3>& values,
+              bool perspective) {
+  glm::dvec3 weight = b;
+  if (perspective) {
+    weight = glm::dvec3(b.x / v[0].w, b.y / v[1].w, b.z / v[2].w);
+    weight /= weight.x + weight.y + weight.z;
+  }
+  return values[0] * weight.x + values[1] * weight.y + values[2] * weight.z;
+}
+
+glm::dvec2 PixelCentre(std::uint32_t x, std::uint32_t y) { return {x + 0.5, y + 0.5}; }
+
+bool HasGeometry(const f32::RasterSample& g) { return g.triangle0.w != 0.0f; }
+
+// The twelve triangles of the cube around `volume`, as corner indices
+// (bit 0: +x, bit 1: +y, bit 2: +z), two per face; the face's outward axis
+// is `axis` with sign `positive`.
+struct CubeFace {
+  int axis;
+  bool positive;
+  std::array<int, 4> corners;  // around the face
+};
+constexpr std::array<CubeFace, 6> kCubeFaces = {{
+    {0, false, {0, 2, 6, 4}},
+    {0, true, {1, 5, 7, 3}},
+    {1, false, {0, 4, 5, 1}},
+    {1, true, {2, 3, 7, 6}},
+    {2, false, {0, 1, 3, 2}},
+    {2, true, {4, 6, 7, 5}},
+}};
+
+// A cube corner as the vertex shader computes it: centre +- half in float32.
+glm::vec4 CubeCorner(const glm::vec4& volume, int corner) {
+  const float h = volume.w;
+  return {(corner & 1) != 0 ? volume.x + h : volume.x - h, (corner & 2) != 0 ? volume.y + h : volume.y - h,
+          (corner & 4) != 0 ? volume.z + h : volume.z - h, 1.0f};
+}
+
+}  // namespace
+
+RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample) {
+  RasterGeometry out;
+  if (sample.pick != DepthPick::kEyeDepth) return out;
+  const L d = sample.eye_depth;
+  const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
+  const glm::vec<2, L> ndc = PixelNdc(frame, sample.x, sample.y);
+  const LVec3 camera = ToLong(frame.camera_position);
+  const LVec3 centre_view(ndc.x * tan_x * d, ndc.y * tan_y * d, -d);
+  // One pixel in view units at this depth, along x and (screen y down) y.
+  const L pixel_x = 2.0L * tan_x * d / frame.width, pixel_y = 2.0L * tan_y * d / frame.height;
+  // An equilateral triangle whose inscribed circle is centred on the pixel
+  // centre; its orientation turns from sample to sample.
+  const L turn = std::fmod(static_cast<L>(sample.index) * 0.6180339887498948482L, 1.0L) * 2.0L * std::numbers::pi_v<L>;
+  std::array<glm::vec4, 3> corners;
+  for (int k = 0; k < 3; ++k) {
+    const L angle = turn + k * 2.0L * std::numbers::pi_v<L> / 3.0L;
+    const L dx = 2.0L * kTriangleInradius * std::cos(angle), dy = 2.0L * kTriangleInradius * std::sin(angle);
+    const LVec3 view = centre_view + LVec3(dx * pixel_x, -dy * pixel_y, 0.0L);
+    corners[k] = ToFloat4(camera + Rotate(frame.rotation, view), 1.0f);
+  }
+
+  // The float corners must still hold the pixel centre well inside, seen
+  // by the exact camera (a device's float32 matrix moves them by about
+  // 2^-24 of the screen more, far below the margin).
+  std::array<glm::vec<2, L>, 3> screen;
+  for (int k = 0; k < 3; ++k) {
+    const auto s = ExactScreen(frame, Xyz(corners[k]));
+    if (!s) return out;
+    screen[k] = *s;
+  }
+  const glm::vec<2, L> centre(sample.x + 0.5L, sample.y + 0.5L);
+  const L orientation = EdgeDistance(screen[0], screen[1], screen[2]) > 0.0L ? 1.0L : -1.0L;
+  for (int k = 0; k < 3; ++k) {
+    const L inside = orientation * EdgeDistance(screen[k], screen[(k + 1) % 3], centre);
+    if (!(inside > 0.5L * kTriangleInradius)) return out;
+  }
+
+  // The truth: the pixel's ray meets the plane of the float corners.
+  const LVec3 ray = Rotate(frame.rotation, LVec3(ndc.x * tan_x, ndc.y * tan_y, -1.0L));
+  const LVec3 c0 = Xyz(corners[0]);
+  const LVec3 normal = glm::cross(Xyz(corners[1]) - c0, Xyz(corners[2]) - c0);
+  const L t = glm::dot(normal, c0 - camera) / glm::dot(normal, ray);
+  if (!(t > 0.0L) || !std::isfinite(static_cast<double>(t))) return out;
+
+  // The light volume: its centre must stay well inside around the ray too
+  // (within half its half edge of the ray), or what the device covers is
+  // not predictable either.
+  const LVec3 point = camera + ray * t;
+  const glm::vec4 volume = ToFloat4(point, static_cast<float>(d / 4.0L));
+  const LVec3 off = Xyz(volume) - camera;
+  const L along = glm::dot(off, ray) / glm::dot(ray, ray);
+  if (glm::length(off - ray * along) > 0.5L * volume.w) return out;
+
+  out.sample = {corners[0], corners[1], corners[2], volume};
+  out.rendered_depth = static_cast<double>(t);
+  return out;
+}
+
+float RasterPipelineFloat(Encoding encoding, const f32::FrameParams& frame_params,
+                          const f32::DepthParams& depth, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                          const f32::RasterSample& geometry) {
+  if (!HasGeometry(geometry)) return std::numeric_limits<float>::quiet_NaN();
+  const std::array<glm::vec4, 3> corners = {geometry.triangle0, geometry.triangle1, geometry.triangle2};
+  std::array<ScreenVertex, 3> vertices;
+  std::array<double, 3> window_z, view_z;
+  const bool gl_clip = (Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u;
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec4 clip = Transform(depth.view_projection, corners[k]);
+    vertices[k] = ToScreen(clip, frame_params);
+    const float ndc_z = clip.z / clip.w;
+    window_z[k] = gl_clip ? ndc_z * 0.5f + 0.5f : ndc_z;
+    view_z[k] = Transform(frame_params.world_view, corners[k]).z;
+  }
+  const auto b = Barycentrics(vertices, PixelCentre(pixel_x, pixel_y));
+  if (!b) return std::numeric_limits<float>::quiet_NaN();
+  switch (Info(encoding.format).stores) {
+    case DepthInput::kHardware: return static_cast<float>(Interpolate(vertices, *b, window_z, false));
+    case DepthInput::kLinear: {
+      const auto z = static_cast<float>(Interpolate(vertices, *b, view_z, true));
+      return -z / frame_params.camera_position.w;
+    }
+    case DepthInput::kViewZ: return static_cast<float>(Interpolate(vertices, *b, view_z, true));
+  }
+  return std::numeric_limits<float>::quiet_NaN();
+}
+
+f32::FrameParams RasterFrameParams(const f32::FrameParams& frame_params,
+                                   const f32::DepthParams& standard_depth, std::uint32_t pixel_x,
+                                   std::uint32_t pixel_y, const f32::RasterSample& geometry) {
+  f32::FrameParams out = frame_params;
+  const glm::dvec2 centre = PixelCentre(pixel_x, pixel_y);
+  const glm::vec4 zero(0.0f);
+  // The full-screen triangle: vertices at uv (0,0), (2,0), (0,2), that is
+  // screen (0,0), (2W,0), (0,2H), with w = 1.
+  const double width = frame_params.resolution.x, height = frame_params.resolution.y;
+  const std::array<ScreenVertex, 3> screen_triangle = {ScreenVertex{{0.0, 0.0}, 1.0},
+                                                       ScreenVertex{{2.0 * width, 0.0}, 1.0},
+                                                       ScreenVertex{{0.0, 2.0 * height}, 1.0}};
+  const glm::dvec3 b(1.0 - centre.x / (2.0 * width) - centre.y / (2.0 * height), centre.x / (2.0 * width),
+                     centre.y / (2.0 * height));
+  const auto interpolate = [&](glm::vec4& origin, glm::vec4& du, glm::vec4& dv) {
+    std::array<glm::dvec3, 3> at;
+    const std::array<glm::vec2, 3> uvs = {glm::vec2(0.0f, 0.0f), glm::vec2(2.0f, 0.0f), glm::vec2(0.0f, 2.0f)};
+    for (int k = 0; k < 3; ++k) {
+      // screen.h's interpolate_screen_attribute, in float32, at the vertex.
+      const glm::vec3 value =
+          glm::vec3(origin) + glm::vec3(du) * uvs[k].x + glm::vec3(dv) * uvs[k].y;
+      at[k] = glm::dvec3(value);
+    }
+    origin = glm::vec4(glm::vec3(Interpolate(screen_triangle, b, at, false)), origin.w);
+    du = dv = zero;
+  };
+  interpolate(out.frustum_ray_origin, out.frustum_ray_du, out.frustum_ray_dv);
+  interpolate(out.eye_ray_view_origin, out.eye_ray_view_du, out.eye_ray_view_dv);
+  interpolate(out.eye_ray_world_origin, out.eye_ray_world_du, out.eye_ray_world_dv);
+
+  // The light volume: the back face that covers the pixel centre.
+  if (!HasGeometry(geometry)) return out;
+  const glm::dvec3 camera(glm::vec3(frame_params.camera_position));
+  for (const CubeFace& face : kCubeFaces) {
+    // A back face has the camera on the cube's side of its plane.
+    const double plane = geometry.volume[face.axis] + (face.positive ? 1.0 : -1.0) * geometry.volume.w;
+    const bool back = face.positive ? camera[face.axis] < plane : camera[face.axis] > plane;
+    if (!back) continue;
+    for (int half = 0; half < 2; ++half) {
+      const std::array<int, 3> tri = {face.corners[0], face.corners[1 + half], face.corners[2 + half]};
+      std::array<ScreenVertex, 3> vertices;
+      std::array<glm::dvec3, 3> view;
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec4 corner = CubeCorner(geometry.volume, tri[k]);
+        vertices[k] = ToScreen(Transform(standard_depth.view_projection, corner), frame_params);
+        view[k] = glm::dvec3(glm::vec3(Transform(frame_params.world_view, corner)));
+      }
+      const auto weights = Barycentrics(vertices, centre);
+      if (!weights) continue;
+      out.volume_position_origin = glm::vec4(glm::vec3(Interpolate(vertices, *weights, view, true)), 0.0f);
+      out.volume_position_du = out.volume_position_dv = zero;
+      return out;
+    }
+  }
+  return out;
+}
+
+}  // namespace depthbench
