@@ -23,6 +23,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "bench/backends/vulkan/arithmetic_probe.h"
 #include "bench/backends/vulkan/raster_pass.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
@@ -368,6 +369,33 @@ TEST_F(RasterPassTest, UserGlslVariantsRunAndHlslOnesAreRefused) {
   EXPECT_NE(status.message().find("HLSL variant files run in the compute form only"), std::string::npos)
       << status.message();
   ASSERT_TRUE(RegisterVariantFiles({}).ok());
+}
+
+// The arithmetic probes rewrite the raster form's programs too (its
+// program hash says so), and the rewritten programs run: no-contraction
+// changes no bit on lavapipe, which fuses nothing.
+TEST_F(RasterPassTest, ArithmeticProbesApplyToTheRasterPrograms) {
+  const RunLayout layout = RepresentativeLayout();
+  const std::vector<std::uint32_t> which = AllIndices(layout);
+  ASSERT_TRUE(raster_->Prepare(layout.cells, PassKind::kRaster).ok());
+  BackendOptions options;
+  options.arithmetic_probes = kNoContraction;
+  auto probed = MakeVulkanBackend(context_, options);
+  ASSERT_TRUE(probed.ok()) << probed.status().message();
+  const Status status = (*probed)->Prepare(layout.cells, PassKind::kRaster);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ((*probed)->name(), "vulkan:no-contraction");
+  EXPECT_NE((*probed)->program().hash, raster_->program().hash);
+  EXPECT_NE((*probed)->program().hash.find("no-contraction"), std::string::npos);
+  const Batch batch = BuildBatch(layout, 128, 400);
+  std::vector<float> scratch, probed_scratch;
+  auto plain = raster_->Run(batch, which, scratch);
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  auto rewritten = (*probed)->Run(batch, which, probed_scratch);
+  ASSERT_TRUE(rewritten.ok()) << rewritten.status().message();
+  ASSERT_EQ(plain->size(), rewritten->size());
+  EXPECT_EQ(std::memcmp(plain->data(), rewritten->data(), plain->size() * sizeof(float)), 0);
+  probed->reset();
 }
 
 TEST_F(RasterPassTest, ABatchWithoutGeometryIsRefused) {
