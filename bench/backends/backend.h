@@ -53,8 +53,19 @@ class Backend {
   virtual ProgramInfo program() const = 0;
 
   virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
-  // Raster backends that produce their own depths: how those agreed with
-  // the batch's, per depth slot of the prepared cells (empty otherwise).
+  // Raster backends that produce their own depths (a real rasterizer):
+  // renders the batch's geometry into every depth slot of the prepared
+  // cells and returns the texel codes, [depth slot * count + sample], valid
+  // until the next call. The sweep adopts them into the batch
+  // (BatchBuilder::AdoptStoredDepths) before any backend's Run, so every
+  // backend reconstructs from the device's texels; Run then reads the
+  // images this call rendered.
+  virtual bool renders_depths() const { return false; }
+  virtual Expected<std::span<const std::uint32_t>> RenderDepths(const ShaderInputs& /*batch*/) {
+    return Unavailable(name() + " does not render depths");
+  }
+  // How the rendered depths agreed with the batch's (the host's model of
+  // a rasterizer, before adoption), per depth slot, since Prepare.
   virtual std::vector<RasterAgreement> raster_agreement() const { return {}; }
 
   // World positions of the prepared cells listed in `which` (indices into

@@ -97,11 +97,6 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   const std::size_t pipelines = pipeline_slots_.size();
   for (auto* v : {&mapping_a_, &mapping_b_, &produced_}) v->resize(pipelines * count);
   pipeline_floats_.resize(pipelines * count);
-  const auto mapping_of = [&](std::size_t k) {
-    return DepthMappings{samples.near.data(), samples.far.data(), mapping_a_.data() + k * count,
-                         mapping_b_.data() + k * count};
-  };
-  constexpr std::size_t kChunk = 1024;
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
@@ -123,7 +118,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         mapping_a_[k * count + i] = a;
         mapping_b_[k * count + i] = b;
       }
-      const DepthMappings mapping = mapping_of(k).At(lo);
+      const DepthMappings mapping = MappingOf(batch, k).At(lo);
       float* floats = pipeline_floats_.data() + k * count + lo;
       PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
       if (raster) {
@@ -147,7 +142,6 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.codes.resize(slots * count);
   batch.reference.Resize(slots * count);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
-    std::array<double, kChunk> denoted;
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
       const Encoding encoding = encodings_[s];
@@ -173,18 +167,48 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }
-      const std::size_t pipeline = pipeline_of_slot_[s];
-      DecodeEyeDepths(encoding, model_, mapping_of(pipeline).At(lo), batch.depths.data() + at, n, denoted.data(),
-                      nullptr, isa_);
-      References(encoding, samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo, batch.reference,
-                 at, isa_);
-      // Raster samples with nothing drawn have no point to judge.
-      for (std::size_t i = lo; raster && i < lo + n; ++i) {
-        if (batch.raster[i].triangle0.w == 0.0f) {
-          batch.reference.status[s * count + i] = ReferenceStatus::kDegenerate;
-          batch.reference.inverse_distance_sq[s * count + i] = 0.0;
-        }
-      }
+      ReferenceChunk(batch, s, lo, n);
+    }
+  });
+}
+
+DepthMappings BatchBuilder::MappingOf(const Batch& batch, std::size_t pipeline) const {
+  return {batch.samples.near.data(), batch.samples.far.data(), mapping_a_.data() + pipeline * batch.count,
+          mapping_b_.data() + pipeline * batch.count};
+}
+
+void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo, std::size_t n) const {
+  std::array<double, kChunk> denoted;
+  const std::size_t count = batch.count, at = slot * count + lo, pipeline = pipeline_of_slot_[slot];
+  const Encoding encoding = encodings_[slot];
+  DecodeEyeDepths(encoding, model_, MappingOf(batch, pipeline).At(lo), batch.depths.data() + at, n, denoted.data(),
+                  nullptr, isa_);
+  References(encoding, batch.samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo,
+             batch.reference, at, isa_);
+  // Raster samples with nothing drawn have no point to judge.
+  for (std::size_t i = lo; !batch.raster.empty() && i < lo + n; ++i) {
+    if (batch.raster[i].triangle0.w == 0.0f) {
+      batch.reference.status[at + i - lo] = ReferenceStatus::kDegenerate;
+      batch.reference.inverse_distance_sq[at + i - lo] = 0.0;
+    }
+  }
+}
+
+void BatchBuilder::AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes,
+                                     std::span<const float> fetched, ThreadPool& pool) const {
+  const std::size_t count = batch.count, slots = encodings_.size();
+  for (std::size_t s = 0; s < slots; ++s) {
+    for (std::size_t i = 0; i < count; ++i) {
+      if (batch.raster[i].triangle0.w == 0.0f) continue;
+      batch.codes[s * count + i] = codes[s * count + i];
+      batch.depths[s * count + i] = fetched[s * count + i];
+    }
+  }
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      const std::size_t lo = (job % chunks) * kChunk;
+      ReferenceChunk(batch, job / chunks, lo, std::min<std::size_t>(count - lo, kChunk));
     }
   });
 }

@@ -13,6 +13,7 @@
 
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/cells.h"
+#include "bench/pipeline/encode.h"
 #include "bench/pipeline/reference.h"
 #include "bench/pipeline/sampler.h"
 #include "bench/pipeline/shader_inputs.h"
@@ -40,7 +41,22 @@ class BatchBuilder {
   // Fills `batch` with samples [first, first + count).
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const;
 
+  // The raster pipeline on a device: replaces the stored texels of the
+  // samples that have geometry by the ones the device rendered (codes and
+  // fetched floats, [depth slot * count + sample]) and computes their
+  // references again. The production part stays the host's model's, so the
+  // storage part then holds the device's own rounding and interpolation.
+  // `batch` must be the last one Build filled.
+  void AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes, std::span<const float> fetched,
+                         ThreadPool& pool) const;
+
  private:
+  static constexpr std::size_t kChunk = 1024;  // samples per job of the encode and reference loops
+  DepthMappings MappingOf(const Batch& batch, std::size_t pipeline) const;
+  // Decodes slot `slot`'s stored values of samples [lo, lo + n) and
+  // computes their references.
+  void ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo, std::size_t n) const;
+
   const SampleSource& sampler_;
   std::vector<Encoding> encodings_;
   ProductionModel model_;

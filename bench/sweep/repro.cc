@@ -9,6 +9,7 @@
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/stats.h"
 #include "bench/pipeline/user_variant.h"
+#include "bench/sweep/sweep.h"
 
 namespace depthbench {
 namespace {
@@ -54,6 +55,13 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
   ThreadPool pool(1);
   Batch batch;
   builder.Build(index, 1, batch, pool);
+  for (Backend* backend : backends) {
+    DB_RETURN_IF_ERROR(backend->Prepare(layout.cells, PassKindOf(sampler.production())));
+  }
+  if (Backend* renderer = DepthRenderer(sampler.production(), backends)) {
+    std::vector<float> fetched;
+    DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, layout, batch, pool, fetched));
+  }
   const Frame& frame = batch.frames[0];
   const PixelSample sample = sampler.SampleAt(index, frame);
 
@@ -73,7 +81,6 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
   for (std::uint32_t c = 0; c < every.size(); ++c) every[c] = c;
   std::vector<float> scratch;
   for (std::size_t b = 0; b < backends.size(); ++b) {
-    DB_RETURN_IF_ERROR(backends[b]->Prepare(layout.cells, PassKindOf(sampler.production())));
     DB_ASSIGN_OR_RETURN(std::span<const float> out, backends[b]->Run(batch, every, scratch));
     outputs[b].assign(out.begin(), out.end());
   }

@@ -14,6 +14,7 @@
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
+#include "bench/pipeline/encode.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/sampler.h"
 
@@ -66,6 +67,29 @@ void CopyEncodingMetrics(const CellStats& from, CellStats& to) {
 }
 
 }  // namespace
+
+Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> backends) {
+  if (PassKindOf(production) != PassKind::kRaster) return nullptr;
+  for (Backend* backend : backends) {
+    if (backend->renders_depths()) return backend;
+  }
+  return nullptr;
+}
+
+Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, const RunLayout& layout, Batch& batch,
+                           ThreadPool& pool, std::vector<float>& fetched) {
+  auto codes = renderer.RenderDepths(batch);
+  if (!codes.ok()) return codes.status().WithContext("rendering depths on the " + renderer.name() + " backend");
+  fetched.resize(codes->size());
+  for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
+    const Format format = layout.encodings[slot].format;
+    for (std::size_t i = slot * batch.count; i < (slot + 1) * batch.count; ++i) {
+      fetched[i] = FetchTexel(format, (*codes)[i]);
+    }
+  }
+  builder.AdoptStoredDepths(batch, *codes, fetched, pool);
+  return Status::Ok();
+}
 
 std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& domain) {
   std::vector<Cell> out;
@@ -145,6 +169,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   std::iota(slot_order.begin(), slot_order.end(), 0u);
   std::stable_sort(slot_order.begin(), slot_order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return cells_of_slot[a].size() > cells_of_slot[b].size(); });
+  // The first backend that renders its own depths (a raster pipeline on
+  // a device) produces the texels every backend reconstructs from.
+  Backend* renderer = DepthRenderer(options.domain.production, backends);
+  std::vector<float> rendered_fetched;
   std::vector<std::uint32_t> every_cell(cell_count);
   std::iota(every_cell.begin(), every_cell.end(), 0u);
 
@@ -158,6 +186,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     builder.Build(first, count, batch, pool);
+    if (renderer != nullptr) {
+      DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, layout, batch, pool, rendered_fetched));
+    }
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];
       CellAccumulator* acc = accumulators.data() + b * cell_count;

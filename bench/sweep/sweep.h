@@ -12,6 +12,8 @@
 
 #include "bench/backends/backend.h"
 #include "bench/base/isa.h"
+#include "bench/base/thread_pool.h"
+#include "bench/pipeline/batch.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 #include "bench/results/results.h"
@@ -47,6 +49,15 @@ struct SweepOptions {
 // The cells of `cells` that the domain can exercise (finite-far cells need
 // finite frames, infinite-far cells need the domain to allow them).
 std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& domain);
+
+// The backend whose rendered depths every backend reconstructs from: the
+// first that renders its own (Backend::renders_depths), under the raster
+// production model; null otherwise.
+Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> backends);
+// Renders the batch's depths on `renderer` and adopts them into the batch
+// (BatchBuilder::AdoptStoredDepths); `fetched` is scratch.
+Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, const RunLayout& layout, Batch& batch,
+                           ThreadPool& pool, std::vector<float>& fetched);
 
 // Runs the sweep on each backend (prepared by this call) and returns the
 // results, one CellResult per (cell, backend).
