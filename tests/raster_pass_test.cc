@@ -398,6 +398,35 @@ TEST_F(RasterPassTest, ArithmeticProbesApplyToTheRasterPrograms) {
   probed->reset();
 }
 
+// The sweep's order: RenderDepths draws every depth slot (the sweep adopts
+// the texels into the batch), then Run reconstructs from those atlases
+// without drawing them again. The positions are those of a Run that draws
+// both passes itself, and the texels those it stored.
+TEST_F(RasterPassTest, RenderDepthsThenRunReadsTheRenderedAtlases) {
+  const RunLayout layout = RepresentativeLayout();
+  const std::vector<std::uint32_t> which = AllIndices(layout);
+  ASSERT_TRUE(raster_->Prepare(layout.cells, PassKind::kRaster).ok());
+  EXPECT_TRUE(raster_->renders_depths());
+  EXPECT_FALSE(compute_->renders_depths());
+  const Batch batch = BuildBatch(layout, 3000, 777);
+  std::vector<float> scratch;
+  auto alone = raster_->Run(batch, which, scratch);
+  ASSERT_TRUE(alone.ok()) << alone.status().message();
+  const std::vector<float> both_passes(alone->begin(), alone->end());
+  const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+
+  // Another batch in between, so that the atlases hold something else.
+  ASSERT_TRUE(raster_->Run(BuildBatch(layout, 0, 300), which, scratch).ok());
+  auto rendered = raster_->RenderDepths(batch);
+  ASSERT_TRUE(rendered.ok()) << rendered.status().message();
+  EXPECT_EQ(std::vector<std::uint32_t>(rendered->begin(), rendered->end()), texels);
+  auto after = raster_->Run(batch, which, scratch);
+  ASSERT_TRUE(after.ok()) << after.status().message();
+  ASSERT_EQ(after->size(), both_passes.size());
+  EXPECT_EQ(std::memcmp(after->data(), both_passes.data(), both_passes.size() * sizeof(float)), 0);
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
+}
+
 TEST_F(RasterPassTest, ABatchWithoutGeometryIsRefused) {
   const RunLayout layout = RepresentativeLayout();
   ASSERT_TRUE(raster_->Prepare(layout.cells, PassKind::kRaster).ok());

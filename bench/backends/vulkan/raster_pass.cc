@@ -369,18 +369,18 @@ std::uint64_t RasterPass::MaxBatchSamples() const {
   return std::uint64_t{kAtlasWidth} * rows;
 }
 
-Status RasterPass::CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which) const {
+Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const {
   if (batch.raster.size() < batch.count) {
     return InvalidArgument(fmt::format(
         "the raster form draws the batch's geometry, and a batch of {} samples has it for {}: its domain's "
         "production must be the raster pipeline's (--pipeline raster)",
         batch.count, batch.raster.size()));
   }
-  for (const std::uint32_t index : which) {
-    const std::size_t codes_needed = (std::size_t{cells_[index].depth_slot} + 1) * batch.count;
-    if (batch.codes.size() < codes_needed) {
-      return InvalidArgument(fmt::format("cell {} compares {} texel codes; the batch has {}",
-                                         cells_[index].cell.Name(), codes_needed, batch.codes.size()));
+  for (std::size_t slot = 0; slot < drawn.size(); ++slot) {
+    const std::size_t codes_needed = (slot + 1) * batch.count;
+    if (drawn[slot] && batch.codes.size() < codes_needed) {
+      return InvalidArgument(fmt::format("depth slot {} is compared with {} texel codes; the batch has {}", slot,
+                                         codes_needed, batch.codes.size()));
     }
   }
   const std::uint64_t rows = (std::uint64_t{batch.count} + kAtlasWidth - 1) / kAtlasWidth;
@@ -477,14 +477,20 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
   return Status::Ok();
 }
 
-Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                       std::uint32_t unwritten_bits) {
-  DB_RETURN_IF_ERROR(CheckRun(batch, which));
+// Everything a submission of either pass needs: the atlases, the batch's
+// buffers, room for the positions of `which`, the descriptors and the
+// samples' viewports.
+Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                         const std::vector<bool>& drawn) {
+  DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
+  const std::uint32_t rows_before = atlas_rows_;
   DB_RETURN_IF_ERROR(EnsureAtlases(rows));
+  if (atlas_rows_ != rows_before) rendered_.reset();
   DB_RETURN_IF_ERROR(Upload(batch, rows));
-  const VkDeviceSize position_bytes = VkDeviceSize{3} * count * which.size() * sizeof(float);
+  // A render alone writes no positions, but the binding needs a buffer.
+  const VkDeviceSize position_bytes = std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), 1) * sizeof(float);
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(
       positions_, position_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
       HostAccess::kReadback));
@@ -532,14 +538,42 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
                      -resolution.y, 0.0f, 1.0f};
     scissors_[i] = {{static_cast<std::int32_t>(x), static_cast<std::int32_t>(y)}, {1, 1}};
   }
+  return Status::Ok();
+}
 
+Expected<std::span<const std::uint32_t>> RasterPass::Render(const ShaderInputs& batch) {
+  std::vector<bool> drawn(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  rendered_.reset();
+  DB_RETURN_IF_ERROR(Stage(batch, {}, drawn));
+  const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, {}, drawn, rows, 0); }));
+  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+  CompareTexels(batch, drawn);
+  rendered_ = RenderedBatch{batch.first_index, batch.count};
+  return std::span<const std::uint32_t>(texels_);
+}
+
+Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                       std::uint32_t unwritten_bits) {
+  // Pass 1 again only where Render did not just draw this batch.
+  const bool rendered = rendered_ && rendered_->first_index == batch.first_index && rendered_->count == batch.count;
   std::vector<bool> drawn(slots_.size(), false);
-  for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
+  if (!rendered) {
+    for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
+  }
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn));
+  const std::uint32_t count = batch.count;
+  const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
   DB_RETURN_IF_ERROR(
       pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, which, drawn, rows, unwritten_bits); }));
   DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
-  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-  CompareTexels(batch, drawn);
+  if (!rendered) {
+    DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+    CompareTexels(batch, drawn);
+    // Only some slots may have been drawn: none of the atlases holds a whole render now.
+    rendered_.reset();
+  }
 
   // Nothing was drawn for a sample without geometry: it has no position.
   auto* positions = static_cast<float*>(positions_.mapped());
@@ -554,12 +588,17 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
 
 void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
                         const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const {
-  vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
-  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     if (drawn[slot]) RecordProduction(commands, batch, slot, rows);
   }
+  if (which.empty()) {
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    return;
+  }
+  vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
 
   // Pass 2 has no attachments: its fragments write the positions.
   VkRenderingInfo rendering{};
@@ -667,6 +706,7 @@ void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std:
 void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn) {
   const std::size_t count = batch.count;
   texels_.assign(slots_.size() * count, 0);
+  std::copy_n(batch.codes.begin(), std::min(texels_.size(), batch.codes.size()), texels_.begin());
   const auto* readback = static_cast<const std::byte*>(readback_.mapped());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!drawn[s]) continue;
@@ -677,8 +717,8 @@ void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool
     RasterAgreement& agreement = agreement_[s];
     for (std::size_t i = 0; i < count; ++i) {
       if (!HasGeometry(batch.raster[i])) continue;
-      const std::uint32_t device = CodeOf(format, texels + i * bytes);
       const std::uint32_t host = batch.codes[s * count + i];
+      const std::uint32_t device = CodeOf(format, texels + i * bytes);
       texels_[s * count + i] = device;
       ++agreement.texels;
       agreement.differing += device != host ? 1 : 0;

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -62,8 +63,15 @@ class RasterPass {
   RasterPass(const RasterPass&) = delete;
   RasterPass& operator=(const RasterPass&) = delete;
 
-  // Draws both passes for the prepared cells listed in `which` (count > 0,
-  // at least one cell). Returns their positions as the compute form lays
+  // Pass 1 alone, for every depth slot of the prepared cells
+  // (Backend::RenderDepths): returns the texel bits, laid out as
+  // ShaderInputs::codes (the batch's own code for a sample without
+  // geometry), valid until the next call. A Run on the same batch then
+  // reads the atlases rendered here.
+  Expected<std::span<const std::uint32_t>> Render(const ShaderInputs& batch);
+  // Pass 2 for the prepared cells listed in `which` (count > 0, at least
+  // one cell), after pass 1 in the same command buffer unless Render drew
+  // this batch last. Returns their positions as the compute form lays
   // them out (cell k's component c of sample i at (k * 3 + c) * count + i),
   // in mapped memory valid until the next Run. Every position starts as
   // `unwritten_bits`; a sample with no geometry gets quiet NaNs (nothing
@@ -74,9 +82,9 @@ class RasterPass {
 
   // Per depth slot, since Create: RasterAgreement (backend.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
-  // The texel bits pass 1 produced in the last Run, laid out as
-  // ShaderInputs::codes; 0 for slots it did not draw and for samples with
-  // no geometry.
+  // The texel bits pass 1 produced last, laid out as ShaderInputs::codes:
+  // the batch's own where it drew nothing (a sample without geometry, a
+  // slot the run did not need).
   const std::vector<std::uint32_t>& texels() const { return texels_; }
   // The most samples the atlas holds.
   std::uint64_t MaxBatchSamples() const;
@@ -93,10 +101,12 @@ class RasterPass {
 
   Status BuildPipelines(std::span<const CellPlan> cells, const std::filesystem::path& shader_dir,
                         std::uint32_t arithmetic_probes, std::vector<std::string>& sources);
-  Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
+  // `drawn`: per depth slot, whether the submission draws it (pass 1).
+  Status CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const;
+  Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn);
   Status EnsureAtlases(std::uint32_t rows);
   Status Upload(const ShaderInputs& batch, std::uint32_t rows);
-  // `drawn`: per depth slot, whether the run draws it (a listed cell reads it).
+  // `drawn`: per depth slot, whether pass 1 draws it; pass 2 draws `which`.
   void Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
               const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const;
   void RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot,
@@ -120,6 +130,12 @@ class RasterPass {
   VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
   std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
 
+  // The batch whose every depth slot the atlases hold (Render), if any.
+  struct RenderedBatch {
+    std::uint64_t first_index;
+    std::uint32_t count;
+  };
+  std::optional<RenderedBatch> rendered_;
   std::vector<RasterAgreement> agreement_;
   std::vector<std::uint32_t> texels_;
 };

@@ -205,6 +205,8 @@ class VulkanBackend final : public Backend {
   Expected<std::span<const float>> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::vector<float>& scratch) override;
   std::uint64_t MaxBatchSamples() const override;
+  bool renders_depths() const override { return raster_ != nullptr; }
+  Expected<std::span<const std::uint32_t>> RenderDepths(const ShaderInputs& batch) override;
   std::vector<RasterAgreement> raster_agreement() const override {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
@@ -355,6 +357,19 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant,
                                             &shape};
   return pass_->CreatePipeline(spirv, specialization,
                                fmt::format("'{}'", VariantProgramName(variant, VariantPass::kAccuracy, shader_dir_)));
+}
+
+Expected<std::span<const std::uint32_t>> VulkanBackend::RenderDepths(const ShaderInputs& batch) {
+  if (raster_ == nullptr) return Unavailable(name() + " renders depths only when prepared for the raster form");
+  if (batch.count == 0) return std::span<const std::uint32_t>();
+  std::vector<std::uint32_t> every_cell(cells_.size());
+  for (std::uint32_t k = 0; k < every_cell.size(); ++k) every_cell[k] = k;
+  DB_RETURN_IF_ERROR(CheckBatch(batch, every_cell).WithContext(DeviceContext()));
+  const ValidationScope validation(*context_);
+  Expected<std::span<const std::uint32_t>> codes = raster_->Render(batch);
+  if (!codes.ok()) return codes.status().WithContext(DeviceContext());
+  DB_RETURN_IF_ERROR(validation.Check("RenderDepths").WithContext(DeviceContext()));
+  return codes;
 }
 
 // The positions stay in the mapped readback buffer when their slices are
