@@ -1,5 +1,7 @@
 // RasterPass: the raster form of the Vulkan backend (PassKind::kRaster). A
-// run records two passes into one command buffer, with dynamic rendering:
+// run records two passes into one command buffer, with dynamic rendering
+// (the sweep has pass 1 drawn on its own first, Render, so that every
+// backend reconstructs from the device's texels; Run then draws pass 2):
 //
 //   1. depth production, per depth slot: every sample's small triangle
 //      (ShaderInputs::raster) drawn into the slot's atlas, a depth
