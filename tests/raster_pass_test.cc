@@ -29,6 +29,7 @@
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
+#include "bench/pipeline/encode.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/encode.h"
 #include "bench/pipeline/sampler.h"
@@ -419,7 +420,28 @@ TEST_F(RasterPassTest, RenderDepthsThenRunReadsTheRenderedAtlases) {
   ASSERT_TRUE(raster_->Run(BuildBatch(layout, 0, 300), which, scratch).ok());
   auto rendered = raster_->RenderDepths(batch);
   ASSERT_TRUE(rendered.ok()) << rendered.status().message();
-  EXPECT_EQ(std::vector<std::uint32_t>(rendered->begin(), rendered->end()), texels);
+  EXPECT_EQ(std::vector<std::uint32_t>(rendered->codes.begin(), rendered->codes.end()), texels);
+  // What the device's texel fetch returns for each code: the float itself
+  // for float formats; for unorm codes the device's conversion, within
+  // 2 ulps of the correctly rounded one (lavapipe's is up to 2 off; the
+  // Vulkan specification does not require correct rounding).
+  ASSERT_EQ(rendered->fetched.size(), rendered->codes.size());
+  for (std::size_t s = 0; s < layout.encodings.size(); ++s) {
+    const Format format = layout.encodings[s].format;
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      if (batch.raster[i].triangle0.w == 0.0f) continue;
+      const std::size_t at = s * batch.count + i;
+      const float exact = FetchTexel(format, rendered->codes[at]);
+      const float device = rendered->fetched[at];
+      if (Info(format).texel == TexelKind::kUnorm) {
+        const float ulp = std::nextafter(exact, 2.0f) - exact;
+        EXPECT_LE(std::fabs(device - exact), 2.0f * ulp)
+            << Info(format).name << " code " << rendered->codes[at];
+      } else {
+        EXPECT_EQ(device, exact) << Info(format).name << " code " << rendered->codes[at];
+      }
+    }
+  }
   auto after = raster_->Run(batch, which, scratch);
   ASSERT_TRUE(after.ok()) << after.status().message();
   ASSERT_EQ(after->size(), both_passes.size());

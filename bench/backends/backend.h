@@ -33,6 +33,12 @@ inline PassKind PassKindOf(ProductionModel production) {
   return production == ProductionModel::kRaster ? PassKind::kRaster : PassKind::kCompute;
 }
 
+// What a raster backend rendered (Backend::RenderDepths).
+struct RenderedDepths {
+  std::span<const std::uint32_t> codes;
+  std::span<const float> fetched;
+};
+
 // How the depths a raster backend produced compare with the batch's (the
 // host's model of a rasterizer, bench/pipeline/raster_model.h), over the
 // samples that have geometry, since Prepare: one per depth slot.
@@ -55,13 +61,14 @@ class Backend {
   virtual Status Prepare(std::span<const CellPlan> cells, PassKind pass = PassKind::kCompute) = 0;
   // Raster backends that produce their own depths (a real rasterizer):
   // renders the batch's geometry into every depth slot of the prepared
-  // cells and returns the texel codes, [depth slot * count + sample], valid
-  // until the next call. The sweep adopts them into the batch
+  // cells and returns the texel codes and what a texel fetch returns for
+  // them (the device's own conversion to float), [depth slot * count +
+  // sample], valid until the next call. The sweep adopts them into the batch
   // (BatchBuilder::AdoptStoredDepths) before any backend's Run, so every
   // backend reconstructs from the device's texels; Run then reads the
   // images this call rendered.
   virtual bool renders_depths() const { return false; }
-  virtual Expected<std::span<const std::uint32_t>> RenderDepths(const ShaderInputs& /*batch*/) {
+  virtual Expected<RenderedDepths> RenderDepths(const ShaderInputs& /*batch*/) {
     return Unavailable(name() + " does not render depths");
   }
   // How the rendered depths agreed with the batch's (the host's model of

@@ -59,8 +59,7 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
     DB_RETURN_IF_ERROR(backend->Prepare(layout.cells, PassKindOf(sampler.production())));
   }
   if (Backend* renderer = DepthRenderer(sampler.production(), backends)) {
-    std::vector<float> fetched;
-    DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, layout, batch, pool, fetched));
+    DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
   }
   const Frame& frame = batch.frames[0];
   const PixelSample sample = sampler.SampleAt(index, frame);

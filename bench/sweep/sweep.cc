@@ -14,7 +14,6 @@
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
-#include "bench/pipeline/encode.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/sampler.h"
 
@@ -76,18 +75,10 @@ Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> bac
   return nullptr;
 }
 
-Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, const RunLayout& layout, Batch& batch,
-                           ThreadPool& pool, std::vector<float>& fetched) {
-  auto codes = renderer.RenderDepths(batch);
-  if (!codes.ok()) return codes.status().WithContext("rendering depths on the " + renderer.name() + " backend");
-  fetched.resize(codes->size());
-  for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
-    const Format format = layout.encodings[slot].format;
-    for (std::size_t i = slot * batch.count; i < (slot + 1) * batch.count; ++i) {
-      fetched[i] = FetchTexel(format, (*codes)[i]);
-    }
-  }
-  builder.AdoptStoredDepths(batch, *codes, fetched, pool);
+Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, Batch& batch, ThreadPool& pool) {
+  auto rendered = renderer.RenderDepths(batch);
+  if (!rendered.ok()) return rendered.status().WithContext("rendering depths on the " + renderer.name() + " backend");
+  builder.AdoptStoredDepths(batch, rendered->codes, rendered->fetched, pool);
   return Status::Ok();
 }
 
@@ -172,7 +163,6 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // The first backend that renders its own depths (a raster pipeline on
   // a device) produces the texels every backend reconstructs from.
   Backend* renderer = DepthRenderer(options.domain.production, backends);
-  std::vector<float> rendered_fetched;
   std::vector<std::uint32_t> every_cell(cell_count);
   std::iota(every_cell.begin(), every_cell.end(), 0u);
 
@@ -187,7 +177,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     builder.Build(first, count, batch, pool);
     if (renderer != nullptr) {
-      DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, layout, batch, pool, rendered_fetched));
+      DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
     }
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];

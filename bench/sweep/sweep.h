@@ -55,9 +55,8 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
 // production model; null otherwise.
 Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> backends);
 // Renders the batch's depths on `renderer` and adopts them into the batch
-// (BatchBuilder::AdoptStoredDepths); `fetched` is scratch.
-Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, const RunLayout& layout, Batch& batch,
-                           ThreadPool& pool, std::vector<float>& fetched);
+// (BatchBuilder::AdoptStoredDepths).
+Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, Batch& batch, ThreadPool& pool);
 
 // Runs the sweep on each backend (prepared by this call) and returns the
 // results, one CellResult per (cell, backend).

@@ -44,6 +44,9 @@ std::array<VkDeviceSize, kInputBindings> InputBytes(const ShaderInputs& batch) {
           std::size_t{batch.count} * sizeof(std::uint32_t), std::size_t{batch.count} * sizeof(f32::RasterSample)};
 }
 constexpr VkShaderStageFlags kDrawStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+// The draws, and the fetch that reads pass 1's texels back (fetch.comp).
+constexpr VkShaderStageFlags kSetStages = kDrawStages | VK_SHADER_STAGE_COMPUTE_BIT;
+constexpr std::uint32_t kFetchWorkgroup = 64;  // fetch.comp's local size
 
 // gbuffer.frag's specialization constant VIEW_Z.
 constexpr std::uint32_t kViewZConstant = 0;
@@ -289,13 +292,13 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
 
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
-    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kDrawStages, nullptr};
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kSetStages, nullptr};
   }
   bindings[kAtlases].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   // A set per atlas: the sets differ in the atlas alone, and a cell's draws
   // bind its slot's.
   DB_ASSIGN_OR_RETURN(pass->pass_, ComputePass::Create(pass->context_, bindings, sizeof(f32::RasterConstants),
-                                                       kDrawStages, std::max(atlases, 1u)));
+                                                       kSetStages, std::max(atlases, 1u)));
   DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
   DB_RETURN_IF_ERROR(pass->BuildPipelines(cells, shader_dir, arithmetic_probes, sources));
   return pass;
@@ -320,6 +323,11 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> light_volume,
                       stage("light_volume.vert", ShaderStage::kVertex));
   const VkPipelineLayout layout = pass_->pipeline_layout();
+  {
+    const std::filesystem::path path = shader_dir / "raster" / "fetch.comp";
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(path, ShaderStage::kCompute, &sources));
+    DB_ASSIGN_OR_RETURN(fetch_, pass_->CreatePipeline(spirv, VkSpecializationInfo{}, path.string()));
+  }
 
   for (Slot& slot : slots_) {
     if (!slot.atlas) continue;
@@ -489,8 +497,11 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(EnsureAtlases(rows));
   if (atlas_rows_ != rows_before) rendered_.reset();
   DB_RETURN_IF_ERROR(Upload(batch, rows));
-  // A render alone writes no positions, but the binding needs a buffer.
-  const VkDeviceSize position_bytes = std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), 1) * sizeof(float);
+  // A render alone writes no positions but the fetched texels of every
+  // depth slot, in the same buffer.
+  const VkDeviceSize position_bytes =
+      std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), VkDeviceSize{count} * slots_.size()) *
+      sizeof(float);
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(
       positions_, position_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
       HostAccess::kReadback));
@@ -541,7 +552,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   return Status::Ok();
 }
 
-Expected<std::span<const std::uint32_t>> RasterPass::Render(const ShaderInputs& batch) {
+Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   std::vector<bool> drawn(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
   rendered_.reset();
@@ -549,9 +560,20 @@ Expected<std::span<const std::uint32_t>> RasterPass::Render(const ShaderInputs& 
   const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
   DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, {}, drawn, rows, 0); }));
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
   CompareTexels(batch, drawn);
+  // The batch's own fetched value where nothing was drawn, as for the codes.
+  const std::size_t count = batch.count;
+  fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
+  const auto* device_fetched = static_cast<const float*>(positions_.mapped());
+  for (std::size_t s = 0; s < slots_.size(); ++s) {
+    if (!drawn[s]) continue;
+    for (std::size_t i = 0; i < count; ++i) {
+      if (HasGeometry(batch.raster[i])) fetched_[s * count + i] = device_fetched[s * count + i];
+    }
+  }
   rendered_ = RenderedBatch{batch.first_index, batch.count};
-  return std::span<const std::uint32_t>(texels_);
+  return RenderedDepths{texels_, fetched_};
 }
 
 Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
@@ -592,8 +614,20 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
     if (drawn[slot]) RecordProduction(commands, batch, slot, rows);
   }
   if (which.empty()) {
-    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    // A render alone: what a fetch returns for every drawn texel.
+    for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+      if (!drawn[slot]) continue;
+      pass_->Bind(commands, fetch_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, *slots_[slot].atlas);
+      f32::RasterConstants constants{};
+      constants.sample_count = batch.count;
+      constants.atlas_width = kAtlasWidth;
+      constants.output_offset = static_cast<std::uint32_t>(slot * batch.count);
+      pass_->PushConstants(commands, &constants, sizeof(constants));
+      vkCmdDispatch(commands, (batch.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
+    }
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                        VK_ACCESS_HOST_READ_BIT);
     return;
   }
   vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
@@ -690,7 +724,9 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& 
   }
   RecordImageBarrier(commands, atlas.value, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                     VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+                     VK_ACCESS_TRANSFER_READ_BIT,
+                     VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                     VK_ACCESS_SHADER_READ_BIT);
 }
 
 // Instances are samples, kViewportsPerDraw to a draw: instance i takes

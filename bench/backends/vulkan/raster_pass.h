@@ -66,11 +66,11 @@ class RasterPass {
   RasterPass& operator=(const RasterPass&) = delete;
 
   // Pass 1 alone, for every depth slot of the prepared cells
-  // (Backend::RenderDepths): returns the texel bits, laid out as
-  // ShaderInputs::codes (the batch's own code for a sample without
-  // geometry), valid until the next call. A Run on the same batch then
-  // reads the atlases rendered here.
-  Expected<std::span<const std::uint32_t>> Render(const ShaderInputs& batch);
+  // (Backend::RenderDepths): returns the texel bits and what a texel fetch
+  // returns for them, laid out as ShaderInputs::codes (the batch's own for
+  // a sample without geometry), valid until the next call. A Run on the
+  // same batch then reads the atlases rendered here.
+  Expected<RenderedDepths> Render(const ShaderInputs& batch);
   // Pass 2 for the prepared cells listed in `which` (count > 0, at least
   // one cell), after pass 1 in the same command buffer unless Render drew
   // this batch last. Returns their positions as the compute form lays
@@ -123,7 +123,8 @@ class RasterPass {
   // the atlas (sampled by pass 2) and the positions.
   std::unique_ptr<ComputePass> pass_;
   DeviceObject<VkSampler> sampler_;
-  std::vector<DeviceObject<VkPipeline>> reconstruction_;  // indexed by Variant; null where no cell uses it
+  std::vector<DeviceObject<VkPipeline>> reconstruction_;
+  DeviceObject<VkPipeline> fetch_;  // shaders/raster/fetch.comp  // indexed by Variant; null where no cell uses it
 
   std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), atlas_rows_ rows each
   std::uint32_t atlas_rows_ = 0;
@@ -140,6 +141,7 @@ class RasterPass {
   std::optional<RenderedBatch> rendered_;
   std::vector<RasterAgreement> agreement_;
   std::vector<std::uint32_t> texels_;
+  std::vector<float> fetched_;
 };
 
 }  // namespace depthbench

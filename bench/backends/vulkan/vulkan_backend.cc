@@ -206,7 +206,7 @@ class VulkanBackend final : public Backend {
                                        std::vector<float>& scratch) override;
   std::uint64_t MaxBatchSamples() const override;
   bool renders_depths() const override { return raster_ != nullptr; }
-  Expected<std::span<const std::uint32_t>> RenderDepths(const ShaderInputs& batch) override;
+  Expected<RenderedDepths> RenderDepths(const ShaderInputs& batch) override;
   std::vector<RasterAgreement> raster_agreement() const override {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
@@ -359,17 +359,17 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant,
                                fmt::format("'{}'", VariantProgramName(variant, VariantPass::kAccuracy, shader_dir_)));
 }
 
-Expected<std::span<const std::uint32_t>> VulkanBackend::RenderDepths(const ShaderInputs& batch) {
+Expected<RenderedDepths> VulkanBackend::RenderDepths(const ShaderInputs& batch) {
   if (raster_ == nullptr) return Unavailable(name() + " renders depths only when prepared for the raster form");
-  if (batch.count == 0) return std::span<const std::uint32_t>();
+  if (batch.count == 0) return RenderedDepths{};
   std::vector<std::uint32_t> every_cell(cells_.size());
   for (std::uint32_t k = 0; k < every_cell.size(); ++k) every_cell[k] = k;
   DB_RETURN_IF_ERROR(CheckBatch(batch, every_cell).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
-  Expected<std::span<const std::uint32_t>> codes = raster_->Render(batch);
-  if (!codes.ok()) return codes.status().WithContext(DeviceContext());
+  Expected<RenderedDepths> rendered = raster_->Render(batch);
+  if (!rendered.ok()) return rendered.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("RenderDepths").WithContext(DeviceContext()));
-  return codes;
+  return rendered;
 }
 
 // The positions stay in the mapped readback buffer when their slices are

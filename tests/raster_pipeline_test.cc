@@ -1,0 +1,189 @@
+// --pipeline raster on lavapipe: every cell runs through a real graphics
+// pipeline (depth attachments, texel fetch, rays from the vertex stage).
+// At far/near 1e4 with the camera at the origin, in the far plane's decade:
+//   - reversed D32F reads as the compute form (float32 production) within
+//     half a bit;
+//   - standard D24 loses more, for two measured reasons: the vertex
+//     transform (the view-projection matrix times a world-space corner,
+//     where depth is spread over three coordinates, rounds three to four
+//     times where the compute form's A * z + B rounds twice), seen in the
+//     host's model with exact interpolation; and the device's own vertex
+//     arithmetic and depth-plane evaluation, which the Vulkan specification
+//     leaves to the implementation (docs/raster.md): lavapipe within half a
+//     bit of the host's model.
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "bench/backends/cpu/cpu_backend.h"
+#include "bench/backends/vulkan/vulkan_backend.h"
+#include "bench/sweep/sweep.h"
+
+namespace depthbench {
+namespace {
+
+constexpr int kDeepestDecade = 3;  // z/n in [1e3, 1e4): the far plane's decade at f/n 1e4
+constexpr std::uint64_t kSamples = 60000;
+
+class RasterPipelineTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    VulkanContextOptions context_options;
+    context_options.validation = true;
+    auto context = VulkanContext::Create(context_options);
+    ASSERT_TRUE(context.ok()) << context.status().message();
+    context_ = new std::shared_ptr<VulkanContext>(std::move(context).value());
+    compute_ = new Results(Sweep(ProductionModel::kFloat32, /*with_vulkan=*/true));
+    raster_ = new Results(Sweep(ProductionModel::kRaster, /*with_vulkan=*/true));
+    host_model_ = new Results(Sweep(ProductionModel::kRaster, /*with_vulkan=*/false));
+  }
+  static void TearDownTestSuite() {
+    delete compute_;
+    delete raster_;
+    delete host_model_;
+    delete context_;
+  }
+
+  // Every cell at f/n 1e4 with the camera at the origin, on the Vulkan
+  // backend and the CPU backend: in the raster form the Vulkan backend
+  // renders the depths both reconstruct from; without it, the CPU backend
+  // alone runs the host's model of the raster pipeline.
+  static Results Sweep(ProductionModel production, bool with_vulkan) {
+    SweepOptions options;
+    options.seed = 41;
+    options.samples = kSamples;
+    options.domain.ratio = {1e4, 1e4};
+    options.domain.infinite_far = false;
+    options.domain.camera_distance = {0.0, 0.0};
+    options.domain.production = production;
+    auto vulkan = MakeVulkanBackend(*context_, BackendOptions{});
+    EXPECT_TRUE(vulkan.ok()) << vulkan.status().message();
+    if (!vulkan.ok()) return {};
+    auto cpu = MakeCpuBackend();
+    std::vector<Backend*> backends = {cpu.get()};
+    if (with_vulkan) backends.insert(backends.begin(), vulkan->get());
+    auto run = RunSweep(options, backends);
+    EXPECT_TRUE(run.ok()) << run.status().message();
+    if (!run.ok()) return {};
+    const std::vector<std::string> messages = (*context_)->TakeValidationMessages();
+    EXPECT_TRUE(messages.empty()) << messages.front();
+    return std::move(run).value();
+  }
+
+  static const CellResult* Find(const Results& results, const Cell& cell, const std::string& backend) {
+    for (const CellResult& c : results.cells) {
+      if (c.cell == cell && c.backend == backend) return &c;
+    }
+    return nullptr;
+  }
+
+  static double DeepestP999(const CellResult& c, Metric metric = Metric::kTotal) {
+    const BandStats band = c.stats.ForDepth(kDeepestDecade);
+    EXPECT_GT(band.finite, 10000u) << c.cell.Name();
+    return BitsLost(Summarize(band, metric).p999);
+  }
+
+  static std::shared_ptr<VulkanContext>* context_;
+  static Results* compute_;
+  static Results* raster_;
+  static Results* host_model_;
+};
+std::shared_ptr<VulkanContext>* RasterPipelineTest::context_ = nullptr;
+Results* RasterPipelineTest::compute_ = nullptr;
+Results* RasterPipelineTest::raster_ = nullptr;
+Results* RasterPipelineTest::host_model_ = nullptr;
+
+TEST_F(RasterPipelineTest, EveryCellRunsAndIsJudged) {
+  ASSERT_FALSE(compute_->cells.empty());
+  int cells = 0;
+  for (const CellResult& c : compute_->cells) {
+    if (c.backend != "vulkan") continue;
+    const CellResult* r = Find(*raster_, c.cell, "vulkan");
+    ASSERT_NE(r, nullptr) << c.cell.Name() << " did not run in raster mode";
+    ++cells;
+    // At the origin every sample of the natural population has geometry:
+    // as many are judged as in the compute form, none non-finite.
+    const BandStats raster = r->stats.All(), compute = c.stats.All();
+    EXPECT_GT(compute.finite, kSamples / 2) << c.cell.Name();
+    EXPECT_EQ(raster.finite, compute.finite) << c.cell.Name();
+    EXPECT_EQ(raster.nan + raster.inf, 0u) << c.cell.Name() << ": non-finite findings";
+  }
+  EXPECT_GE(cells, 8 * 3);  // every variant, with at least three encodings each
+}
+
+TEST_F(RasterPipelineTest, FarPlaneFiguresFollowTheComputeFormAndTheHostModel) {
+  int compared = 0;
+  for (const CellResult& c : compute_->cells) {
+    if (c.backend != "vulkan") continue;
+    const bool standard_d24 = c.cell.convention == Convention::kStandard && c.cell.format == Format::kX8D24Unorm;
+    const bool reversed_d32 = c.cell.convention == Convention::kReversed && c.cell.format == Format::kD32Sfloat;
+    if (!standard_d24 && !reversed_d32) continue;
+    const CellResult* device = Find(*raster_, c.cell, "vulkan");
+    const CellResult* model = Find(*host_model_, c.cell, "cpu");
+    ASSERT_NE(device, nullptr);
+    ASSERT_NE(model, nullptr);
+    const double compute_bits = DeepestP999(c), model_bits = DeepestP999(*model), device_bits = DeepestP999(*device);
+    if (reversed_d32) {
+      // Float32 depth keeps its relative precision through any few
+      // roundings: half a bit.
+      EXPECT_NEAR(device_bits, compute_bits, 0.5) << c.cell.Name();
+    } else {
+      // The vertex transform: the host's model (exact interpolation) loses
+      // up to a bit more than the compute form, never less than it less
+      // a quarter (the quarter-bit bins).
+      EXPECT_LT(model_bits - compute_bits, 1.0) << c.cell.Name();
+      EXPECT_GT(model_bits - compute_bits, -0.25) << c.cell.Name();
+    }
+    // The device's rasterizer against the host's model of it. Lavapipe's
+    // depth differs from the exact interpolation of its vertices by up to
+    // 4 or 5 codes of D24 (about as many ulps of 1, the depth plane being
+    // evaluated in float32 from an origin away from the pixel; forbidding
+    // contraction changes nothing), where the format's own step is one
+    // code: up to about half a bit at p99.9 (0.54 measured), plus the
+    // quarter-bit bins and the sampling noise of 1e4 samples in the decade.
+    EXPECT_NEAR(device_bits, model_bits, 0.75) << c.cell.Name();
+    ++compared;
+  }
+  EXPECT_EQ(compared, 8);  // the four projective variants, two encodings each
+}
+
+TEST_F(RasterPipelineTest, TheShaderPartIsTheComputeFormsOnTheDevicesTexels) {
+  // The device's texels (and its fetch's conversion to float) are adopted
+  // into the reference, so with clip depth [0, 1] the shader part of a
+  // variant without rays is its arithmetic alone, as in the compute form:
+  // within the quarter-bit bins and the sampling noise of a p99.9 (half a
+  // bit). Before the fetch was adopted, lavapipe's unorm conversion (up to
+  // 2 ulps off) read as 13 bits of "shader" error here.
+  int compared = 0;
+  for (const CellResult& c : compute_->cells) {
+    if (c.backend != "vulkan" || Info(c.cell.variant).input != DepthInput::kHardware) continue;
+    if ((Info(c.cell.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u) continue;
+    const CellResult* device = Find(*raster_, c.cell, "vulkan");
+    ASSERT_NE(device, nullptr);
+    EXPECT_NEAR(DeepestP999(*device, Metric::kArith), DeepestP999(c, Metric::kArith), 0.5) << c.cell.Name();
+    ++compared;
+  }
+  EXPECT_EQ(compared, 4 * 3 * 2);  // four variants, three formats, standard and reversed (finite far)
+}
+
+TEST_F(RasterPipelineTest, RasterizedFloatDepthShowsTheCostOfTheGlRemap) {
+  // What only the raster form shows: with GL-style clip depth the shader
+  // maps window depth d back to NDC as -1 + 2d. The compute form's d was
+  // made as 0.5 * ndc + 0.5 from a float NDC, so that map gives the NDC
+  // back exactly (Sterbenz) and costs nothing. A rasterizer interpolates
+  // d itself, with float32's full resolution near 0 (reversed Z's far
+  // plane), and -1 + 2d rounds that to the resolution of 1: several bits
+  // of the shader's (10.7 measured for reciprocal against 1.5). The host's
+  // model shows the same, so it is the pipeline, not lavapipe.
+  const Cell cell{Variant::kReciprocal, Convention::kReversedGl, Format::kD32Sfloat};
+  const CellResult* compute = Find(*compute_, cell, "vulkan");
+  const CellResult* device = Find(*raster_, cell, "vulkan");
+  const CellResult* model = Find(*host_model_, cell, "cpu");
+  ASSERT_TRUE(compute != nullptr && device != nullptr && model != nullptr);
+  EXPECT_GT(DeepestP999(*device, Metric::kArith), DeepestP999(*compute, Metric::kArith) + 4.0);
+  EXPECT_GT(DeepestP999(*model, Metric::kArith), DeepestP999(*compute, Metric::kArith) + 4.0);
+}
+
+}  // namespace
+}  // namespace depthbench
