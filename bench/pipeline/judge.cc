@@ -141,7 +141,7 @@ template <bool kDistances>
         if constexpr (kDistances) to.distance.Record(Metric::kArith, arith_bin, s.arith[i], index);
       }
     } else {
-      const auto count = [&](CellAccumulator::Slot& slot) __attribute__((always_inline)) {
+      const auto count = [&](CellAccumulator::Slot & slot) __attribute__((always_inline)) {
         if (in.status[i] == ReferenceStatus::kDegenerate) {
           ++slot.degenerate;
         } else if (in.status[i] == ReferenceStatus::kOutside) {
@@ -205,8 +205,8 @@ template <int N>
     for (const JudgedCell& cell : cells) {
       const float* p = cell.positions.data();
       ForEachFrameRun(
-          batch, from, to,
-          [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
+          batch, from,
+          to, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
             const std::size_t at = offset + begin;
             const RunInputs in{p + begin,
                                p + count + begin,
