@@ -29,6 +29,7 @@ template <class Real>
 }
 
 constexpr std::uint32_t kMaxRun = kSamplesPerFrame;  // a frame's samples at most
+constexpr std::uint32_t kFramesPerGroup = 4;
 
 // Everything JudgeSlot runs is inlined into it ([[gnu::always_inline]]), so
 // that its two copies below are each compiled whole for their instruction
@@ -115,7 +116,10 @@ template <int N>
 // A sample of the natural distribution goes to its joint band, with every
 // figure, and to its camera-distance band, with the total and the shader's
 // part (what camera distance does shows there whole); a targeted pick to
-// its coverage band alone (CellAccumulator::SlotsOf).
+// its coverage band alone (CellAccumulator::SlotsOf). Without distance
+// bands (CellAccumulator::SkipDistanceBands) nothing goes to the
+// discarded slot at all: kDistances is false.
+template <bool kDistances>
 [[gnu::always_inline]] inline void Record(const RunInputs& in, std::uint64_t first_index, std::uint32_t n,
                                           const RunScratch& s, CellAccumulator& accumulator,
                                           CellAccumulator::Slot& distance) {
@@ -129,42 +133,49 @@ template <int N>
       const int total_bin = static_cast<int>(s.total_bin[i]), arith_bin = static_cast<int>(s.arith_bin[i]);
       to.band.Record(Metric::kTotal, total_bin, s.total[i], index);
       to.band.Record(Metric::kAbsolute, static_cast<int>(s.absolute_bin[i]), absolute_sq, index);
-      to.distance.Record(Metric::kTotal, total_bin, s.total[i], index);
+      if constexpr (kDistances) to.distance.Record(Metric::kTotal, total_bin, s.total[i], index);
       // Against a stored value that denotes no holdable point, the shader
       // has no error to speak of.
       if (holdable) {
         to.band.Record(Metric::kArith, arith_bin, s.arith[i], index);
-        to.distance.Record(Metric::kArith, arith_bin, s.arith[i], index);
+        if constexpr (kDistances) to.distance.Record(Metric::kArith, arith_bin, s.arith[i], index);
       }
     } else {
-      for (CellAccumulator::Slot* slot : {&to.band, &to.distance}) {
+      const auto count = [&](CellAccumulator::Slot & slot) __attribute__((always_inline)) {
         if (in.status[i] == ReferenceStatus::kDegenerate) {
-          ++slot->degenerate;
+          ++slot.degenerate;
         } else if (in.status[i] == ReferenceStatus::kOutside) {
           // Outside the frustum or the range of depths asked for: not
           // judged, whatever the output (a texel beyond the far plane may
           // well reconstruct to infinity).
-          ++slot->outside;
+          ++slot.outside;
         } else if (!holdable) {
-          ++slot->stored_nonfinite;
+          ++slot.stored_nonfinite;
         } else {
-          slot->RecordNonFinite(absolute_sq != absolute_sq, index);
+          slot.RecordNonFinite(absolute_sq != absolute_sq, index);
         }
-      }
+      };
+      count(to.band);
+      if constexpr (kDistances) count(to.distance);
     }
   }
 }
 
 // Calls run(frame, begin, end) for each frame's samples [begin, end) of
-// the batch, in order: the camera and the distance band are the frame's.
+// the batch's samples [from, to), in order: the camera and the distance
+// band are the frame's.
 template <class Run>
-[[gnu::always_inline]] inline void ForEachFrameRun(const Batch& batch, Run run) {
-  for (std::uint32_t begin = 0; begin < batch.count;) {
+[[gnu::always_inline]] inline void ForEachFrameRun(const Batch& batch, std::uint32_t from, std::uint32_t to, Run run) {
+  for (std::uint32_t begin = from; begin < to;) {
     const std::uint32_t frame = batch.FrameOf(begin);
-    const std::uint32_t end = std::min<std::uint32_t>(batch.count, (frame + 1) * kSamplesPerFrame - batch.first_offset);
+    const std::uint32_t end = std::min<std::uint32_t>(to, (frame + 1) * kSamplesPerFrame - batch.first_offset);
     run(frame, begin, end);
     begin = end;
   }
+}
+template <class Run>
+[[gnu::always_inline]] inline void ForEachFrameRun(const Batch& batch, Run run) {
+  ForEachFrameRun(batch, 0, batch.count, run);
 }
 
 }  // namespace
@@ -185,33 +196,44 @@ template <int N>
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * count;
   const ReferenceArrays& ref = batch.reference;
   RunScratch scratch;
-  // Frame by frame: a frame's reference stays in cache while every cell
-  // reads it.
-  ForEachFrameRun(
-      batch, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
-        const std::uint32_t n = end - begin;
-        const glm::dvec3 camera = batch.frames[frame].camera_position;
-        const std::size_t at = offset + begin;
-        for (const JudgedCell& cell : cells) {
-          const float* p = cell.positions.data();
-          const RunInputs in{p + begin,
-                             p + count + begin,
-                             p + 2 * std::size_t{count} + begin,
-                             batch.ray_x.data() + begin,
-                             batch.ray_y.data() + begin,
-                             batch.ray_z.data() + begin,
-                             ref.true_depth.data() + at,
-                             ref.denoted_depth.data() + at,
-                             ref.inverse_distance_sq.data() + at,
-                             ref.joint_band.data() + at,
-                             ref.status.data() + at,
-                             ref.stored_holdable.data() + at,
-                             batch.samples.coverage.data() + begin};
-          Measure<N>(in, camera, n, scratch);
-          Record(in, batch.first_index + begin, n, scratch, *cell.accumulator,
-                 cell.accumulator->Distance(batch.distance_bands[frame]));
-        }
-      });
+  // A few frames at a time: their reference stays in cache while every
+  // cell reads it, and each cell records them in one go, while the lines
+  // of its accumulator that they reach are in L1.
+  for (std::uint32_t from = 0; from < count;) {
+    const std::uint32_t to =
+        std::min<std::uint32_t>(count, (batch.FrameOf(from) + kFramesPerGroup) * kSamplesPerFrame - batch.first_offset);
+    for (const JudgedCell& cell : cells) {
+      const float* p = cell.positions.data();
+      ForEachFrameRun(
+          batch, from,
+          to, [&](std::uint32_t frame, std::uint32_t begin, std::uint32_t end) __attribute__((always_inline)) {
+            const std::size_t at = offset + begin;
+            const RunInputs in{p + begin,
+                               p + count + begin,
+                               p + 2 * std::size_t{count} + begin,
+                               batch.ray_x.data() + begin,
+                               batch.ray_y.data() + begin,
+                               batch.ray_z.data() + begin,
+                               ref.true_depth.data() + at,
+                               ref.denoted_depth.data() + at,
+                               ref.inverse_distance_sq.data() + at,
+                               ref.joint_band.data() + at,
+                               ref.status.data() + at,
+                               ref.stored_holdable.data() + at,
+                               batch.samples.coverage.data() + begin};
+            const std::uint32_t n = end - begin;
+            Measure<N>(in, batch.frames[frame].camera_position, n, scratch);
+            CellAccumulator& accumulator = *cell.accumulator;
+            CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
+            if (accumulator.records_distances()) {
+              Record<true>(in, batch.first_index + begin, n, scratch, accumulator, distance);
+            } else {
+              Record<false>(in, batch.first_index + begin, n, scratch, accumulator, distance);
+            }
+          });
+    }
+    from = to;
+  }
   for (const JudgedCell& cell : cells) cell.accumulator->Count(count);
 }
 

@@ -249,6 +249,7 @@ class CellAccumulator {
   // what the whole natural distribution does, so it is not recorded sample
   // by sample; DistanceBandOf() makes it from the joint bands at the end.
   void SkipDistanceBands() { skip_distance_ = true; }
+  bool records_distances() const { return !skip_distance_; }
   Slot& Coverage(int band) { return slots_.get()[kDistanceBands + kJointBands + band]; }
   // The slots a sample's figures go to, chosen without a branch (targeted
   // picks interleave with natural samples at random, and a mispredicted
