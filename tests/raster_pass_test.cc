@@ -292,7 +292,7 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   std::filesystem::create_directories(copy);
   std::filesystem::copy(DEPTHBENCH_SOURCE_DIR "/shaders", copy / "shaders", std::filesystem::copy_options::recursive);
   std::filesystem::copy(DEPTHBENCH_SOURCE_DIR "/shared", copy / "shared", std::filesystem::copy_options::recursive);
-  const std::filesystem::path pass = copy / "shaders" / "raster" / "raster_pass.glsl";
+  const std::filesystem::path pass = copy / "shaders" / "raster" / "reconstruct.inc";
   std::ifstream in(pass);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   in.close();
@@ -328,48 +328,46 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   std::filesystem::remove_all(copy);
 }
 
-// A variant from the user's GLSL file gets its raster program by the same
-// mechanism as the built-in ones, and runs the compute form's arithmetic on
-// the same stored depth: the same bits (d32_sfloat, so that the host reads
-// exactly the device's value). HLSL files have no raster program.
-TEST_F(RasterPassTest, UserGlslVariantsRunAndHlslOnesAreRefused) {
+// A variant from the user's file, GLSL or HLSL, gets its raster program by
+// the same mechanism as the built-in ones, and runs the compute form's
+// arithmetic on the same stored depth: the same bits (d32_sfloat, so that
+// the host reads exactly the device's value). The HLSL example is the
+// inverse view-projection written as a Unity project writes it: its
+// raster program is the HLSL pass, with the texture turned into the
+// combined image sampler the host binds.
+TEST_F(RasterPassTest, UserVariantsInBothLanguagesRunAsInTheComputeForm) {
   const std::filesystem::path examples = std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "bench" / "examples";
-  auto glsl = RegisterVariantFile((examples / "divide_subtract_first.glsl").string());
-  ASSERT_TRUE(glsl.ok()) << glsl.status().message();
-  const RunLayout layout = MakeRunLayout(std::vector<Cell>{{*glsl, Convention::kStandard, Format::kD32Sfloat}});
-  Status status = raster_->Prepare(layout.cells, PassKind::kRaster);
-  ASSERT_TRUE(status.ok()) << status.message();
-  ASSERT_TRUE(compute_->Prepare(layout.cells, PassKind::kCompute).ok());
-  Batch batch = BuildBatch(layout, 640, 300);
-  const std::vector<std::uint32_t> which = {0};
-  std::vector<float> scratch;
-  auto drawn = raster_->Run(batch, which, scratch);
-  ASSERT_TRUE(drawn.ok()) << drawn.status().message();
-  const std::vector<float> raster(drawn->begin(), drawn->end());
-  const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
-  for (std::uint32_t i = 0; i < batch.count; ++i) batch.depths[i] = FetchTexel(Format::kD32Sfloat, texels[i]);
-  auto computed = compute_->Run(batch, which, scratch);
-  ASSERT_TRUE(computed.ok()) << computed.status().message();
-  std::size_t compared = 0;
-  for (std::uint32_t i = 0; i < batch.count; ++i) {
-    if (!HasGeometry(batch.raster[i])) continue;
-    for (std::uint32_t c = 0; c < 3; ++c) {
-      const float got = raster[c * batch.count + i], want = (*computed)[c * batch.count + i];
-      EXPECT_EQ(std::memcmp(&got, &want, sizeof(got)), 0) << "sample " << i << " component " << c << ": " << got
-                                                          << " vs " << want;
+  for (const char* file : {"divide_subtract_first.glsl", "unity_world_position.hlsl"}) {
+    SCOPED_TRACE(file);
+    auto user = RegisterVariantFile((examples / file).string());
+    ASSERT_TRUE(user.ok()) << user.status().message();
+    const RunLayout layout = MakeRunLayout(std::vector<Cell>{{*user, Convention::kStandard, Format::kD32Sfloat}});
+    Status status = raster_->Prepare(layout.cells, PassKind::kRaster);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_TRUE(compute_->Prepare(layout.cells, PassKind::kCompute).ok());
+    Batch batch = BuildBatch(layout, 640, 300);
+    const std::vector<std::uint32_t> which = {0};
+    std::vector<float> scratch;
+    auto drawn = raster_->Run(batch, which, scratch);
+    ASSERT_TRUE(drawn.ok()) << drawn.status().message();
+    const std::vector<float> raster(drawn->begin(), drawn->end());
+    const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+    for (std::uint32_t i = 0; i < batch.count; ++i) batch.depths[i] = FetchTexel(Format::kD32Sfloat, texels[i]);
+    auto computed = compute_->Run(batch, which, scratch);
+    ASSERT_TRUE(computed.ok()) << computed.status().message();
+    std::size_t compared = 0;
+    for (std::uint32_t i = 0; i < batch.count; ++i) {
+      if (!HasGeometry(batch.raster[i])) continue;
+      for (std::uint32_t c = 0; c < 3; ++c) {
+        const float got = raster[c * batch.count + i], want = (*computed)[c * batch.count + i];
+        EXPECT_EQ(std::memcmp(&got, &want, sizeof(got)), 0) << "sample " << i << " component " << c << ": " << got
+                                                            << " vs " << want;
+      }
+      ++compared;
     }
-    ++compared;
+    EXPECT_GT(compared, batch.count / 2);
+    ASSERT_TRUE(RegisterVariantFiles({}).ok());
   }
-  EXPECT_GT(compared, batch.count / 2);
-
-  auto hlsl = RegisterVariantFile((examples / "unity_world_position.hlsl").string());
-  ASSERT_TRUE(hlsl.ok()) << hlsl.status().message();
-  status = raster_->Prepare(MakeRunLayout(std::vector<Cell>{{*hlsl, Convention::kStandard, Format::kD32Sfloat}}).cells,
-                            PassKind::kRaster);
-  EXPECT_EQ(status.code(), StatusCode::kUnavailable);
-  EXPECT_NE(status.message().find("HLSL variant files run in the compute form only"), std::string::npos)
-      << status.message();
-  ASSERT_TRUE(RegisterVariantFiles({}).ok());
 }
 
 // The arithmetic probes rewrite the raster form's programs too (its

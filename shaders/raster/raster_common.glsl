@@ -18,10 +18,4 @@ layout(push_constant) uniform Draw { RasterConstants draw; };
 // starts every draw at a multiple of this.
 const int VIEWPORTS_PER_DRAW = 16;
 
-uint frame_of(uint sample_index) { return (draw.first_in_frame + sample_index) / draw.samples_per_frame; }
-
-uint sample_at(vec4 frag_coord) { return uint(frag_coord.y) * draw.atlas_width + uint(frag_coord.x); }
-
-DepthParams depth_of(uint frame_index, uint convention_slot) {
-  return depth_params[frame_index * draw.conventions_per_frame + convention_slot];
-}
+#include "atlas.inc"

@@ -156,11 +156,19 @@ Expected<std::unique_ptr<LinkedShader>> ParseAndLink(const std::string& source, 
                      100);
   // The raster form's stages need Vulkan 1.3 anyway; under 1.2 rules a
   // vertex stage's gl_ViewportIndex is the core capability
-  // (shaderOutputViewportIndex), not an extension's.
+  // (shaderOutputViewportIndex), not an extension's. HLSL stays at 1.1:
+  // glslang's HLSL front end decorates storage buffers as SPIR-V 1.3 does
+  // (BufferBlock), which later versions reject, and its only graphics
+  // program, a fragment stage, needs nothing newer.
   const bool graphics = stage != EShLangCompute;
-  shader.setEnvClient(glslang::EShClientVulkan, graphics ? glslang::EShTargetVulkan_1_2 : glslang::EShTargetVulkan_1_1);
-  shader.setEnvTarget(glslang::EShTargetSpv, graphics ? glslang::EShTargetSpv_1_5 : glslang::EShTargetSpv_1_3);
+  const bool vulkan_1_2 = graphics && !hlsl;
+  shader.setEnvClient(glslang::EShClientVulkan, vulkan_1_2 ? glslang::EShTargetVulkan_1_2 : glslang::EShTargetVulkan_1_1);
+  shader.setEnvTarget(glslang::EShTargetSpv, vulkan_1_2 ? glslang::EShTargetSpv_1_5 : glslang::EShTargetSpv_1_3);
   if (hlsl) shader.setEntryPoint("main");
+  // HLSL has no combined image sampler type; the raster form's fragment
+  // program binds one (shaders/user/raster_pass.hlsl), so its Texture2D is
+  // made one. The compute programs' textures stay sampled images.
+  if (hlsl && graphics) shader.setTextureSamplerTransformMode(EShTexSampTransUpgradeTextureRemoveSampler);
   const auto messages = static_cast<EShMessages>(kMessages | (hlsl ? EShMsgReadHlsl : EShMsgDefault));
   RelativeIncluder includer(root_name, root_dir, sources);
   if (!shader.parse(GetDefaultResources(), kDefaultGlslVersion, false, messages, includer)) {

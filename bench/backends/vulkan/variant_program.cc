@@ -55,7 +55,9 @@ std::string GeneratedProgram(Variant variant, VariantPass pass, const std::files
     case VariantPass::kSpeed:
       text += include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
       break;
-    case VariantPass::kRaster: text += include(dir / "raster" / "raster_pass.glsl"); break;
+    case VariantPass::kRaster:
+      text += include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
+      break;
   }
   return text;
 }
@@ -78,12 +80,6 @@ Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass
   const UserShader* user = Info(variant).user;
   if (!Generated(variant, pass)) return CompileShader(BuiltInProgram(variant, pass, shader_dir), ShaderStage::kCompute, sources);
   const bool raster = pass == VariantPass::kRaster;
-  if (raster && user != nullptr && user->language == ShaderLanguage::kHlsl) {
-    return Unavailable(fmt::format(
-        "{}: the raster form has no HLSL fragment program yet; HLSL variant files run in the compute form only "
-        "(--pipeline compute), or write the function in GLSL",
-        user->path.string()));
-  }
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
   const std::string program = VariantProgramName(variant, pass, shader_dir);
   Expected<std::vector<std::uint32_t>> compiled =
