@@ -72,6 +72,41 @@ TEST(ConstantsTest, EngineMatricesAreTheFloatPipelineOfTheExactOnes) {
   }
 }
 
+// BuildDepthParams writes its two matrix products over the nonzero entries
+// of the projection and of its inverse; they must equal glm's full
+// products of the same matrices, double-double word for word (a zero's
+// sign aside), under every convention (the infinite ones included), at the origin
+// and far from it.
+TEST(ConstantsTest, SparseProductsAreTheFullOnes) {
+  using DD = DoubleDouble;
+  for (const double distance : {0.0, 1e5}) {
+    for (std::uint64_t f = 0; f < 40; ++f) {
+      const Frame frame = SampledFrame(distance, f);
+      const hp::FrameParams params = BuildFrameParams(frame);
+      for (int c = 0; c < kHardwareConventionCount; ++c) {
+        const auto convention = static_cast<Convention>(c);
+        const hp::DepthParams d = BuildDepthParams(frame, params, convention);
+        const DD a = d.coefficients.x, b = d.coefficients.y, zero(0.0);
+        hp::mat4 inverse_projection(zero), projection(zero);
+        inverse_projection[0][0] = params.lens.x;
+        inverse_projection[1][1] = params.lens.y;
+        inverse_projection[2][3] = d.coefficients.z;
+        inverse_projection[3][2] = DD(-1.0);
+        inverse_projection[3][3] = d.coefficients.w;
+        projection[0][0] = params.lens.z;
+        projection[1][1] = params.lens.w;
+        projection[2][2] = -a;
+        projection[2][3] = DD(-1.0);
+        projection[3][2] = b;
+        EXPECT_TRUE(d.inverse_view_projection == params.camera_world * inverse_projection)
+            << "frame " << f << " " << Info(convention).name;
+        EXPECT_TRUE(d.view_projection == projection * params.world_view)
+            << "frame " << f << " " << Info(convention).name;
+      }
+    }
+  }
+}
+
 TEST(ConstantsTest, TheTruthDoesNotMoveOnlyWhatTheShadersReceive) {
   Domain domain;
   domain.ratio = {1e6, 1e6};

@@ -109,22 +109,25 @@ hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, C
   d.reserved0 = d.reserved1 = d.reserved2 = 0;
 
   // Inverse projection for view = (x/H, y/V, -1) * z and ndc_z = A + B/z:
-  // (ndc.x, ndc.y, ndc_z, 1) -> (ndc.x/H, ndc.y/V, -1, (ndc_z - A)/B).
-  const DD zero(0.0);
-  hp::mat4 inverse_projection;
-  inverse_projection[0] = hp::vec4(f.lens.x, zero, zero, zero);  // 1/H = tan_x
-  inverse_projection[1] = hp::vec4(zero, f.lens.y, zero, zero);  // 1/V = tan_y
-  inverse_projection[2] = hp::vec4(zero, zero, zero, d.coefficients.z);
-  inverse_projection[3] = hp::vec4(zero, zero, DD(-1.0), d.coefficients.w);
-  d.inverse_view_projection = f.camera_world * inverse_projection;
-  // The projection itself (EngineProjectionMatrix's layout), times the view.
-  hp::mat4 projection(zero);
-  projection[0][0] = f.lens.z;
-  projection[1][1] = f.lens.w;
-  projection[2][2] = -a;
-  projection[2][3] = DD(-1.0);
-  projection[3][2] = b;
-  d.view_projection = projection * f.world_view;
+  // (ndc.x, ndc.y, ndc_z, 1) -> (ndc.x/H, ndc.y/V, -1, (ndc_z - A)/B), whose
+  // columns are (1/H, 0, 0, 0), (0, 1/V, 0, 0), (0, 0, 0, P), (0, 0, -1, Q).
+  // Both products below are written out over the sparse matrix's nonzero
+  // entries, in the order glm's full product adds them (left to right, the
+  // left matrix's entry first): adding a zero product is exact, so every
+  // entry equals the full product's, at a fifth of the cost (this runs for
+  // every frame and convention). tests/constants_test.cc holds them equal.
+  const hp::mat4& cw = f.camera_world;
+  d.inverse_view_projection[0] = cw[0] * f.lens.x;  // 1/H = tan_x
+  d.inverse_view_projection[1] = cw[1] * f.lens.y;  // 1/V = tan_y
+  d.inverse_view_projection[2] = cw[3] * d.coefficients.z;
+  d.inverse_view_projection[3] = cw[2] * DD(-1.0) + cw[3] * d.coefficients.w;
+  // The projection (EngineProjectionMatrix's layout: columns (H, 0, 0, 0),
+  // (0, V, 0, 0), (0, 0, -A, -1), (0, 0, B, 0)) times the view.
+  const DD minus_a = -a, minus_one(-1.0);
+  for (int c = 0; c < 4; ++c) {
+    const hp::vec4& v = f.world_view[c];
+    d.view_projection[c] = hp::vec4(f.lens.z * v.x, f.lens.w * v.y, minus_a * v.z + b * v.w, minus_one * v.z);
+  }
   return d;
 }
 
