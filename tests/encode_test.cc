@@ -1,6 +1,7 @@
 // The encoder rounds exactly as the formats and an ideal pipeline do.
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -115,6 +116,25 @@ float ExactPipelineFloat(Encoding e, const Frame& frame, double z) {
   if ((bits & 4u) == 0u) return window.ToFloat();
   float ndc = (window * mp::real(2.0) - mp::real(1.0)).ToFloat();
   return static_cast<float>(0.5 * static_cast<double>(ndc) + 0.5);
+}
+
+// The distance between two texels that the raster form reports: unorm
+// codes apart, or floats stepped over, whichever binade or sign the two
+// lie in (a raw difference of float bits reads billions across zero).
+TEST(EncodeTest, CodeDistanceCountsValuesBetweenTexels) {
+  EXPECT_EQ(CodeDistance(Format::kX8D24Unorm, 5, 2), 3u);
+  EXPECT_EQ(CodeDistance(Format::kD16Unorm, 0, 65535), 65535u);
+  const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+  EXPECT_EQ(CodeDistance(Format::kD32Sfloat, bits(1.0f), bits(std::nextafter(1.0f, 2.0f))), 1u);
+  EXPECT_EQ(CodeDistance(Format::kD32Sfloat, bits(2.0f), bits(std::nextafter(2.0f, 0.0f))), 1u);  // a binade's edge
+  const float tiny = std::numeric_limits<float>::denorm_min();
+  EXPECT_EQ(CodeDistance(Format::kR32Sfloat, bits(tiny), bits(-tiny)), 2u);  // through zero
+  EXPECT_EQ(CodeDistance(Format::kR32Sfloat, bits(0.0f), bits(-0.0f)), 0u);
+  EXPECT_EQ(CodeDistance(Format::kR32Sfloat, bits(-1.0f), bits(1.0f)), 2u * bits(1.0f));
+  EXPECT_EQ(CodeDistance(Format::kR16Sfloat, 0x3C00u, 0xBC00u), 2u * 0x3C00u);  // half 1.0 and -1.0
+  EXPECT_EQ(CodeDistance(Format::kD32Sfloat, bits(-std::numeric_limits<float>::max()),
+                         bits(std::numeric_limits<float>::max())),
+            2u * bits(std::numeric_limits<float>::max()));
 }
 
 TEST(EncodeTest, PipelineFloatIsCorrectlyRoundedEverywhere) {

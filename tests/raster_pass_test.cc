@@ -251,7 +251,7 @@ TEST_F(RasterPassTest, CountsAgreementPerDepthSlot) {
         ++expected[slot].texels;
         expected[slot].differing += device != host ? 1 : 0;
         expected[slot].max_code_distance =
-            std::max(expected[slot].max_code_distance, device > host ? device - host : host - device);
+            std::max(expected[slot].max_code_distance, CodeDistance(layout.encodings[slot].format, device, host));
       }
     }
   }

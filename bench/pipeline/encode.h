@@ -91,6 +91,11 @@ void DecodeEyeDepths(Encoding encoding, ProductionModel model, const DepthMappin
 
 // Format conversions, exposed for tests.
 float FetchTexel(Format format, std::uint32_t code);
+// How far apart two texel codes of a format lie in its values: the
+// difference of unorm codes; for float codes, the representable values
+// stepped over between them (ulps), across binades and through zero (+0
+// and -0 are one value), saturating at 2^32 - 1.
+std::uint32_t CodeDistance(Format format, std::uint32_t a, std::uint32_t b);
 std::uint32_t FloatToUnorm(float value, int bits);  // clamps to [0, 1] first
 std::uint16_t FloatToHalf(float value);             // round to nearest even
 float HalfToFloat(std::uint16_t half);

@@ -31,6 +31,11 @@ namespace depthbench {
 // made visible to `to_access` in `to_stage`.
 void RecordMemoryBarrier(VkCommandBuffer commands, VkPipelineStageFlags from_stage, VkAccessFlags from_access,
                          VkPipelineStageFlags to_stage, VkAccessFlags to_access);
+// The same, for one image (its first mip level and layer), moving it from
+// layout `from` to layout `to`.
+void RecordImageBarrier(VkCommandBuffer commands, const VulkanImage& image, VkImageLayout from, VkImageLayout to,
+                        VkPipelineStageFlags from_stage, VkAccessFlags from_access, VkPipelineStageFlags to_stage,
+                        VkAccessFlags to_access);
 
 // A shader module of `spirv`; `what` names the shader in errors.
 Expected<DeviceObject<VkShaderModule>> CreateShaderModule(VkDevice device, std::span<const std::uint32_t> spirv,

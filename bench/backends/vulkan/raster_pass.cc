@@ -13,6 +13,7 @@
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/backends/vulkan/vulkan_formats.h"
+#include "bench/pipeline/encode.h"
 
 namespace depthbench {
 
@@ -178,22 +179,6 @@ Expected<DeviceObject<VkPipeline>> CreateGraphicsPipeline(VkDevice device, VkPip
   DB_RETURN_IF_ERROR(CheckVk(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
                              "vkCreateGraphicsPipelines for " + what));
   return DeviceObject<VkPipeline>(device, pipeline, vkDestroyPipeline);
-}
-
-void RecordImageBarrier(VkCommandBuffer commands, const VulkanImage& image, VkImageLayout from, VkImageLayout to,
-                        VkPipelineStageFlags from_stage, VkAccessFlags from_access, VkPipelineStageFlags to_stage,
-                        VkAccessFlags to_access) {
-  VkImageMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-  barrier.srcAccessMask = from_access;
-  barrier.dstAccessMask = to_access;
-  barrier.oldLayout = from;
-  barrier.newLayout = to;
-  barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image.image.get();
-  barrier.subresourceRange = {image.aspect, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(commands, from_stage, to_stage, 0, 0, nullptr, 0, nullptr, 1, &barrier);
 }
 
 VkRenderingAttachmentInfo ClearedAttachment(const VulkanImage& image, VkImageLayout layout, VkClearValue clear) {
@@ -759,7 +744,7 @@ void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool
       ++agreement.texels;
       agreement.differing += device != host ? 1 : 0;
       agreement.uncovered += coverage[i] == std::byte{0} ? 1 : 0;
-      agreement.max_code_distance = std::max(agreement.max_code_distance, device > host ? device - host : host - device);
+      agreement.max_code_distance = std::max(agreement.max_code_distance, CodeDistance(format, device, host));
     }
   }
 }
