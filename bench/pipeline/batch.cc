@@ -178,11 +178,40 @@ DepthMappings BatchBuilder::MappingOf(const Batch& batch, std::size_t pipeline) 
 }
 
 void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo, std::size_t n) const {
-  std::array<double, kChunk> denoted;
+  std::array<double, kChunk> denoted{};  // (every element is written below; the compiler cannot tell)
   const std::size_t count = batch.count, at = slot * count + lo, pipeline = pipeline_of_slot_[slot];
   const Encoding encoding = encodings_[slot];
-  DecodeEyeDepths(encoding, model_, MappingOf(batch, pipeline).At(lo), batch.depths.data() + at, n, denoted.data(),
-                  nullptr, isa_);
+  const DepthMappings mapping = MappingOf(batch, pipeline).At(lo);
+  // A stored value that is its pipeline's float, bit for bit (a float32
+  // texel's, but for stored-value picks and a device's texels), denotes
+  // the depth that float does, decoded already under the same mapping:
+  // only the others are decoded, gathered, four lanes at a time as ever.
+  const float* stored = batch.depths.data() + at;
+  const float* produced_floats = pipeline_floats_.data() + pipeline * count + lo;
+  std::array<std::uint32_t, kChunk> other;
+  std::size_t others = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    other[others] = static_cast<std::uint32_t>(i);
+    others += std::bit_cast<std::uint32_t>(stored[i]) != std::bit_cast<std::uint32_t>(produced_floats[i]) ? 1 : 0;
+  }
+  if (2 * others > n) {
+    DecodeEyeDepths(encoding, model_, mapping, stored, n, denoted.data(), nullptr, isa_);
+  } else {
+    std::copy_n(produced_.data() + pipeline * count + lo, n, denoted.begin());
+    if (others > 0) {
+      std::array<float, kChunk> values;
+      std::array<std::array<double, kChunk>, 4> gathered;
+      const double* arrays[] = {mapping.near, mapping.far, mapping.a, mapping.b};
+      for (std::size_t j = 0; j < others; ++j) {
+        values[j] = stored[other[j]];
+        for (int p = 0; p < 4; ++p) gathered[p][j] = arrays[p][other[j]];
+      }
+      std::array<double, kChunk> decoded;
+      DecodeEyeDepths(encoding, model_, {gathered[0].data(), gathered[1].data(), gathered[2].data(), gathered[3].data()},
+                      values.data(), others, decoded.data(), nullptr, isa_);
+      for (std::size_t j = 0; j < others; ++j) denoted[other[j]] = decoded[j];
+    }
+  }
   References(encoding, batch.samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo,
              batch.reference, at, isa_);
   // Raster samples with nothing drawn have no point to judge.
