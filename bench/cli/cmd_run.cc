@@ -29,6 +29,7 @@ struct RunFlags {
   std::vector<std::string> split;
   unsigned threads = 0;
   std::uint32_t batch = 16384;
+  std::string judge = "auto";
   bool quiet = false;
   DomainFlags domain;
   CellFlags cells;
@@ -95,6 +96,7 @@ Expected<int> Run(const RunFlags& f) {
   options.seed = f.seed;
   options.threads = f.threads;
   options.batch_size = f.batch;
+  options.judge = f.judge == "host" ? JudgeSite::kHost : f.judge == "device" ? JudgeSite::kDevice : JudgeSite::kAuto;
   if (!f.shard.empty()) {
     DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
@@ -182,6 +184,12 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--batch", flags->batch,
                   "samples per batch (memory is proportional to it; cut to what the Vulkan device can bind at once)")
       ->check(CLI::Range(64u, 1u << 22));
+  cmd->add_option("--judge", flags->judge,
+                  "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
+                  "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "
+                  "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
+      ->check(CLI::IsMember({"auto", "host", "device"}))
+      ->group("Backends");
   cmd->add_flag("--quiet", flags->quiet, "no progress line");
   flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);

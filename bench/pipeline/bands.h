@@ -43,7 +43,7 @@ enum class Coverage : std::uint8_t {
 inline constexpr int kCoverageBands = static_cast<int>(Coverage::kEdgePixel);  // the kinds but kNatural
 // Band index of a coverage kind (not kNatural), and its label ("stored 0",
 // "far doubling", "corner pixel", ...).
-inline int CoverageBand(Coverage kind) { return static_cast<int>(kind) - 1; }
+constexpr int CoverageBand(Coverage kind) { return static_cast<int>(kind) - 1; }
 std::string CoverageBandName(int band);
 
 // floor(log10(x)) clamped to [0, count), by comparison with exact powers of

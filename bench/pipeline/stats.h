@@ -270,13 +270,18 @@ class CellAccumulator {
     return slots_.get()[natural ? kDistanceBands + joint_band : kDistanceBands + kJointBands + CoverageBand(coverage)];
   }
 
+  // Every slot by number, in the order the device judge counts them too
+  // (shared/judge.h): camera-distance bands, joint bands, coverage bands.
+  static constexpr int kSlotCount = kDistanceBands + kJointBands + kCoverageBands;
+  Slot& At(int slot) { return slots_.get()[slot]; }
+
   // Samples recorded since the last flush (the caller counts them).
   void Count(std::uint64_t samples) { pending_ += samples; }
   std::uint64_t pending() const { return pending_; }
   void FlushInto(CellStats& out);
 
  private:
-  static constexpr int kSlots = kDistanceBands + kJointBands + kCoverageBands;
+  static constexpr int kSlots = kSlotCount;
   static constexpr int kDiscarded = kSlots;  // one past the slots flushed
   struct Unmap {
     void operator()(Slot* slots) const;

@@ -13,6 +13,7 @@
 #include "bench/base/interrupt.h"
 #include "bench/base/text_table.h"
 #include "bench/base/thread_pool.h"
+#include "bench/device_judge/device_judge.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/sampler.h"
@@ -65,7 +66,36 @@ void CopyEncodingMetrics(const CellStats& from, CellStats& to) {
   copy(from.coverage, to.coverage);
 }
 
+// The judge on the device of `backend`, where `site` asks for one; null
+// where the outputs are judged on the host.
+Expected<std::unique_ptr<DeviceJudge>> DeviceJudgeFor(JudgeSite site, Backend& backend, const RunLayout& layout,
+                                                      bool record_distances, ProductionModel production) {
+  if (site == JudgeSite::kHost) return std::unique_ptr<DeviceJudge>();
+  const bool gpu = backend.device().kind == "gpu";
+  if (site == JudgeSite::kAuto && (!gpu || PassKindOf(production) != PassKind::kCompute)) {
+    return std::unique_ptr<DeviceJudge>();
+  }
+  if (PassKindOf(production) != PassKind::kCompute) {
+    return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
+  }
+  Expected<std::unique_ptr<DeviceJudge>> judge = DeviceJudge::Create(backend, layout, record_distances);
+  if (!judge.ok() && site == JudgeSite::kAuto) return std::unique_ptr<DeviceJudge>();
+  return judge;
+}
+
 }  // namespace
+
+const char* JudgeSiteName(JudgeSite site) {
+  switch (site) {
+    case JudgeSite::kAuto:
+      return "auto";
+    case JudgeSite::kHost:
+      return "host";
+    case JudgeSite::kDevice:
+      return "device";
+  }
+  return "?";
+}
 
 Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> backends) {
   if (PassKindOf(production) != PassKind::kRaster) return nullptr;
@@ -146,6 +176,27 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   if (only_distance_band) {
     for (CellAccumulator& a : accumulators) a.SkipDistanceBands();
   }
+  // Backends whose outputs are judged on their device; the others' on the
+  // host, below.
+  std::vector<std::unique_ptr<DeviceJudge>> device_judges(backends.size());
+  for (std::size_t b = 0; b < backends.size(); ++b) {
+    DB_RETURN_IF_ERROR(StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band,
+                                                options.domain.production),
+                                 device_judges[b])
+                           .WithContext("judging on the " + backends[b]->name() + " backend's device"));
+  }
+  const auto accumulators_of = [&](std::size_t b) {
+    return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
+  };
+  // Device counts join the host's accumulators, which then flush as ever.
+  const auto flush_devices = [&](bool due_only) -> Status {
+    for (std::size_t b = 0; b < backends.size(); ++b) {
+      if (device_judges[b] == nullptr) continue;
+      if (due_only && accumulators[b * cell_count].pending() < kFlushEvery) continue;
+      DB_RETURN_IF_ERROR(device_judges[b]->Flush(accumulators_of(b)));
+    }
+    return Status::Ok();
+  };
   // Storage and production errors belong to an encoding, whatever reads
   // it: one accumulator per depth slot, copied into its cells at the end.
   const std::size_t slot_count = layout.encodings.size();
@@ -194,7 +245,17 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         if (b == 0) RecordEncodingErrors(batch, depth_slot, storage_accumulators[slot], options.isa);
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
-      if (backend.concurrent()) {
+      if (device_judges[b] != nullptr) {
+        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b))
+                               .WithContext("running and judging on the " + backend.name() + " backend"));
+        if (b == 0) {
+          pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
+            for (std::size_t slot = lo; slot < hi; ++slot) {
+              RecordEncodingErrors(batch, static_cast<std::uint32_t>(slot), storage_accumulators[slot], options.isa);
+            }
+          });
+        }
+      } else if (backend.concurrent()) {
         FirstError error;
         pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
           for (std::size_t next = lo; next < hi; ++next) {
@@ -222,6 +283,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         });
       }
     }
+    DB_RETURN_IF_ERROR(flush_devices(true));
     for (std::size_t k = 0; k < accumulators.size(); ++k) {
       if (accumulators[k].pending() >= kFlushEvery) accumulators[k].FlushInto(stats[k]);
     }
@@ -235,6 +297,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   }
 
   // The last flush, on the pool: each accumulator is its own.
+  DB_RETURN_IF_ERROR(flush_devices(false));
   pool.ParallelFor(slot_count + accumulators.size(), [&](std::size_t lo, std::size_t hi, unsigned) {
     for (std::size_t k = lo; k < hi; ++k) {
       if (k < slot_count) {

@@ -30,6 +30,13 @@ struct SweepProgress {
   std::string Describe() const;
 };
 
+// Where a backend's outputs are judged: on the host (every backend), or on
+// the device a Vulkan backend ran them on (bench/device_judge/), or by
+// device kind: on the device for a GPU, on the host for a CPU device
+// (lavapipe), where the host's vector loops are the faster judge.
+enum class JudgeSite { kAuto, kHost, kDevice };
+const char* JudgeSiteName(JudgeSite site);
+
 struct SweepOptions {
   std::uint64_t seed = 1;
   std::uint64_t samples = 1'000'000;  // of the whole sweep (all shards)
@@ -43,6 +50,8 @@ struct SweepOptions {
   // joint bands at the end rather than recorded per sample: the same
   // figures, less work (false: record it, as tests do to compare).
   bool derive_lone_distance_band = true;
+  // kDevice fails for a backend that cannot judge on its device.
+  JudgeSite judge = JudgeSite::kAuto;
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

@@ -210,6 +210,8 @@ class VulkanBackend final : public Backend {
   std::vector<RasterAgreement> raster_agreement() const override {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
+  Expected<DevicePositions> RunLeavingOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which);
+  const std::shared_ptr<VulkanContext>& context() const { return context_; }
   std::vector<std::uint32_t> raster_texels() const {
     return raster_ != nullptr ? raster_->texels() : std::vector<std::uint32_t>{};
   }
@@ -227,6 +229,9 @@ class VulkanBackend final : public Backend {
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
+  // The compute form's upload, dispatches and wait; the positions stay in
+  // their buffer, laid out as the returned slices say.
+  Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which);
   // What either form would read out of bounds.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
   // What the compute form's device cannot address or dispatch.
@@ -399,13 +404,8 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
     DB_RETURN_IF_ERROR(CheckEveryOutputWritten(positions, batch, which, SliceLayout{0, batch.count}));
     return std::span<const float>(positions, output_floats);
   }
-  const SliceLayout slices = SliceLayoutFor(batch, shape_);
-  const BindingBytes bytes = BytesFor(batch, slices, which.size());
-  DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const ValidationScope validation(*context_);
-  const DispatchPlan plan = PlanDispatches(cells_, which, slices);
-  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); }));
+  DB_ASSIGN_OR_RETURN(const SliceLayout slices, RunCompute(batch, which));
   DB_RETURN_IF_ERROR(buffers_[kPositions].InvalidateForHostReads());
   DB_RETURN_IF_ERROR(validation.Check("Run"));
   const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
@@ -418,6 +418,29 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
                 batch.count * sizeof(float));
   }
   return std::span<const float>(scratch);
+}
+
+Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which) {
+  const SliceLayout slices = SliceLayoutFor(batch, shape_);
+  const BindingBytes bytes = BytesFor(batch, slices, which.size());
+  DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
+  const DispatchPlan plan = PlanDispatches(cells_, which, slices);
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); }));
+  return slices;
+}
+
+Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
+                                                            std::span<const std::uint32_t> which) {
+  if (raster_ != nullptr) return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
+  if (batch.count == 0 || which.empty()) return DevicePositions{};
+  DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
+  const ValidationScope validation(*context_);
+  Expected<SliceLayout> slices = RunCompute(batch, which);
+  if (!slices.ok()) return slices.status().WithContext(DeviceContext());
+  DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
+  return DevicePositions{buffers_[kPositions].handle(), std::size_t{3} * which.size() * slices->length * sizeof(float),
+                         slices->lead, slices->length};
 }
 
 // Outputs a shader never wrote would be judged as if it had: refused, with
@@ -561,6 +584,18 @@ void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, 
 std::vector<std::uint32_t> RasterTexels(const Backend& backend) {
   const auto* vulkan = dynamic_cast<const VulkanBackend*>(&backend);
   return vulkan != nullptr ? vulkan->raster_texels() : std::vector<std::uint32_t>{};
+}
+
+Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
+                                             std::span<const std::uint32_t> which) {
+  auto* vulkan = dynamic_cast<VulkanBackend*>(&backend);
+  if (vulkan == nullptr) return Unavailable("the " + backend.name() + " backend keeps no outputs on a device");
+  return vulkan->RunLeavingOnDevice(batch, which);
+}
+
+std::shared_ptr<VulkanContext> ContextOf(const Backend& backend) {
+  const auto* vulkan = dynamic_cast<const VulkanBackend*>(&backend);
+  return vulkan != nullptr ? vulkan->context() : nullptr;
 }
 
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "bench/backends/backend.h"
@@ -29,5 +30,25 @@ Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanConte
 // any other backend or form. What the device stored, for tests that compare
 // the forms on the same stored depths.
 std::vector<std::uint32_t> RasterTexels(const Backend& backend);
+
+// Where a Run of the compute form left its positions in device memory:
+// component c (x, y, z) of sample i of the k-th cell listed is element
+// (k * 3 + c) * slice_length + lead + i of `buffer`'s first `bytes`.
+// Elements the shader did not write hold the backend's unwritten-output
+// bits (0x7fa00bad).
+struct DevicePositions {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize bytes = 0;
+  std::uint32_t lead = 0;
+  std::uint32_t slice_length = 0;
+};
+// Runs the listed cells as Backend::Run does, but leaves their positions on
+// the device for a judge there (bench/device_judge/), valid until the
+// backend's next run: nothing is read back or checked on the host.
+// Unavailable for a backend other than Vulkan's and for the raster form.
+Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
+                                             std::span<const std::uint32_t> which);
+// The device a Vulkan backend runs on (null for any other backend).
+std::shared_ptr<VulkanContext> ContextOf(const Backend& backend);
 
 }  // namespace depthbench

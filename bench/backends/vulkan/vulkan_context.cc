@@ -447,6 +447,8 @@ Status VulkanContext::CreateDevice() {
   vkGetPhysicalDeviceFeatures2(physical_device_, &supported);
   const VkPhysicalDeviceFeatures& core = supported.features;
   shader_float64_ = core.shaderFloat64 == VK_TRUE;
+  // The device judge (bench/device_judge/) counts with 64-bit atomics.
+  int64_atomics_ = core.shaderInt64 == VK_TRUE && api12 && features12.shaderBufferInt64Atomics == VK_TRUE;
   raster_features_ = {.graphics_queue = properties_.queue_graphics,
                       .dynamic_rendering = api13 && features13.dynamicRendering == VK_TRUE,
                       .multi_viewport = core.multiViewport == VK_TRUE,
@@ -459,16 +461,19 @@ Status VulkanContext::CreateDevice() {
   enabled.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
   enabled.pNext = supported.pNext;
   enabled.features.shaderFloat64 = core.shaderFloat64;
+  enabled.features.shaderInt64 = core.shaderInt64;
   enabled.features.multiViewport = core.multiViewport;
   enabled.features.depthClamp = core.depthClamp;
   enabled.features.fragmentStoresAndAtomics = core.fragmentStoresAndAtomics;
-  // Of the 1.2 and 1.3 features, only these two are wanted.
+  // Of the 1.2 and 1.3 features, only these three are wanted.
   const VkBool32 viewport_index = features12.shaderOutputViewportIndex;
+  const VkBool32 int64_atomics = features12.shaderBufferInt64Atomics;
   void* const after12 = features12.pNext;
   features12 = VkPhysicalDeviceVulkan12Features{};
   features12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
   features12.pNext = after12;
   features12.shaderOutputViewportIndex = viewport_index;
+  features12.shaderBufferInt64Atomics = int64_atomics;
   const VkBool32 dynamic_rendering = features13.dynamicRendering;
   void* const after13 = features13.pNext;
   features13 = VkPhysicalDeviceVulkan13Features{};

@@ -209,6 +209,9 @@ class VulkanContext {
   const VulkanDeviceProperties& properties() const { return properties_; }
   // Whether shaders may use float64 (enabled wherever the device has it).
   bool shader_float64() const { return shader_float64_; }
+  // Whether shaders may use 64-bit integers and their atomics on storage
+  // buffers (enabled wherever the device has them).
+  bool int64_atomics() const { return int64_atomics_; }
   const RasterFeatures& raster_features() const { return raster_features_; }
 
   bool validation_enabled() const { return validation_enabled_; }
@@ -253,6 +256,7 @@ class VulkanContext {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   bool shader_float64_ = false;
+  bool int64_atomics_ = false;
   RasterFeatures raster_features_;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
 };

@@ -1,0 +1,60 @@
+// DeviceJudge: the judge run where a Vulkan backend's outputs already are.
+//
+// The host judge (bench/pipeline/judge.h) reads every position back and
+// bins it on the host's cores; on a GPU that readback and those cores are
+// what the device waits for. Here the reconstruction pass leaves its
+// positions in device memory, the host uploads the batch's reference (per
+// sample the ray and coverage kind; per depth slot and sample the true and
+// the denoted depth, the inverse squared distance, the band and the
+// status), and shaders/judge/judge.comp counts the total, shader and
+// absolute errors into histograms that stay on the device. The host reads
+// back only each batch's maxima (a few kilobytes) and, when a flush is due,
+// the histograms.
+//
+// What it records equals the host judge's, bin for bin, count for count,
+// maximum and worst index included: the shader repeats the host's float64
+// operations in order and unfused, and reads bins from the same bits
+// (tests/device_judge_test.cc holds the two equal). The storage and
+// production errors of each encoding stay with the host
+// (RecordEncodingErrors), as do the sampler and the reference.
+#pragma once
+
+#include <memory>
+#include <span>
+
+#include "bench/backends/backend.h"
+#include "bench/base/status.h"
+#include "bench/pipeline/batch.h"
+#include "bench/pipeline/stats.h"
+
+namespace depthbench {
+
+class DeviceJudge {
+ public:
+  // A judge on the device of `backend`, a Vulkan backend prepared for the
+  // compute form with the cells of `layout`. Unavailable, saying why, for
+  // another backend or form, or a device without float64 arithmetic and
+  // 64-bit atomics. `record_distances`: whether natural samples also go to
+  // their camera-distance band (CellAccumulator::records_distances).
+  static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,
+                                                       bool record_distances);
+  ~DeviceJudge();
+  DeviceJudge(const DeviceJudge&) = delete;
+  DeviceJudge& operator=(const DeviceJudge&) = delete;
+
+  // Runs every cell of the layout on `batch` and judges the outputs on the
+  // device. Each batch's maxima go straight into `accumulators` (one per
+  // cell, in layout order), which also count the batch's samples; the
+  // counts stay on the device until Flush.
+  Status Judge(const Batch& batch, std::span<CellAccumulator> accumulators);
+  // Adds what the device counted since the last flush into `accumulators`
+  // and clears it there. Due before any of them holds 2^31 samples.
+  Status Flush(std::span<CellAccumulator> accumulators);
+
+ private:
+  struct State;
+  explicit DeviceJudge(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace depthbench

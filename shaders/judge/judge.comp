@@ -1,0 +1,172 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+// The judge on the device (bench/device_judge/device_judge.h): compares the
+// positions a reconstruction pass left in device memory with the host's
+// reference and counts the errors into histograms that stay on the device.
+// It records exactly what the host judge (bench/pipeline/judge.cc) records
+// for the total, shader (arith) and absolute errors, sample by sample: the
+// same float64 operations in the same order, none fused (`precise`), and
+// the same bins read from the bits of each square. A dispatch's workgroup
+// row y judges the y-th cell of the run, one sample per invocation.
+//
+// Two phases over the same batch: phase 0 adds bins and counts and raises
+// each slot's largest square (a 64-bit atomic maximum on its bits: squares
+// are never negative, so their bits order as they do); phase 1 finds, for
+// each slot whose largest square this batch reached, the smallest index
+// that reached it, as the host keeps the first sample on a tie.
+#include "../../shared/compat.h"
+#include "../../shared/judge.h"
+
+layout(local_size_x = 64) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer CellSlots { uint depth_slot_of_cell[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
+// Per frame: the camera (float32 bits) and its camera-distance band.
+layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
+// Per sample: the world-space ray at unit eye depth, x then y then z
+// slices of `count` values; then the coverage kinds, one per sample.
+layout(std430, set = 0, binding = 3) readonly buffer Rays { double rays[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Coverage { uint coverage[]; };
+// Per (depth slot, sample): true depth, denoted depth and inverse squared
+// distance, each a slice of slots * count values; and the packed joint
+// band | status << 8 | stored_holdable << 16.
+layout(std430, set = 0, binding = 5) readonly buffer Reference { double reference[]; };
+layout(std430, set = 0, binding = 6) readonly buffer ReferenceInfo { uint reference_info[]; };
+// Per (cell, slot): DB_JUDGE_SLOT_UINTS counters (bins, then counts).
+layout(std430, set = 0, binding = 7) buffer Counts { uint counts[]; };
+// Per (cell, slot): the smallest index of a non-finite finding.
+layout(std430, set = 0, binding = 8) buffer FirstNonFinite { uint64_t first_nonfinite[]; };
+// Per (cell, slot, metric): this batch's largest square's bits; then, in
+// the same order, the smallest index that reached it.
+layout(std430, set = 0, binding = 9) buffer Maxima { uint64_t maxima[]; };
+// Per cell: samples with a component the reconstruction never wrote.
+layout(std430, set = 0, binding = 10) buffer Unwritten { uint unwritten[]; };
+layout(push_constant) uniform Pass { JudgePass pass; };
+
+// What the reconstruction pass leaves where it wrote nothing (the Vulkan
+// backend's kUnwrittenBits).
+const uint kUnwrittenBits = 0x7fa00badu;
+const int kLowestOctave[3] = int[3](-56, -56, -48);  // stats.h's kLowestOctave of total, arith, absolute
+const uint kNoSlot = 0xffffffffu;
+
+// The dense bin of a square (stats.h's DenseBinsOfSquares): 0 for zero,
+// subnormal or NaN, else floor(4 log2 sqrt(q)) from q's exponent and a
+// comparison of its significand with sqrt(2)'s, shifted and clamped.
+uint dense_bin(double q, int lowest_octave) {
+  if (!(q >= 2.2250738585072014e-308lf)) {  // 2^-1022
+    return 0u;
+  }
+  uvec2 words = unpackDouble2x32(q);  // x: low word, y: high word
+  int exponent = int(words.y >> 20u) - 1023;
+  uint fraction_high = words.y & 0xfffffu;
+  bool upper = fraction_high > 0x6a09eu || (fraction_high == 0x6a09eu && words.x >= 0x667f3bcdu);
+  int slot = 2 * exponent + (upper ? 1 : 0) - lowest_octave * 4 + 1;
+  return uint(clamp(slot, 0, int(DB_JUDGE_BINS) - 1));
+}
+
+uint64_t sample_index(uint i) {
+  uint64_t first = (uint64_t(pass.first_index_hi) << 32) | uint64_t(pass.first_index_lo);
+  return first + uint64_t(i);
+}
+
+// One value of metric m (0 total, 1 arith, 2 absolute) in slot `slot` of
+// cell k.
+void record(uint k, uint slot, uint m, double square, uint64_t index) {
+  uint at = k * DB_JUDGE_SLOTS + slot;
+  uint64_t bits = doubleBitsToUint64(square);
+  uint max_at = at * DB_JUDGE_METRICS + m;
+  if (pass.phase == 0u) {
+    atomicAdd(counts[at * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m])], 1u);
+    if (bits > maxima[max_at]) {
+      atomicMax(maxima[max_at], bits);
+    }
+  } else if (bits != 0ul && bits == maxima[max_at]) {
+    atomicMin(maxima[pass.cells * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + max_at], index);
+  }
+}
+
+// A sample the judge does not measure: counted by cause.
+void count(uint k, uint slot, uint status, bool holdable, bool is_nan, uint64_t index) {
+  if (pass.phase != 0u) {
+    return;
+  }
+  uint at = k * DB_JUDGE_SLOTS + slot;
+  uint base = at * DB_JUDGE_SLOT_UINTS + DB_JUDGE_METRICS * DB_JUDGE_BINS;
+  if (status == DB_JUDGE_STATUS_DEGENERATE) {
+    atomicAdd(counts[base + 3u], 1u);
+  } else if (status == DB_JUDGE_STATUS_OUTSIDE) {
+    atomicAdd(counts[base + 4u], 1u);
+  } else if (!holdable) {
+    atomicAdd(counts[base + 2u], 1u);
+  } else {
+    atomicAdd(counts[base + (is_nan ? 0u : 1u)], 1u);
+    atomicMin(first_nonfinite[at], index);
+  }
+}
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  uint k = gl_WorkGroupID.y;
+  if (i >= pass.count) {
+    return;
+  }
+  uint depth_slot = depth_slot_of_cell[k];
+  uint element = pass.lead + i;
+  uint base = k * 3u * pass.slice_length + element;
+  vec3 p = vec3(positions[base], positions[base + pass.slice_length], positions[base + 2u * pass.slice_length]);
+  if (floatBitsToUint(p.x) == kUnwrittenBits || floatBitsToUint(p.y) == kUnwrittenBits ||
+      floatBitsToUint(p.z) == kUnwrittenBits) {
+    if (pass.phase == 0u) {
+      atomicAdd(unwritten[k], 1u);
+    }
+    return;
+  }
+  uvec4 frame = frames[(i + pass.first_offset) / 64u];
+  dvec3 camera = dvec3(uintBitsToFloat(frame.x), uintBitsToFloat(frame.y), uintBitsToFloat(frame.z));
+  dvec3 ray = dvec3(rays[i], rays[pass.count + i], rays[2u * pass.count + i]);
+  uint r = depth_slot * pass.count + i;
+  uint slots_count = pass.depth_slots * pass.count;
+  double true_depth = reference[r];
+  double denoted_depth = reference[slots_count + r];
+  double inverse_distance_sq = reference[2u * slots_count + r];
+  uint info = reference_info[r];
+
+  // judge.cc's Errors, operation for operation.
+  precise dvec3 q = dvec3(p) - camera;
+  precise dvec3 t = q - true_depth * ray;
+  precise dvec3 a = q - denoted_depth * ray;
+  precise double absolute_sq = t.x * t.x + t.y * t.y + t.z * t.z;
+  precise double total_sq = absolute_sq * inverse_distance_sq;
+  precise double arith_sq = (a.x * a.x + a.y * a.y + a.z * a.z) * inverse_distance_sq;
+
+  uint kind = coverage[i];
+  bool natural = kind == 0u;
+  uint band = natural ? DB_JUDGE_DISTANCE_SLOTS + (info & 0xffu)
+                      : DB_JUDGE_DISTANCE_SLOTS + DB_JUDGE_JOINT_SLOTS + kind - 1u;
+  uint distance = natural && pass.record_distances != 0u ? frame.w : kNoSlot;
+  uint status = (info >> 8u) & 0xffu;
+  bool holdable = ((info >> 16u) & 1u) != 0u;
+  bool finite = absolute_sq < 1.0lf / 0.0lf;  // false for NaN
+  uint64_t index = sample_index(i);
+  if (status == DB_JUDGE_STATUS_JUDGED && finite) {
+    record(k, band, 0u, total_sq, index);
+    record(k, band, 2u, absolute_sq, index);
+    if (distance != kNoSlot) {
+      record(k, distance, 0u, total_sq, index);
+    }
+    if (holdable) {
+      record(k, band, 1u, arith_sq, index);
+      if (distance != kNoSlot) {
+        record(k, distance, 1u, arith_sq, index);
+      }
+    }
+  } else {
+    bool is_nan = absolute_sq != absolute_sq;
+    count(k, band, status, holdable, is_nan, index);
+    if (distance != kNoSlot) {
+      count(k, distance, status, holdable, is_nan, index);
+    }
+  }
+}

@@ -1,0 +1,45 @@
+// The device judge's layout (bench/device_judge/, shaders/judge/judge.comp):
+// what the judge shader and the host agree on. The host checks these
+// numbers against the accumulator's (bench/pipeline/stats.h, bands.h) at
+// compile time.
+// No include guard: see compat.h.
+
+// Bins of one metric: underflow, the kept quarter octaves, overflow.
+DB_CONST_UINT(DB_JUDGE_BINS, 258u)
+// The metrics the device records, in this order: total, arith (the
+// shader's part), absolute. Storage and production belong to the encoding
+// and stay with the host.
+DB_CONST_UINT(DB_JUDGE_METRICS, 3u)
+// Slots of one cell, as CellAccumulator numbers them: camera-distance
+// bands, then joint (ratio x depth) bands, then coverage bands.
+DB_CONST_UINT(DB_JUDGE_DISTANCE_SLOTS, 5u)
+DB_CONST_UINT(DB_JUDGE_JOINT_SLOTS, 110u)
+DB_CONST_UINT(DB_JUDGE_SLOTS, 123u)
+// Counts of one slot after its bins: NaN, Inf, stored non-finite,
+// degenerate, outside, and one unused, so that a slot is a whole number of
+// 64-bit words.
+DB_CONST_UINT(DB_JUDGE_COUNTS, 6u)
+DB_CONST_UINT(DB_JUDGE_SLOT_UINTS, 780u)  // DB_JUDGE_METRICS * DB_JUDGE_BINS + DB_JUDGE_COUNTS
+
+// Reference status (bench/pipeline/reference.h) as the judge reads it.
+DB_CONST_UINT(DB_JUDGE_STATUS_JUDGED, 0u)
+DB_CONST_UINT(DB_JUDGE_STATUS_DEGENERATE, 1u)
+DB_CONST_UINT(DB_JUDGE_STATUS_OUTSIDE, 2u)
+
+// Push constants of one judge dispatch. Sample i of the batch (index
+// first_index + i) is element lead + i of the positions' slices, which are
+// `slice_length` elements long; it lies in frame (i + first_offset) / 64.
+struct JudgePass {
+  uint count;
+  uint lead;
+  uint slice_length;
+  uint first_offset;
+  uint first_index_lo;
+  uint first_index_hi;
+  uint phase;             // 0: bins, counts and maxima; 1: the index of each maximum
+  uint record_distances;  // 1: natural samples also go to their camera-distance band
+  uint cells;
+  uint depth_slots;  // slices of the reference buffers
+  uint reserved1;
+  uint reserved2;
+};
