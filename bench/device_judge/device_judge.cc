@@ -54,7 +54,11 @@ enum Binding : std::uint32_t {
   kUnwritten,
   kBindingCount,
 };
-bool HostReads(Binding b) { return b >= kCounts; }
+// The counters live in device memory alone (atomics across the bus would
+// cost the device its speed); transfers copy them into host-readable
+// buffers: each batch's maxima and the unwritten counts after the batch,
+// the histograms and counts at a flush.
+bool Counter(Binding b) { return b >= kCounts; }
 
 }  // namespace
 
@@ -64,6 +68,8 @@ struct DeviceJudge::State {
   std::unique_ptr<ComputePass> pass;
   DeviceObject<VkPipeline> pipeline;
   std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions unused: the backend owns it)
+  VulkanBuffer batch_readback;  // the maxima, then the unwritten counts
+  VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
   std::vector<Cell> cells;
   bool record_distances = true;
@@ -72,10 +78,29 @@ struct DeviceJudge::State {
   std::size_t counted_slots() const { return cell_count() * L::DB_JUDGE_SLOTS; }
   std::size_t maxima() const { return counted_slots() * L::DB_JUDGE_METRICS; }
 
+  VkDeviceSize counts_bytes() const { return counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t); }
+  VkDeviceSize first_bytes() const { return counted_slots() * sizeof(std::uint64_t); }
+  VkDeviceSize maxima_bytes() const { return 2 * maxima() * sizeof(std::uint64_t); }
+  VkDeviceSize unwritten_bytes() const { return cell_count() * sizeof(std::uint32_t); }
+
   Status Grow(Binding binding, VkDeviceSize bytes) {
-    return context->GrowHostBuffer(buffers[binding], std::max<VkDeviceSize>(bytes, 16),
-                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                   HostReads(binding) ? HostAccess::kReadback : HostAccess::kUpload);
+    return context->GrowHostBuffer(
+        buffers[binding], std::max<VkDeviceSize>(bytes, 16),
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+        Counter(binding) ? HostAccess::kNone : HostAccess::kUpload);
+  }
+  // Copies `bytes` of each source to `readback`, one after the other, and
+  // makes them visible to the host.
+  void RecordReadback(VkCommandBuffer commands, std::initializer_list<std::pair<Binding, VkDeviceSize>> sources,
+                      const VulkanBuffer& readback) const {
+    VkDeviceSize offset = 0;
+    for (const auto& [binding, bytes] : sources) {
+      const VkBufferCopy region{0, offset, bytes};
+      vkCmdCopyBuffer(commands, buffers[binding].handle(), readback.handle(), 1, &region);
+      offset += bytes;
+    }
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   }
   // Empties the counts on the device: zeros, and no index for the first
   // non-finite finding.
@@ -128,10 +153,16 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   auto* slots = static_cast<std::uint32_t*>(state->buffers[kCellSlots].mapped());
   for (std::size_t k = 0; k < layout.cells.size(); ++k) slots[k] = layout.cells[k].depth_slot;
   DB_RETURN_IF_ERROR(state->buffers[kCellSlots].FlushHostWrites());
-  DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->counted_slots() * sizeof(std::uint64_t)));
-  DB_RETURN_IF_ERROR(state->Grow(kMaxima, 2 * state->maxima() * sizeof(std::uint64_t)));
-  DB_RETURN_IF_ERROR(state->Grow(kUnwritten, state->cell_count() * sizeof(std::uint32_t)));
+  DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kMaxima, state->maxima_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kUnwritten, state->unwritten_bytes()));
+  DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->maxima_bytes() + state->unwritten_bytes(),
+                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
+                               state->batch_readback));
+  DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->counts_bytes() + state->first_bytes(),
+                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
+                               state->flush_readback));
   const State& s = *state;
   DB_RETURN_IF_ERROR(state->pass->Submit([&s](VkCommandBuffer commands) {
     s.RecordClear(commands);
@@ -190,10 +221,10 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       count * sizeof(std::uint32_t),
       3 * slot_samples * sizeof(double),
       slot_samples * sizeof(std::uint32_t),
-      counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t),
-      counted_slots() * sizeof(std::uint64_t),
-      2 * maxima() * sizeof(std::uint64_t),
-      cell_count() * sizeof(std::uint32_t)};
+      counts_bytes(),
+      first_bytes(),
+      maxima_bytes(),
+      unwritten_bytes()};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -210,8 +241,11 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), 0, half, 0u);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), half, half, 0xffffffffu);
-  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  // Those fills, and the reconstruction pass's positions (an earlier
+  // submission to the same queue), before the judge reads.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   pass->Bind(commands, pipeline.get());
   L::JudgePass constants{.count = batch.count,
                          .lead = positions.lead,
@@ -230,20 +264,21 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(cell_count()), 1);
-    // Phase 1 reads the maxima phase 0 raised; the host reads both.
+    // Phase 1 reads the maxima phase 0 raised; the copy below reads both.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
-                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT);
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
   }
+  RecordReadback(commands, {{kMaxima, maxima_bytes()}, {kUnwritten, unwritten_bytes()}}, batch_readback);
 }
 
 // A batch's maxima join the accumulators' as the host judge's Record does:
 // a larger square replaces the slot's maximum and index; an equal one
 // keeps the earlier batch's, whose indices are smaller.
 Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) const {
-  DB_RETURN_IF_ERROR(buffers[kMaxima].InvalidateForHostReads());
-  DB_RETURN_IF_ERROR(buffers[kUnwritten].InvalidateForHostReads());
-  const auto* unwritten = static_cast<const std::uint32_t*>(buffers[kUnwritten].mapped());
+  DB_RETURN_IF_ERROR(batch_readback.InvalidateForHostReads());
+  const auto* words = static_cast<const std::uint64_t*>(batch_readback.mapped());
+  const auto* unwritten = reinterpret_cast<const std::uint32_t*>(words + 2 * maxima());
   for (std::size_t k = 0; k < cell_count(); ++k) {
     if (unwritten[k] == 0) continue;
     return InvalidArgument(fmt::format(
@@ -251,7 +286,6 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) 
         "another element; nothing it did not write is judged",
         Info(cells[k].variant).name, unwritten[k], cells[k].Name()));
   }
-  const auto* words = static_cast<const std::uint64_t*>(buffers[kMaxima].mapped());
   for (std::size_t at = 0; at < maxima(); ++at) {
     if (words[at] == 0) continue;
     const std::size_t cell = at / (L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS);
@@ -289,10 +323,20 @@ Status DeviceJudge::Flush(std::span<CellAccumulator> accumulators) {
   if (accumulators.size() != s.cell_count()) {
     return InvalidArgument(fmt::format("{} accumulators for {} cells", accumulators.size(), s.cell_count()));
   }
-  DB_RETURN_IF_ERROR(s.buffers[kCounts].InvalidateForHostReads());
-  DB_RETURN_IF_ERROR(s.buffers[kFirstNonFinite].InvalidateForHostReads());
-  const auto* counts = static_cast<const std::uint32_t*>(s.buffers[kCounts].mapped());
-  const auto* first = static_cast<const std::uint64_t*>(s.buffers[kFirstNonFinite].mapped());
+  // The counts come back and are cleared on the device in one submission.
+  const ValidationScope validation(*s.context);
+  DB_RETURN_IF_ERROR(s.pass->Submit([&s](VkCommandBuffer commands) {
+    s.RecordReadback(commands, {{kCounts, s.counts_bytes()}, {kFirstNonFinite, s.first_bytes()}}, s.flush_readback);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+    s.RecordClear(commands);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  }));
+  DB_RETURN_IF_ERROR(validation.Check("reading back the device judge's counts"));
+  DB_RETURN_IF_ERROR(s.flush_readback.InvalidateForHostReads());
+  const auto* counts = static_cast<const std::uint32_t*>(s.flush_readback.mapped());
+  const auto* first = reinterpret_cast<const std::uint64_t*>(counts + s.counted_slots() * L::DB_JUDGE_SLOT_UINTS);
   for (std::size_t at = 0; at < s.counted_slots(); ++at) {
     const std::uint32_t* from = counts + at * L::DB_JUDGE_SLOT_UINTS;
     const std::uint32_t* tally = from + L::DB_JUDGE_METRICS * L::DB_JUDGE_BINS;
@@ -312,13 +356,7 @@ Status DeviceJudge::Flush(std::span<CellAccumulator> accumulators) {
     to.degenerate += tally[3];
     to.outside += tally[4];
   }
-  const ValidationScope validation(*s.context);
-  DB_RETURN_IF_ERROR(s.pass->Submit([&s](VkCommandBuffer commands) {
-    s.RecordClear(commands);
-    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  }));
-  return validation.Check("clearing the device judge's counts");
+  return Status::Ok();
 }
 
 }  // namespace depthbench

@@ -258,6 +258,11 @@ class VulkanBackend final : public Backend {
   std::vector<DeviceObject<VkPipeline>> pipelines_;
   std::array<VulkanBuffer, kBindingCount> buffers_;
   std::unique_ptr<RasterPass> raster_;  // the raster form, when prepared for it
+  // Where the compute form's positions go: memory the host reads them from
+  // (Run), or device memory alone, where a judge on the device reads them
+  // (RunLeavingOnDevice); and the kind the buffer now is.
+  HostAccess positions_access_ = HostAccess::kReadback;
+  HostAccess positions_held_in_ = HostAccess::kReadback;
 };
 
 VulkanBackend::VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -405,6 +410,7 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
     return std::span<const float>(positions, output_floats);
   }
   const ValidationScope validation(*context_);
+  positions_access_ = HostAccess::kReadback;
   DB_ASSIGN_OR_RETURN(const SliceLayout slices, RunCompute(batch, which));
   DB_RETURN_IF_ERROR(buffers_[kPositions].InvalidateForHostReads());
   DB_RETURN_IF_ERROR(validation.Check("Run"));
@@ -436,6 +442,7 @@ Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& 
   if (batch.count == 0 || which.empty()) return DevicePositions{};
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
+  positions_access_ = HostAccess::kNone;
   Expected<SliceLayout> slices = RunCompute(batch, which);
   if (!slices.ok()) return slices.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
@@ -508,7 +515,11 @@ Status VulkanBackend::CheckRun(const ShaderInputs& batch, std::span<const std::u
 }
 
 Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
-  const HostAccess access = binding == kPositions ? HostAccess::kReadback : HostAccess::kUpload;
+  const HostAccess access = binding == kPositions ? positions_access_ : HostAccess::kUpload;
+  if (binding == kPositions && positions_held_in_ != positions_access_) {
+    buffers_[kPositions] = VulkanBuffer();  // (the previous run has completed)
+    positions_held_in_ = positions_access_;
+  }
   // The output is filled with kUnwrittenBits on the device before each run.
   const VkBufferUsageFlags usage =
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |

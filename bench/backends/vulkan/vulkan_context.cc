@@ -529,22 +529,34 @@ Expected<VulkanBuffer> VulkanContext::CreateHostBuffer(VkDeviceSize size, VkBuff
   constexpr VkMemoryPropertyFlags kVisible = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
   constexpr VkMemoryPropertyFlags kCoherent = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   constexpr VkMemoryPropertyFlags kCached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
-  DB_ASSIGN_OR_RETURN(
-      const std::uint32_t memory_type,
-      access == HostAccess::kReadback
-          ? FindMemoryType(requirements.memoryTypeBits,
-                           {kVisible | kCoherent | kCached, kVisible | kCached, kVisible | kCoherent, kVisible})
-          : FindMemoryType(requirements.memoryTypeBits, {kVisible | kCoherent, kVisible}));
-
-  VkMemoryAllocateInfo allocate_info{};
-  allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-  allocate_info.allocationSize = requirements.size;
-  allocate_info.memoryTypeIndex = memory_type;
+  constexpr VkMemoryPropertyFlags kLocal = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  // Most preferred first. Uploads go to device memory the host can write
+  // (a GPU's BAR) where there is room, so that shaders read them without
+  // crossing the bus again; a full BAR falls back to host memory.
+  std::vector<VkMemoryPropertyFlags> candidates = {kLocal, 0};
+  if (access == HostAccess::kReadback) {
+    candidates = {kVisible | kCoherent | kCached, kVisible | kCached, kVisible | kCoherent, kVisible};
+  } else if (access == HostAccess::kUpload) {
+    candidates = {kLocal | kVisible | kCoherent, kVisible | kCoherent, kVisible};
+  }
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkAllocateMemory(device_, &allocate_info, nullptr, &memory),
-                             fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
+  std::uint32_t memory_type = 0;
+  VkResult result = VK_ERROR_OUT_OF_DEVICE_MEMORY;
+  for (const VkMemoryPropertyFlags wanted : candidates) {
+    Expected<std::uint32_t> type = FindMemoryType(requirements.memoryTypeBits, {wanted});
+    if (!type.ok()) continue;
+    memory_type = *type;
+    VkMemoryAllocateInfo allocate_info{};
+    allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate_info.allocationSize = requirements.size;
+    allocate_info.memoryTypeIndex = memory_type;
+    result = vkAllocateMemory(device_, &allocate_info, nullptr, &memory);
+    if (result == VK_SUCCESS) break;
+  }
+  DB_RETURN_IF_ERROR(CheckVk(result, fmt::format("vkAllocateMemory of {} bytes", requirements.size)));
   buffer.memory_ = DeviceObject<VkDeviceMemory>(device_, memory, vkFreeMemory);
   DB_RETURN_IF_ERROR(CheckVk(vkBindBufferMemory(device_, handle, memory, 0), "vkBindBufferMemory"));
+  if (access == HostAccess::kNone) return buffer;
   DB_RETURN_IF_ERROR(CheckVk(vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped_), "vkMapMemory"));
   buffer.coherent_ = (memory_properties_.memoryTypes[memory_type].propertyFlags & kCoherent) != 0;
   return buffer;

@@ -192,6 +192,7 @@ struct RasterFeatures {
 enum class HostAccess {
   kUpload,    // written by the host, read by shaders: coherent write-combined memory is best
   kReadback,  // written by shaders, read by the host: cached memory is much faster to read
+  kNone,      // shaders' and transfer commands' alone: device-local memory, not mapped
 };
 
 class VulkanContext {
@@ -223,7 +224,8 @@ class VulkanContext {
   // earliest satisfiable entry of `candidates` (most preferred first).
   Expected<std::uint32_t> FindMemoryType(std::uint32_t type_bits,
                                          std::initializer_list<VkMemoryPropertyFlags> candidates) const;
-  // A mapped buffer of `size` bytes (> 0) in memory suited to `access`.
+  // A buffer of `size` bytes (> 0) in memory suited to `access`, mapped
+  // unless the host has no access.
   Expected<VulkanBuffer> CreateHostBuffer(VkDeviceSize size, VkBufferUsageFlags usage, HostAccess access) const;
   // Makes `buffer` hold at least `bytes`: a larger one replaces it when it
   // holds fewer (its contents are lost), grown geometrically so that
