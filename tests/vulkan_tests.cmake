@@ -8,3 +8,4 @@ depthbench_test(variant_file_test variant_file_test.cc LIBS depthbench_sweep dep
 depthbench_test(arithmetic_probe_test arithmetic_probe_test.cc LIBS depthbench_backends SPIRV-Tools-static)
 depthbench_test(raster_pass_test raster_pass_test.cc LIBS depthbench_backends)
 depthbench_test(raster_pipeline_test raster_pipeline_test.cc LIBS depthbench_sweep depthbench_backends)
+depthbench_test(device_judge_test device_judge_test.cc LIBS depthbench_sweep depthbench_backends)

@@ -31,9 +31,6 @@ std::string SweepProgress::Describe() const {
 }
 namespace {
 
-// A 32-bit bin can count 4.29e9 samples; flush well before.
-constexpr std::uint64_t kFlushEvery = std::uint64_t{1} << 31;
-
 // The first error any worker reports.
 class FirstError {
  public:
@@ -130,6 +127,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (backends.empty()) return InvalidArgument("no backend to run");
   if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
+  // A 32-bit bin can count 4.29e9 samples; flush well before.
+  const std::uint64_t flush_every = std::clamp<std::uint64_t>(options.flush_every, 1, std::uint64_t{1} << 31);
   if (!ProcessorRuns(options.isa)) return Unavailable("this processor does not run the requested instruction set");
   const std::vector<Cell> all = AllCells();
   const std::vector<Cell> cells = CellsForDomain(
@@ -192,7 +191,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const auto flush_devices = [&](bool due_only) -> Status {
     for (std::size_t b = 0; b < backends.size(); ++b) {
       if (device_judges[b] == nullptr) continue;
-      if (due_only && accumulators[b * cell_count].pending() < kFlushEvery) continue;
+      if (due_only && accumulators[b * cell_count].pending() < flush_every) continue;
       DB_RETURN_IF_ERROR(device_judges[b]->Flush(accumulators_of(b)));
     }
     return Status::Ok();
@@ -285,10 +284,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     }
     DB_RETURN_IF_ERROR(flush_devices(true));
     for (std::size_t k = 0; k < accumulators.size(); ++k) {
-      if (accumulators[k].pending() >= kFlushEvery) accumulators[k].FlushInto(stats[k]);
+      if (accumulators[k].pending() >= flush_every) accumulators[k].FlushInto(stats[k]);
     }
     for (std::size_t e = 0; e < slot_count; ++e) {
-      if (storage_accumulators[e].pending() >= kFlushEvery) storage_accumulators[e].FlushInto(storage_stats[e]);
+      if (storage_accumulators[e].pending() >= flush_every) storage_accumulators[e].FlushInto(storage_stats[e]);
     }
     progress.samples_done += count;
     progress.reconstructions_done += static_cast<std::uint64_t>(count) * cell_count * backends.size();

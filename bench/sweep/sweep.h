@@ -50,6 +50,10 @@ struct SweepOptions {
   // joint bands at the end rather than recorded per sample: the same
   // figures, less work (false: record it, as tests do to compare).
   bool derive_lone_distance_band = true;
+  // Samples after which the 32-bit counters are moved into the statistics
+  // (at most 2^31, well before they could overflow; tests lower it to
+  // make the flush happen mid-run).
+  std::uint64_t flush_every = std::uint64_t{1} << 31;
   // kDevice fails for a backend that cannot judge on its device.
   JudgeSite judge = JudgeSite::kAuto;
   std::function<void(const SweepProgress&)> progress;  // called after every batch
