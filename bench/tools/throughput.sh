@@ -1,8 +1,17 @@
 #!/usr/bin/env bash
 # Throughput and memory of `depthbench run` end to end: verified
-# reconstructions per second on the CPU backend and on lavapipe, and the
-# peak resident memory for 10^6 and 10^8 samples (it must not grow with the
-# sample count). Usage: bench/tools/throughput.sh [BUILD_DIR] [RUNS]
+# reconstructions per second and the peak resident memory, which must not
+# grow with the sample count.
+#
+#   bench/tools/throughput.sh [BUILD_DIR] [RUNS] [DEVICE]
+#
+# Without DEVICE: the CPU backend at 10^6, 10^7 and 10^8 samples, and
+# lavapipe with either judge (--judge host: outputs read back and binned on
+# the host's cores; --judge device: binned where they are). With DEVICE (a
+# part of a Vulkan device's name, as --device takes it, "nvidia"): that
+# device with either judge at 10^7 and 10^8 samples, in batches of 2^20
+# samples. DEPTHBENCH names another program to run (a packed copy's
+# run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
 # turn (A B C ... A B C ...), so that the drift of a shared machine's speed
@@ -11,24 +20,37 @@
 set -euo pipefail
 build=${1:-build}
 runs=${2:-3}
-depthbench="$build/bench/depthbench"
+device=${3:-}
+depthbench=${DEPTHBENCH:-$build/bench/depthbench}
 [[ -x $depthbench ]] || { echo "no $depthbench: build first (see README.md)" >&2; exit 2; }
 [[ $runs =~ ^[1-9][0-9]*$ ]] || { echo "RUNS must be a whole number of at least 1, not '$runs'" >&2; exit 2; }
 
-labels=(
-  "cpu backend, 1e6 samples (106 cells)"
-  "cpu backend, 1e7 samples"
-  "cpu backend, 1e8 samples"
-  "lavapipe, 1e6 samples (106 cells)"
-  "lavapipe, 1e7 samples"
-)
-arguments=(
-  "--backend cpu --samples 1e6"
-  "--backend cpu --samples 1e7"
-  "--backend cpu --samples 1e8"
-  "--backend vulkan --samples 1e6"
-  "--backend vulkan --samples 1e7"
-)
+if [[ -z $device ]]; then
+  labels=(
+    "cpu backend, 1e6 samples (106 cells)"
+    "cpu backend, 1e7 samples"
+    "cpu backend, 1e8 samples"
+    "lavapipe, host judge, 1e6 samples"
+    "lavapipe, host judge, 1e7 samples"
+    "lavapipe, device judge, 1e6 samples"
+  )
+  arguments=(
+    "--backend cpu --samples 1e6"
+    "--backend cpu --samples 1e7"
+    "--backend cpu --samples 1e8"
+    "--backend vulkan --judge host --samples 1e6"
+    "--backend vulkan --judge host --samples 1e7"
+    "--backend vulkan --judge device --samples 1e6"
+  )
+else
+  labels=() arguments=()
+  for samples in 1e7 1e8; do
+    for judge in host device; do
+      labels+=("$device, $judge judge, $samples samples")
+      arguments+=("--backend vulkan --device $device --judge $judge --batch 1048576 --samples $samples")
+    done
+  done
+fi
 declare -a rates peaks  # per configuration: space-separated figures of its runs
 
 log=$(mktemp)
