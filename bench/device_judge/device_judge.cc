@@ -109,7 +109,7 @@ struct DeviceJudge::State {
     vkCmdFillBuffer(commands, buffers[kFirstNonFinite].handle(), 0, VK_WHOLE_SIZE, 0xffffffffu);
     vkCmdFillBuffer(commands, buffers[kUnwritten].handle(), 0, VK_WHOLE_SIZE, 0u);
   }
-  Status Upload(const Batch& batch);
+  Status Upload(const Batch& batch, ThreadPool& pool);
   void Bind(const DevicePositions& positions, const Batch& batch);
   void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
   Status MergeMaxima(std::span<CellAccumulator> accumulators) const;
@@ -173,7 +173,9 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   return std::unique_ptr<DeviceJudge>(new DeviceJudge(std::move(state)));
 }
 
-Status DeviceJudge::State::Upload(const Batch& batch) {
+// The batch's reference, written into the upload buffers on every thread:
+// at a GPU's rate one thread's copies would leave the device waiting.
+Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
   const std::size_t slot_samples = batch.reference.true_depth.size();
   DB_RETURN_IF_ERROR(Grow(kFrames, frames * 4 * sizeof(std::uint32_t)));
@@ -188,22 +190,36 @@ Status DeviceJudge::State::Upload(const Batch& batch) {
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
     frame_words[4 * f + 3] = batch.distance_bands[f];
   }
-  auto* rays = static_cast<double*>(buffers[kRays].mapped());
-  std::memcpy(rays, batch.ray_x.data(), count * sizeof(double));
-  std::memcpy(rays + count, batch.ray_y.data(), count * sizeof(double));
-  std::memcpy(rays + 2 * count, batch.ray_z.data(), count * sizeof(double));
-  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
-  for (std::size_t i = 0; i < count; ++i) coverage[i] = static_cast<std::uint32_t>(batch.samples.coverage[i]);
   const ReferenceArrays& ref = batch.reference;
+  auto* rays = static_cast<double*>(buffers[kRays].mapped());
+  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
   auto* reference = static_cast<double*>(buffers[kReference].mapped());
-  std::memcpy(reference, ref.true_depth.data(), slot_samples * sizeof(double));
-  std::memcpy(reference + slot_samples, ref.denoted_depth.data(), slot_samples * sizeof(double));
-  std::memcpy(reference + 2 * slot_samples, ref.inverse_distance_sq.data(), slot_samples * sizeof(double));
   auto* info = static_cast<std::uint32_t*>(buffers[kReferenceInfo].mapped());
-  for (std::size_t r = 0; r < slot_samples; ++r) {
-    info[r] = ref.joint_band[r] | static_cast<std::uint32_t>(ref.status[r]) << 8 |
-              static_cast<std::uint32_t>(ref.stored_holdable[r] != 0) << 16;
-  }
+  // Per sample, then per (slot, sample): chunks of both, in one loop.
+  constexpr std::size_t kChunk = 16384;
+  const std::size_t sample_chunks = (count + kChunk - 1) / kChunk;
+  const std::size_t slot_chunks = (slot_samples + kChunk - 1) / kChunk;
+  pool.ParallelFor(sample_chunks + slot_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      const bool per_sample = job < sample_chunks;
+      const std::size_t lo = (per_sample ? job : job - sample_chunks) * kChunk;
+      const std::size_t n = std::min(kChunk, (per_sample ? count : slot_samples) - lo);
+      if (per_sample) {
+        std::memcpy(rays + lo, batch.ray_x.data() + lo, n * sizeof(double));
+        std::memcpy(rays + count + lo, batch.ray_y.data() + lo, n * sizeof(double));
+        std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
+        for (std::size_t i = lo; i < lo + n; ++i) coverage[i] = static_cast<std::uint32_t>(batch.samples.coverage[i]);
+        continue;
+      }
+      std::memcpy(reference + lo, ref.true_depth.data() + lo, n * sizeof(double));
+      std::memcpy(reference + slot_samples + lo, ref.denoted_depth.data() + lo, n * sizeof(double));
+      std::memcpy(reference + 2 * slot_samples + lo, ref.inverse_distance_sq.data() + lo, n * sizeof(double));
+      for (std::size_t r = lo; r < lo + n; ++r) {
+        info[r] = ref.joint_band[r] | static_cast<std::uint32_t>(ref.status[r]) << 8 |
+                  static_cast<std::uint32_t>(ref.stored_holdable[r] != 0) << 16;
+      }
+    }
+  });
   for (Binding b : {kFrames, kRays, kCoverage, kReference, kReferenceInfo}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
@@ -301,7 +317,7 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) 
   return Status::Ok();
 }
 
-Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> accumulators) {
+Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> accumulators, ThreadPool& pool) {
   State& s = *state_;
   if (accumulators.size() != s.cell_count()) {
     return InvalidArgument(fmt::format("{} accumulators for {} cells", accumulators.size(), s.cell_count()));
@@ -309,7 +325,7 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> accumul
   if (batch.count == 0) return Status::Ok();
   DB_ASSIGN_OR_RETURN(const DevicePositions positions, RunLeavingOnDevice(*s.backend, batch, s.every_cell));
   const ValidationScope validation(*s.context);
-  DB_RETURN_IF_ERROR(s.Upload(batch));
+  DB_RETURN_IF_ERROR(s.Upload(batch, pool));
   s.Bind(positions, batch);
   DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions); }));
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));

@@ -24,6 +24,7 @@
 
 #include "bench/backends/backend.h"
 #include "bench/base/status.h"
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/stats.h"
 
@@ -45,8 +46,8 @@ class DeviceJudge {
   // Runs every cell of the layout on `batch` and judges the outputs on the
   // device. Each batch's maxima go straight into `accumulators` (one per
   // cell, in layout order), which also count the batch's samples; the
-  // counts stay on the device until Flush.
-  Status Judge(const Batch& batch, std::span<CellAccumulator> accumulators);
+  // counts stay on the device until Flush. `pool` writes the uploads.
+  Status Judge(const Batch& batch, std::span<CellAccumulator> accumulators, ThreadPool& pool);
   // Adds what the device counted since the last flush into `accumulators`
   // and clears it there. Due before any of them holds 2^31 samples.
   Status Flush(std::span<CellAccumulator> accumulators);

@@ -245,7 +245,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (device_judges[b] != nullptr) {
-        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b))
+        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), pool)
                                .WithContext("running and judging on the " + backend.name() + " backend"));
         if (b == 0) {
           pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
