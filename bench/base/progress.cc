@@ -7,8 +7,8 @@
 
 namespace depthbench {
 
-Progress::Progress(std::string stage, bool terminal)
-    : stage_(std::move(stage)), terminal_(terminal), start_(std::chrono::steady_clock::now()), last_(start_) {}
+Progress::Progress(std::string stage, bool terminal, bool quiet)
+    : stage_(std::move(stage)), terminal_(terminal), quiet_(quiet), start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 Progress::~Progress() {
   if (open_) std::fputs("\n", stderr);
@@ -32,6 +32,7 @@ std::chrono::duration<double> LogInterval() {
 }  // namespace
 
 void Progress::Update(double fraction, const std::string& detail) {
+  if (quiet_) return;
   auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const std::string left =
@@ -52,6 +53,7 @@ void Progress::Update(double fraction, const std::string& detail) {
 }
 
 void Progress::Finish(const std::string& summary) {
+  if (quiet_) return;
   double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   std::string line = fmt::format("[{}] {} ({:.1f} s)\n", stage_, summary, elapsed);
   std::fputs(terminal_ && open_ ? ("\r\x1b[K" + line).c_str() : line.c_str(), stderr);

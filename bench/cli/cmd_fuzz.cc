@@ -112,7 +112,7 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
         "production and exact constants");
   }
   options.cells = CellsForDomain(cells, options.domain);
-  Progress progress("fuzz", StderrIsTerminal() && !f.quiet);
+  Progress progress("fuzz", StderrIsTerminal(), f.quiet);
   options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
   DB_ASSIGN_OR_RETURN(const CampaignResult result, RunCampaign(options, backends));
   if (!f.quiet) progress.Finish(fmt::format("{} inputs", result.cases));
@@ -198,7 +198,7 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
     options.domain = domain;
     options.seed = f.seed;
     options.seconds = f.seconds;
-    Progress progress(cell.Name(), StderrIsTerminal() && !f.quiet);
+    Progress progress(cell.Name(), StderrIsTerminal(), f.quiet);
     options.progress = [&](double fraction, double worst) {
       progress.Update(fraction, fmt::format("worst {:.2f} bits lost", BitsLost(worst)));
     };

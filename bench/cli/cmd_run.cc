@@ -131,7 +131,7 @@ Expected<int> Run(const RunFlags& f) {
     return kExitOk;
   }
 
-  Progress progress("run", StderrIsTerminal() && !f.quiet);
+  Progress progress("run", StderrIsTerminal(), f.quiet);
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
   DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
   if (!f.quiet) {

@@ -111,7 +111,7 @@ Expected<int> Speed(const SpeedFlags& f) {
   if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
   DB_ASSIGN_OR_RETURN(const std::unique_ptr<GpuPassTimer> timer, GpuPassTimer::Create(shared_context, shader_dir));
 
-  Progress progress("speed", StderrIsTerminal() && !f.quiet);
+  Progress progress("speed", StderrIsTerminal(), f.quiet);
   options.progress = [&](std::size_t done, std::size_t total, const std::string& what) {
     progress.Update(static_cast<double>(done) / static_cast<double>(total), what);
   };
