@@ -28,7 +28,7 @@ struct RunFlags {
   std::string repro;
   std::vector<std::string> split;
   unsigned threads = 0;
-  std::uint32_t batch = 16384;
+  std::uint32_t batch = 0;  // by the judge (SweepOptions::batch_size)
   std::string judge = "auto";
   bool quiet = false;
   DomainFlags domain;
@@ -182,13 +182,16 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--split", flags->split, "also print p99.9 per band: ratio, depth, distance")->delimiter(',');
   cmd->add_option("--threads", flags->threads, "worker threads (default: one per core)");
   cmd->add_option("--batch", flags->batch,
-                  "samples per batch (memory is proportional to it; cut to what the Vulkan device can bind at once)")
+                  fmt::format("samples per batch (memory is proportional to it; cut to what the Vulkan device can "
+                              "bind at once); default {}, or {} when a GPU judges (the fastest measured)",
+                              kHostBatch, kDeviceJudgeBatch))
       ->check(CLI::Range(64u, 1u << 22));
   cmd->add_option("--judge", flags->judge,
                   "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
                   "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "
                   "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
       ->check(CLI::IsMember({"auto", "host", "device"}))
+      ->type_name("WHERE")
       ->group("Backends");
   cmd->add_flag("--quiet", flags->quiet, "no progress line");
   flags->domain.Add(*cmd);

@@ -126,7 +126,6 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
 Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (backends.empty()) return InvalidArgument("no backend to run");
-  if (options.batch_size == 0) return InvalidArgument("batch size must be positive");
   // A 32-bit bin can count 4.29e9 samples; flush well before.
   const std::uint64_t flush_every = std::clamp<std::uint64_t>(options.flush_every, 1, std::uint64_t{1} << 31);
   if (!ProcessorRuns(options.isa)) return Unavailable("this processor does not run the requested instruction set");
@@ -143,9 +142,6 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     DB_RETURN_IF_ERROR(backend->Prepare(layout.cells, PassKindOf(options.domain.production))
                            .WithContext("preparing the " + backend->name() + " backend"));
   }
-  // A batch no backend can take whole is cut to what the smallest takes.
-  std::uint64_t batch_size = options.batch_size;
-  for (const Backend* backend : backends) batch_size = std::min(batch_size, backend->MaxBatchSamples());
 
   const auto started = std::chrono::steady_clock::now();
   Results results;
@@ -184,6 +180,12 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
                                  device_judges[b])
                            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
   }
+  // A batch no backend can take whole is cut to what the smallest takes.
+  const bool judged_on_device =
+      std::any_of(device_judges.begin(), device_judges.end(), [](const auto& judge) { return judge != nullptr; });
+  std::uint64_t batch_size =
+      options.batch_size != 0 ? options.batch_size : judged_on_device ? kDeviceJudgeBatch : kHostBatch;
+  for (const Backend* backend : backends) batch_size = std::min(batch_size, backend->MaxBatchSamples());
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
   };
