@@ -6,9 +6,9 @@
 
 // Bins of one metric: underflow, the kept quarter octaves, overflow.
 DB_CONST_UINT(DB_JUDGE_BINS, 258u)
-// The metrics the device records, in this order: total, arith (the
-// shader's part), absolute. Storage and production belong to the encoding
-// and stay with the host.
+// The metrics an accumulator holds, three at most. A cell's: total, arith
+// (the shader's part), absolute. A depth slot's (its encoding's, whatever
+// reads it): storage, production.
 DB_CONST_UINT(DB_JUDGE_METRICS, 3u)
 // Slots of one cell, as CellAccumulator numbers them: camera-distance
 // bands, then joint (ratio x depth) bands, then coverage bands.
@@ -26,6 +26,8 @@ DB_CONST_UINT(DB_JUDGE_STATUS_JUDGED, 0u)
 DB_CONST_UINT(DB_JUDGE_STATUS_DEGENERATE, 1u)
 DB_CONST_UINT(DB_JUDGE_STATUS_OUTSIDE, 2u)
 
+// Accumulators: one per cell of the run, then (where the dispatch records
+// them) one per depth slot; workgroup row y judges accumulator y.
 // Push constants of one judge dispatch. Sample i of the batch (index
 // first_index + i) is element lead + i of the positions' slices, which are
 // `slice_length` elements long; it lies in frame (i + first_offset) / 64.
@@ -39,7 +41,7 @@ struct JudgePass {
   uint phase;             // 0: bins, counts and maxima; 1: the index of each maximum
   uint record_distances;  // 1: natural samples also go to their camera-distance band
   uint cells;
-  uint depth_slots;  // slices of the reference buffers
-  uint reserved1;
+  uint depth_slots;  // slices of the reference buffers, and the depth slots' accumulators
+  uint accumulators;  // cells, or cells + depth_slots when the encodings' errors are recorded too
   uint reserved2;
 };

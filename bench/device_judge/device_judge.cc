@@ -35,8 +35,10 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
 static_assert(sizeof(L::JudgePass) == 48);
 
-// The metrics the device records, in its order, as the host numbers them.
-constexpr std::array<Metric, L::DB_JUDGE_METRICS> kDeviceMetrics = {Metric::kTotal, Metric::kArith, Metric::kAbsolute};
+// The metrics the device records, in its order, as the host numbers them:
+// a cell's, and a depth slot's (its third is unused).
+constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal, Metric::kArith, Metric::kAbsolute};
+constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
 constexpr std::uint32_t kWorkgroupSize = 64;  // judge.comp's local_size_x
 
 // judge.comp's storage buffers, by binding number.
@@ -71,11 +73,14 @@ struct DeviceJudge::State {
   VulkanBuffer batch_readback;  // the maxima, then the unwritten counts
   VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
-  std::vector<Cell> cells;
+  std::vector<Cell> run_cells;
+  std::size_t depth_slots = 0;
   bool record_distances = true;
 
   std::size_t cell_count() const { return every_cell.size(); }
-  std::size_t counted_slots() const { return cell_count() * L::DB_JUDGE_SLOTS; }
+  // The cells' accumulators, then the depth slots'.
+  std::size_t accumulators() const { return cell_count() + depth_slots; }
+  std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
   std::size_t maxima() const { return counted_slots() * L::DB_JUDGE_METRICS; }
 
   VkDeviceSize counts_bytes() const { return counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t); }
@@ -111,8 +116,21 @@ struct DeviceJudge::State {
   }
   Status Upload(const Batch& batch, ThreadPool& pool);
   void Bind(const DevicePositions& positions, const Batch& batch);
-  void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
-  Status MergeMaxima(std::span<CellAccumulator> accumulators) const;
+  void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions, bool encodings) const;
+  Status MergeMaxima(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
+  // Device accumulator k's host accumulator (null where none is kept) and
+  // the host's numbers of its metrics.
+  std::pair<CellAccumulator*, std::span<const Metric>> HostOf(std::size_t k, std::span<CellAccumulator> cells,
+                                                              std::span<CellAccumulator> encodings) const {
+    if (k < cell_count()) return {&cells[k], kCellMetrics};
+    k -= cell_count();
+    return {k < encodings.size() ? &encodings[k] : nullptr, kEncodingMetrics};
+  }
+  Status CheckSizes(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const {
+    if (cells.size() == cell_count() && (encodings.empty() || encodings.size() == depth_slots)) return Status::Ok();
+    return InvalidArgument(fmt::format("{} and {} accumulators for {} cells and {} depth slots", cells.size(),
+                                       encodings.size(), cell_count(), depth_slots));
+  }
 };
 
 DeviceJudge::DeviceJudge(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -132,9 +150,10 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   state->backend = &backend;
   state->context = context;
   state->record_distances = record_distances;
+  state->depth_slots = layout.encodings.size();
   for (std::uint32_t k = 0; k < layout.cells.size(); ++k) {
     state->every_cell.push_back(k);
-    state->cells.push_back(layout.cells[k].cell);
+    state->run_cells.push_back(layout.cells[k].cell);
   }
   const ValidationScope validation(*context);
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
@@ -181,7 +200,7 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
   DB_RETURN_IF_ERROR(Grow(kFrames, frames * 4 * sizeof(std::uint32_t)));
   DB_RETURN_IF_ERROR(Grow(kRays, 3 * count * sizeof(double)));
   DB_RETURN_IF_ERROR(Grow(kCoverage, count * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(Grow(kReference, 3 * slot_samples * sizeof(double)));
+  DB_RETURN_IF_ERROR(Grow(kReference, 5 * slot_samples * sizeof(double)));
   DB_RETURN_IF_ERROR(Grow(kReferenceInfo, slot_samples * sizeof(std::uint32_t)));
 
   auto* frame_words = static_cast<std::uint32_t*>(buffers[kFrames].mapped());
@@ -214,6 +233,8 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
       std::memcpy(reference + lo, ref.true_depth.data() + lo, n * sizeof(double));
       std::memcpy(reference + slot_samples + lo, ref.denoted_depth.data() + lo, n * sizeof(double));
       std::memcpy(reference + 2 * slot_samples + lo, ref.inverse_distance_sq.data() + lo, n * sizeof(double));
+      std::memcpy(reference + 3 * slot_samples + lo, ref.storage_square.data() + lo, n * sizeof(double));
+      std::memcpy(reference + 4 * slot_samples + lo, ref.production_square.data() + lo, n * sizeof(double));
       for (std::size_t r = lo; r < lo + n; ++r) {
         info[r] = ref.joint_band[r] | static_cast<std::uint32_t>(ref.status[r]) << 8 |
                   static_cast<std::uint32_t>(ref.stored_holdable[r] != 0) << 16;
@@ -235,7 +256,7 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       batch.frames.size() * 4 * sizeof(std::uint32_t),
       3 * count * sizeof(double),
       count * sizeof(std::uint32_t),
-      3 * slot_samples * sizeof(double),
+      5 * slot_samples * sizeof(double),
       slot_samples * sizeof(std::uint32_t),
       counts_bytes(),
       first_bytes(),
@@ -252,7 +273,8 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
   pass->WriteDescriptors(writes);
 }
 
-void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const {
+void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions,
+                                bool encodings) const {
   // This batch's maxima start at nothing: zero squares, no index.
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), 0, half, 0u);
@@ -273,13 +295,14 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                          .record_distances = record_distances ? 1u : 0u,
                          .cells = static_cast<std::uint32_t>(cell_count()),
                          .depth_slots = static_cast<std::uint32_t>(batch.reference.true_depth.size() / batch.count),
-                         .reserved1 = 0,
+                         .accumulators = static_cast<std::uint32_t>(accumulators()),
                          .reserved2 = 0};
+  const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
   const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(cell_count()), 1);
+    vkCmdDispatch(commands, groups, rows, 1);
     // Phase 1 reads the maxima phase 0 raised; the copy below reads both.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
@@ -291,7 +314,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
 // A batch's maxima join the accumulators' as the host judge's Record does:
 // a larger square replaces the slot's maximum and index; an equal one
 // keeps the earlier batch's, whose indices are smaller.
-Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) const {
+Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const {
   DB_RETURN_IF_ERROR(batch_readback.InvalidateForHostReads());
   const auto* words = static_cast<const std::uint64_t*>(batch_readback.mapped());
   const auto* unwritten = reinterpret_cast<const std::uint32_t*>(words + 2 * maxima());
@@ -300,14 +323,15 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) 
     return InvalidArgument(fmt::format(
         "the {} shader did not write its output for {} samples (cell {}): it returns before writing, or writes "
         "another element; nothing it did not write is judged",
-        Info(cells[k].variant).name, unwritten[k], cells[k].Name()));
+        Info(run_cells[k].variant).name, unwritten[k], run_cells[k].Name()));
   }
   for (std::size_t at = 0; at < maxima(); ++at) {
     if (words[at] == 0) continue;
-    const std::size_t cell = at / (L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS);
-    const auto slot = static_cast<int>(at / L::DB_JUDGE_METRICS % L::DB_JUDGE_SLOTS);
-    const int m = static_cast<int>(kDeviceMetrics[at % L::DB_JUDGE_METRICS]);
-    CellAccumulator::Slot& to = accumulators[cell].At(slot);
+    const auto [host, metrics] = HostOf(at / (L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS), cells, encodings);
+    const std::size_t device_metric = at % L::DB_JUDGE_METRICS;
+    if (host == nullptr || device_metric >= metrics.size()) continue;
+    const int m = static_cast<int>(metrics[device_metric]);
+    CellAccumulator::Slot& to = host->At(static_cast<int>(at / L::DB_JUDGE_METRICS % L::DB_JUDGE_SLOTS));
     const double square = std::bit_cast<double>(words[at]);
     if (square > to.max_square[m]) {
       to.max_square[m] = square;
@@ -317,28 +341,27 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> accumulators) 
   return Status::Ok();
 }
 
-Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> accumulators, ThreadPool& pool) {
+Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
+                          ThreadPool& pool) {
   State& s = *state_;
-  if (accumulators.size() != s.cell_count()) {
-    return InvalidArgument(fmt::format("{} accumulators for {} cells", accumulators.size(), s.cell_count()));
-  }
+  DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
   DB_ASSIGN_OR_RETURN(const DevicePositions positions, RunLeavingOnDevice(*s.backend, batch, s.every_cell));
   const ValidationScope validation(*s.context);
   DB_RETURN_IF_ERROR(s.Upload(batch, pool));
   s.Bind(positions, batch);
-  DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions); }));
+  DB_RETURN_IF_ERROR(s.pass->Submit(
+      [&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
-  DB_RETURN_IF_ERROR(s.MergeMaxima(accumulators));
-  for (CellAccumulator& a : accumulators) a.Count(batch.count);
+  DB_RETURN_IF_ERROR(s.MergeMaxima(cells, encodings));
+  for (CellAccumulator& a : cells) a.Count(batch.count);
+  for (CellAccumulator& a : encodings) a.Count(batch.count);
   return Status::Ok();
 }
 
-Status DeviceJudge::Flush(std::span<CellAccumulator> accumulators) {
+Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) {
   State& s = *state_;
-  if (accumulators.size() != s.cell_count()) {
-    return InvalidArgument(fmt::format("{} accumulators for {} cells", accumulators.size(), s.cell_count()));
-  }
+  DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   // The counts come back and are cleared on the device in one submission.
   const ValidationScope validation(*s.context);
   DB_RETURN_IF_ERROR(s.pass->Submit([&s](VkCommandBuffer commands) {
@@ -357,10 +380,11 @@ Status DeviceJudge::Flush(std::span<CellAccumulator> accumulators) {
     const std::uint32_t* from = counts + at * L::DB_JUDGE_SLOT_UINTS;
     const std::uint32_t* tally = from + L::DB_JUDGE_METRICS * L::DB_JUDGE_BINS;
     if (std::all_of(from, from + L::DB_JUDGE_SLOT_UINTS, [](std::uint32_t n) { return n == 0; })) continue;
-    CellAccumulator::Slot& to =
-        accumulators[at / L::DB_JUDGE_SLOTS].At(static_cast<int>(at % L::DB_JUDGE_SLOTS));
-    for (std::size_t m = 0; m < kDeviceMetrics.size(); ++m) {
-      auto& bins = to.bins[static_cast<int>(kDeviceMetrics[m])];
+    const auto [host, metrics] = s.HostOf(at / L::DB_JUDGE_SLOTS, cells, encodings);
+    if (host == nullptr) continue;
+    CellAccumulator::Slot& to = host->At(static_cast<int>(at % L::DB_JUDGE_SLOTS));
+    for (std::size_t m = 0; m < metrics.size(); ++m) {
+      auto& bins = to.bins[static_cast<int>(metrics[m])];
       for (std::size_t b = 0; b < L::DB_JUDGE_BINS; ++b) bins[b] += from[m * L::DB_JUDGE_BINS + b];
     }
     if (tally[0] + tally[1] > 0 && (to.nan + to.inf == 0 || first[at] < to.first_nonfinite_index)) {

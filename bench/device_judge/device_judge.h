@@ -5,18 +5,19 @@
 // what the device waits for. Here the reconstruction pass leaves its
 // positions in device memory, the host uploads the batch's reference (per
 // sample the ray and coverage kind; per depth slot and sample the true and
-// the denoted depth, the inverse squared distance, the band and the
-// status), and shaders/judge/judge.comp counts the total, shader and
-// absolute errors into histograms that stay on the device. The host reads
+// the denoted depth, the inverse squared distance, the squared storage and
+// production errors, the band and the status), and
+// shaders/judge/judge.comp counts every error into histograms that stay on
+// the device: each cell's total, shader and absolute errors, and each
+// encoding's storage and production errors. The host reads
 // back only each batch's maxima (a few kilobytes) and, when a flush is due,
 // the histograms.
 //
 // What it records equals the host judge's, bin for bin, count for count,
 // maximum and worst index included: the shader repeats the host's float64
 // operations in order and unfused, and reads bins from the same bits
-// (tests/device_judge_test.cc holds the two equal). The storage and
-// production errors of each encoding stay with the host
-// (RecordEncodingErrors), as do the sampler and the reference.
+// (tests/device_judge_test.cc holds the two equal). The sampler, the
+// encoding and the reference stay with the host.
 #pragma once
 
 #include <memory>
@@ -44,13 +45,17 @@ class DeviceJudge {
   DeviceJudge& operator=(const DeviceJudge&) = delete;
 
   // Runs every cell of the layout on `batch` and judges the outputs on the
-  // device. Each batch's maxima go straight into `accumulators` (one per
-  // cell, in layout order), which also count the batch's samples; the
-  // counts stay on the device until Flush. `pool` writes the uploads.
-  Status Judge(const Batch& batch, std::span<CellAccumulator> accumulators, ThreadPool& pool);
-  // Adds what the device counted since the last flush into `accumulators`
-  // and clears it there. Due before any of them holds 2^31 samples.
-  Status Flush(std::span<CellAccumulator> accumulators);
+  // device. Each batch's maxima go straight into `cells` (one accumulator
+  // per cell, in layout order) and, unless it is empty, `encodings` (one
+  // per depth slot: the storage and production errors, which the device
+  // then records too); they also count the batch's samples. The counts
+  // stay on the device until Flush. `pool` writes the uploads.
+  Status Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
+               ThreadPool& pool);
+  // Adds what the device counted since the last flush into the
+  // accumulators (`encodings` as Judge was given them) and clears it there.
+  // Due before any of them holds 2^31 samples.
+  Status Flush(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings);
 
  private:
   struct State;

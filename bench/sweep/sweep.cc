@@ -171,6 +171,11 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   if (only_distance_band) {
     for (CellAccumulator& a : accumulators) a.SkipDistanceBands();
   }
+  // Storage and production errors belong to an encoding, whatever reads
+  // it: one accumulator per depth slot, copied into its cells at the end.
+  const std::size_t slot_count = layout.encodings.size();
+  std::vector<CellAccumulator> storage_accumulators(slot_count);
+  std::vector<CellStats> storage_stats(slot_count);
   // Backends whose outputs are judged on their device; the others' on the
   // host, below.
   std::vector<std::unique_ptr<DeviceJudge>> device_judges(backends.size());
@@ -189,20 +194,19 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
   };
+  // The first backend's run records the encodings' errors (below).
+  const auto encodings_of = [&](std::size_t b) {
+    return b == 0 ? std::span<CellAccumulator>(storage_accumulators) : std::span<CellAccumulator>();
+  };
   // Device counts join the host's accumulators, which then flush as ever.
   const auto flush_devices = [&](bool due_only) -> Status {
     for (std::size_t b = 0; b < backends.size(); ++b) {
       if (device_judges[b] == nullptr) continue;
       if (due_only && accumulators[b * cell_count].pending() < flush_every) continue;
-      DB_RETURN_IF_ERROR(device_judges[b]->Flush(accumulators_of(b)));
+      DB_RETURN_IF_ERROR(device_judges[b]->Flush(accumulators_of(b), encodings_of(b)));
     }
     return Status::Ok();
   };
-  // Storage and production errors belong to an encoding, whatever reads
-  // it: one accumulator per depth slot, copied into its cells at the end.
-  const std::size_t slot_count = layout.encodings.size();
-  std::vector<CellAccumulator> storage_accumulators(slot_count);
-  std::vector<CellStats> storage_stats(slot_count);
   std::vector<std::vector<float>> scratch(pool.size());
   std::vector<std::vector<std::uint32_t>> cells_of_slot(slot_count);
   for (std::uint32_t c = 0; c < cell_count; ++c) cells_of_slot[layout.cells[c].depth_slot].push_back(c);
@@ -247,15 +251,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (device_judges[b] != nullptr) {
-        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), pool)
+        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), encodings_of(b), pool)
                                .WithContext("running and judging on the " + backend.name() + " backend"));
-        if (b == 0) {
-          pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
-            for (std::size_t slot = lo; slot < hi; ++slot) {
-              RecordEncodingErrors(batch, static_cast<std::uint32_t>(slot), storage_accumulators[slot], options.isa);
-            }
-          });
-        }
       } else if (backend.concurrent()) {
         FirstError error;
         pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {

@@ -9,7 +9,9 @@
 // for the total, shader (arith) and absolute errors, sample by sample: the
 // same float64 operations in the same order, none fused (`precise`), and
 // the same bins read from the bits of each square. A dispatch's workgroup
-// row y judges the y-th cell of the run, one sample per invocation.
+// row y judges the y-th cell of the run, one sample per invocation; rows
+// past the cells record the storage and production errors of each depth
+// slot (shared/judge.h).
 //
 // Two phases over the same batch: phase 0 adds bins and counts and raises
 // each slot's largest square (a 64-bit atomic maximum on its bits: squares
@@ -29,17 +31,18 @@ layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
 // slices of `count` values; then the coverage kinds, one per sample.
 layout(std430, set = 0, binding = 3) readonly buffer Rays { double rays[]; };
 layout(std430, set = 0, binding = 4) readonly buffer Coverage { uint coverage[]; };
-// Per (depth slot, sample): true depth, denoted depth and inverse squared
-// distance, each a slice of slots * count values; and the packed joint
-// band | status << 8 | stored_holdable << 16.
+// Per (depth slot, sample): true depth, denoted depth, inverse squared
+// distance, squared relative storage and production errors, each a slice
+// of slots * count values; and the packed joint band | status << 8 |
+// stored_holdable << 16.
 layout(std430, set = 0, binding = 5) readonly buffer Reference { double reference[]; };
 layout(std430, set = 0, binding = 6) readonly buffer ReferenceInfo { uint reference_info[]; };
-// Per (cell, slot): DB_JUDGE_SLOT_UINTS counters (bins, then counts).
+// Per (accumulator, slot): DB_JUDGE_SLOT_UINTS counters (bins, then counts).
 layout(std430, set = 0, binding = 7) buffer Counts { uint counts[]; };
-// Per (cell, slot): the smallest index of a non-finite finding.
+// Per (accumulator, slot): the smallest index of a non-finite finding.
 layout(std430, set = 0, binding = 8) buffer FirstNonFinite { uint64_t first_nonfinite[]; };
-// Per (cell, slot, metric): this batch's largest square's bits; then, in
-// the same order, the smallest index that reached it.
+// Per (accumulator, slot, metric): this batch's largest square's bits;
+// then, in the same order, the smallest index that reached it.
 layout(std430, set = 0, binding = 9) buffer Maxima { uint64_t maxima[]; };
 // Per cell: samples with a component the reconstruction never wrote.
 layout(std430, set = 0, binding = 10) buffer Unwritten { uint unwritten[]; };
@@ -71,19 +74,23 @@ uint64_t sample_index(uint i) {
   return first + uint64_t(i);
 }
 
-// One value of metric m (0 total, 1 arith, 2 absolute) in slot `slot` of
-// cell k.
+// One value of metric m in slot `slot` of accumulator k: a cell's 0 total,
+// 1 arith, 2 absolute; a depth slot's 0 storage, 1 production.
 void record(uint k, uint slot, uint m, double square, uint64_t index) {
   uint at = k * DB_JUDGE_SLOTS + slot;
   uint64_t bits = doubleBitsToUint64(square);
   uint max_at = at * DB_JUDGE_METRICS + m;
+  // As the host's `square > max_square`: zero never sets a maximum, nor
+  // does NaN (an encoding's square can be one, and its bits would order
+  // above every number's).
+  bool candidate = square > 0.0lf;
   if (pass.phase == 0u) {
     atomicAdd(counts[at * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m])], 1u);
-    if (bits > maxima[max_at]) {
+    if (candidate && bits > maxima[max_at]) {
       atomicMax(maxima[max_at], bits);
     }
-  } else if (bits != 0ul && bits == maxima[max_at]) {
-    atomicMin(maxima[pass.cells * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + max_at], index);
+  } else if (candidate && bits == maxima[max_at]) {
+    atomicMin(maxima[pass.accumulators * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + max_at], index);
   }
 }
 
@@ -106,10 +113,36 @@ void count(uint k, uint slot, uint status, bool holdable, bool is_nan, uint64_t 
   }
 }
 
+// The slot of a sample's figures: its joint band, or its coverage band if
+// it is a targeted pick (kind > 0).
+uint band_slot(uint info, uint kind) {
+  return kind == 0u ? DB_JUDGE_DISTANCE_SLOTS + (info & 0xffu)
+                    : DB_JUDGE_DISTANCE_SLOTS + DB_JUDGE_JOINT_SLOTS + kind - 1u;
+}
+
+// The storage and production errors of depth slot s's sample i (judge.cc's
+// RecordEncodingErrors): in its band, for samples the reference judges.
+void record_encoding(uint k, uint s, uint i) {
+  uint r = s * pass.count + i;
+  uint info = reference_info[r];
+  if (((info >> 8u) & 0xffu) != DB_JUDGE_STATUS_JUDGED) {
+    return;
+  }
+  uint slot_samples = pass.depth_slots * pass.count;
+  uint band = band_slot(info, coverage[i]);
+  uint64_t index = sample_index(i);
+  record(k, band, 0u, reference[3u * slot_samples + r], index);
+  record(k, band, 1u, reference[4u * slot_samples + r], index);
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint k = gl_WorkGroupID.y;
   if (i >= pass.count) {
+    return;
+  }
+  if (k >= pass.cells) {
+    record_encoding(k, k - pass.cells, i);
     return;
   }
   uint depth_slot = depth_slot_of_cell[k];
@@ -143,8 +176,7 @@ void main() {
 
   uint kind = coverage[i];
   bool natural = kind == 0u;
-  uint band = natural ? DB_JUDGE_DISTANCE_SLOTS + (info & 0xffu)
-                      : DB_JUDGE_DISTANCE_SLOTS + DB_JUDGE_JOINT_SLOTS + kind - 1u;
+  uint band = band_slot(info, kind);
   uint distance = natural && pass.record_distances != 0u ? frame.w : kNoSlot;
   uint status = (info >> 8u) & 0xffu;
   bool holdable = ((info >> 16u) & 1u) != 0u;
