@@ -186,10 +186,11 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
                            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
   }
   // A batch no backend can take whole is cut to what the smallest takes.
-  const bool judged_on_device =
-      std::any_of(device_judges.begin(), device_judges.end(), [](const auto& judge) { return judge != nullptr; });
-  std::uint64_t batch_size =
-      options.batch_size != 0 ? options.batch_size : judged_on_device ? kDeviceJudgeBatch : kHostBatch;
+  bool gpu_judges = false;
+  for (std::size_t b = 0; b < backends.size(); ++b) {
+    gpu_judges = gpu_judges || (device_judges[b] != nullptr && backends[b]->device().kind == "gpu");
+  }
+  std::uint64_t batch_size = options.batch_size != 0 ? options.batch_size : gpu_judges ? kDeviceJudgeBatch : kHostBatch;
   for (const Backend* backend : backends) batch_size = std::min(batch_size, backend->MaxBatchSamples());
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
