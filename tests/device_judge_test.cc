@@ -120,6 +120,25 @@ TEST_F(DeviceJudgeTest, AnotherSeedRecordsOtherStatistics) {
   EXPECT_EQ(differing, first->cells.size());
 }
 
+// The judge's widest binding (five doubles per depth slot and sample)
+// outgrows the device's limit before the backend's do when cells are few
+// and depth slots many: divide alone reads 24 slots with 24 cells. A batch
+// asked for larger is cut to what the judge binds (lavapipe binds 128 MiB:
+// 2^22 samples would need 3.8 GiB), or the validation layer objects.
+TEST_F(DeviceJudgeTest, CutsABatchToWhatTheDeviceBinds) {
+  SweepOptions options = Options(TypicalDomain());
+  options.cells = {};
+  for (const Cell& cell : AllCells()) {
+    if (cell.variant == Variant::kDivide) options.cells.push_back(cell);
+  }
+  options.samples = 300000;
+  options.shard = {};
+  options.batch_size = 1u << 22;
+  auto run = Sweep(options, JudgeSite::kDevice);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  EXPECT_EQ(run->run.samples_judged, 300000u);
+}
+
 TEST_F(DeviceJudgeTest, TheCpuBackendHasNoDeviceToJudgeOn) {
   SweepOptions options = Options(TypicalDomain());
   options.samples = 3000;

@@ -341,6 +341,13 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> cells, std::sp
   return Status::Ok();
 }
 
+std::uint64_t DeviceJudge::MaxBatchSamples() const {
+  const State& s = *state_;
+  // Per sample: five doubles per depth slot (the reference), three (the ray).
+  const std::uint64_t widest = sizeof(double) * std::max<std::uint64_t>(5 * s.depth_slots, 3);
+  return std::max<std::uint64_t>(s.context->properties().limits.maxStorageBufferRange / widest, kWorkgroupSize);
+}
+
 Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
                           ThreadPool& pool) {
   State& s = *state_;

@@ -52,6 +52,9 @@ class DeviceJudge {
   // stay on the device until Flush. `pool` writes the uploads.
   Status Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
                ThreadPool& pool);
+  // The most samples one batch may have: the widest binding (the
+  // reference of every depth slot) within the device's limit.
+  std::uint64_t MaxBatchSamples() const;
   // Adds what the device counted since the last flush into the
   // accumulators (`encodings` as Judge was given them) and clears it there.
   // Due before any of them holds 2^31 samples.

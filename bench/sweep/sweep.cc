@@ -192,6 +192,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   }
   std::uint64_t batch_size = options.batch_size != 0 ? options.batch_size : gpu_judges ? kDeviceJudgeBatch : kHostBatch;
   for (const Backend* backend : backends) batch_size = std::min(batch_size, backend->MaxBatchSamples());
+  for (const auto& judge : device_judges) {
+    if (judge != nullptr) batch_size = std::min(batch_size, judge->MaxBatchSamples());
+  }
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
   };
