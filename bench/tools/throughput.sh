@@ -9,8 +9,8 @@
 # lavapipe with either judge (--judge host: outputs read back and binned on
 # the host's cores; --judge device: binned where they are). With DEVICE (a
 # part of a Vulkan device's name, as --device takes it, "nvidia"): that
-# device with either judge at 10^7 and 10^8 samples, in batches of 2^20
-# samples. DEPTHBENCH names another program to run (a packed copy's
+# device with either judge at 10^7 and 10^8 samples, each in its default
+# batches. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
@@ -47,7 +47,7 @@ else
   for samples in 1e7 1e8; do
     for judge in host device; do
       labels+=("$device, $judge judge, $samples samples")
-      arguments+=("--backend vulkan --device $device --judge $judge --batch 1048576 --samples $samples")
+      arguments+=("--backend vulkan --device $device --judge $judge --samples $samples")
     done
   done
 fi
