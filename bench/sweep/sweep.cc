@@ -82,18 +82,6 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudgeFor(JudgeSite site, Backend& b
 
 }  // namespace
 
-const char* JudgeSiteName(JudgeSite site) {
-  switch (site) {
-    case JudgeSite::kAuto:
-      return "auto";
-    case JudgeSite::kHost:
-      return "host";
-    case JudgeSite::kDevice:
-      return "device";
-  }
-  return "?";
-}
-
 Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> backends) {
   if (PassKindOf(production) != PassKind::kRaster) return nullptr;
   for (Backend* backend : backends) {

@@ -35,7 +35,6 @@ struct SweepProgress {
 // device kind: on the device for a GPU, on the host for a CPU device
 // (lavapipe), where the host's vector loops are the faster judge.
 enum class JudgeSite { kAuto, kHost, kDevice };
-const char* JudgeSiteName(JudgeSite site);
 
 // Default batch sizes, the fastest measured. On the host, a batch's
 // arrays and the accumulators they reach stay in cache. With the judge on
