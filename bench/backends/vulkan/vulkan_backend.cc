@@ -438,7 +438,9 @@ Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::
 
 Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
                                                             std::span<const std::uint32_t> which) {
-  if (raster_ != nullptr) return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
+  if (raster_ != nullptr) {
+    return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
+  }
   if (batch.count == 0 || which.empty()) return DevicePositions{};
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
