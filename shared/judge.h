@@ -21,6 +21,16 @@ DB_CONST_UINT(DB_JUDGE_SLOTS, 123u)
 DB_CONST_UINT(DB_JUDGE_COUNTS, 6u)
 DB_CONST_UINT(DB_JUDGE_SLOT_UINTS, 780u)  // DB_JUDGE_METRICS * DB_JUDGE_BINS + DB_JUDGE_COUNTS
 
+// The reference pass's inputs: doubles per frame (near, far, largest eye
+// depth, eye depths of interest), words per frame (far/near band, the
+// linear mapping's far plane, A and B of each hardware convention), and the
+// bands it computes (bench/pipeline/bands.h).
+DB_CONST_UINT(DB_JUDGE_FRAME_DEPTHS, 5u)
+DB_CONST_UINT(DB_JUDGE_HARDWARE_CONVENTIONS, 8u)
+DB_CONST_UINT(DB_JUDGE_FRAME_WORDS, 18u)  // 2 + 2 * DB_JUDGE_HARDWARE_CONVENTIONS
+DB_CONST_UINT(DB_JUDGE_DEPTH_BANDS, 10u)
+DB_CONST_UINT(DB_JUDGE_INFINITE_RATIO_BAND, 10u)
+
 // Reference status (bench/pipeline/reference.h) as the judge reads it.
 DB_CONST_UINT(DB_JUDGE_STATUS_JUDGED, 0u)
 DB_CONST_UINT(DB_JUDGE_STATUS_DEGENERATE, 1u)
@@ -28,7 +38,7 @@ DB_CONST_UINT(DB_JUDGE_STATUS_OUTSIDE, 2u)
 
 // Accumulators: one per cell of the run, then (where the dispatch records
 // them) one per depth slot; workgroup row y judges accumulator y.
-// Push constants of one judge dispatch. Sample i of the batch (index
+// Push constants of one dispatch of either pass. Sample i of the batch (index
 // first_index + i) is element lead + i of the positions' slices, which are
 // `slice_length` elements long; it lies in frame (i + first_offset) / 64.
 struct JudgePass {
@@ -43,5 +53,5 @@ struct JudgePass {
   uint cells;
   uint depth_slots;  // slices of the reference buffers, and the depth slots' accumulators
   uint accumulators;  // cells, or cells + depth_slots when the encodings' errors are recorded too
-  uint reserved2;
+  uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
 };

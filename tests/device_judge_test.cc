@@ -11,10 +11,13 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
+#include "bench/device_judge/device_judge.h"
+#include "bench/numerics/formulas_mpfr.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
@@ -55,6 +58,7 @@ class DeviceJudgeTest : public ::testing::Test {
     return results;
   }
 
+  static const std::shared_ptr<VulkanContext>& Context() { return *context_; }
   static std::shared_ptr<VulkanContext>* context_;
 };
 std::shared_ptr<VulkanContext>* DeviceJudgeTest::context_ = nullptr;
@@ -105,6 +109,121 @@ TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
 
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
   ExpectSameStatistics(ExtremesDomain(), "extremes");
+}
+
+// One batch of `domain` (every cell it allows), its reference computed by
+// the host (in `batch`) and by the device (returned).
+struct TwoReferences {
+  RunLayout layout;
+  Batch batch;
+  ReferenceArrays device;
+};
+void ComputeBothReferences(const Domain& domain, TwoReferences& out) {
+  const std::shared_ptr<VulkanContext>& context = DeviceJudgeTest::Context();
+  out.layout = MakeRunLayout(CellsForDomain(AllCells(), domain));
+  auto vulkan = MakeVulkanBackend(context, BackendOptions{});
+  ASSERT_TRUE(vulkan.ok()) << vulkan.status().message();
+  ASSERT_TRUE((*vulkan)->Prepare(out.layout.cells, PassKind::kCompute).ok());
+  auto judge = DeviceJudge::Create(**vulkan, out.layout, domain.production, true);
+  ASSERT_TRUE(judge.ok()) << judge.status().message();
+  const Sampler sampler(3, domain);
+  const BatchBuilder builder(sampler, out.layout.encodings);
+  ThreadPool pool(2);
+  builder.Build(1000000037, 6000, out.batch, pool);  // a batch that starts inside a frame
+  std::vector<CellAccumulator> accumulators(out.layout.cells.size());
+  ASSERT_TRUE((*judge)->Judge(out.batch, accumulators, {}, pool).ok());
+  auto device = (*judge)->LastReference();
+  ASSERT_TRUE(device.ok()) << device.status().message();
+  out.device = std::move(device).value();
+  EXPECT_TRUE(context->TakeValidationMessages().empty());
+}
+
+// The device's reference against the host's, element by element and bit
+// for bit: the first differences are named.
+void ExpectSameReference(const Domain& domain, const std::string& name) {
+  SCOPED_TRACE(name);
+  TwoReferences both;
+  ComputeBothReferences(domain, both);
+  const ReferenceArrays &host = both.batch.reference, &device = both.device;
+  ASSERT_EQ(device.true_depth.size(), host.true_depth.size());
+  const auto same = [](double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); };
+  std::size_t differing = 0, judged = 0;
+  for (std::size_t r = 0; r < host.true_depth.size(); ++r) {
+    const bool equal = same(host.true_depth[r], device.true_depth[r]) &&
+                       same(host.denoted_depth[r], device.denoted_depth[r]) &&
+                       same(host.inverse_distance_sq[r], device.inverse_distance_sq[r]) &&
+                       same(host.storage_square[r], device.storage_square[r]) &&
+                       same(host.production_square[r], device.production_square[r]) &&
+                       host.joint_band[r] == device.joint_band[r] && host.status[r] == device.status[r] &&
+                       host.stored_holdable[r] == device.stored_holdable[r];
+    judged += host.status[r] == ReferenceStatus::kJudged ? 1 : 0;
+    if (!equal && differing++ < 5) {
+      const Encoding e = both.layout.encodings[r / both.batch.count];
+      ADD_FAILURE() << Info(e.convention).name << "/" << Info(e.format).name << ", sample " << r % both.batch.count
+                    << fmt::format(": true {} / {}, denoted {} / {}, inverse {} / {}, storage {} / {}, production "
+                                   "{} / {}, band {} / {}, status {} / {}, holdable {} / {}",
+                                   host.true_depth[r], device.true_depth[r], host.denoted_depth[r],
+                                   device.denoted_depth[r], host.inverse_distance_sq[r], device.inverse_distance_sq[r],
+                                   host.storage_square[r], device.storage_square[r], host.production_square[r],
+                                   device.production_square[r], host.joint_band[r], device.joint_band[r],
+                                   static_cast<int>(host.status[r]), static_cast<int>(device.status[r]),
+                                   host.stored_holdable[r], device.stored_holdable[r]);
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_GT(judged, host.true_depth.size() / 2);
+}
+
+// Far/near 1e9 with depths produced exactly or in float32, where a decode
+// near the far plane cancels 30 bits in any precision unless it is written
+// without the cancellation (shared/depth_mapping.h).
+Domain FarOverNear1e9(ProductionModel production) {
+  Domain domain = WideDomain();
+  domain.ratio = {1e9, 1e9};
+  domain.production = production;
+  return domain;
+}
+
+TEST_F(DeviceJudgeTest, ComputesTheHostsReference) {
+  ExpectSameReference(TypicalDomain(), "typical");
+  ExpectSameReference(WideDomain(), "wide");
+  ExpectSameReference(ExtremesDomain(), "extremes");
+  ExpectSameReference(FarOverNear1e9(ProductionModel::kFloat32), "f/n 1e9");
+  ExpectSameReference(FarOverNear1e9(ProductionModel::kExact), "f/n 1e9, exact production");
+}
+
+// The device's decode of stored window depths at far/near 1e9 against
+// MPFR's (400 bits) evaluation of the same mapping: the device keeps the
+// double nearest the double-double, so it may be off by half an ulp of a
+// double (2^-53) plus the double-double's own error (below 2^-96, as
+// tests/reference_test.cc shows on the host): 2^-52 bounds both, 29 bits
+// below float32's rounding. A textbook decode B / (d - A) in double would
+// miss it by up to 2^-23 near the far plane.
+TEST_F(DeviceJudgeTest, ItsDecodeAgreesWithMpfrAtFarOverNear1e9) {
+  TwoReferences both;
+  ComputeBothReferences(FarOverNear1e9(ProductionModel::kExact), both);
+  const Batch& batch = both.batch;
+  double worst = 0.0;
+  std::size_t checked = 0, near_far_plane = 0;
+  for (std::size_t s = 0; s < both.layout.encodings.size(); ++s) {
+    const Encoding e = both.layout.encodings[s];
+    if (Info(e.format).stores != DepthInput::kHardware) continue;
+    const std::uint32_t bits = Info(e.convention).bits;
+    for (std::size_t i = 0; i < batch.count; ++i) {
+      const std::size_t r = s * batch.count + i;
+      const double denoted = both.device.denoted_depth[r];
+      if (!(denoted > 0.0) || denoted == std::numeric_limits<double>::max()) continue;
+      const mp::real d(static_cast<double>(batch.depths[r]));
+      const mp::real exact = mp::eye_depth_from_window_depth(mp::real(batch.samples.near[i]),
+                                                             mp::real(batch.samples.far[i]), bits, d, mp::real(1.0) - d);
+      worst = std::max(worst, std::fabs(((mp::real(denoted) - exact) / exact).ToDouble()));
+      ++checked;
+      near_far_plane += denoted > 0.5 * batch.samples.depth_limit[i] ? 1 : 0;
+    }
+  }
+  EXPECT_LE(worst, std::ldexp(1.0, -52));
+  EXPECT_GT(checked, 10000u);
+  EXPECT_GT(near_far_plane, 1000u);  // the last doubling, where the cancellation would be
 }
 
 // The comparison above can fail: a different sample population (another

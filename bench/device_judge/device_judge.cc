@@ -34,6 +34,10 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
 static_assert(sizeof(L::JudgePass) == 48);
+static_assert(L::DB_JUDGE_HARDWARE_CONVENTIONS == kHardwareConventionCount &&
+              L::DB_JUDGE_FRAME_WORDS == 2 + 2 * L::DB_JUDGE_HARDWARE_CONVENTIONS);
+static_assert(L::DB_JUDGE_DEPTH_BANDS == kDepthBands && L::DB_JUDGE_INFINITE_RATIO_BAND == kInfiniteRatioBand);
+static_assert(kSamplesPerFrame == 64);  // bindings.glsl's frame_of
 
 // The metrics the device records, in its order, as the host numbers them:
 // a cell's, and a depth slot's (its third is unused).
@@ -41,13 +45,19 @@ constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal
 constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
 constexpr std::uint32_t kWorkgroupSize = 64;  // judge.comp's local_size_x
 
-// judge.comp's storage buffers, by binding number.
+// The storage buffers of both passes, by binding number
+// (shaders/judge/bindings.glsl says what each holds).
 enum Binding : std::uint32_t {
-  kCellSlots,
+  kLayout,
   kPositions,  // the backend's
   kFrames,
   kRays,
   kCoverage,
+  kFrameDepths,
+  kFrameConstants,
+  kEyeDepths,
+  kPipelineFloats,
+  kStoredFloats,
   kReference,
   kReferenceInfo,
   kCounts,
@@ -56,11 +66,21 @@ enum Binding : std::uint32_t {
   kUnwritten,
   kBindingCount,
 };
-// The counters live in device memory alone (atomics across the bus would
-// cost the device its speed); transfers copy them into host-readable
-// buffers: each batch's maxima and the unwritten counts after the batch,
-// the histograms and counts at a flush.
-bool Counter(Binding b) { return b >= kCounts; }
+// The reference and the counters live in device memory alone (atomics
+// across the bus would cost the device its speed); transfers copy them
+// into host-readable buffers: each batch's maxima and the unwritten counts
+// after the batch, the histograms and counts at a flush.
+bool DeviceOnly(Binding b) { return b >= kReference; }
+
+// What the reference pass needs of a depth slot's encoding
+// (bindings.glsl's Layout): what the format stores, the convention's bits
+// and hardware index, and the slot's pipeline.
+std::uint32_t EncodingWord(Encoding encoding, std::uint32_t pipeline) {
+  const ConventionInfo& convention = Info(encoding.convention);
+  const auto hardware = convention.hardware ? static_cast<std::uint32_t>(encoding.convention) : 0u;
+  return static_cast<std::uint32_t>(Info(encoding.format).stores) | (convention.bits & 0xfu) << 4 | hardware << 8 |
+         pipeline << 16;
+}
 
 }  // namespace
 
@@ -68,13 +88,17 @@ struct DeviceJudge::State {
   Backend* backend = nullptr;
   std::shared_ptr<VulkanContext> context;
   std::unique_ptr<ComputePass> pass;
-  DeviceObject<VkPipeline> pipeline;
+  DeviceObject<VkPipeline> reference_pipeline;
+  DeviceObject<VkPipeline> judge_pipeline;
   std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions unused: the backend owns it)
   VulkanBuffer batch_readback;  // the maxima, then the unwritten counts
   VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
   std::vector<Cell> run_cells;
   std::size_t depth_slots = 0;
+  std::size_t pipelines = 0;
+  std::uint32_t last_count = 0;  // samples of the last batch judged
+  bool exact_production = false;
   bool record_distances = true;
 
   std::size_t cell_count() const { return every_cell.size(); }
@@ -92,7 +116,7 @@ struct DeviceJudge::State {
     return context->GrowHostBuffer(
         buffers[binding], std::max<VkDeviceSize>(bytes, 16),
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-        Counter(binding) ? HostAccess::kNone : HostAccess::kUpload);
+        DeviceOnly(binding) ? HostAccess::kNone : HostAccess::kUpload);
   }
   // Copies `bytes` of each source to `readback`, one after the other, and
   // makes them visible to the host.
@@ -137,9 +161,12 @@ DeviceJudge::DeviceJudge(std::unique_ptr<State> state) : state_(std::move(state)
 DeviceJudge::~DeviceJudge() = default;
 
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, const RunLayout& layout,
-                                                           bool record_distances) {
+                                                           ProductionModel production, bool record_distances) {
   std::shared_ptr<VulkanContext> context = ContextOf(backend);
   if (context == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
+  if (production == ProductionModel::kRaster) {
+    return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
+  }
   if (!context->shader_float64() || !context->int64_atomics()) {
     return Unavailable(fmt::format(
         "Vulkan device '{}' lacks float64 arithmetic or 64-bit atomics on storage buffers, which the device judge "
@@ -150,7 +177,10 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   state->backend = &backend;
   state->context = context;
   state->record_distances = record_distances;
+  state->exact_production = production == ProductionModel::kExact;
   state->depth_slots = layout.encodings.size();
+  const std::vector<std::uint32_t> pipeline_of_slot = PipelineOfSlots(layout.encodings);
+  for (std::uint32_t p : pipeline_of_slot) state->pipelines = std::max<std::size_t>(state->pipelines, p + 1);
   for (std::uint32_t k = 0; k < layout.cells.size(); ++k) {
     state->every_cell.push_back(k);
     state->run_cells.push_back(layout.cells[k].cell);
@@ -162,16 +192,22 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   }
   DB_RETURN_IF_ERROR(StoreInto(ComputePass::Create(context, bindings, sizeof(L::JudgePass)), state->pass));
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / "judge.comp"));
   const VkSpecializationInfo none{};
-  DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, none, "the device judge"), state->pipeline));
+  for (auto [name, pipeline] : {std::pair{"reference.comp", &state->reference_pipeline},
+                                std::pair{"judge.comp", &state->judge_pipeline}}) {
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
+    DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, none, "the device judge"), *pipeline));
+  }
 
   // What stays the same for the whole run: which depth slot each cell
-  // reads, and the counters, empty.
-  DB_RETURN_IF_ERROR(state->Grow(kCellSlots, state->cell_count() * sizeof(std::uint32_t)));
-  auto* slots = static_cast<std::uint32_t*>(state->buffers[kCellSlots].mapped());
-  for (std::size_t k = 0; k < layout.cells.size(); ++k) slots[k] = layout.cells[k].depth_slot;
-  DB_RETURN_IF_ERROR(state->buffers[kCellSlots].FlushHostWrites());
+  // reads, each slot's encoding, and the counters, empty.
+  DB_RETURN_IF_ERROR(state->Grow(kLayout, state->accumulators() * sizeof(std::uint32_t)));
+  auto* words = static_cast<std::uint32_t*>(state->buffers[kLayout].mapped());
+  for (std::size_t k = 0; k < layout.cells.size(); ++k) words[k] = layout.cells[k].depth_slot;
+  for (std::size_t s = 0; s < state->depth_slots; ++s) {
+    words[state->cell_count() + s] = EncodingWord(layout.encodings[s], pipeline_of_slot[s]);
+  }
+  DB_RETURN_IF_ERROR(state->buffers[kLayout].FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kMaxima, state->maxima_bytes()));
@@ -192,56 +228,96 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   return std::unique_ptr<DeviceJudge>(new DeviceJudge(std::move(state)));
 }
 
-// The batch's reference, written into the upload buffers on every thread:
-// at a GPU's rate one thread's copies would leave the device waiting.
+// What the reference starts from, written into the upload buffers on every
+// thread: at a GPU's rate one thread's copies would leave the device
+// waiting.
 Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
-  const std::size_t slot_samples = batch.reference.true_depth.size();
-  DB_RETURN_IF_ERROR(Grow(kFrames, frames * 4 * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(Grow(kRays, 3 * count * sizeof(double)));
-  DB_RETURN_IF_ERROR(Grow(kCoverage, count * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(Grow(kReference, 5 * slot_samples * sizeof(double)));
-  DB_RETURN_IF_ERROR(Grow(kReferenceInfo, slot_samples * sizeof(std::uint32_t)));
+  const std::size_t slot_samples = depth_slots * count, pipeline_samples = pipelines * count;
+  if (batch.depths.size() != slot_samples || batch.pipeline_floats.size() != pipeline_samples) {
+    return InvalidArgument(fmt::format("a batch of {} samples with {} stored and {} pipeline values, for {} depth "
+                                       "slots and {} pipelines",
+                                       count, batch.depths.size(), batch.pipeline_floats.size(), depth_slots,
+                                       pipelines));
+  }
+  for (const auto& [binding, bytes] : std::initializer_list<std::pair<Binding, std::size_t>>{
+           {kFrames, frames * 4 * sizeof(std::uint32_t)},
+           {kFrameDepths, frames * L::DB_JUDGE_FRAME_DEPTHS * sizeof(double)},
+           {kFrameConstants, frames * L::DB_JUDGE_FRAME_WORDS * sizeof(std::uint32_t)},
+           {kRays, 3 * count * sizeof(double)},
+           {kCoverage, count * sizeof(std::uint32_t)},
+           {kEyeDepths, count * sizeof(double)},
+           {kPipelineFloats, pipeline_samples * sizeof(float)},
+           {kStoredFloats, slot_samples * sizeof(float)},
+           {kReference, 5 * slot_samples * sizeof(double)},
+           {kReferenceInfo, slot_samples * sizeof(std::uint32_t)}}) {
+    DB_RETURN_IF_ERROR(Grow(binding, bytes));
+  }
 
+  // Per frame. The frame's planes are read from the sample arrays at its
+  // first sample in the batch: the reference then starts from the very
+  // values the host's would.
   auto* frame_words = static_cast<std::uint32_t*>(buffers[kFrames].mapped());
+  auto* frame_depths = static_cast<double*>(buffers[kFrameDepths].mapped());
+  auto* frame_constants = static_cast<std::uint32_t*>(buffers[kFrameConstants].mapped());
+  const SampleArrays& samples = batch.samples;
   for (std::size_t f = 0; f < frames; ++f) {
     const glm::dvec3& camera = batch.frames[f].camera_position;  // float32 values (sampler.h)
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
     frame_words[4 * f + 3] = batch.distance_bands[f];
+    const std::size_t i = f == 0 ? 0 : f * kSamplesPerFrame - batch.first_offset;
+    double* depths = frame_depths + f * L::DB_JUDGE_FRAME_DEPTHS;
+    depths[0] = samples.near[i];
+    depths[1] = samples.far[i];
+    depths[2] = samples.depth_limit[i];
+    depths[3] = samples.interest_min[i];
+    depths[4] = samples.interest_max[i];
+    std::uint32_t* words = frame_constants + f * L::DB_JUDGE_FRAME_WORDS;
+    words[0] = samples.ratio_band[i];
+    words[1] = std::bit_cast<std::uint32_t>(batch.frame_params[f].camera_position.w);
+    for (int c = 0; c < kHardwareConventionCount; ++c) {
+      const f32::DepthParams& depth = batch.depth_params[f * kHardwareConventionCount + c];
+      words[2 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.x);
+      words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
+    }
   }
-  const ReferenceArrays& ref = batch.reference;
+  // Per sample, then per (pipeline, sample) and (slot, sample): chunks of
+  // each, in one loop.
   auto* rays = static_cast<double*>(buffers[kRays].mapped());
   auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
-  auto* reference = static_cast<double*>(buffers[kReference].mapped());
-  auto* info = static_cast<std::uint32_t*>(buffers[kReferenceInfo].mapped());
-  // Per sample, then per (slot, sample): chunks of both, in one loop.
+  auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
+  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
+  auto* stored_floats = static_cast<float*>(buffers[kStoredFloats].mapped());
   constexpr std::size_t kChunk = 16384;
   const std::size_t sample_chunks = (count + kChunk - 1) / kChunk;
+  const std::size_t pipeline_chunks = (pipeline_samples + kChunk - 1) / kChunk;
   const std::size_t slot_chunks = (slot_samples + kChunk - 1) / kChunk;
-  pool.ParallelFor(sample_chunks + slot_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor(sample_chunks + pipeline_chunks + slot_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
-      const bool per_sample = job < sample_chunks;
-      const std::size_t lo = (per_sample ? job : job - sample_chunks) * kChunk;
-      const std::size_t n = std::min(kChunk, (per_sample ? count : slot_samples) - lo);
-      if (per_sample) {
-        std::memcpy(rays + lo, batch.ray_x.data() + lo, n * sizeof(double));
-        std::memcpy(rays + count + lo, batch.ray_y.data() + lo, n * sizeof(double));
-        std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
-        for (std::size_t i = lo; i < lo + n; ++i) coverage[i] = static_cast<std::uint32_t>(batch.samples.coverage[i]);
+      if (job >= sample_chunks + pipeline_chunks) {
+        const std::size_t lo = (job - sample_chunks - pipeline_chunks) * kChunk;
+        std::memcpy(stored_floats + lo, batch.depths.data() + lo, std::min(kChunk, slot_samples - lo) * sizeof(float));
         continue;
       }
-      std::memcpy(reference + lo, ref.true_depth.data() + lo, n * sizeof(double));
-      std::memcpy(reference + slot_samples + lo, ref.denoted_depth.data() + lo, n * sizeof(double));
-      std::memcpy(reference + 2 * slot_samples + lo, ref.inverse_distance_sq.data() + lo, n * sizeof(double));
-      std::memcpy(reference + 3 * slot_samples + lo, ref.storage_square.data() + lo, n * sizeof(double));
-      std::memcpy(reference + 4 * slot_samples + lo, ref.production_square.data() + lo, n * sizeof(double));
-      for (std::size_t r = lo; r < lo + n; ++r) {
-        info[r] = ref.joint_band[r] | static_cast<std::uint32_t>(ref.status[r]) << 8 |
-                  static_cast<std::uint32_t>(ref.stored_holdable[r] != 0) << 16;
+      if (job >= sample_chunks) {
+        const std::size_t lo = (job - sample_chunks) * kChunk;
+        std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
+                    std::min(kChunk, pipeline_samples - lo) * sizeof(float));
+        continue;
+      }
+      const std::size_t lo = job * kChunk, n = std::min(kChunk, count - lo);
+      std::memcpy(rays + lo, batch.ray_x.data() + lo, n * sizeof(double));
+      std::memcpy(rays + count + lo, batch.ray_y.data() + lo, n * sizeof(double));
+      std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
+      std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
+      for (std::size_t i = lo; i < lo + n; ++i) {
+        coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
+                      static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
       }
     }
   });
-  for (Binding b : {kFrames, kRays, kCoverage, kReference, kReferenceInfo}) {
+  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats,
+                    kStoredFloats}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
   return Status::Ok();
@@ -249,13 +325,18 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
 
 // Points every binding at the bytes this batch uses.
 void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& batch) {
-  const std::size_t count = batch.count, slot_samples = batch.reference.true_depth.size();
+  const std::size_t count = batch.count, frames = batch.frames.size(), slot_samples = depth_slots * count;
   const std::array<VkDeviceSize, kBindingCount> bytes = {
-      cell_count() * sizeof(std::uint32_t),
+      accumulators() * sizeof(std::uint32_t),
       positions.bytes,
-      batch.frames.size() * 4 * sizeof(std::uint32_t),
+      frames * 4 * sizeof(std::uint32_t),
       3 * count * sizeof(double),
       count * sizeof(std::uint32_t),
+      frames * L::DB_JUDGE_FRAME_DEPTHS * sizeof(double),
+      frames * L::DB_JUDGE_FRAME_WORDS * sizeof(std::uint32_t),
+      count * sizeof(double),
+      pipelines * count * sizeof(float),
+      slot_samples * sizeof(float),
       5 * slot_samples * sizeof(double),
       slot_samples * sizeof(std::uint32_t),
       counts_bytes(),
@@ -279,12 +360,6 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), 0, half, 0u);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), half, half, 0xffffffffu);
-  // Those fills, and the reconstruction pass's positions (an earlier
-  // submission to the same queue), before the judge reads.
-  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  pass->Bind(commands, pipeline.get());
   L::JudgePass constants{.count = batch.count,
                          .lead = positions.lead,
                          .slice_length = positions.slice_length,
@@ -294,11 +369,21 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                          .phase = 0,
                          .record_distances = record_distances ? 1u : 0u,
                          .cells = static_cast<std::uint32_t>(cell_count()),
-                         .depth_slots = static_cast<std::uint32_t>(batch.reference.true_depth.size() / batch.count),
+                         .depth_slots = static_cast<std::uint32_t>(depth_slots),
                          .accumulators = static_cast<std::uint32_t>(accumulators()),
-                         .reserved2 = 0};
-  const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
+                         .exact_production = exact_production ? 1u : 0u};
   const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  // The reference of every (depth slot, sample).
+  pass->Bind(commands, reference_pipeline.get());
+  pass->PushConstants(commands, &constants, sizeof(constants));
+  vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(depth_slots), 1);
+  // The fills, the reference, and the reconstruction pass's positions (an
+  // earlier submission to the same queue), before the judge reads.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+  pass->Bind(commands, judge_pipeline.get());
+  const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
@@ -360,10 +445,39 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   DB_RETURN_IF_ERROR(s.pass->Submit(
       [&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
+  s.last_count = batch.count;
   DB_RETURN_IF_ERROR(s.MergeMaxima(cells, encodings));
   for (CellAccumulator& a : cells) a.Count(batch.count);
   for (CellAccumulator& a : encodings) a.Count(batch.count);
   return Status::Ok();
+}
+
+Expected<ReferenceArrays> DeviceJudge::LastReference() const {
+  const State& s = *state_;
+  const std::size_t slot_samples = s.depth_slots * s.last_count;
+  const VkDeviceSize doubles = 5 * slot_samples * sizeof(double), words = slot_samples * sizeof(std::uint32_t);
+  DB_ASSIGN_OR_RETURN(VulkanBuffer readback, s.context->CreateHostBuffer(doubles + words + 16,
+                                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                                         HostAccess::kReadback));
+  if (slot_samples > 0) {
+    DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) {
+      s.RecordReadback(commands, {{kReference, doubles}, {kReferenceInfo, words}}, readback);
+    }));
+  }
+  DB_RETURN_IF_ERROR(readback.InvalidateForHostReads());
+  const auto* values = static_cast<const double*>(readback.mapped());
+  const auto* info = reinterpret_cast<const std::uint32_t*>(values + 5 * slot_samples);
+  ReferenceArrays out;
+  out.Resize(slot_samples);
+  std::vector<double>* columns[] = {&out.true_depth, &out.denoted_depth, &out.inverse_distance_sq, &out.storage_square,
+                                    &out.production_square};
+  for (std::size_t c = 0; c < 5; ++c) std::copy_n(values + c * slot_samples, slot_samples, columns[c]->begin());
+  for (std::size_t r = 0; r < slot_samples; ++r) {
+    out.joint_band[r] = static_cast<std::uint8_t>(info[r] & 0xffu);
+    out.status[r] = static_cast<ReferenceStatus>((info[r] >> 8) & 0xffu);
+    out.stored_holdable[r] = static_cast<std::uint8_t>((info[r] >> 16) & 1u);
+  }
+  return out;
 }
 
 Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) {

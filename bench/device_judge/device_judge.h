@@ -1,23 +1,33 @@
-// DeviceJudge: the judge run where a Vulkan backend's outputs already are.
+// DeviceJudge: the reference and the judge run where a Vulkan backend's
+// outputs already are.
 //
 // The host judge (bench/pipeline/judge.h) reads every position back and
-// bins it on the host's cores; on a GPU that readback and those cores are
-// what the device waits for. Here the reconstruction pass leaves its
-// positions in device memory, the host uploads the batch's reference (per
-// sample the ray and coverage kind; per depth slot and sample the true and
-// the denoted depth, the inverse squared distance, the squared storage and
-// production errors, the band and the status), and
-// shaders/judge/judge.comp counts every error into histograms that stay on
-// the device: each cell's total, shader and absolute errors, and each
-// encoding's storage and production errors. The host reads
-// back only each batch's maxima (a few kilobytes) and, when a flush is due,
-// the histograms.
+// bins it on the host's cores, against a reference the host computed; on a
+// GPU that readback and those cores are what the device waits for. Here the
+// reconstruction pass leaves its positions in device memory and the host
+// uploads only what the reference starts from: per frame its planes and
+// float32 constants, per sample the ray, the eye depth and the coverage
+// kind, per pipeline and sample the float it produced, per depth slot and
+// sample the fetched texel. Two passes follow on the device:
+//   - shaders/judge/reference.comp decodes, in double-double, the depth
+//     each stored value and each pipeline float denotes, and computes the
+//     reference of every (depth slot, sample): true and denoted depth,
+//     inverse squared distance, squared storage and production errors,
+//     band and status;
+//   - shaders/judge/judge.comp counts every error into histograms that
+//     stay on the device: each cell's total, shader and absolute errors,
+//     and each encoding's storage and production errors.
+// The host reads back only each batch's maxima (a few kilobytes) and, when
+// a flush is due, the histograms.
 //
 // What it records equals the host judge's, bin for bin, count for count,
-// maximum and worst index included: the shader repeats the host's float64
-// operations in order and unfused, and reads bins from the same bits
-// (tests/device_judge_test.cc holds the two equal). The sampler, the
-// encoding and the reference stay with the host.
+// maximum and worst index included: both shaders repeat the host's float64
+// and double-double operations in order and unfused, and the judge reads
+// bins from the same bits (tests/device_judge_test.cc holds the reference
+// and the statistics equal). That needs the device's float64 add,
+// multiply, divide and fma to round as IEEE 754 says, which Vulkan does not
+// promise; docs/device-judge.md says what a device that differs would
+// change. The sampler and the encoding stay with the host.
 #pragma once
 
 #include <memory>
@@ -34,17 +44,20 @@ namespace depthbench {
 class DeviceJudge {
  public:
   // A judge on the device of `backend`, a Vulkan backend prepared for the
-  // compute form with the cells of `layout`. Unavailable, saying why, for
-  // another backend or form, or a device without float64 arithmetic and
-  // 64-bit atomics. `record_distances`: whether natural samples also go to
-  // their camera-distance band (CellAccumulator::records_distances).
+  // compute form with the cells of `layout`, for depths produced by
+  // `production` (kFloat32 or kExact). Unavailable, saying why, for
+  // another backend, form or production, or a device without float64
+  // arithmetic and 64-bit atomics. `record_distances`: whether natural
+  // samples also go to their camera-distance band
+  // (CellAccumulator::records_distances).
   static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,
-                                                       bool record_distances);
+                                                       ProductionModel production, bool record_distances);
   ~DeviceJudge();
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;
 
-  // Runs every cell of the layout on `batch` and judges the outputs on the
+  // Runs every cell of the layout on `batch` (built with or without the
+  // host's reference: HostReference) and judges the outputs on the
   // device. Each batch's maxima go straight into `cells` (one accumulator
   // per cell, in layout order) and, unless it is empty, `encodings` (one
   // per depth slot: the storage and production errors, which the device
@@ -55,6 +68,9 @@ class DeviceJudge {
   // The most samples one batch may have: the widest binding (the
   // reference of every depth slot) within the device's limit.
   std::uint64_t MaxBatchSamples() const;
+  // The reference the device computed for the last batch Judge was given,
+  // in the host's layout (for tests and diagnosis).
+  Expected<ReferenceArrays> LastReference() const;
   // Adds what the device counted since the last flush into the
   // accumulators (`encodings` as Judge was given them) and clears it there.
   // Due before any of them holds 2^31 samples.

@@ -22,22 +22,37 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
   return layout;
 }
 
-BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
-    : sampler_(sampler), encodings_(std::move(encodings)), model_(sampler.production()), isa_(isa) {
-  for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
+std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings) {
+  std::vector<std::uint32_t> pipeline_of_slot;
+  std::vector<std::uint32_t> first_slots;  // of each pipeline
+  for (std::uint32_t s = 0; s < encodings.size(); ++s) {
     auto shares = [&](std::uint32_t k) {
-      const Encoding a = encodings_[pipeline_slots_[k]], b = encodings_[s];
+      const Encoding a = encodings[first_slots[k]], b = encodings[s];
       return a.convention == b.convention && Info(a.format).stores == Info(b.format).stores;
     };
     std::uint32_t k = 0;
-    while (k < pipeline_slots_.size() && !shares(k)) ++k;
-    if (k == pipeline_slots_.size()) pipeline_slots_.push_back(s);
-    pipeline_of_slot_.push_back(k);
+    while (k < first_slots.size() && !shares(k)) ++k;
+    if (k == first_slots.size()) first_slots.push_back(s);
+    pipeline_of_slot.push_back(k);
+  }
+  return pipeline_of_slot;
+}
+
+BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
+    : sampler_(sampler),
+      encodings_(std::move(encodings)),
+      model_(sampler.production()),
+      isa_(isa),
+      pipeline_of_slot_(PipelineOfSlots(encodings_)) {
+  for (std::uint32_t s = 0; s < encodings_.size(); ++s) {
+    if (pipeline_of_slot_[s] == pipeline_slots_.size()) pipeline_slots_.push_back(s);
   }
 }
 
-void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const {
+void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
+                         HostReference reference) const {
   const std::size_t slots = encodings_.size();
+  const bool with_reference = reference == HostReference::kCompute;
   batch.first_index = first;
   batch.count = count;
   batch.first_offset = static_cast<std::uint32_t>(first % kSamplesPerFrame);
@@ -95,8 +110,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // stored texels, their decode and the reference.
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
-  for (auto* v : {&mapping_a_, &mapping_b_, &produced_}) v->resize(pipelines * count);
-  pipeline_floats_.resize(pipelines * count);
+  for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(pipelines * count);
+  produced_.resize(with_reference ? pipelines * count : 0);
+  batch.pipeline_floats.resize(pipelines * count);
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
@@ -119,7 +135,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         mapping_b_[k * count + i] = b;
       }
       const DepthMappings mapping = MappingOf(batch, k).At(lo);
-      float* floats = pipeline_floats_.data() + k * count + lo;
+      float* floats = batch.pipeline_floats.data() + k * count + lo;
       PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
       if (raster) {
         // The host's model of the rasterizer, where there is geometry (the
@@ -134,20 +150,22 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           if (value == value) floats[i - lo] = value;
         }
       }
-      DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);
+      if (with_reference) {
+        DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);
+      }
     }
   });
 
   batch.depths.resize(slots * count);
   batch.codes.resize(slots * count);
-  batch.reference.Resize(slots * count);
+  batch.reference.Resize(with_reference ? slots * count : 0);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
       const Encoding encoding = encodings_[s];
       const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
       const std::size_t at = s * count + lo;
-      StoreFloats(encoding.format, pipeline_floats_.data() + pipeline_of_slot_[s] * count + lo, n,
+      StoreFloats(encoding.format, batch.pipeline_floats.data() + pipeline_of_slot_[s] * count + lo, n,
                   batch.codes.data() + at, batch.depths.data() + at);
       // Stored-value picks: the edges of a hardware or linear format are
       // the same in every frame; view z's depend on the frame's far plane.
@@ -167,7 +185,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }
-      ReferenceChunk(batch, s, lo, n);
+      if (with_reference) ReferenceChunk(batch, s, lo, n);
     }
   });
 }
@@ -187,7 +205,7 @@ void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo
   // the depth that float does, decoded already under the same mapping:
   // only the others are decoded, gathered, four lanes at a time as ever.
   const float* stored = batch.depths.data() + at;
-  const float* produced_floats = pipeline_floats_.data() + pipeline * count + lo;
+  const float* produced_floats = batch.pipeline_floats.data() + pipeline * count + lo;
   std::array<std::uint32_t, kChunk> other;
   std::size_t others = 0;
   for (std::size_t i = 0; i < n; ++i) {

@@ -2,7 +2,7 @@
 // judge. The builder draws the samples, encodes every depth the run's cells
 // read, packs the shader inputs (the part a backend sees, shader_inputs.h)
 // and computes the reference for every (encoding, sample), which only the
-// judge reads.
+// judge reads (unless the judge computes it on its device: HostReference).
 #pragma once
 
 #include <cstdint>
@@ -27,10 +27,23 @@ struct Batch : ShaderInputs {
   std::vector<std::uint8_t> distance_bands;  // [frame]: DistanceBand of the camera
   std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
   SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
-  ReferenceArrays reference;                 // [depth slot * count + sample]
+  ReferenceArrays reference;                 // [depth slot * count + sample]; empty under HostReference::kSkip
+  // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
+  // count + sample].
+  std::vector<float> pipeline_floats;
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 };
+
+// The pipeline whose float each depth slot stores, [depth slot]: the
+// formats of one convention that store the same kind of value share one
+// (encode.h). Pipelines are numbered in the order their first slot comes.
+std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
+
+// Whether Build computes the reference: kSkip where every judge computes
+// its own (bench/device_judge/), which then starts from the stored and the
+// pipeline's floats.
+enum class HostReference : std::uint8_t { kCompute, kSkip };
 
 class BatchBuilder {
  public:
@@ -39,7 +52,8 @@ class BatchBuilder {
   BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa = Isa::kWidest);
 
   // Fills `batch` with samples [first, first + count).
-  void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool) const;
+  void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
+             HostReference reference = HostReference::kCompute) const;
 
   // The raster pipeline on a device: replaces the stored texels of the
   // samples that have geometry by the ones the device rendered (codes and
@@ -66,10 +80,9 @@ class BatchBuilder {
   // computed for encodings_[pipeline_slots_[k]].
   std::vector<std::uint32_t> pipeline_of_slot_;
   std::vector<std::uint32_t> pipeline_slots_;
-  // Reused across batches, [pipeline * count + sample]: the pipeline's
-  // floats, the float32 constants of their mapping (encode.h) and the
-  // depth each float denotes (the produced depth).
-  mutable std::vector<float> pipeline_floats_;
+  // Reused across batches, [pipeline * count + sample]: the float32
+  // constants of the pipelines' mappings (encode.h) and the depth each
+  // pipeline's float denotes (the produced depth).
   mutable std::vector<double> mapping_a_, mapping_b_, produced_;
 };
 

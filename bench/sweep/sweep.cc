@@ -72,10 +72,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudgeFor(JudgeSite site, Backend& b
   if (site == JudgeSite::kAuto && (!gpu || PassKindOf(production) != PassKind::kCompute)) {
     return std::unique_ptr<DeviceJudge>();
   }
-  if (PassKindOf(production) != PassKind::kCompute) {
-    return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
-  }
-  Expected<std::unique_ptr<DeviceJudge>> judge = DeviceJudge::Create(backend, layout, record_distances);
+  Expected<std::unique_ptr<DeviceJudge>> judge = DeviceJudge::Create(backend, layout, production, record_distances);
   if (!judge.ok() && site == JudgeSite::kAuto) return std::unique_ptr<DeviceJudge>();
   return judge;
 }
@@ -183,6 +180,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (const auto& judge : device_judges) {
     if (judge != nullptr) batch_size = std::min(batch_size, judge->MaxBatchSamples());
   }
+  // The host computes the reference only where it judges.
+  const bool host_judges = std::find(device_judges.begin(), device_judges.end(), nullptr) != device_judges.end();
+  const HostReference host_reference = host_judges ? HostReference::kCompute : HostReference::kSkip;
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
   };
@@ -223,7 +223,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // judged (base/interrupt.h); the caller marks it partial.
   for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
-    builder.Build(first, count, batch, pool);
+    builder.Build(first, count, batch, pool, host_reference);
     if (renderer != nullptr) {
       DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
     }

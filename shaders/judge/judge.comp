@@ -3,15 +3,15 @@
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
 // The judge on the device (bench/device_judge/device_judge.h): compares the
-// positions a reconstruction pass left in device memory with the host's
-// reference and counts the errors into histograms that stay on the device.
-// It records exactly what the host judge (bench/pipeline/judge.cc) records
-// for the total, shader (arith) and absolute errors, sample by sample: the
-// same float64 operations in the same order, none fused (`precise`), and
-// the same bins read from the bits of each square. A dispatch's workgroup
-// row y judges the y-th cell of the run, one sample per invocation; rows
-// past the cells record the storage and production errors of each depth
-// slot (shared/judge.h).
+// positions a reconstruction pass left in device memory with the reference
+// (reference.comp, run just before) and counts the errors into histograms
+// that stay on the device. It records exactly what the host judge
+// (bench/pipeline/judge.cc) records for the total, shader (arith) and
+// absolute errors, sample by sample: the same float64 operations in the
+// same order, none fused (`precise`), and the same bins read from the bits
+// of each square. A dispatch's workgroup row y judges the y-th cell of the
+// run, one sample per invocation; rows past the cells record the storage
+// and production errors of each depth slot (shared/judge.h).
 //
 // Two phases over the same batch: phase 0 adds bins and counts and raises
 // each slot's largest square (a 64-bit atomic maximum on its bits: squares
@@ -23,30 +23,7 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer CellSlots { uint depth_slot_of_cell[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
-// Per frame: the camera (float32 bits) and its camera-distance band.
-layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
-// Per sample: the world-space ray at unit eye depth, x then y then z
-// slices of `count` values; then the coverage kinds, one per sample.
-layout(std430, set = 0, binding = 3) readonly buffer Rays { double rays[]; };
-layout(std430, set = 0, binding = 4) readonly buffer Coverage { uint coverage[]; };
-// Per (depth slot, sample): true depth, denoted depth, inverse squared
-// distance, squared relative storage and production errors, each a slice
-// of slots * count values; and the packed joint band | status << 8 |
-// stored_holdable << 16.
-layout(std430, set = 0, binding = 5) readonly buffer Reference { double reference[]; };
-layout(std430, set = 0, binding = 6) readonly buffer ReferenceInfo { uint reference_info[]; };
-// Per (accumulator, slot): DB_JUDGE_SLOT_UINTS counters (bins, then counts).
-layout(std430, set = 0, binding = 7) buffer Counts { uint counts[]; };
-// Per (accumulator, slot): the smallest index of a non-finite finding.
-layout(std430, set = 0, binding = 8) buffer FirstNonFinite { uint64_t first_nonfinite[]; };
-// Per (accumulator, slot, metric): this batch's largest square's bits;
-// then, in the same order, the smallest index that reached it.
-layout(std430, set = 0, binding = 9) buffer Maxima { uint64_t maxima[]; };
-// Per cell: samples with a component the reconstruction never wrote.
-layout(std430, set = 0, binding = 10) buffer Unwritten { uint unwritten[]; };
-layout(push_constant) uniform Pass { JudgePass pass; };
+#include "bindings.glsl"
 
 // What the reconstruction pass leaves where it wrote nothing (the Vulkan
 // backend's kUnwrittenBits).
@@ -129,7 +106,7 @@ void record_encoding(uint k, uint s, uint i) {
     return;
   }
   uint slot_samples = pass.depth_slots * pass.count;
-  uint band = band_slot(info, coverage[i]);
+  uint band = band_slot(info, coverage[i] & 0xffu);
   uint64_t index = sample_index(i);
   record(k, band, 0u, reference[3u * slot_samples + r], index);
   record(k, band, 1u, reference[4u * slot_samples + r], index);
@@ -145,7 +122,7 @@ void main() {
     record_encoding(k, k - pass.cells, i);
     return;
   }
-  uint depth_slot = depth_slot_of_cell[k];
+  uint depth_slot = run_layout[k];
   uint element = pass.lead + i;
   uint base = k * 3u * pass.slice_length + element;
   vec3 p = vec3(positions[base], positions[base + pass.slice_length], positions[base + 2u * pass.slice_length]);
@@ -156,7 +133,7 @@ void main() {
     }
     return;
   }
-  uvec4 frame = frames[(i + pass.first_offset) / 64u];
+  uvec4 frame = frames[frame_of(i)];
   dvec3 camera = dvec3(uintBitsToFloat(frame.x), uintBitsToFloat(frame.y), uintBitsToFloat(frame.z));
   dvec3 ray = dvec3(rays[i], rays[pass.count + i], rays[2u * pass.count + i]);
   uint r = depth_slot * pass.count + i;
@@ -174,7 +151,7 @@ void main() {
   precise double total_sq = absolute_sq * inverse_distance_sq;
   precise double arith_sq = (a.x * a.x + a.y * a.y + a.z * a.z) * inverse_distance_sq;
 
-  uint kind = coverage[i];
+  uint kind = coverage[i] & 0xffu;
   bool natural = kind == 0u;
   uint band = band_slot(info, kind);
   uint distance = natural && pass.record_distances != 0u ? frame.w : kNoSlot;

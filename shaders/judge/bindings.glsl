@@ -1,0 +1,54 @@
+// The device judge's storage buffers (bench/device_judge/device_judge.cc's
+// Binding names them in this order), read by both of its passes: the
+// reference (reference.comp) and the judge (judge.comp). Sample i of a
+// batch lies in frame (i + pass.first_offset) / 64.
+
+// The run's layout: per cell, the depth slot it reads; then per depth slot
+// its encoding: what the format stores (0 window depth, 1 eye depth / far,
+// 2 view z) | DB_CONVENTION_* bits << 4 | hardware convention index << 8 |
+// pipeline << 16.
+layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
+// The positions the reconstruction pass wrote (the Vulkan backend's).
+layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
+// Per frame: the camera (float32 bits) and its camera-distance band.
+layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
+// Per sample: the world-space ray at unit eye depth, x then y then z
+// slices of `count` values.
+layout(std430, set = 0, binding = 3) readonly buffer Rays { double rays[]; };
+// Per sample: the coverage kind | 1 << 8 for a stored-value pick.
+layout(std430, set = 0, binding = 4) readonly buffer Coverage { uint coverage[]; };
+// Per frame, five doubles: near, far (0 for an infinite far plane), the
+// largest eye depth, and the eye depths of interest (lowest, highest).
+layout(std430, set = 0, binding = 5) readonly buffer FrameDepths { double frame_depths[]; };
+// Per frame, DB_JUDGE_FRAME_WORDS words: the far/near band, the linear
+// mapping's float32 far plane, then A and B (float32) of each hardware
+// convention.
+layout(std430, set = 0, binding = 6) readonly buffer FrameConstants { uint frame_constants[]; };
+// Per sample: the eye depth (the near plane for a stored-value pick).
+layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_depths[]; };
+// Per (pipeline, sample): the float32 the pipeline produced.
+layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { float pipeline_floats[]; };
+// Per (depth slot, sample): the value a texture fetch returns.
+layout(std430, set = 0, binding = 9) readonly buffer StoredFloats { float stored_floats[]; };
+
+// Written by the reference pass, read by the judge. Per (depth slot,
+// sample): true depth, denoted depth, inverse squared distance, squared
+// relative storage and production errors, each a slice of slots * count
+// values; and the packed joint band | status << 8 | stored_holdable << 16.
+layout(std430, set = 0, binding = 10) buffer Reference { double reference[]; };
+layout(std430, set = 0, binding = 11) buffer ReferenceInfo { uint reference_info[]; };
+
+// The judge's counters. Per (accumulator, slot): DB_JUDGE_SLOT_UINTS
+// counters (bins, then counts).
+layout(std430, set = 0, binding = 12) buffer Counts { uint counts[]; };
+// Per (accumulator, slot): the smallest index of a non-finite finding.
+layout(std430, set = 0, binding = 13) buffer FirstNonFinite { uint64_t first_nonfinite[]; };
+// Per (accumulator, slot, metric): this batch's largest square's bits;
+// then, in the same order, the smallest index that reached it.
+layout(std430, set = 0, binding = 14) buffer Maxima { uint64_t maxima[]; };
+// Per cell: samples with a component the reconstruction never wrote.
+layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
+
+layout(push_constant) uniform Pass { JudgePass pass; };
+
+uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }
