@@ -8,8 +8,11 @@
 // 2 view z) | DB_CONVENTION_* bits << 4 | hardware convention index << 8 |
 // pipeline << 16.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
+// Float32 values are read as their bits and made doubles by float_value:
+// a device may flush float32 subnormals to zero in arithmetic and
+// conversions (NVIDIA's does), and the host does not.
 // The positions the reconstruction pass wrote (the Vulkan backend's).
-layout(std430, set = 0, binding = 1) readonly buffer Positions { float positions[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Positions { uint position_bits[]; };
 // Per frame: the camera (float32 bits) and its camera-distance band.
 layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
 // Per sample: the world-space ray at unit eye depth, x then y then z
@@ -27,9 +30,9 @@ layout(std430, set = 0, binding = 6) readonly buffer FrameConstants { uint frame
 // Per sample: the eye depth (the near plane for a stored-value pick).
 layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_depths[]; };
 // Per (pipeline, sample): the float32 the pipeline produced.
-layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { float pipeline_floats[]; };
+layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { uint pipeline_float_bits[]; };
 // Per (depth slot, sample): the value a texture fetch returns.
-layout(std430, set = 0, binding = 9) readonly buffer StoredFloats { float stored_floats[]; };
+layout(std430, set = 0, binding = 9) readonly buffer StoredFloats { uint stored_float_bits[]; };
 
 // Written by the reference pass, read by the judge. Per (depth slot,
 // sample): true depth, denoted depth, inverse squared distance, squared
@@ -52,3 +55,12 @@ layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
 layout(push_constant) uniform Pass { JudgePass pass; };
 
 uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }
+
+// The float32 with these bits, exactly, subnormals included.
+double float_value(uint bits) {
+  if ((bits & 0x7f800000u) != 0u) {
+    return double(uintBitsToFloat(bits));  // normal, infinite or NaN
+  }
+  double magnitude = double(bits & 0x7fffffu) * 1.401298464324817e-45lf;  // 2^-149
+  return (bits >> 31u) != 0u ? -magnitude : magnitude;
+}

@@ -125,16 +125,16 @@ void main() {
   uint depth_slot = run_layout[k];
   uint element = pass.lead + i;
   uint base = k * 3u * pass.slice_length + element;
-  vec3 p = vec3(positions[base], positions[base + pass.slice_length], positions[base + 2u * pass.slice_length]);
-  if (floatBitsToUint(p.x) == kUnwrittenBits || floatBitsToUint(p.y) == kUnwrittenBits ||
-      floatBitsToUint(p.z) == kUnwrittenBits) {
+  uvec3 p = uvec3(position_bits[base], position_bits[base + pass.slice_length],
+                  position_bits[base + 2u * pass.slice_length]);
+  if (p.x == kUnwrittenBits || p.y == kUnwrittenBits || p.z == kUnwrittenBits) {
     if (pass.phase == 0u) {
       atomicAdd(unwritten[k], 1u);
     }
     return;
   }
   uvec4 frame = frames[frame_of(i)];
-  dvec3 camera = dvec3(uintBitsToFloat(frame.x), uintBitsToFloat(frame.y), uintBitsToFloat(frame.z));
+  dvec3 camera = dvec3(float_value(frame.x), float_value(frame.y), float_value(frame.z));
   dvec3 ray = dvec3(rays[i], rays[pass.count + i], rays[2u * pass.count + i]);
   uint r = depth_slot * pass.count + i;
   uint slots_count = pass.depth_slots * pass.count;
@@ -144,7 +144,7 @@ void main() {
   uint info = reference_info[r];
 
   // judge.cc's Errors, operation for operation.
-  precise dvec3 q = dvec3(p) - camera;
+  precise dvec3 q = dvec3(float_value(p.x), float_value(p.y), float_value(p.z)) - camera;
   precise dvec3 t = q - true_depth * ray;
   precise dvec3 a = q - denoted_depth * ray;
   precise double absolute_sq = t.x * t.x + t.y * t.y + t.z * t.z;

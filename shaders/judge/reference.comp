@@ -41,8 +41,9 @@ dvec2 eye_depth_from_window_depth(dvec2 near, dvec2 far, uint convention, dvec2 
 // The eye depth a float value denotes (encode.cc's DecodeValue), rounded
 // to double: under the exact mapping, or under the float32 constants A, B
 // (window depth) or far plane `a` (eye depth / far).
-double decode(uint stores, uint convention, double near, double far, double a, double b, float value) {
-  dvec2 v = dd(double(value));
+double decode(uint stores, uint convention, double near, double far, double a, double b, uint value_bits) {
+  double value = float_value(value_bits);
+  dvec2 v = dd(value);
   if (stores == kStoresWindowDepth) {
     if (pass.exact_production != 0u) {
       return eye_depth_from_window_depth(dd(near), dd(far), convention, v, dd_sub(dd(1.0lf), v)).x;
@@ -53,7 +54,7 @@ double decode(uint stores, uint convention, double near, double far, double a, d
   if (stores == kStoresLinear) {
     return dd_mul(v, dd(pass.exact_production != 0u ? far : a)).x;
   }
-  return -double(value);
+  return -value;
 }
 
 // bands.h's DecadeBand: the powers of ten up to x, at most count - 1.
@@ -92,10 +93,10 @@ void main() {
   double a = 0.0lf;
   double b = 0.0lf;
   if (stores == kStoresWindowDepth) {
-    a = double(uintBitsToFloat(frame_constants[fc + 2u + 2u * hardware]));
-    b = double(uintBitsToFloat(frame_constants[fc + 3u + 2u * hardware]));
+    a = float_value(frame_constants[fc + 2u + 2u * hardware]);
+    b = float_value(frame_constants[fc + 3u + 2u * hardware]);
   } else if (stores == kStoresLinear) {
-    a = double(uintBitsToFloat(frame_constants[fc + 1u]));
+    a = float_value(frame_constants[fc + 1u]);
   }
 
   // The sample (reference.cc's SampleArrays::Set).
@@ -105,8 +106,8 @@ void main() {
   precise double ray_length_sq = ray.x * ray.x + ray.y * ray.y + ray.z * ray.z;
   precise double eye_inverse_distance_sq = 1.0lf / (eye_depth * eye_depth * ray_length_sq);
 
-  double denoted_hi = decode(stores, convention, near, far, a, b, stored_floats[slot * pass.count + i]);
-  double produced_hi = decode(stores, convention, near, far, a, b, pipeline_floats[pipeline * pass.count + i]);
+  double denoted_hi = decode(stores, convention, near, far, a, b, stored_float_bits[slot * pass.count + i]);
+  double produced_hi = decode(stores, convention, near, far, a, b, pipeline_float_bits[pipeline * pass.count + i]);
 
   // reference.cc's ReferenceOf.
   double t = eye ? eye_depth : denoted_hi;
