@@ -57,7 +57,7 @@ enum Binding : std::uint32_t {
   kFrameConstants,
   kEyeDepths,
   kPipelineFloats,
-  kStoredFloats,
+  kTexels,  // the backend's
   kReference,
   kReferenceInfo,
   kCounts,
@@ -90,7 +90,7 @@ struct DeviceJudge::State {
   std::unique_ptr<ComputePass> pass;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
-  std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions unused: the backend owns it)
+  std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions and kTexels unused: the backend owns them)
   VulkanBuffer batch_readback;  // the maxima, then the unwritten counts
   VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
@@ -234,11 +234,9 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
 Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
   const std::size_t slot_samples = depth_slots * count, pipeline_samples = pipelines * count;
-  if (batch.depths.size() != slot_samples || batch.pipeline_floats.size() != pipeline_samples) {
-    return InvalidArgument(fmt::format("a batch of {} samples with {} stored and {} pipeline values, for {} depth "
-                                       "slots and {} pipelines",
-                                       count, batch.depths.size(), batch.pipeline_floats.size(), depth_slots,
-                                       pipelines));
+  if (batch.pipeline_floats.size() != pipeline_samples) {
+    return InvalidArgument(fmt::format("a batch of {} samples with {} pipeline values, for {} pipelines", count,
+                                       batch.pipeline_floats.size(), pipelines));
   }
   for (const auto& [binding, bytes] : std::initializer_list<std::pair<Binding, std::size_t>>{
            {kFrames, frames * 4 * sizeof(std::uint32_t)},
@@ -248,7 +246,6 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
            {kCoverage, count * sizeof(std::uint32_t)},
            {kEyeDepths, count * sizeof(double)},
            {kPipelineFloats, pipeline_samples * sizeof(float)},
-           {kStoredFloats, slot_samples * sizeof(float)},
            {kReference, 5 * slot_samples * sizeof(double)},
            {kReferenceInfo, slot_samples * sizeof(std::uint32_t)}}) {
     DB_RETURN_IF_ERROR(Grow(binding, bytes));
@@ -281,24 +278,17 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
   }
-  // Per sample, then per (pipeline, sample) and (slot, sample): chunks of
-  // each, in one loop.
+  // Per sample, then per (pipeline, sample): chunks of each, in one loop.
+  // (The texels are the backend's, in device memory already.)
   auto* rays = static_cast<double*>(buffers[kRays].mapped());
   auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
   auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
   auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
-  auto* stored_floats = static_cast<float*>(buffers[kStoredFloats].mapped());
   constexpr std::size_t kChunk = 16384;
   const std::size_t sample_chunks = (count + kChunk - 1) / kChunk;
   const std::size_t pipeline_chunks = (pipeline_samples + kChunk - 1) / kChunk;
-  const std::size_t slot_chunks = (slot_samples + kChunk - 1) / kChunk;
-  pool.ParallelFor(sample_chunks + pipeline_chunks + slot_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor(sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
-      if (job >= sample_chunks + pipeline_chunks) {
-        const std::size_t lo = (job - sample_chunks - pipeline_chunks) * kChunk;
-        std::memcpy(stored_floats + lo, batch.depths.data() + lo, std::min(kChunk, slot_samples - lo) * sizeof(float));
-        continue;
-      }
       if (job >= sample_chunks) {
         const std::size_t lo = (job - sample_chunks) * kChunk;
         std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
@@ -316,8 +306,7 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
       }
     }
   });
-  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats,
-                    kStoredFloats}) {
+  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
   return Status::Ok();
@@ -336,7 +325,7 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       frames * L::DB_JUDGE_FRAME_WORDS * sizeof(std::uint32_t),
       count * sizeof(double),
       pipelines * count * sizeof(float),
-      slot_samples * sizeof(float),
+      positions.texel_bytes,
       5 * slot_samples * sizeof(double),
       slot_samples * sizeof(std::uint32_t),
       counts_bytes(),
@@ -346,7 +335,8 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    infos[b] = {b == kPositions ? positions.buffer : buffers[b].handle(), 0, bytes[b]};
+    const VkBuffer backends = b == kPositions ? positions.buffer : b == kTexels ? positions.texels : VK_NULL_HANDLE;
+    infos[b] = {backends != VK_NULL_HANDLE ? backends : buffers[b].handle(), 0, bytes[b]};
     writes[b].dstBinding = b;
     writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[b].pBufferInfo = &infos[b];
@@ -438,7 +428,7 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   State& s = *state_;
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
-  DB_ASSIGN_OR_RETURN(const DevicePositions positions, RunLeavingOnDevice(*s.backend, batch, s.every_cell));
+  DB_ASSIGN_OR_RETURN(const DevicePositions positions, RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool));
   const ValidationScope validation(*s.context);
   DB_RETURN_IF_ERROR(s.Upload(batch, pool));
   s.Bind(positions, batch);

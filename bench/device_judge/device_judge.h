@@ -7,8 +7,9 @@
 // reconstruction pass leaves its positions in device memory and the host
 // uploads only what the reference starts from: per frame its planes and
 // float32 constants, per sample the ray, the eye depth and the coverage
-// kind, per pipeline and sample the float it produced, per depth slot and
-// sample the fetched texel. Two passes follow on the device:
+// kind, per pipeline and sample the float it produced; the fetched texels
+// are the ones the backend uploaded for its pass. Two passes follow on the
+// device:
 //   - shaders/judge/reference.comp decodes, in double-double, the depth
 //     each stored value and each pipeline float denotes, and computes the
 //     reference of every (depth slot, sample): true and denoted depth,

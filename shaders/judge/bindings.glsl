@@ -31,8 +31,9 @@ layout(std430, set = 0, binding = 6) readonly buffer FrameConstants { uint frame
 layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_depths[]; };
 // Per (pipeline, sample): the float32 the pipeline produced.
 layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { uint pipeline_float_bits[]; };
-// Per (depth slot, sample): the value a texture fetch returns.
-layout(std430, set = 0, binding = 9) readonly buffer StoredFloats { uint stored_float_bits[]; };
+// Per (depth slot, sample): the value a texture fetch returns, in the
+// backend's buffer, laid out as the positions are.
+layout(std430, set = 0, binding = 9) readonly buffer Texels { uint texel_bits[]; };
 
 // Written by the reference pass, read by the judge. Per (depth slot,
 // sample): true depth, denoted depth, inverse squared distance, squared

@@ -106,7 +106,7 @@ void main() {
   precise double ray_length_sq = ray.x * ray.x + ray.y * ray.y + ray.z * ray.z;
   precise double eye_inverse_distance_sq = 1.0lf / (eye_depth * eye_depth * ray_length_sq);
 
-  double denoted_hi = decode(stores, convention, near, far, a, b, stored_float_bits[slot * pass.count + i]);
+  double denoted_hi = decode(stores, convention, near, far, a, b, texel_bits[slot * pass.slice_length + pass.lead + i]);
   double produced_hi = decode(stores, convention, near, far, a, b, pipeline_float_bits[pipeline * pass.count + i]);
 
   // reference.cc's ReferenceOf.

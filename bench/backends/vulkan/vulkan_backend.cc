@@ -210,7 +210,8 @@ class VulkanBackend final : public Backend {
   std::vector<RasterAgreement> raster_agreement() const override {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
-  Expected<DevicePositions> RunLeavingOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which);
+  Expected<DevicePositions> RunLeavingOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                               ThreadPool* pool);
   const std::shared_ptr<VulkanContext>& context() const { return context_; }
   std::vector<std::uint32_t> raster_texels() const {
     return raster_ != nullptr ? raster_->texels() : std::vector<std::uint32_t>{};
@@ -231,7 +232,8 @@ class VulkanBackend final : public Backend {
                                                std::vector<float>& scratch);
   // The compute form's upload, dispatches and wait; the positions stay in
   // their buffer, laid out as the returned slices say.
-  Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which);
+  Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                   ThreadPool* pool = nullptr);
   // What either form would read out of bounds.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
   // What the compute form's device cannot address or dispatch.
@@ -240,7 +242,7 @@ class VulkanBackend final : public Backend {
                                  std::span<const std::uint32_t> which, const SliceLayout& slices) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
   Status Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
-                std::span<const f32::CellSlice> cell_slices);
+                std::span<const f32::CellSlice> cell_slices, ThreadPool* pool);
   void BindBuffers(const BindingBytes& bytes);
   void Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
               const DispatchPlan& plan) const;
@@ -426,18 +428,19 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
   return std::span<const float>(scratch);
 }
 
-Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which) {
+Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                               ThreadPool* pool) {
   const SliceLayout slices = SliceLayoutFor(batch, shape_);
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const DispatchPlan plan = PlanDispatches(cells_, which, slices);
-  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices));
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices, pool));
   DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); }));
   return slices;
 }
 
 Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
-                                                            std::span<const std::uint32_t> which) {
+                                                            std::span<const std::uint32_t> which, ThreadPool* pool) {
   if (raster_ != nullptr) {
     return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
   }
@@ -445,11 +448,15 @@ Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& 
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
   positions_access_ = HostAccess::kNone;
-  Expected<SliceLayout> slices = RunCompute(batch, which);
+  Expected<SliceLayout> slices = RunCompute(batch, which, pool);
   if (!slices.ok()) return slices.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
-  return DevicePositions{buffers_[kPositions].handle(), std::size_t{3} * which.size() * slices->length * sizeof(float),
-                         slices->lead, slices->length};
+  return DevicePositions{buffers_[kPositions].handle(),
+                         std::size_t{3} * which.size() * slices->length * sizeof(float),
+                         slices->lead,
+                         slices->length,
+                         buffers_[kStoredDepths].handle(),
+                         DepthSlotsOf(batch) * slices->length * sizeof(float)};
 }
 
 // Outputs a shader never wrote would be judged as if it had: refused, with
@@ -531,7 +538,7 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
 }
 
 Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
-                             std::span<const f32::CellSlice> cell_slices) {
+                             std::span<const f32::CellSlice> cell_slices, ThreadPool* pool) {
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
   }
@@ -548,9 +555,23 @@ Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slice
     std::memcpy(to + std::size_t{slices.lead} * 4, samples, std::size_t{batch.count} * 4);
     std::memset(to + end * 4, 0, (slices.length - end) * 4);
   };
-  put_slice(kPixels, 0, batch.pixels.data());
-  for (std::size_t slot = 0; slot < DepthSlotsOf(batch); ++slot) {
-    put_slice(kStoredDepths, slot, batch.depths.data() + slot * batch.count);
+  // Slice 0 of the pixels, then each depth slot's texels: on the pool's
+  // threads where there is one (at a GPU's rate one thread's copies are a
+  // visible share of a batch).
+  const auto put = [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t k = begin; k < end; ++k) {
+      if (k == 0) {
+        put_slice(kPixels, 0, batch.pixels.data());
+      } else {
+        put_slice(kStoredDepths, k - 1, batch.depths.data() + (k - 1) * batch.count);
+      }
+    }
+  };
+  const std::size_t slices_to_put = 1 + DepthSlotsOf(batch);
+  if (pool != nullptr) {
+    pool->ParallelFor(slices_to_put, put);
+  } else {
+    put(0, slices_to_put, 0);
   }
   for (std::uint32_t binding = 0; binding < kPositions; ++binding) {
     DB_RETURN_IF_ERROR(buffers_[binding].FlushHostWrites());
@@ -600,10 +621,10 @@ std::vector<std::uint32_t> RasterTexels(const Backend& backend) {
 }
 
 Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
-                                             std::span<const std::uint32_t> which) {
+                                             std::span<const std::uint32_t> which, ThreadPool* pool) {
   auto* vulkan = dynamic_cast<VulkanBackend*>(&backend);
   if (vulkan == nullptr) return Unavailable("the " + backend.name() + " backend keeps no outputs on a device");
-  return vulkan->RunLeavingOnDevice(batch, which);
+  return vulkan->RunLeavingOnDevice(batch, which, pool);
 }
 
 std::shared_ptr<VulkanContext> ContextOf(const Backend& backend) {

@@ -12,6 +12,7 @@
 
 #include "bench/backends/backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/base/thread_pool.h"
 
 namespace depthbench {
 
@@ -41,13 +42,18 @@ struct DevicePositions {
   VkDeviceSize bytes = 0;
   std::uint32_t lead = 0;
   std::uint32_t slice_length = 0;
+  // The fetched texels the pass read, laid out as the positions are: depth
+  // slot s's sample i at s * slice_length + lead + i.
+  VkBuffer texels = VK_NULL_HANDLE;
+  VkDeviceSize texel_bytes = 0;
 };
 // Runs the listed cells as Backend::Run does, but leaves their positions on
 // the device for a judge there (bench/device_judge/), valid until the
-// backend's next run: nothing is read back or checked on the host.
+// backend's next run: nothing is read back or checked on the host. `pool`,
+// where given, writes the upload.
 // Unavailable for a backend other than Vulkan's and for the raster form.
 Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
-                                             std::span<const std::uint32_t> which);
+                                             std::span<const std::uint32_t> which, ThreadPool* pool = nullptr);
 // The device a Vulkan backend runs on (null for any other backend).
 std::shared_ptr<VulkanContext> ContextOf(const Backend& backend);
 
