@@ -1,7 +1,9 @@
 #include "bench/sweep/sweep.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <numeric>
@@ -218,15 +220,12 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const std::uint64_t end = options.shard.End(options.samples);
   SweepProgress progress;
   progress.samples_total = end - begin;
-  Batch batch;
-  // On SIGINT or SIGTERM the sweep stops between batches and returns what it
-  // judged (base/interrupt.h); the caller marks it partial.
-  for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size) {
-    const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
-    builder.Build(first, count, batch, pool, host_reference);
-    if (renderer != nullptr) {
-      DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
-    }
+  // What follows the build of a batch: every backend runs and is judged,
+  // the accumulators flush where due, progress is reported. `stage_pool`
+  // serves it: the sweep's pool, or where it overlaps the next build, a
+  // pool of its own.
+  const auto judge_batch = [&](const Batch& batch, ThreadPool& stage_pool) -> Status {
+    const std::uint32_t count = batch.count;
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];
       CellAccumulator* acc = accumulators.data() + b * cell_count;
@@ -243,11 +242,11 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (device_judges[b] != nullptr) {
-        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), encodings_of(b), pool)
+        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), encodings_of(b), stage_pool)
                                .WithContext("running and judging on the " + backend.name() + " backend"));
       } else if (backend.concurrent()) {
         FirstError error;
-        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
+        stage_pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned worker) {
           for (std::size_t next = lo; next < hi; ++next) {
             const std::uint32_t slot = slot_order[next];
             auto out = backend.Run(batch, cells_of_slot[slot], scratch[worker]);
@@ -265,7 +264,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
         auto out = backend.Run(batch, every_cell, scratch[0]);
         if (!out.ok()) return out.status().WithContext("running the " + backend.name() + " backend");
         const std::span<const float> positions = *out;
-        pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
+        stage_pool.ParallelFor(slot_count, [&](std::size_t lo, std::size_t hi, unsigned) {
           for (std::size_t next = lo; next < hi; ++next) {
             const std::uint32_t slot = slot_order[next];
             judge(slot, [&](std::uint32_t c) { return positions.subspan(c * per_cell, per_cell); });
@@ -284,7 +283,40 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     progress.reconstructions_done += static_cast<std::uint64_t>(count) * cell_count * backends.size();
     progress.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (options.progress) options.progress(progress);
+    return Status::Ok();
+  };
+
+  // Where every backend judges on its device, the host builds the next
+  // batch while the devices take the last one: two batches in turn, and the
+  // judging stage on a thread of its own with a small pool for its uploads
+  // (they are copies into device memory; the build has the cores).
+  // Otherwise the host's judge needs the pool, and the stages take turns.
+  const bool overlap = host_reference == HostReference::kSkip;
+  std::unique_ptr<ThreadPool> stage_pool;
+  if (overlap) stage_pool = std::make_unique<ThreadPool>(std::min(4u, pool.size()));
+  std::array<Batch, 2> batches;
+  std::future<Status> judging;  // the stage of the batch before, while it runs
+  const auto finish_judging = [&]() -> Status { return judging.valid() ? judging.get() : Status::Ok(); };
+  std::size_t turn = 0;
+  // On SIGINT or SIGTERM the sweep stops between batches and returns what it
+  // judged (base/interrupt.h); the caller marks it partial.
+  for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size, turn ^= 1) {
+    const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
+    Batch& batch = batches[turn];
+    builder.Build(first, count, batch, pool, host_reference);
+    if (renderer != nullptr) {
+      DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
+    }
+    if (!overlap) {
+      DB_RETURN_IF_ERROR(judge_batch(batch, pool));
+      continue;
+    }
+    DB_RETURN_IF_ERROR(finish_judging());
+    judging = std::async(std::launch::async, [&judge_batch, &batch, &stage_pool] {
+      return judge_batch(batch, *stage_pool);
+    });
   }
+  DB_RETURN_IF_ERROR(finish_judging());
 
   // The last flush, on the pool: each accumulator is its own.
   DB_RETURN_IF_ERROR(flush_devices(false));
