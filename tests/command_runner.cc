@@ -6,10 +6,15 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
+#include <string>
+#include <system_error>
 #include <thread>
+#include <vector>
 
 namespace depthbench::testing {
 
@@ -68,11 +73,38 @@ CommandResult FinishDepthbench(const StartedCommand& started) {
 
 CommandResult RunDepthbench(const std::vector<std::string>& args) { return FinishDepthbench(StartDepthbench(args)); }
 
+namespace {
+
+// The directories MakeTempDir made, removed when the test program ends
+// (by the process that made them: a forked child leaves them alone), or
+// kept for a look at a failure with DEPTHBENCH_KEEP_TEST_DIRS=1.
+class TempDirs {
+ public:
+  ~TempDirs() {
+    if (::getpid() != owner_ || std::getenv("DEPTHBENCH_KEEP_TEST_DIRS") != nullptr) return;
+    std::error_code ignored;
+    for (const std::string& dir : dirs_) std::filesystem::remove_all(dir, ignored);
+  }
+  void Add(std::string dir) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(std::move(dir));
+  }
+
+ private:
+  pid_t owner_ = ::getpid();
+  std::mutex mutex_;
+  std::vector<std::string> dirs_;
+};
+TempDirs temp_dirs;
+
+}  // namespace
+
 std::string MakeTempDir(const std::string& name) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("depthbench_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  temp_dirs.Add(dir.string());
   return dir.string();
 }
 

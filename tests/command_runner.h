@@ -37,7 +37,8 @@ struct StartedCommand {
 StartedCommand StartDepthbench(const std::vector<std::string>& args);
 CommandResult FinishDepthbench(const StartedCommand& started);
 
-// A fresh empty directory under the system's temporary directory.
+// A fresh empty directory under the system's temporary directory, removed
+// when the test program ends (kept with DEPTHBENCH_KEEP_TEST_DIRS=1).
 std::string MakeTempDir(const std::string& name);
 
 // Copies the source tree's shaders/ and shared/ into `dir`, so that a test
