@@ -53,8 +53,12 @@ for name in libGLdispatch.so.0 libEGL.so.1 libGLX.so.0 libGL.so.1 libOpenGL.so.0
     fi
   done
 done
-for object in "$binary" $glvnd; do
-  if [ "$object" != "$binary" ]; then cp -L "$object" "$out/lib/"; fi
+# The batch-building benchmark too, where it was built (bin/; it measures
+# the host's share of a sweep on the GPU machine's own cores).
+microbench="$build/bench/depthbench_batch_microbench"
+if [ -x "$microbench" ]; then cp "$microbench" "$out/bin/"; else microbench=""; fi
+for object in "$binary" $microbench $glvnd; do
+  if [ "$object" != "$binary" ] && [ "$object" != "$microbench" ]; then cp -L "$object" "$out/lib/"; fi
   ldd "$object" | awk '$2 == "=>" && $3 ~ /^\// { print $3 }' | while read -r library; do
     case $(basename "$library") in
       libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*|libstdc++.so.*|libgcc_s.so.*) ;;
