@@ -93,6 +93,9 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name) {
   ASSERT_TRUE(host.ok()) << host.status().message();
   ASSERT_TRUE(device.ok()) << device.status().message();
   ASSERT_EQ(host->cells.size(), device->cells.size());
+  // The results say where each was judged.
+  EXPECT_EQ(host->run.backends.at(0).judge, "host");
+  EXPECT_EQ(device->run.backends.at(0).judge, "device");
   Reached reached;
   for (std::size_t c = 0; c < host->cells.size(); ++c) {
     const CellStats& a = host->cells[c].stats;

@@ -163,7 +163,8 @@ json ToJson(const Results& results) {
     backends.push_back({{"name", b.name},
                         {"device", DeviceToJson(b.device)},
                         {"shaders", b.program.shaders},
-                        {"program_hash", b.program.hash}});
+                        {"program_hash", b.program.hash},
+                        {"judge", b.judge}});
   }
   json run_cells = json::array();
   for (const Cell& c : run.cells) run_cells.push_back(c.Name());
@@ -389,6 +390,12 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
     DB_ASSIGN_OR_RETURN(record.program.shaders, b.String("shaders"));
     DB_ASSIGN_OR_RETURN(record.program.hash, b.String("program_hash"));
+    if (b.Has("judge")) {  // (older files lack it: judged on the host)
+      DB_RETURN_IF_ERROR(StoreInto(b.String("judge"), record.judge));
+      if (record.judge != "host" && record.judge != "device") {
+        return b.Error("judge must be \"host\" or \"device\", not \"" + record.judge + "\"");
+      }
+    }
     run.backends.push_back(record);
     return Status::Ok();
   }));

@@ -51,6 +51,10 @@ struct BackendRecord {
   std::string name;  // "cpu", "vulkan"
   DeviceInfo device;
   ProgramInfo program;  // what its formulas were built from
+  // Where its outputs were judged: "host", or "device" (bench/device_judge/).
+  // Not part of a sweep's identity: both give the same figures, so shards
+  // judged either way merge.
+  std::string judge = "host";
 };
 
 struct RunInfo {

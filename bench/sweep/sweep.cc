@@ -171,6 +171,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
                                                 options.domain.production),
                                  device_judges[b])
                            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
+    if (device_judges[b] != nullptr) run.backends[b].judge = "device";
   }
   // A batch no backend can take whole is cut to what the smallest takes.
   bool gpu_judges = false;
