@@ -38,6 +38,9 @@ static_assert(L::DB_JUDGE_HARDWARE_CONVENTIONS == kHardwareConventionCount &&
               L::DB_JUDGE_FRAME_WORDS == 2 + 2 * L::DB_JUDGE_HARDWARE_CONVENTIONS);
 static_assert(L::DB_JUDGE_DEPTH_BANDS == kDepthBands && L::DB_JUDGE_INFINITE_RATIO_BAND == kInfiniteRatioBand);
 static_assert(kSamplesPerFrame == 64);  // bindings.glsl's frame_of
+static_assert(L::DB_JUDGE_STORES_WINDOW_DEPTH == static_cast<unsigned>(DepthInput::kHardware) &&
+              L::DB_JUDGE_STORES_LINEAR == static_cast<unsigned>(DepthInput::kLinear) &&
+              L::DB_JUDGE_STORES_VIEW_Z == static_cast<unsigned>(DepthInput::kViewZ));
 
 // The metrics the device records, in its order, as the host numbers them:
 // a cell's, and a depth slot's (its third is unused).
@@ -74,12 +77,15 @@ bool DeviceOnly(Binding b) { return b >= kReference; }
 
 // What the reference pass needs of a depth slot's encoding
 // (bindings.glsl's Layout): what the format stores, the convention's bits
-// and hardware index, and the slot's pipeline.
+// and hardware index, whether its far plane is at infinity, and the slot's
+// pipeline.
 std::uint32_t EncodingWord(Encoding encoding, std::uint32_t pipeline) {
   const ConventionInfo& convention = Info(encoding.convention);
   const auto hardware = convention.hardware ? static_cast<std::uint32_t>(encoding.convention) : 0u;
+  // As reference.cc's ReferencesBody reads a far plane at infinity.
+  const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
   return static_cast<std::uint32_t>(Info(encoding.format).stores) | (convention.bits & 0xfu) << 4 | hardware << 8 |
-         pipeline << 16;
+         (infinite_far ? 1u : 0u) << 12 | pipeline << 16;
 }
 
 }  // namespace

@@ -4,9 +4,9 @@
 // batch lies in frame (i + pass.first_offset) / 64.
 
 // The run's layout: per cell, the depth slot it reads; then per depth slot
-// its encoding: what the format stores (0 window depth, 1 eye depth / far,
-// 2 view z) | DB_CONVENTION_* bits << 4 | hardware convention index << 8 |
-// pipeline << 16.
+// its encoding: what the format stores (DB_JUDGE_STORES_*) |
+// DB_CONVENTION_* bits << 4 | hardware convention index << 8 | 1 << 12
+// for a far plane at infinity | pipeline << 16.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and

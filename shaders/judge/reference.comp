@@ -20,8 +20,6 @@ layout(local_size_x = 64) in;
 #include "bindings.glsl"
 #include "double_double.glsl"
 
-const uint kStoresWindowDepth = 0u;
-const uint kStoresLinear = 1u;
 // reference.cc's kPlaneSlack (2^-20) and kLargestFloatSquared.
 const double kPlaneSlack = 9.5367431640625e-7lf;
 const double kLargestFloatSquared = 3.4028234663852886e+38lf * 3.4028234663852886e+38lf;
@@ -44,14 +42,14 @@ dvec2 eye_depth_from_window_depth(dvec2 near, dvec2 far, uint convention, dvec2 
 double decode(uint stores, uint convention, double near, double far, double a, double b, uint value_bits) {
   double value = float_value(value_bits);
   dvec2 v = dd(value);
-  if (stores == kStoresWindowDepth) {
+  if (stores == DB_JUDGE_STORES_WINDOW_DEPTH) {
     if (pass.exact_production != 0u) {
       return eye_depth_from_window_depth(dd(near), dd(far), convention, v, dd_sub(dd(1.0lf), v)).x;
     }
     dvec2 ndc = (convention & DB_CONVENTION_CLIP_MINUS_ONE) == 0u ? v : dd_sub(dd_mul(v, dd(2.0lf)), dd(1.0lf));
     return dd_div(dd(b), dd_sub(ndc, dd(a))).x;
   }
-  if (stores == kStoresLinear) {
+  if (stores == DB_JUDGE_STORES_LINEAR) {
     return dd_mul(v, dd(pass.exact_production != 0u ? far : a)).x;
   }
   return -value;
@@ -77,9 +75,9 @@ void main() {
   uint encoding = run_layout[pass.cells + slot];
   uint stores = encoding & 0xfu;
   uint convention = (encoding >> 4u) & 0xfu;
-  uint hardware = (encoding >> 8u) & 0xffu;
+  uint hardware = (encoding >> 8u) & 0xfu;
+  bool infinite_far = ((encoding >> 12u) & 1u) != 0u;
   uint pipeline = encoding >> 16u;
-  bool infinite_far = stores == kStoresWindowDepth && (convention & DB_CONVENTION_INFINITE) != 0u;
 
   uint frame = frame_of(i);
   uint fd = frame * DB_JUDGE_FRAME_DEPTHS;
@@ -92,10 +90,10 @@ void main() {
   uint ratio_band = frame_constants[fc];
   double a = 0.0lf;
   double b = 0.0lf;
-  if (stores == kStoresWindowDepth) {
+  if (stores == DB_JUDGE_STORES_WINDOW_DEPTH) {
     a = float_value(frame_constants[fc + 2u + 2u * hardware]);
     b = float_value(frame_constants[fc + 3u + 2u * hardware]);
-  } else if (stores == kStoresLinear) {
+  } else if (stores == DB_JUDGE_STORES_LINEAR) {
     a = float_value(frame_constants[fc + 1u]);
   }
 
