@@ -295,13 +295,13 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   const bool overlap = host_reference == HostReference::kSkip;
   std::unique_ptr<ThreadPool> stage_pool;
   if (overlap) stage_pool = std::make_unique<ThreadPool>(std::min(4u, pool.size()));
-  std::array<Batch, 2> batches;
-  std::future<Status> judging;  // the stage of the batch before, while it runs
+  std::array<Batch, 2> batches;  // (the second only where the stages overlap)
+  std::future<Status> judging;   // the stage of the batch before, while it runs
   const auto finish_judging = [&]() -> Status { return judging.valid() ? judging.get() : Status::Ok(); };
   std::size_t turn = 0;
   // On SIGINT or SIGTERM the sweep stops between batches and returns what it
   // judged (base/interrupt.h); the caller marks it partial.
-  for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size, turn ^= 1) {
+  for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size, turn = overlap ? turn ^ 1 : 0) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     Batch& batch = batches[turn];
     builder.Build(first, count, batch, pool, host_reference);
