@@ -113,7 +113,10 @@ bool Parse(const fs::path& file, const std::string& tmp, Case& c, std::string& e
 }
 
 bool Shell(const std::string& tmp, const std::string& command) {
-  const std::string line = "cd '" + tmp + "' && " + command;
+  // `cd` on a line of its own: after `cd DIR && COMMAND`, a `&` inside
+  // COMMAND would put the cd in the background job too, and the rest of
+  // the line would run in the test's own folder.
+  const std::string line = "cd '" + tmp + "' || exit 1\n" + command;
   return std::system(line.c_str()) == 0;
 }
 
