@@ -104,6 +104,23 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       },
       256);
 
+  // The samples of each chunk that pick a stored value (a few percent),
+  // listed once for every depth slot's loop below: [chunk * kChunk + k].
+  const std::size_t chunks = (count + kChunk - 1) / kChunk;
+  edge_samples_.resize(chunks * kChunk);
+  edge_counts_.resize(chunks);
+  pool.ParallelFor(chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t c = begin; c < end; ++c) {
+      std::uint32_t* list = edge_samples_.data() + c * kChunk;
+      std::uint32_t listed = 0;
+      for (std::size_t i = c * kChunk; i < std::min<std::size_t>(count, (c + 1) * kChunk); ++i) {
+        list[listed] = static_cast<std::uint32_t>(i);
+        listed += batch.samples.pick[i] != DepthPick::kEyeDepth ? 1 : 0;
+      }
+      edge_counts_[c] = listed;
+    }
+  });
+
   // Encodings, in chunks of samples, each loop over arrays: per pipeline
   // (shared by a convention's formats) the mapping's float32 constants, the
   // pipeline's floats and the depths they denote; then per depth slot the
@@ -113,7 +130,6 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(pipelines * count);
   produced_.resize(with_reference ? pipelines * count : 0);
   batch.pipeline_floats.resize(pipelines * count);
-  const std::size_t chunks = (count + kChunk - 1) / kChunk;
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t k = job / chunks;
@@ -121,8 +137,11 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       const Encoding encoding = encodings_[pipeline_slots_[k]];
       const std::size_t convention = static_cast<std::size_t>(encoding.convention);
       const DepthInput stores = Info(encoding.format).stores;
-      for (std::size_t i = lo; i < lo + n; ++i) {
+      // One frame's samples at a time: they share its constants.
+      for (std::size_t i = lo; i < lo + n;) {
         const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
+        const std::size_t frame_end =
+            std::min<std::size_t>(lo + n, std::size_t{frame + 1} * kSamplesPerFrame - batch.first_offset);
         double a = 0.0, b = 0.0;
         if (stores == DepthInput::kHardware) {
           const f32::DepthParams& depth = batch.depth_params[frame * kHardwareConventionCount + convention];
@@ -131,8 +150,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         } else if (stores == DepthInput::kLinear) {
           a = batch.frame_params[frame].camera_position.w;
         }
-        mapping_a_[k * count + i] = a;
-        mapping_b_[k * count + i] = b;
+        std::fill(mapping_a_.begin() + k * count + i, mapping_a_.begin() + k * count + frame_end, a);
+        std::fill(mapping_b_.begin() + k * count + i, mapping_b_.begin() + k * count + frame_end, b);
+        i = frame_end;
       }
       const DepthMappings mapping = MappingOf(batch, k).At(lo);
       float* floats = batch.pipeline_floats.data() + k * count + lo;
@@ -176,9 +196,10 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           edges[pick] = EncodeEdge(encoding, batch.frames.front(), static_cast<DepthPick>(pick));
         }
       }
-      for (std::size_t i = lo; i < lo + n; ++i) {
+      const std::size_t chunk = job % chunks;
+      for (const std::uint32_t i :
+           std::span(edge_samples_.data() + chunk * kChunk, edge_counts_[chunk])) {
         const DepthPick pick = samples.pick[i];
-        if (pick == DepthPick::kEyeDepth) continue;
         const StoredDepth edge =
             per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
                       : edges[static_cast<int>(pick)];

@@ -84,6 +84,9 @@ class BatchBuilder {
   // constants of the pipelines' mappings (encode.h) and the depth each
   // pipeline's float denotes (the produced depth).
   mutable std::vector<double> mapping_a_, mapping_b_, produced_;
+  // The samples that pick a stored value, [chunk * kChunk + k] for k below
+  // edge_counts_[chunk].
+  mutable std::vector<std::uint32_t> edge_samples_, edge_counts_;
 };
 
 }  // namespace depthbench

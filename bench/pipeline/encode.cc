@@ -104,27 +104,29 @@ Float4 ExactPipelineFloat4(Encoding encoding, const double* near, const double* 
   return Float4{};
 }
 
-// Steps 1 and 2 for four samples under kFloat32: every operation in
-// float32 (the vector types round each one; -ffp-contract=off keeps a
-// multiply and an add from fusing).
-Float4 Float32PipelineFloat4(Encoding encoding, const double* a, const double* b, const double* z) {
-  Float4 fa, fb, fz;
-  for (int k = 0; k < 4; ++k) {
-    fa[k] = static_cast<float>(a[k]);
-    fb[k] = static_cast<float>(b[k]);
-    fz[k] = static_cast<float>(z[k]);  // the view-space depth an engine holds
-  }
+// Steps 1 and 2 under kFloat32 for n samples: every operation in float32,
+// on the view-space depth an engine holds and the mapping's float32
+// constants. The switch stands outside the loops, which the compiler then
+// runs in SIMD lanes (-ffp-contract=off keeps a multiply and an add from
+// fusing).
+void Float32PipelineFloats(Encoding encoding, const double* a, const double* b, const double* z, std::size_t n,
+                           float* out) {
+  const auto f = [](double x) { return static_cast<float>(x); };
   switch (Info(encoding.format).stores) {
-    case DepthInput::kHardware: {
-      const Float4 clip = fa * fz + fb;
-      const Float4 ndc = clip / fz;
-      if ((Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) return ndc;
-      return ndc * 0.5f + 0.5f;
-    }
-    case DepthInput::kLinear: return fz / fa;
-    case DepthInput::kViewZ: return -fz;
+    case DepthInput::kHardware:
+      if ((Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) {
+        for (std::size_t i = 0; i < n; ++i) out[i] = (f(a[i]) * f(z[i]) + f(b[i])) / f(z[i]);
+      } else {
+        for (std::size_t i = 0; i < n; ++i) out[i] = (f(a[i]) * f(z[i]) + f(b[i])) / f(z[i]) * 0.5f + 0.5f;
+      }
+      return;
+    case DepthInput::kLinear:
+      for (std::size_t i = 0; i < n; ++i) out[i] = f(z[i]) / f(a[i]);
+      return;
+    case DepthInput::kViewZ:
+      for (std::size_t i = 0; i < n; ++i) out[i] = -f(z[i]);
+      return;
   }
-  return Float4{};
 }
 
 }  // namespace
@@ -150,20 +152,20 @@ void FrameMapping(Encoding encoding, const Frame& frame, double& a, double& b) {
 
 void PipelineFloats(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const double* eye_depth,
                     std::size_t n, float* out) {
+  if (model == ProductionModel::kFloat32) {
+    Float32PipelineFloats(encoding, mapping.a, mapping.b, eye_depth, n, out);
+    return;
+  }
   for (std::size_t i = 0; i < n; i += 4) {
-    double lanes[5][4];
+    double lanes[3][4];
     for (std::size_t k = 0; k < 4; ++k) {
       const std::size_t at = i + k < n ? i + k : n - 1;  // pad the tail
       lanes[0][k] = mapping.near[at];
       lanes[1][k] = mapping.far[at];
       lanes[2][k] = eye_depth[at];
-      lanes[3][k] = mapping.a[at];
-      lanes[4][k] = mapping.b[at];
     }
-    const Float4 f = model == ProductionModel::kExact
-                         ? ExactPipelineFloat4(encoding, lanes[0], lanes[1], lanes[2],
-                                               static_cast<int>(std::min<std::size_t>(4, n - i)))
-                         : Float32PipelineFloat4(encoding, lanes[3], lanes[4], lanes[2]);
+    const Float4 f = ExactPipelineFloat4(encoding, lanes[0], lanes[1], lanes[2],
+                                         static_cast<int>(std::min<std::size_t>(4, n - i)));
     for (std::size_t k = 0; k < 4 && i + k < n; ++k) out[i + k] = f[k];
   }
 }
