@@ -19,7 +19,7 @@
 namespace depthbench {
 namespace {
 
-constexpr std::uint32_t kBatch = 65536;  // the sweep's default where a GPU judges
+constexpr std::uint32_t kBatch = 131072;  // the sweep's kDeviceJudgeBatch, its default where a GPU judges
 
 void BM_BuildBatch(benchmark::State& state, HostReference reference) {
   const Domain domain = TypicalDomain();

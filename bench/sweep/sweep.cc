@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <numeric>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -147,7 +148,6 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
 
   const Sampler sampler(options.seed, options.domain);
   const BatchBuilder builder(sampler, layout.encodings, options.isa);
-  ThreadPool pool(options.threads);
   const std::size_t cell_count = layout.cells.size();
   std::vector<CellAccumulator> accumulators(backends.size() * cell_count);
   std::vector<CellStats> stats(backends.size() * cell_count);
@@ -186,6 +186,17 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // The host computes the reference only where it judges.
   const bool host_judges = std::find(device_judges.begin(), device_judges.end(), nullptr) != device_judges.end();
   const HostReference host_reference = host_judges ? HostReference::kCompute : HostReference::kSkip;
+  // Where every backend judges on its device, the host builds the next
+  // batch while the devices take the last one (below): the threads are
+  // shared out between the two stages, a quarter (at most 4) to the
+  // devices' copies, so that neither stage's threads wait for a core. On
+  // an H200's 16 cores 12 + 4 ran 14% faster than 16 + 4
+  // (reports/device-judge/h200.txt).
+  const bool overlap = host_reference == HostReference::kSkip;
+  const unsigned threads =
+      options.threads != 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned stage_threads = overlap ? std::clamp(threads / 4, 1u, 4u) : 0u;
+  ThreadPool pool(std::max(1u, threads - stage_threads));
   const auto accumulators_of = [&](std::size_t b) {
     return std::span<CellAccumulator>(accumulators.data() + b * cell_count, cell_count);
   };
@@ -290,11 +301,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // Where every backend judges on its device, the host builds the next
   // batch while the devices take the last one: two batches in turn, and the
   // judging stage on a thread of its own with a small pool for its uploads
-  // (they are copies into device memory; the build has the cores).
+  // (they are copies into device memory; the build has most of the cores).
   // Otherwise the host's judge needs the pool, and the stages take turns.
-  const bool overlap = host_reference == HostReference::kSkip;
   std::unique_ptr<ThreadPool> stage_pool;
-  if (overlap) stage_pool = std::make_unique<ThreadPool>(std::min(4u, pool.size()));
+  if (overlap) stage_pool = std::make_unique<ThreadPool>(stage_threads);
   std::array<Batch, 2> batches;  // (the second only where the stages overlap)
   std::future<Status> judging;   // the stage of the batch before, while it runs
   const auto finish_judging = [&]() -> Status { return judging.valid() ? judging.get() : Status::Ok(); };

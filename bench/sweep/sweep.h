@@ -38,11 +38,13 @@ enum class JudgeSite { kAuto, kHost, kDevice };
 
 // Default batch sizes, the fastest measured. On the host, a batch's
 // arrays and the accumulators they reach stay in cache. With the judge on
-// an H200 (reports/device-judge/h200.txt) 65536 ran at 765 M
-// reconstructions/s, against 599 at 16384 and 575 at 2^20, whose arrays
-// no longer fit the host's caches.
+// an H200 (reports/device-judge/h200.txt, section 7), where the host
+// builds one batch while the device judges the last, 131072 ran at 3.69
+// and 3.81 G reconstructions/s, against 3.26 and 3.52 at 65536 and 3.75
+// and 3.78 at 262144: fewer batches wait on fewer round trips, and past
+// that the arrays leave the host's caches.
 inline constexpr std::uint32_t kHostBatch = 16384;
-inline constexpr std::uint32_t kDeviceJudgeBatch = 65536;
+inline constexpr std::uint32_t kDeviceJudgeBatch = 131072;
 
 struct SweepOptions {
   std::uint64_t seed = 1;
