@@ -56,7 +56,8 @@ Expected<std::unique_ptr<ComputePass>> ComputePass::Create(std::shared_ptr<Vulka
 }
 
 ComputePass::~ComputePass() {
-  // Submit leaves nothing in flight, so the command buffer is not pending.
+  // Nothing is left in flight: the command buffer is not pending.
+  (void)Wait();
   if (command_buffer_ != VK_NULL_HANDLE) vkFreeCommandBuffers(device(), context_->command_pool(), 1, &command_buffer_);
 }
 
@@ -171,6 +172,12 @@ void ComputePass::PushConstants(VkCommandBuffer commands, const void* data, std:
 }
 
 Status ComputePass::Submit(const std::function<void(VkCommandBuffer)>& record) {
+  DB_RETURN_IF_ERROR(SubmitWithoutWaiting(record));
+  return Wait();
+}
+
+Status ComputePass::SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record) {
+  DB_RETURN_IF_ERROR(Wait());
   VkCommandBufferBeginInfo begin_info{};
   begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -184,6 +191,14 @@ Status ComputePass::Submit(const std::function<void(VkCommandBuffer)>& record) {
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &command_buffer_;
   DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
+  pending_ = true;
+  return Status::Ok();
+}
+
+Status ComputePass::Wait() {
+  if (!pending_) return Status::Ok();
+  pending_ = false;
+  const VkFence fence = fence_.get();
   const Status waited = CheckVk(
       vkWaitForFences(device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()), "vkWaitForFences");
   // A wait that failed may leave the work running: drain the queue, so that

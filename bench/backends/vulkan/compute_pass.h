@@ -10,7 +10,9 @@
 // the set at resources with WriteDescriptors; CreatePipeline once per
 // shader; then Submit(record) any number of times. Submit returns only when the device
 // has finished (or failed) the work, so no work is in flight when the pass
-// or the resources its commands used are destroyed.
+// or the resources its commands used are destroyed. SubmitWithoutWaiting
+// returns at once; the wait is then owed: Wait() pays it, and so do the
+// next submission and the destructor, before they touch what the work uses.
 #pragma once
 
 #include <cstdint>
@@ -77,6 +79,14 @@ class ComputePass {
   // Records commands through `record`, submits them and waits for the
   // device. Should the wait fail, the queue is drained before returning.
   Status Submit(const std::function<void(VkCommandBuffer)>& record);
+  // The same, returning once the work is queued: the host may meanwhile
+  // write other memory, and a later submission to the queue may wait for
+  // it with a barrier. This pass's descriptors and the resources its
+  // commands use stay untouched until Wait().
+  Status SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record);
+  // Waits for the work SubmitWithoutWaiting queued, if any (at once if the
+  // device has finished it). Should the wait fail, the queue is drained.
+  Status Wait();
 
  private:
   ComputePass(std::shared_ptr<VulkanContext> context, VkShaderStageFlags stages)
@@ -92,6 +102,7 @@ class ComputePass {
   std::vector<VkDescriptorSet> sets_;  // freed with the pool
   DeviceObject<VkFence> fence_;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // from the context's pool; freed by the destructor
+  bool pending_ = false;                             // queued by SubmitWithoutWaiting and not waited for
   VkShaderStageFlags stages_;
   std::uint32_t push_constant_bytes_ = 0;
 };

@@ -196,6 +196,11 @@ class VulkanBackend final : public Backend {
   std::string name() const override {
     return options_.arithmetic_probes == 0 ? "vulkan" : "vulkan:" + ArithmeticProbesName(options_.arithmetic_probes);
   }
+  ~VulkanBackend() override {
+    // Work RunLeavingOnDevice left queued reads the buffers destroyed below.
+    if (pass_ != nullptr) (void)pass_->Wait();
+  }
+
   const DeviceInfo& device() const override { return device_; }
   ProgramInfo program() const override { return program_; }
   // One command buffer, one fence and one set of buffers: one Run at a time.
@@ -230,10 +235,12 @@ class VulkanBackend final : public Backend {
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
-  // The compute form's upload, dispatches and wait; the positions stay in
-  // their buffer, laid out as the returned slices say.
+  // The compute form's upload and dispatches; the positions stay in their
+  // buffer, laid out as the returned slices say. `wait`: return once the
+  // device has finished; otherwise once the work is queued, and the next
+  // run (or the destructor) waits for it.
   Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                   ThreadPool* pool = nullptr);
+                                   ThreadPool* pool = nullptr, bool wait = true);
   // What either form would read out of bounds.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
   // What the compute form's device cannot address or dispatch.
@@ -429,13 +436,16 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
 }
 
 Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                               ThreadPool* pool) {
+                                               ThreadPool* pool, bool wait) {
+  // The last run's work, if it was left queued, reads what this one rewrites.
+  DB_RETURN_IF_ERROR(pass_->Wait());
   const SliceLayout slices = SliceLayoutFor(batch, shape_);
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const DispatchPlan plan = PlanDispatches(cells_, which, slices);
   DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices, pool));
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); }));
+  const auto record = [&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); };
+  DB_RETURN_IF_ERROR(wait ? pass_->Submit(record) : pass_->SubmitWithoutWaiting(record));
   return slices;
 }
 
@@ -448,7 +458,7 @@ Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& 
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
   positions_access_ = HostAccess::kNone;
-  Expected<SliceLayout> slices = RunCompute(batch, which, pool);
+  Expected<SliceLayout> slices = RunCompute(batch, which, pool, /*wait=*/false);
   if (!slices.ok()) return slices.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
   return DevicePositions{buffers_[kPositions].handle(),

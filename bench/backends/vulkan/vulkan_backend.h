@@ -50,7 +50,10 @@ struct DevicePositions {
 // Runs the listed cells as Backend::Run does, but leaves their positions on
 // the device for a judge there (bench/device_judge/), valid until the
 // backend's next run: nothing is read back or checked on the host. `pool`,
-// where given, writes the upload.
+// where given, writes the upload. It returns once the work is queued: a
+// later submission to the device's queue reads the positions after a
+// barrier, and the host meanwhile writes other memory (the judge's
+// inputs); the backend's next run waits for it.
 // Unavailable for a backend other than Vulkan's and for the raster form.
 Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
                                              std::span<const std::uint32_t> which, ThreadPool* pool = nullptr);
