@@ -15,8 +15,11 @@ namespace depthbench {
 
 class ThreadPool {
  public:
-  // threads == 0: one per hardware thread.
+  // threads == 0: one per hardware thread (ThreadCount).
   explicit ThreadPool(unsigned threads = 0);
+  // What a pool asked for `threads` runs: threads, or where 0, one per
+  // hardware thread.
+  static unsigned ThreadCount(unsigned threads);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;

@@ -30,6 +30,11 @@ inline constexpr const char* kDomainHelp =
     "far/near 1e1-1e8 and infinite, cameras up to 1e6 from the origin), extremes (near 1e-6-1e-2, far/near 1e6-1e9 "
     "and infinite, cameras 1e5-1e7 out), or a scene file NAME.toml (as choose reads)";
 
+// What --threads says, for the commands that run a sweep.
+inline constexpr const char* kThreadsHelp =
+    "threads in all (default: one per core); where the device judges, a quarter of them, at most 4, feed it while "
+    "the rest build the next batch";
+
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;

@@ -197,7 +197,7 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--junit", flags->junit, "write JUnit XML, one test case per cell");
   cmd->add_option("--json", flags->json, "write the full comparison as JSON");
   cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer");
-  cmd->add_option("--threads", flags->threads, "worker threads (default: one per core)");
+  cmd->add_option("--threads", flags->threads, kThreadsHelp);
   cmd->callback([flags, &action] { action = [flags] { return Gate(*flags); }; });
 }
 

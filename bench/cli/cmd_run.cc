@@ -180,9 +180,7 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   "replay a reproducer file written by depthbench fuzz (its cells, on the selected backends) and say "
                   "whether the finding still holds (exit 1) or not (exit 0)");
   cmd->add_option("--split", flags->split, "also print p99.9 per band: ratio, depth, distance")->delimiter(',');
-  cmd->add_option("--threads", flags->threads,
-                  "threads in all (default: one per core); where the device judges, a quarter of them, at most 4, "
-                  "feed it while the rest build the next batch");
+  cmd->add_option("--threads", flags->threads, kThreadsHelp);
   cmd->add_option("--batch", flags->batch,
                   fmt::format("samples per batch (memory is proportional to it; cut to what the Vulkan device can "
                               "bind at once); default {}, or {} when a GPU judges (the fastest measured)",
