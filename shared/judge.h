@@ -33,6 +33,10 @@ DB_CONST_UINT(DB_JUDGE_DEPTH_BANDS, 10u)
 DB_CONST_UINT(DB_JUDGE_STORES_WINDOW_DEPTH, 0u)
 DB_CONST_UINT(DB_JUDGE_STORES_LINEAR, 1u)
 DB_CONST_UINT(DB_JUDGE_STORES_VIEW_Z, 2u)
+// How a depth slot's format keeps a value (bench/pipeline/cells.h's TexelKind).
+DB_CONST_UINT(DB_JUDGE_TEXEL_UNORM, 0u)
+DB_CONST_UINT(DB_JUDGE_TEXEL_FLOAT32, 1u)
+DB_CONST_UINT(DB_JUDGE_TEXEL_FLOAT16, 2u)
 DB_CONST_UINT(DB_JUDGE_INFINITE_RATIO_BAND, 10u)
 
 // Reference status (bench/pipeline/reference.h) as the judge reads it.
@@ -52,10 +56,13 @@ struct JudgePass {
   uint first_offset;
   uint first_index_lo;
   uint first_index_hi;
-  uint phase;             // 0: bins, counts and maxima; 1: the index of each maximum
+  uint phase;             // judge: 0 bins, counts and maxima, 1 the index of each maximum; storage: 0 the
+                          // pipelines' floats, 1 the stored-value picks
   uint record_distances;  // 1: natural samples also go to their camera-distance band
   uint cells;
   uint depth_slots;  // slices of the reference buffers, and the depth slots' accumulators
   uint accumulators;  // cells, or cells + depth_slots when the encodings' errors are recorded too
   uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
+  uint edges;             // the storage pass's stored-value picks
+  uint unused;
 };

@@ -6,8 +6,12 @@
 // and degenerate ones, every coverage kind), camera-distance bands
 // recorded sample by sample, batches that start and end inside frames,
 // and flushes in the middle of the run.
+#include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -112,9 +116,7 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name) {
   EXPECT_GT(reached.maxima, 1000u);
 }
 
-TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
-  ExpectSameStatistics(WideDomain(), "wide");
-}
+TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) { ExpectSameStatistics(WideDomain(), "wide"); }
 
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
   ExpectSameStatistics(ExtremesDomain(), "extremes");
@@ -155,28 +157,29 @@ void ExpectSameReference(const Domain& domain, const std::string& name) {
   ComputeBothReferences(domain, both);
   const ReferenceArrays &host = both.batch.reference, &device = both.device;
   ASSERT_EQ(device.true_depth.size(), host.true_depth.size());
-  const auto same = [](double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); };
+  const auto same = [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+  };
   std::size_t differing = 0, judged = 0;
   for (std::size_t r = 0; r < host.true_depth.size(); ++r) {
-    const bool equal = same(host.true_depth[r], device.true_depth[r]) &&
-                       same(host.denoted_depth[r], device.denoted_depth[r]) &&
-                       same(host.inverse_distance_sq[r], device.inverse_distance_sq[r]) &&
-                       same(host.storage_square[r], device.storage_square[r]) &&
-                       same(host.production_square[r], device.production_square[r]) &&
-                       host.joint_band[r] == device.joint_band[r] && host.status[r] == device.status[r] &&
-                       host.stored_holdable[r] == device.stored_holdable[r];
+    const bool equal =
+        same(host.true_depth[r], device.true_depth[r]) && same(host.denoted_depth[r], device.denoted_depth[r]) &&
+        same(host.inverse_distance_sq[r], device.inverse_distance_sq[r]) &&
+        same(host.storage_square[r], device.storage_square[r]) &&
+        same(host.production_square[r], device.production_square[r]) && host.joint_band[r] == device.joint_band[r] &&
+        host.status[r] == device.status[r] && host.stored_holdable[r] == device.stored_holdable[r];
     judged += host.status[r] == ReferenceStatus::kJudged ? 1 : 0;
     if (!equal && differing++ < 5) {
       const Encoding e = both.layout.encodings[r / both.batch.count];
       ADD_FAILURE() << Info(e.convention).name << "/" << Info(e.format).name << ", sample " << r % both.batch.count
-                    << fmt::format(": true {} / {}, denoted {} / {}, inverse {} / {}, storage {} / {}, production "
-                                   "{} / {}, band {} / {}, status {} / {}, holdable {} / {}",
-                                   host.true_depth[r], device.true_depth[r], host.denoted_depth[r],
-                                   device.denoted_depth[r], host.inverse_distance_sq[r], device.inverse_distance_sq[r],
-                                   host.storage_square[r], device.storage_square[r], host.production_square[r],
-                                   device.production_square[r], host.joint_band[r], device.joint_band[r],
-                                   static_cast<int>(host.status[r]), static_cast<int>(device.status[r]),
-                                   host.stored_holdable[r], device.stored_holdable[r]);
+                    << fmt::format(
+                           ": true {} / {}, denoted {} / {}, inverse {} / {}, storage {} / {}, production "
+                           "{} / {}, band {} / {}, status {} / {}, holdable {} / {}",
+                           host.true_depth[r], device.true_depth[r], host.denoted_depth[r], device.denoted_depth[r],
+                           host.inverse_distance_sq[r], device.inverse_distance_sq[r], host.storage_square[r],
+                           device.storage_square[r], host.production_square[r], device.production_square[r],
+                           host.joint_band[r], device.joint_band[r], static_cast<int>(host.status[r]),
+                           static_cast<int>(device.status[r]), host.stored_holdable[r], device.stored_holdable[r]);
     }
   }
   EXPECT_EQ(differing, 0u);
@@ -208,6 +211,86 @@ TEST_F(DeviceJudgeTest, ComputesTheHostsReference) {
 // tests/reference_test.cc shows on the host): 2^-52 bounds both, 29 bits
 // below float32's rounding. A textbook decode B / (d - A) in double would
 // miss it by up to 2^-23 near the far plane.
+// Float32 values where storing is hardest to get right: each side of
+// every rounding midpoint of the halves (subnormal ones included) and of
+// the unorm steps near 0 and 1, the limits of each format, and what lies
+// outside [0, 1]: negative values, NaN, infinities, float32 subnormals.
+std::vector<float> HardValuesToStore() {
+  std::vector<float> values;
+  const auto around = [&](float x) {
+    values.push_back(std::nextafter(x, -INFINITY));
+    values.push_back(x);
+    values.push_back(std::nextafter(x, INFINITY));
+  };
+  for (std::uint16_t h = 0; h < 0x7bff; ++h) {
+    const float low = HalfToFloat(h), high = HalfToFloat(static_cast<std::uint16_t>(h + 1));
+    around(low + (high - low) / 2);  // exact: twelve significant bits
+  }
+  for (const double scale : {65535.0, 16777215.0}) {
+    for (int k = 0; k < 2000; ++k) {
+      around(static_cast<float>((k + 0.5) / scale));
+      around(static_cast<float>((scale - 1 - k + 0.5) / scale));
+    }
+  }
+  for (const float x : {0.0f, 1.0f, 1.5f, 65504.0f, 65520.0f, 1e30f, 0x1p-25f, 0x1p-24f, 0x1p-14f,
+                        std::numeric_limits<float>::min(), std::numeric_limits<float>::denorm_min()}) {
+    around(x);
+    around(-x);
+  }
+  for (const float x : {INFINITY, -INFINITY, NAN, -NAN}) values.push_back(x);
+  return values;
+}
+
+// The storage pass against encode.cc's StoreFloats, texel for texel, on
+// the hard values in every pipeline: the picks keep the host's texels.
+TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
+  const std::shared_ptr<VulkanContext>& context = Context();
+  const Domain domain = TypicalDomain();
+  // One cell per encoding: every depth slot, in what lavapipe binds at once.
+  std::vector<Cell> cells;
+  for (const Cell& cell : CellsForDomain(AllCells(), domain)) {
+    const auto same = [&](const Cell& c) { return c.encoding() == cell.encoding(); };
+    if (std::none_of(cells.begin(), cells.end(), same)) cells.push_back(cell);
+  }
+  const RunLayout layout = MakeRunLayout(cells);
+  ASSERT_GE(layout.encodings.size(), 20u);
+  auto vulkan = MakeVulkanBackend(context, BackendOptions{});
+  ASSERT_TRUE(vulkan.ok()) << vulkan.status().message();
+  ASSERT_TRUE((*vulkan)->Prepare(layout.cells, PassKind::kCompute).ok());
+  auto judge = DeviceJudge::Create(**vulkan, layout, domain.production, true);
+  ASSERT_TRUE(judge.ok()) << judge.status().message();
+  const std::vector<float> values = HardValuesToStore();
+  const auto count = static_cast<std::uint32_t>(values.size());
+  const Sampler sampler(5, domain);
+  ThreadPool pool(2);
+  Batch batch;
+  BatchBuilder(sampler, layout.encodings).Build(7, count, batch, pool, BatchFor::kDeviceJudge);
+  for (std::size_t at = 0; at < batch.pipeline_floats.size(); ++at) batch.pipeline_floats[at] = values[at % count];
+  std::vector<CellAccumulator> accumulators(layout.cells.size());
+  const Status judged = (*judge)->Judge(batch, accumulators, {}, pool);
+  ASSERT_TRUE(judged.ok()) << judged.message();
+  auto texels = (*judge)->LastTexels();
+  ASSERT_TRUE(texels.ok()) << texels.status().message();
+  ASSERT_EQ(texels->size(), layout.encodings.size() * count);
+  std::size_t differing = 0, picks = 0;
+  for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
+    const Format format = layout.encodings[slot].format;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const bool pick = batch.samples.pick[i] != DepthPick::kEyeDepth;
+      picks += pick && slot == 0 ? 1 : 0;
+      const float expected = pick ? batch.depths[slot * count + i] : StoreFloat(format, values[i]).fetched;
+      const float device = (*texels)[slot * count + i];
+      if (std::bit_cast<std::uint32_t>(expected) != std::bit_cast<std::uint32_t>(device) && differing++ < 5) {
+        ADD_FAILURE() << fmt::format("{}, sample {} (pick {}): {:a} stored as {:a} on the host, {:a} on the device",
+                                     Info(format).name, i, pick, values[i], expected, device);
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0u);
+  EXPECT_GT(picks, 0u);  // both phases ran
+  EXPECT_TRUE(context->TakeValidationMessages().empty());
+}
+
 TEST_F(DeviceJudgeTest, ItsDecodeAgreesWithMpfrAtFarOverNear1e9) {
   TwoReferences both;
   ComputeBothReferences(FarOverNear1e9(ProductionModel::kExact), both);
@@ -223,8 +306,8 @@ TEST_F(DeviceJudgeTest, ItsDecodeAgreesWithMpfrAtFarOverNear1e9) {
       const double denoted = both.device.denoted_depth[r];
       if (!(denoted > 0.0) || denoted == std::numeric_limits<double>::max()) continue;
       const mp::real d(static_cast<double>(batch.depths[r]));
-      const mp::real exact = mp::eye_depth_from_window_depth(mp::real(batch.samples.near[i]),
-                                                             mp::real(batch.samples.far[i]), bits, d, mp::real(1.0) - d);
+      const mp::real exact = mp::eye_depth_from_window_depth(
+          mp::real(batch.samples.near[i]), mp::real(batch.samples.far[i]), bits, d, mp::real(1.0) - d);
       worst = std::max(worst, std::fabs(((mp::real(denoted) - exact) / exact).ToDouble()));
       ++checked;
       near_far_plane += denoted > 0.5 * batch.samples.depth_limit[i] ? 1 : 0;
@@ -244,7 +327,8 @@ TEST_F(DeviceJudgeTest, AnotherSeedRecordsOtherStatistics) {
   auto second = Sweep(options, JudgeSite::kDevice);
   ASSERT_TRUE(first.ok() && second.ok());
   std::size_t differing = 0;
-  for (std::size_t c = 0; c < first->cells.size(); ++c) differing += first->cells[c].stats == second->cells[c].stats ? 0 : 1;
+  for (std::size_t c = 0; c < first->cells.size(); ++c)
+    differing += first->cells[c].stats == second->cells[c].stats ? 0 : 1;
   EXPECT_EQ(differing, first->cells.size());
 }
 
@@ -275,8 +359,7 @@ TEST_F(DeviceJudgeTest, TheCpuBackendHasNoDeviceToJudgeOn) {
   options.judge = JudgeSite::kDevice;
   auto refused = RunSweep(options, backends);
   ASSERT_FALSE(refused.ok());
-  EXPECT_NE(refused.status().message().find("no device to judge on"), std::string::npos)
-      << refused.status().message();
+  EXPECT_NE(refused.status().message().find("no device to judge on"), std::string::npos) << refused.status().message();
   options.judge = JudgeSite::kAuto;  // judged on the host
   EXPECT_TRUE(RunSweep(options, backends).ok());
 }

@@ -33,7 +33,10 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_DEGENERATE == static_cast<unsigned>(ReferenceStatus::kDegenerate) &&
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
-static_assert(sizeof(L::JudgePass) == 48);
+static_assert(sizeof(L::JudgePass) == 56);
+static_assert(L::DB_JUDGE_TEXEL_UNORM == static_cast<unsigned>(TexelKind::kUnorm) &&
+              L::DB_JUDGE_TEXEL_FLOAT32 == static_cast<unsigned>(TexelKind::kFloat32) &&
+              L::DB_JUDGE_TEXEL_FLOAT16 == static_cast<unsigned>(TexelKind::kFloat16));
 static_assert(L::DB_JUDGE_HARDWARE_CONVENTIONS == kHardwareConventionCount &&
               L::DB_JUDGE_FRAME_WORDS == 2 + 2 * L::DB_JUDGE_HARDWARE_CONVENTIONS);
 static_assert(L::DB_JUDGE_DEPTH_BANDS == kDepthBands && L::DB_JUDGE_INFINITE_RATIO_BAND == kInfiniteRatioBand);
@@ -48,7 +51,7 @@ constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal
 constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
 constexpr std::uint32_t kWorkgroupSize = 64;  // judge.comp's local_size_x
 
-// The storage buffers of both passes, by binding number
+// The storage buffers of the three passes, by binding number
 // (shaders/judge/bindings.glsl says what each holds).
 enum Binding : std::uint32_t {
   kLayout,
@@ -67,13 +70,15 @@ enum Binding : std::uint32_t {
   kFirstNonFinite,
   kMaxima,
   kUnwritten,
+  kEdgeSamples,
+  kEdgeTexels,
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
 // across the bus would cost the device its speed); transfers copy them
 // into host-readable buffers: each batch's maxima and the unwritten counts
 // after the batch, the histograms and counts at a flush.
-bool DeviceOnly(Binding b) { return b >= kReference; }
+bool DeviceOnly(Binding b) { return b >= kReference && b <= kUnwritten; }
 
 // What the reference pass needs of a depth slot's encoding
 // (bindings.glsl's Layout): what the format stores, the convention's bits
@@ -87,6 +92,13 @@ std::uint32_t EncodingWord(Encoding encoding, std::uint32_t pipeline) {
   return static_cast<std::uint32_t>(Info(encoding.format).stores) | (convention.bits & 0xfu) << 4 | hardware << 8 |
          (infinite_far ? 1u : 0u) << 12 | pipeline << 16;
 }
+// What the storage pass needs of a depth slot's format: how it keeps a
+// value, and a unorm's bits.
+std::uint32_t TexelWord(Format format) {
+  const FormatInfo& info = Info(format);
+  return static_cast<std::uint32_t>(info.texel) |
+         (info.texel == TexelKind::kUnorm ? static_cast<std::uint32_t>(info.bits) : 0u) << 8;
+}
 
 }  // namespace
 
@@ -94,16 +106,20 @@ struct DeviceJudge::State {
   Backend* backend = nullptr;
   std::shared_ptr<VulkanContext> context;
   std::unique_ptr<ComputePass> pass;
+  DeviceObject<VkPipeline> store_pipeline;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
   std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions and kTexels unused: the backend owns them)
-  VulkanBuffer batch_readback;  // the maxima, then the unwritten counts
-  VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
+  VulkanBuffer batch_readback;                      // the maxima, then the unwritten counts
+  VulkanBuffer flush_readback;                      // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
   std::vector<Cell> run_cells;
   std::size_t depth_slots = 0;
   std::size_t pipelines = 0;
-  std::uint32_t last_count = 0;  // samples of the last batch judged
+  std::uint32_t last_count = 0;    // samples of the last batch judged
+  DevicePositions last_positions;  // the backend's buffers for it
+  std::uint32_t edges = 0;         // stored-value picks of the batch uploaded last
+  std::vector<std::uint32_t> edge_scratch;
   bool exact_production = false;
   bool record_distances = true;
 
@@ -111,6 +127,7 @@ struct DeviceJudge::State {
   // The cells' accumulators, then the depth slots'.
   std::size_t accumulators() const { return cell_count() + depth_slots; }
   std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
+  std::size_t layout_words() const { return cell_count() + 2 * depth_slots; }
   std::size_t maxima() const { return counted_slots() * L::DB_JUDGE_METRICS; }
 
   VkDeviceSize counts_bytes() const { return counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t); }
@@ -146,6 +163,8 @@ struct DeviceJudge::State {
   }
   Status Upload(const Batch& batch, ThreadPool& pool);
   void Bind(const DevicePositions& positions, const Batch& batch);
+  L::JudgePass PassConstants(const Batch& batch, const DevicePositions& positions) const;
+  void RecordStore(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
   void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions, bool encodings) const;
   Status MergeMaxima(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
   // Device accumulator k's host accumulator (null where none is kept) and
@@ -199,19 +218,21 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   DB_RETURN_IF_ERROR(StoreInto(ComputePass::Create(context, bindings, sizeof(L::JudgePass)), state->pass));
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
   const VkSpecializationInfo none{};
-  for (auto [name, pipeline] : {std::pair{"reference.comp", &state->reference_pipeline},
-                                std::pair{"judge.comp", &state->judge_pipeline}}) {
+  for (auto [name, pipeline] :
+       {std::pair{"store.comp", &state->store_pipeline}, std::pair{"reference.comp", &state->reference_pipeline},
+        std::pair{"judge.comp", &state->judge_pipeline}}) {
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
     DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, none, "the device judge"), *pipeline));
   }
 
   // What stays the same for the whole run: which depth slot each cell
-  // reads, each slot's encoding, and the counters, empty.
-  DB_RETURN_IF_ERROR(state->Grow(kLayout, state->accumulators() * sizeof(std::uint32_t)));
+  // reads, each slot's encoding and texel, and the counters, empty.
+  DB_RETURN_IF_ERROR(state->Grow(kLayout, state->layout_words() * sizeof(std::uint32_t)));
   auto* words = static_cast<std::uint32_t*>(state->buffers[kLayout].mapped());
   for (std::size_t k = 0; k < layout.cells.size(); ++k) words[k] = layout.cells[k].depth_slot;
   for (std::size_t s = 0; s < state->depth_slots; ++s) {
     words[state->cell_count() + s] = EncodingWord(layout.encodings[s], pipeline_of_slot[s]);
+    words[state->accumulators() + s] = TexelWord(layout.encodings[s].format);
   }
   DB_RETURN_IF_ERROR(state->buffers[kLayout].FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
@@ -257,13 +278,33 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
     DB_RETURN_IF_ERROR(Grow(binding, bytes));
   }
 
+  // The stored-value picks, and what each slot's texel is for them (the
+  // batch holds theirs alone where it was built for this judge).
+  const SampleArrays& samples = batch.samples;
+  if (batch.depths.size() != slot_samples) {
+    return InvalidArgument(fmt::format("a batch of {} samples with {} stored depths, for {} depth slots", count,
+                                       batch.depths.size(), depth_slots));
+  }
+  std::vector<std::uint32_t>& picks = edge_scratch;
+  picks.clear();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (samples.pick[i] != DepthPick::kEyeDepth) picks.push_back(i);
+  }
+  edges = static_cast<std::uint32_t>(picks.size());
+  DB_RETURN_IF_ERROR(Grow(kEdgeSamples, edges * sizeof(std::uint32_t)));
+  DB_RETURN_IF_ERROR(Grow(kEdgeTexels, depth_slots * edges * sizeof(float)));
+  std::memcpy(buffers[kEdgeSamples].mapped(), picks.data(), edges * sizeof(std::uint32_t));
+  auto* edge_texels = static_cast<float*>(buffers[kEdgeTexels].mapped());
+  for (std::size_t s = 0; s < depth_slots; ++s) {
+    for (std::uint32_t k = 0; k < edges; ++k) edge_texels[s * edges + k] = batch.depths[s * count + picks[k]];
+  }
+
   // Per frame. The frame's planes are read from the sample arrays at its
   // first sample in the batch: the reference then starts from the very
   // values the host's would.
   auto* frame_words = static_cast<std::uint32_t*>(buffers[kFrames].mapped());
   auto* frame_depths = static_cast<double*>(buffers[kFrameDepths].mapped());
   auto* frame_constants = static_cast<std::uint32_t*>(buffers[kFrameConstants].mapped());
-  const SampleArrays& samples = batch.samples;
   for (std::size_t f = 0; f < frames; ++f) {
     const glm::dvec3& camera = batch.frames[f].camera_position;  // float32 values (sampler.h)
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
@@ -312,7 +353,8 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
       }
     }
   });
-  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats}) {
+  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats, kEdgeSamples,
+                    kEdgeTexels}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
   return Status::Ok();
@@ -322,7 +364,7 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
 void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& batch) {
   const std::size_t count = batch.count, frames = batch.frames.size(), slot_samples = depth_slots * count;
   const std::array<VkDeviceSize, kBindingCount> bytes = {
-      accumulators() * sizeof(std::uint32_t),
+      layout_words() * sizeof(std::uint32_t),
       positions.bytes,
       frames * 4 * sizeof(std::uint32_t),
       3 * count * sizeof(double),
@@ -337,7 +379,9 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       counts_bytes(),
       first_bytes(),
       maxima_bytes(),
-      unwritten_bytes()};
+      unwritten_bytes(),
+      std::max<VkDeviceSize>(edges * sizeof(std::uint32_t), 16),
+      std::max<VkDeviceSize>(depth_slots * edges * sizeof(float), 16)};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -350,24 +394,48 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
   pass->WriteDescriptors(writes);
 }
 
+L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DevicePositions& positions) const {
+  return L::JudgePass{.count = batch.count,
+                      .lead = positions.lead,
+                      .slice_length = positions.slice_length,
+                      .first_offset = batch.first_offset,
+                      .first_index_lo = static_cast<std::uint32_t>(batch.first_index),
+                      .first_index_hi = static_cast<std::uint32_t>(batch.first_index >> 32),
+                      .phase = 0,
+                      .record_distances = record_distances ? 1u : 0u,
+                      .cells = static_cast<std::uint32_t>(cell_count()),
+                      .depth_slots = static_cast<std::uint32_t>(depth_slots),
+                      .accumulators = static_cast<std::uint32_t>(accumulators()),
+                      .exact_production = exact_production ? 1u : 0u,
+                      .edges = edges,
+                      .unused = 0};
+}
+
+void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,
+                                     const DevicePositions& positions) const {
+  L::JudgePass constants = PassConstants(batch, positions);
+  pass->Bind(commands, store_pipeline.get());
+  const auto slots = static_cast<std::uint32_t>(depth_slots);
+  // Every slice whole, then the picks (disjoint elements: no barrier between).
+  pass->PushConstants(commands, &constants, sizeof(constants));
+  vkCmdDispatch(commands, (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
+  if (edges > 0) {
+    constants.phase = 1;
+    pass->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, (edges + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
+  }
+  // The reconstruction pass (the backend's, queued next) and the reference read them.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+}
+
 void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions,
                                 bool encodings) const {
   // This batch's maxima start at nothing: zero squares, no index.
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), 0, half, 0u);
   vkCmdFillBuffer(commands, buffers[kMaxima].handle(), half, half, 0xffffffffu);
-  L::JudgePass constants{.count = batch.count,
-                         .lead = positions.lead,
-                         .slice_length = positions.slice_length,
-                         .first_offset = batch.first_offset,
-                         .first_index_lo = static_cast<std::uint32_t>(batch.first_index),
-                         .first_index_hi = static_cast<std::uint32_t>(batch.first_index >> 32),
-                         .phase = 0,
-                         .record_distances = record_distances ? 1u : 0u,
-                         .cells = static_cast<std::uint32_t>(cell_count()),
-                         .depth_slots = static_cast<std::uint32_t>(depth_slots),
-                         .accumulators = static_cast<std::uint32_t>(accumulators()),
-                         .exact_production = exact_production ? 1u : 0u};
+  L::JudgePass constants = PassConstants(batch, positions);
   const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
   // The reference of every (depth slot, sample).
   pass->Bind(commands, reference_pipeline.get());
@@ -434,14 +502,21 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   State& s = *state_;
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
-  DB_ASSIGN_OR_RETURN(const DevicePositions positions, RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool));
   const ValidationScope validation(*s.context);
+  // The inputs first: the storage pass, queued before the backend's,
+  // makes the texels from them.
   DB_RETURN_IF_ERROR(s.Upload(batch, pool));
-  s.Bind(positions, batch);
-  DB_RETURN_IF_ERROR(s.pass->Submit(
-      [&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
+  const auto store = [&](const DevicePositions& on_device) {
+    s.Bind(on_device, batch);
+    return s.pass->SubmitWithoutWaiting([&](VkCommandBuffer commands) { s.RecordStore(commands, batch, on_device); });
+  };
+  DB_ASSIGN_OR_RETURN(const DevicePositions positions,
+                      RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool, store));
+  DB_RETURN_IF_ERROR(
+      s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
   s.last_count = batch.count;
+  s.last_positions = positions;
   DB_RETURN_IF_ERROR(s.MergeMaxima(cells, encodings));
   for (CellAccumulator& a : cells) a.Count(batch.count);
   for (CellAccumulator& a : encodings) a.Count(batch.count);
@@ -452,9 +527,9 @@ Expected<ReferenceArrays> DeviceJudge::LastReference() const {
   const State& s = *state_;
   const std::size_t slot_samples = s.depth_slots * s.last_count;
   const VkDeviceSize doubles = 5 * slot_samples * sizeof(double), words = slot_samples * sizeof(std::uint32_t);
-  DB_ASSIGN_OR_RETURN(VulkanBuffer readback, s.context->CreateHostBuffer(doubles + words + 16,
-                                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                                         HostAccess::kReadback));
+  DB_ASSIGN_OR_RETURN(
+      VulkanBuffer readback,
+      s.context->CreateHostBuffer(doubles + words + 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback));
   if (slot_samples > 0) {
     DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) {
       s.RecordReadback(commands, {{kReference, doubles}, {kReferenceInfo, words}}, readback);
@@ -474,6 +549,30 @@ Expected<ReferenceArrays> DeviceJudge::LastReference() const {
     out.stored_holdable[r] = static_cast<std::uint8_t>((info[r] >> 16) & 1u);
   }
   return out;
+}
+
+Expected<std::vector<float>> DeviceJudge::LastTexels() const {
+  const State& s = *state_;
+  const std::size_t count = s.last_count, slots = count == 0 ? 0 : s.depth_slots;
+  DB_ASSIGN_OR_RETURN(VulkanBuffer readback,
+                      s.context->CreateHostBuffer(std::max<std::size_t>(slots * count * sizeof(float), 16),
+                                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback));
+  if (slots > 0) {
+    DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) {
+      std::vector<VkBufferCopy> regions;
+      for (std::size_t slot = 0; slot < slots; ++slot) {
+        regions.push_back({(slot * s.last_positions.slice_length + s.last_positions.lead) * sizeof(float),
+                           slot * count * sizeof(float), count * sizeof(float)});
+      }
+      vkCmdCopyBuffer(commands, s.last_positions.texels, readback.handle(), static_cast<std::uint32_t>(regions.size()),
+                      regions.data());
+      RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    }));
+  }
+  DB_RETURN_IF_ERROR(readback.InvalidateForHostReads());
+  const auto* texels = static_cast<const float*>(readback.mapped());
+  return std::vector<float>(texels, texels + slots * count);
 }
 
 Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) {

@@ -1,15 +1,18 @@
-// DeviceJudge: the reference and the judge run where a Vulkan backend's
-// outputs already are.
+// DeviceJudge: the texels' storage, the reference and the judge run where
+// a Vulkan backend's outputs already are.
 //
 // The host judge (bench/pipeline/judge.h) reads every position back and
 // bins it on the host's cores, against a reference the host computed; on a
 // GPU that readback and those cores are what the device waits for. Here the
 // reconstruction pass leaves its positions in device memory and the host
-// uploads only what the reference starts from: per frame its planes and
+// uploads only what the device starts from: per frame its planes and
 // float32 constants, per sample the ray, the eye depth and the coverage
-// kind, per pipeline and sample the float it produced; the fetched texels
-// are the ones the backend uploaded for its pass. Two passes follow on the
-// device:
+// kind, per pipeline and sample the float it produced, and the texels of
+// the few stored-value picks. Three passes run on the device:
+//   - shaders/judge/store.comp, queued before the reconstruction pass,
+//     stores every pipeline float in each depth slot's format and writes
+//     what a fetch returns into the buffer that pass reads its texels from
+//     (the host used to upload a texel per slot and sample);
 //   - shaders/judge/reference.comp decodes, in double-double, the depth
 //     each stored value and each pipeline float denotes, and computes the
 //     reference of every (depth slot, sample): true and denoted depth,
@@ -22,13 +25,13 @@
 // a flush is due, the histograms.
 //
 // What it records equals the host judge's, bin for bin, count for count,
-// maximum and worst index included: both shaders repeat the host's float64
+// maximum and worst index included: the shaders repeat the host's float64
 // and double-double operations in order and unfused, and the judge reads
 // bins from the same bits (tests/device_judge_test.cc holds the reference
 // and the statistics equal). That needs the device's float64 add,
 // multiply, divide and fma to round as IEEE 754 says, which Vulkan does not
 // promise; docs/device-judge.md says what a device that differs would
-// change. The sampler and the encoding stay with the host.
+// change. The sampler and the depth production stay with the host.
 #pragma once
 
 #include <memory>
@@ -72,6 +75,10 @@ class DeviceJudge {
   // The reference the device computed for the last batch Judge was given,
   // in the host's layout (for tests and diagnosis).
   Expected<ReferenceArrays> LastReference() const;
+  // The texels the storage pass wrote for the last batch (each depth
+  // slot's fetched values, [depth slot * count + sample]), read from the
+  // backend's buffer: valid until the backend's next run (for tests).
+  Expected<std::vector<float>> LastTexels() const;
   // Adds what the device counted since the last flush into the
   // accumulators (`encodings` as Judge was given them) and clears it there.
   // Due before any of them holds 2^31 samples.

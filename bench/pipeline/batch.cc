@@ -50,9 +50,9 @@ BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> en
 }
 
 void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
-                         HostReference reference) const {
+                         BatchFor judge) const {
   const std::size_t slots = encodings_.size();
-  const bool with_reference = reference == HostReference::kCompute;
+  const bool for_host = judge == BatchFor::kHostJudge;
   batch.first_index = first;
   batch.count = count;
   batch.first_offset = static_cast<std::uint32_t>(first % kSamplesPerFrame);
@@ -128,7 +128,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
   for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(pipelines * count);
-  produced_.resize(with_reference ? pipelines * count : 0);
+  produced_.resize(for_host ? pipelines * count : 0);
   batch.pipeline_floats.resize(pipelines * count);
   pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
@@ -163,14 +163,13 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         for (std::size_t i = lo; i < lo + n; ++i) {
           const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
           const std::size_t drawn_with = stores == DepthInput::kHardware ? convention : 0;
-          const float value = RasterPipelineFloat(
-              encoding, batch.frame_params[frame],
-              batch.depth_params[frame * kHardwareConventionCount + drawn_with], batch.pixels[i] & 0xffffu,
-              batch.pixels[i] >> 16, batch.raster[i]);
+          const float value = RasterPipelineFloat(encoding, batch.frame_params[frame],
+                                                  batch.depth_params[frame * kHardwareConventionCount + drawn_with],
+                                                  batch.pixels[i] & 0xffffu, batch.pixels[i] >> 16, batch.raster[i]);
           if (value == value) floats[i - lo] = value;
         }
       }
-      if (with_reference) {
+      if (for_host) {
         DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);
       }
     }
@@ -178,15 +177,17 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
 
   batch.depths.resize(slots * count);
   batch.codes.resize(slots * count);
-  batch.reference.Resize(with_reference ? slots * count : 0);
+  batch.reference.Resize(for_host ? slots * count : 0);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks;
       const Encoding encoding = encodings_[s];
       const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
       const std::size_t at = s * count + lo;
-      StoreFloats(encoding.format, batch.pipeline_floats.data() + pipeline_of_slot_[s] * count + lo, n,
-                  batch.codes.data() + at, batch.depths.data() + at);
+      if (for_host) {
+        StoreFloats(encoding.format, batch.pipeline_floats.data() + pipeline_of_slot_[s] * count + lo, n,
+                    batch.codes.data() + at, batch.depths.data() + at);
+      }
       // Stored-value picks: the edges of a hardware or linear format are
       // the same in every frame; view z's depend on the frame's far plane.
       const bool per_frame = Info(encoding.format).stores == DepthInput::kViewZ;
@@ -197,8 +198,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         }
       }
       const std::size_t chunk = job % chunks;
-      for (const std::uint32_t i :
-           std::span(edge_samples_.data() + chunk * kChunk, edge_counts_[chunk])) {
+      for (const std::uint32_t i : std::span(edge_samples_.data() + chunk * kChunk, edge_counts_[chunk])) {
         const DepthPick pick = samples.pick[i];
         const StoredDepth edge =
             per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
@@ -206,7 +206,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }
-      if (with_reference) ReferenceChunk(batch, s, lo, n);
+      if (for_host) ReferenceChunk(batch, s, lo, n);
     }
   });
 }
@@ -246,13 +246,14 @@ void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo
         for (int p = 0; p < 4; ++p) gathered[p][j] = arrays[p][other[j]];
       }
       std::array<double, kChunk> decoded;
-      DecodeEyeDepths(encoding, model_, {gathered[0].data(), gathered[1].data(), gathered[2].data(), gathered[3].data()},
-                      values.data(), others, decoded.data(), nullptr, isa_);
+      DecodeEyeDepths(encoding, model_,
+                      {gathered[0].data(), gathered[1].data(), gathered[2].data(), gathered[3].data()}, values.data(),
+                      others, decoded.data(), nullptr, isa_);
       for (std::size_t j = 0; j < others; ++j) denoted[other[j]] = decoded[j];
     }
   }
-  References(encoding, batch.samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo,
-             batch.reference, at, isa_);
+  References(encoding, batch.samples, lo, n, denoted.data(), produced_.data() + pipeline * count + lo, batch.reference,
+             at, isa_);
   // Raster samples with nothing drawn have no point to judge.
   for (std::size_t i = lo; !batch.raster.empty() && i < lo + n; ++i) {
     if (batch.raster[i].triangle0.w == 0.0f) {
@@ -262,8 +263,8 @@ void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo
   }
 }
 
-void BatchBuilder::AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes,
-                                     std::span<const float> fetched, ThreadPool& pool) const {
+void BatchBuilder::AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes, std::span<const float> fetched,
+                                     ThreadPool& pool) const {
   const std::size_t count = batch.count, slots = encodings_.size();
   for (std::size_t s = 0; s < slots; ++s) {
     for (std::size_t i = 0; i < count; ++i) {

@@ -2,7 +2,7 @@
 // judge. The builder draws the samples, encodes every depth the run's cells
 // read, packs the shader inputs (the part a backend sees, shader_inputs.h)
 // and computes the reference for every (encoding, sample), which only the
-// judge reads (unless the judge computes it on its device: HostReference).
+// judge reads (unless the judge computes it on its device: BatchFor).
 #pragma once
 
 #include <cstdint>
@@ -27,7 +27,7 @@ struct Batch : ShaderInputs {
   std::vector<std::uint8_t> distance_bands;  // [frame]: DistanceBand of the camera
   std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
   SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
-  ReferenceArrays reference;                 // [depth slot * count + sample]; empty under HostReference::kSkip
+  ReferenceArrays reference;                 // [depth slot * count + sample]; empty for BatchFor::kDeviceJudge
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
   // count + sample].
   std::vector<float> pipeline_floats;
@@ -40,10 +40,13 @@ struct Batch : ShaderInputs {
 // (encode.h). Pipelines are numbered in the order their first slot comes.
 std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 
-// Whether Build computes the reference: kSkip where every judge computes
-// its own (bench/device_judge/), which then starts from the stored and the
-// pipeline's floats.
-enum class HostReference : std::uint8_t { kCompute, kSkip };
+// Who a batch is built for. kHostJudge: everything, the stored texels
+// and the reference included. kDeviceJudge: where every judge works on its
+// device (bench/device_judge/), which stores the texels and computes the
+// reference itself from the pipelines' floats: the batch's stored depths
+// (depths, codes) hold only the stored-value picks' (the samples whose
+// pick is not kEyeDepth), and its reference is empty.
+enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge };
 
 class BatchBuilder {
  public:
@@ -53,7 +56,7 @@ class BatchBuilder {
 
   // Fills `batch` with samples [first, first + count).
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
-             HostReference reference = HostReference::kCompute) const;
+             BatchFor judge = BatchFor::kHostJudge) const;
 
   // The raster pipeline on a device: replaces the stored texels of the
   // samples that have geometry by the ones the device rendered (codes and

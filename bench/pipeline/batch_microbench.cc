@@ -1,7 +1,7 @@
 // Google Benchmark of the host's share of a sweep: BatchBuilder::Build over
 // the default run's batches (the typical domain, every cell: 28 depth
-// slots), with the host's reference or without it (what the host still
-// does when a device judges: bench/device_judge/). items_per_second is
+// slots), for the host's judge (texels and reference included) or for a
+// judge on the device (what the host still does then: bench/device_judge/). items_per_second is
 // samples built per second; times the 106 cells it bounds the
 // reconstructions per second a sweep can verify on any device. The
 // argument is the number of threads.
@@ -21,7 +21,7 @@ namespace {
 
 constexpr std::uint32_t kBatch = 131072;  // the sweep's kDeviceJudgeBatch, its default where a GPU judges
 
-void BM_BuildBatch(benchmark::State& state, HostReference reference) {
+void BM_BuildBatch(benchmark::State& state, BatchFor judge) {
   const Domain domain = TypicalDomain();
   const RunLayout layout = MakeRunLayout(AllCells());
   const Sampler sampler(1, domain);
@@ -30,7 +30,7 @@ void BM_BuildBatch(benchmark::State& state, HostReference reference) {
   Batch batch;
   std::uint64_t first = 0;
   for (auto _ : state) {
-    builder.Build(first, kBatch, batch, pool, reference);
+    builder.Build(first, kBatch, batch, pool, judge);
     benchmark::DoNotOptimize(batch.depths.data());
     first += kBatch;
   }
@@ -38,10 +38,16 @@ void BM_BuildBatch(benchmark::State& state, HostReference reference) {
   state.counters["depth_slots"] = static_cast<double>(layout.encodings.size());
 }
 
-BENCHMARK_CAPTURE(BM_BuildBatch, with_reference, HostReference::kCompute)
-    ->RangeMultiplier(2)->Range(1, 16)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBatch, without_reference, HostReference::kSkip)
-    ->RangeMultiplier(2)->Range(1, 16)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge)
+    ->RangeMultiplier(2)
+    ->Range(1, 16)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge)
+    ->RangeMultiplier(2)
+    ->Range(1, 16)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace depthbench

@@ -166,10 +166,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // host, below.
   std::vector<std::unique_ptr<DeviceJudge>> device_judges(backends.size());
   for (std::size_t b = 0; b < backends.size(); ++b) {
-    DB_RETURN_IF_ERROR(StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band,
-                                                options.domain.production),
-                                 device_judges[b])
-                           .WithContext("judging on the " + backends[b]->name() + " backend's device"));
+    DB_RETURN_IF_ERROR(
+        StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band, options.domain.production),
+                  device_judges[b])
+            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
     if (device_judges[b] != nullptr) run.backends[b].judge = "device";
   }
   // A batch no backend can take whole is cut to what the smallest takes.
@@ -182,16 +182,16 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (const auto& judge : device_judges) {
     if (judge != nullptr) batch_size = std::min(batch_size, judge->MaxBatchSamples());
   }
-  // The host computes the reference only where it judges.
+  // The host stores the texels and computes the reference only where it judges.
   const bool host_judges = std::find(device_judges.begin(), device_judges.end(), nullptr) != device_judges.end();
-  const HostReference host_reference = host_judges ? HostReference::kCompute : HostReference::kSkip;
+  const BatchFor built_for = host_judges ? BatchFor::kHostJudge : BatchFor::kDeviceJudge;
   // Where every backend judges on its device, the host builds the next
   // batch while the devices take the last one (below): the threads are
   // shared out between the two stages, a quarter (at most 4) to the
   // devices' copies, so that neither stage's threads wait for a core. On
   // an H200's 16 cores 12 + 4 ran 3.49 G/s against 3.05 for 16 + 4, one
   // run each (reports/device-judge/h200.txt, section 7).
-  const bool overlap = host_reference == HostReference::kSkip;
+  const bool overlap = built_for == BatchFor::kDeviceJudge;
   const unsigned threads = ThreadPool::ThreadCount(options.threads);
   const unsigned stage_threads = overlap ? std::clamp(threads / 4, 1u, 4u) : 0u;
   ThreadPool pool(std::max(1u, threads - stage_threads));
@@ -252,7 +252,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       };
       const std::size_t per_cell = static_cast<std::size_t>(count) * 3;
       if (device_judges[b] != nullptr) {
-        DB_RETURN_IF_ERROR(device_judges[b]->Judge(batch, accumulators_of(b), encodings_of(b), stage_pool)
+        DB_RETURN_IF_ERROR(device_judges[b]
+                               ->Judge(batch, accumulators_of(b), encodings_of(b), stage_pool)
                                .WithContext("running and judging on the " + backend.name() + " backend"));
       } else if (backend.concurrent()) {
         FirstError error;
@@ -312,7 +313,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size, turn = overlap ? turn ^ 1 : 0) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     Batch& batch = batches[turn];
-    builder.Build(first, count, batch, pool, host_reference);
+    builder.Build(first, count, batch, pool, built_for);
     if (renderer != nullptr) {
       DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
     }
@@ -321,9 +322,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       continue;
     }
     DB_RETURN_IF_ERROR(finish_judging());
-    judging = std::async(std::launch::async, [&judge_batch, &batch, &stage_pool] {
-      return judge_batch(batch, *stage_pool);
-    });
+    judging =
+        std::async(std::launch::async, [&judge_batch, &batch, &stage_pool] { return judge_batch(batch, *stage_pool); });
   }
   DB_RETURN_IF_ERROR(finish_judging());
 

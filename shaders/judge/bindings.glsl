@@ -1,12 +1,14 @@
 // The device judge's storage buffers (bench/device_judge/device_judge.cc's
-// Binding names them in this order), read by both of its passes: the
-// reference (reference.comp) and the judge (judge.comp). Sample i of a
+// Binding names them in this order), shared by its three passes: the
+// storage (store.comp), the reference (reference.comp) and the judge
+// (judge.comp). Sample i of a
 // batch lies in frame (i + pass.first_offset) / 64.
 
 // The run's layout: per cell, the depth slot it reads; then per depth slot
 // its encoding: what the format stores (DB_JUDGE_STORES_*) |
 // DB_CONVENTION_* bits << 4 | hardware convention index << 8 | 1 << 12
-// for a far plane at infinity | pipeline << 16.
+// for a far plane at infinity | pipeline << 16; then per depth slot its
+// texel: DB_JUDGE_TEXEL_* | unorm bits << 8.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and
@@ -32,8 +34,13 @@ layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_dept
 // Per (pipeline, sample): the float32 the pipeline produced.
 layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { uint pipeline_float_bits[]; };
 // Per (depth slot, sample): the value a texture fetch returns, in the
-// backend's buffer, laid out as the positions are.
+// backend's buffer, laid out as the positions are. The storage pass
+// (store.comp) writes them; the others read them.
+#ifdef DB_TEXELS_WRITABLE
+layout(std430, set = 0, binding = 9) writeonly buffer Texels { uint texel_bits[]; };
+#else
 layout(std430, set = 0, binding = 9) readonly buffer Texels { uint texel_bits[]; };
+#endif
 
 // Written by the reference pass, read by the judge. Per (depth slot,
 // sample): true depth, denoted depth, inverse squared distance, squared
@@ -52,6 +59,11 @@ layout(std430, set = 0, binding = 13) buffer FirstNonFinite { uint64_t first_non
 layout(std430, set = 0, binding = 14) buffer Maxima { uint64_t maxima[]; };
 // Per cell: samples with a component the reconstruction never wrote.
 layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
+// The stored-value picks (store.comp's phase 1): the samples, and per
+// (depth slot, pick) the fetched value's bits the host made, a slice of
+// pass.edges values per slot.
+layout(std430, set = 0, binding = 16) readonly buffer EdgeSamples { uint edge_samples[]; };
+layout(std430, set = 0, binding = 17) readonly buffer EdgeTexels { uint edge_texel_bits[]; };
 
 layout(push_constant) uniform Pass { JudgePass pass; };
 

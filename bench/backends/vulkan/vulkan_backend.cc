@@ -216,7 +216,7 @@ class VulkanBackend final : public Backend {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
   Expected<DevicePositions> RunLeavingOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                               ThreadPool* pool);
+                                               ThreadPool* pool, const TexelWriter& write_texels);
   const std::shared_ptr<VulkanContext>& context() const { return context_; }
   std::vector<std::uint32_t> raster_texels() const {
     return raster_ != nullptr ? raster_->texels() : std::vector<std::uint32_t>{};
@@ -238,9 +238,13 @@ class VulkanBackend final : public Backend {
   // The compute form's upload and dispatches; the positions stay in their
   // buffer, laid out as the returned slices say. `wait`: return once the
   // device has finished; otherwise once the work is queued, and the next
-  // run (or the destructor) waits for it.
+  // run (or the destructor) waits for it. `write_texels`: as
+  // RunLeavingOnDevice's.
   Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                   ThreadPool* pool = nullptr, bool wait = true);
+                                   ThreadPool* pool = nullptr, bool wait = true,
+                                   const TexelWriter& write_texels = nullptr);
+  // The buffers a judge on the device reads, for slices `slices` of `cells` cells.
+  DevicePositions OnDevice(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const;
   // What either form would read out of bounds.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
   // What the compute form's device cannot address or dispatch.
@@ -248,8 +252,9 @@ class VulkanBackend final : public Backend {
   Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
                                  std::span<const std::uint32_t> which, const SliceLayout& slices) const;
   Status EnsureCapacity(Binding binding, VkDeviceSize bytes);
+  // `texels`: whether the batch's stored depths are uploaded too.
   Status Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
-                std::span<const f32::CellSlice> cell_slices, ThreadPool* pool);
+                std::span<const f32::CellSlice> cell_slices, ThreadPool* pool, bool texels);
   void BindBuffers(const BindingBytes& bytes);
   void Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
               const DispatchPlan& plan) const;
@@ -318,8 +323,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
   std::vector<std::string> sources;
   std::unique_ptr<RasterPass> raster;
   if (pass == PassKind::kRaster) {
-    DB_ASSIGN_OR_RETURN(raster,
-                        RasterPass::Create(context_, cells, shader_dir_, options_.arithmetic_probes, sources));
+    DB_ASSIGN_OR_RETURN(raster, RasterPass::Create(context_, cells, shader_dir_, options_.arithmetic_probes, sources));
   } else {
     for (const CellPlan& plan : cells) {
       DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
@@ -342,7 +346,8 @@ std::uint64_t VulkanBackend::MaxBatchSamples() const {
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
   if (raster_ != nullptr) {
     // The positions of every cell, in one storage buffer.
-    const std::uint64_t positions = limits.maxStorageBufferRange / (sizeof(float) * 3 * std::max<std::size_t>(cells_.size(), 1));
+    const std::uint64_t positions =
+        limits.maxStorageBufferRange / (sizeof(float) * 3 * std::max<std::size_t>(cells_.size(), 1));
     return std::min(raster_->MaxBatchSamples(), positions);
   }
   std::uint64_t slots = 1;
@@ -436,21 +441,32 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
 }
 
 Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                               ThreadPool* pool, bool wait) {
+                                                ThreadPool* pool, bool wait, const TexelWriter& write_texels) {
   // The last run's work, if it was left queued, reads what this one rewrites.
   DB_RETURN_IF_ERROR(pass_->Wait());
   const SliceLayout slices = SliceLayoutFor(batch, shape_);
   const BindingBytes bytes = BytesFor(batch, slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
   const DispatchPlan plan = PlanDispatches(cells_, which, slices);
-  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices, pool));
+  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices, pool, write_texels == nullptr));
+  if (write_texels != nullptr) DB_RETURN_IF_ERROR(write_texels(OnDevice(batch, slices, which.size())));
   const auto record = [&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); };
   DB_RETURN_IF_ERROR(wait ? pass_->Submit(record) : pass_->SubmitWithoutWaiting(record));
   return slices;
 }
 
+DevicePositions VulkanBackend::OnDevice(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const {
+  return DevicePositions{buffers_[kPositions].handle(),
+                         std::size_t{3} * cells * slices.length * sizeof(float),
+                         slices.lead,
+                         slices.length,
+                         buffers_[kStoredDepths].handle(),
+                         DepthSlotsOf(batch) * slices.length * sizeof(float)};
+}
+
 Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
-                                                            std::span<const std::uint32_t> which, ThreadPool* pool) {
+                                                            std::span<const std::uint32_t> which, ThreadPool* pool,
+                                                            const TexelWriter& write_texels) {
   if (raster_ != nullptr) {
     return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
   }
@@ -458,15 +474,10 @@ Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& 
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
   positions_access_ = HostAccess::kNone;
-  Expected<SliceLayout> slices = RunCompute(batch, which, pool, /*wait=*/false);
+  Expected<SliceLayout> slices = RunCompute(batch, which, pool, /*wait=*/false, write_texels);
   if (!slices.ok()) return slices.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
-  return DevicePositions{buffers_[kPositions].handle(),
-                         std::size_t{3} * which.size() * slices->length * sizeof(float),
-                         slices->lead,
-                         slices->length,
-                         buffers_[kStoredDepths].handle(),
-                         DepthSlotsOf(batch) * slices->length * sizeof(float)};
+  return OnDevice(batch, *slices, which.size());
 }
 
 // Outputs a shader never wrote would be judged as if it had: refused, with
@@ -539,16 +550,18 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
     buffers_[kPositions] = VulkanBuffer();  // (the previous run has completed)
     positions_held_in_ = positions_access_;
   }
-  // The output is filled with kUnwrittenBits on the device before each run.
-  const VkBufferUsageFlags usage =
-      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-      (binding == kPositions ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT} : VkBufferUsageFlags{0});
+  // The output is filled with kUnwrittenBits on the device before each
+  // run; a judge on the device may copy the texels it stored (for tests).
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                   (binding == kPositions      ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT}
+                                    : binding == kStoredDepths ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_SRC_BIT}
+                                                               : VkBufferUsageFlags{0});
   // The previous run has completed (Run waits), so the old buffer can go.
   return context_->GrowHostBuffer(buffers_[binding], bytes, usage, access);
 }
 
 Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
-                             std::span<const f32::CellSlice> cell_slices, ThreadPool* pool) {
+                             std::span<const f32::CellSlice> cell_slices, ThreadPool* pool, bool texels) {
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
   }
@@ -577,7 +590,7 @@ Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slice
       }
     }
   };
-  const std::size_t slices_to_put = 1 + DepthSlotsOf(batch);
+  const std::size_t slices_to_put = 1 + (texels ? DepthSlotsOf(batch) : 0);
   if (pool != nullptr) {
     pool->ParallelFor(slices_to_put, put);
   } else {
@@ -631,10 +644,11 @@ std::vector<std::uint32_t> RasterTexels(const Backend& backend) {
 }
 
 Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
-                                             std::span<const std::uint32_t> which, ThreadPool* pool) {
+                                             std::span<const std::uint32_t> which, ThreadPool* pool,
+                                             const TexelWriter& write_texels) {
   auto* vulkan = dynamic_cast<VulkanBackend*>(&backend);
   if (vulkan == nullptr) return Unavailable("the " + backend.name() + " backend keeps no outputs on a device");
-  return vulkan->RunLeavingOnDevice(batch, which, pool);
+  return vulkan->RunLeavingOnDevice(batch, which, pool, write_texels);
 }
 
 std::shared_ptr<VulkanContext> ContextOf(const Backend& backend) {

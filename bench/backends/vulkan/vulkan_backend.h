@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -47,16 +48,25 @@ struct DevicePositions {
   VkBuffer texels = VK_NULL_HANDLE;
   VkDeviceSize texel_bytes = 0;
 };
+// Where the texels come from when a judge on the device stores them
+// itself: called once the backend's buffers are ready for the batch and
+// before its pass is queued, with the buffers that pass writes (the
+// positions) and reads (the texels, which the writer fills whole, the lead
+// and padding as zeros). It queues work on the device's queue that writes
+// the texels and ends with a barrier before later compute reads.
+using TexelWriter = std::function<Status(const DevicePositions&)>;
 // Runs the listed cells as Backend::Run does, but leaves their positions on
 // the device for a judge there (bench/device_judge/), valid until the
 // backend's next run: nothing is read back or checked on the host. `pool`,
-// where given, writes the upload. It returns once the work is queued: a
-// later submission to the device's queue reads the positions after a
-// barrier, and the host meanwhile writes other memory (the judge's
-// inputs); the backend's next run waits for it.
+// where given, writes the upload. The texels are the batch's stored
+// depths, uploaded, or what `write_texels` writes on the device (the
+// batch's are then not read). It returns once the work is queued: a later
+// submission to the device's queue reads the positions after a barrier;
+// the backend's next run waits for it.
 // Unavailable for a backend other than Vulkan's and for the raster form.
 Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
-                                             std::span<const std::uint32_t> which, ThreadPool* pool = nullptr);
+                                             std::span<const std::uint32_t> which, ThreadPool* pool = nullptr,
+                                             const TexelWriter& write_texels = nullptr);
 // The device a Vulkan backend runs on (null for any other backend).
 std::shared_ptr<VulkanContext> ContextOf(const Backend& backend);
 
