@@ -50,6 +50,7 @@ static_assert(L::DB_JUDGE_STORES_WINDOW_DEPTH == static_cast<unsigned>(DepthInpu
 constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal, Metric::kArith, Metric::kAbsolute};
 constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
 constexpr std::uint32_t kWorkgroupSize = 64;  // judge.comp's local_size_x
+constexpr std::size_t kUploadChunk = 16384;   // samples per job of the uploads
 
 // The storage buffers of the three passes, by binding number
 // (shaders/judge/bindings.glsl says what each holds).
@@ -161,7 +162,8 @@ struct DeviceJudge::State {
     vkCmdFillBuffer(commands, buffers[kFirstNonFinite].handle(), 0, VK_WHOLE_SIZE, 0xffffffffu);
     vkCmdFillBuffer(commands, buffers[kUnwritten].handle(), 0, VK_WHOLE_SIZE, 0u);
   }
-  Status Upload(const Batch& batch, ThreadPool& pool);
+  Status UploadForStorage(const Batch& batch, ThreadPool& pool);
+  Status UploadForReference(const Batch& batch, ThreadPool& pool);
   void Bind(const DevicePositions& positions, const Batch& batch);
   L::JudgePass PassConstants(const Batch& batch, const DevicePositions& positions) const;
   void RecordStore(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
@@ -255,10 +257,12 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   return std::unique_ptr<DeviceJudge>(new DeviceJudge(std::move(state)));
 }
 
-// What the reference starts from, written into the upload buffers on every
-// thread: at a GPU's rate one thread's copies would leave the device
-// waiting.
-Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
+// What the device starts from, written into the upload buffers on every
+// thread (at a GPU's rate one thread's copies would leave the device
+// waiting), in two parts: what the storage pass reads, before it is
+// queued, and what only the reference reads, while the reconstruction
+// pass runs.
+Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
   const std::size_t slot_samples = depth_slots * count, pipeline_samples = pipelines * count;
   if (batch.pipeline_floats.size() != pipeline_samples) {
@@ -295,10 +299,40 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
   DB_RETURN_IF_ERROR(Grow(kEdgeTexels, depth_slots * edges * sizeof(float)));
   std::memcpy(buffers[kEdgeSamples].mapped(), picks.data(), edges * sizeof(std::uint32_t));
   auto* edge_texels = static_cast<float*>(buffers[kEdgeTexels].mapped());
-  for (std::size_t s = 0; s < depth_slots; ++s) {
-    for (std::uint32_t k = 0; k < edges; ++k) edge_texels[s * edges + k] = batch.depths[s * count + picks[k]];
+  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
+  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
+  // Per depth slot the picks' texels, then chunks of the per-sample and
+  // per-(pipeline, sample) values, in one loop.
+  const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
+  const std::size_t pipeline_chunks = (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
+  pool.ParallelFor(depth_slots + sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      if (job < depth_slots) {
+        for (std::uint32_t k = 0; k < edges; ++k) {
+          edge_texels[job * edges + k] = batch.depths[job * count + picks[k]];
+        }
+      } else if (job < depth_slots + sample_chunks) {
+        const std::size_t lo = (job - depth_slots) * kUploadChunk, n = std::min(kUploadChunk, count - lo);
+        for (std::size_t i = lo; i < lo + n; ++i) {
+          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
+                        static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
+        }
+      } else {
+        const std::size_t lo = (job - depth_slots - sample_chunks) * kUploadChunk;
+        std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
+                    std::min(kUploadChunk, pipeline_samples - lo) * sizeof(float));
+      }
+    }
+  });
+  for (Binding b : {kCoverage, kPipelineFloats, kEdgeSamples, kEdgeTexels}) {
+    DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
+  return Status::Ok();
+}
 
+Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
+  const std::size_t count = batch.count, frames = batch.frames.size();
+  const SampleArrays& samples = batch.samples;
   // Per frame. The frame's planes are read from the sample arrays at its
   // first sample in the batch: the reference then starts from the very
   // values the host's would.
@@ -325,36 +359,18 @@ Status DeviceJudge::State::Upload(const Batch& batch, ThreadPool& pool) {
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
   }
-  // Per sample, then per (pipeline, sample): chunks of each, in one loop.
-  // (The texels are the backend's, in device memory already.)
   auto* rays = static_cast<double*>(buffers[kRays].mapped());
-  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
   auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
-  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
-  constexpr std::size_t kChunk = 16384;
-  const std::size_t sample_chunks = (count + kChunk - 1) / kChunk;
-  const std::size_t pipeline_chunks = (pipeline_samples + kChunk - 1) / kChunk;
-  pool.ParallelFor(sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor((count + kUploadChunk - 1) / kUploadChunk, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
-      if (job >= sample_chunks) {
-        const std::size_t lo = (job - sample_chunks) * kChunk;
-        std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
-                    std::min(kChunk, pipeline_samples - lo) * sizeof(float));
-        continue;
-      }
-      const std::size_t lo = job * kChunk, n = std::min(kChunk, count - lo);
+      const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
       std::memcpy(rays + lo, batch.ray_x.data() + lo, n * sizeof(double));
       std::memcpy(rays + count + lo, batch.ray_y.data() + lo, n * sizeof(double));
       std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
       std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
-      for (std::size_t i = lo; i < lo + n; ++i) {
-        coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
-                      static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
-      }
     }
   });
-  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kCoverage, kEyeDepths, kPipelineFloats, kEdgeSamples,
-                    kEdgeTexels}) {
+  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kEyeDepths}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
   return Status::Ok();
@@ -503,15 +519,16 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
   const ValidationScope validation(*s.context);
-  // The inputs first: the storage pass, queued before the backend's,
-  // makes the texels from them.
-  DB_RETURN_IF_ERROR(s.Upload(batch, pool));
+  // The storage pass's inputs first: queued before the backend's pass, it
+  // makes the texels from them. The reference's go in while both run.
+  DB_RETURN_IF_ERROR(s.UploadForStorage(batch, pool));
   const auto store = [&](const DevicePositions& on_device) {
     s.Bind(on_device, batch);
     return s.pass->SubmitWithoutWaiting([&](VkCommandBuffer commands) { s.RecordStore(commands, batch, on_device); });
   };
   DB_ASSIGN_OR_RETURN(const DevicePositions positions,
                       RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool, store));
+  DB_RETURN_IF_ERROR(s.UploadForReference(batch, pool));
   DB_RETURN_IF_ERROR(
       s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
