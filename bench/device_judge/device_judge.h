@@ -60,9 +60,9 @@ class DeviceJudge {
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;
 
-  // Runs every cell of the layout on `batch` (built with or without the
-  // host's reference: HostReference) and judges the outputs on the
-  // device. Each batch's maxima go straight into `cells` (one accumulator
+  // Stores the texels of `batch` (built for either judge: BatchFor; only
+  // its stored-value picks' texels are read), runs every cell of the
+  // layout on it and judges the outputs on the device. Each batch's maxima go straight into `cells` (one accumulator
   // per cell, in layout order) and, unless it is empty, `encodings` (one
   // per depth slot: the storage and production errors, which the device
   // then records too); they also count the batch's samples. The counts
