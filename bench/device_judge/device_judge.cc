@@ -128,7 +128,11 @@ struct DeviceJudge::State {
   // The cells' accumulators, then the depth slots'.
   std::size_t accumulators() const { return cell_count() + depth_slots; }
   std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
-  std::size_t layout_words() const { return cell_count() + 2 * depth_slots; }
+  std::size_t layout_words() const { return cell_count() + 2 * depth_slots + pipelines; }
+  // Whether the storage pass produces the pipelines' floats (float32
+  // production) or the host uploads them (exact production, which rounds
+  // with MPFR where a tie needs it).
+  bool device_produces() const { return !exact_production; }
   std::size_t maxima() const { return counted_slots() * L::DB_JUDGE_METRICS; }
 
   VkDeviceSize counts_bytes() const { return counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t); }
@@ -236,6 +240,9 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
     words[state->cell_count() + s] = EncodingWord(layout.encodings[s], pipeline_of_slot[s]);
     words[state->accumulators() + s] = TexelWord(layout.encodings[s].format);
   }
+  for (std::uint32_t s = static_cast<std::uint32_t>(state->depth_slots); s-- > 0;) {
+    words[state->accumulators() + state->depth_slots + pipeline_of_slot[s]] = s;  // the pipeline's first slot
+  }
   DB_RETURN_IF_ERROR(state->buffers[kLayout].FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
@@ -265,7 +272,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
 Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
   const std::size_t slot_samples = depth_slots * count, pipeline_samples = pipelines * count;
-  if (batch.pipeline_floats.size() != pipeline_samples) {
+  if (!device_produces() && batch.pipeline_floats.size() != pipeline_samples) {
     return InvalidArgument(fmt::format("a batch of {} samples with {} pipeline values, for {} pipelines", count,
                                        batch.pipeline_floats.size(), pipelines));
   }
@@ -298,41 +305,6 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   DB_RETURN_IF_ERROR(Grow(kEdgeSamples, edges * sizeof(std::uint32_t)));
   DB_RETURN_IF_ERROR(Grow(kEdgeTexels, depth_slots * edges * sizeof(float)));
   std::memcpy(buffers[kEdgeSamples].mapped(), picks.data(), edges * sizeof(std::uint32_t));
-  auto* edge_texels = static_cast<float*>(buffers[kEdgeTexels].mapped());
-  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
-  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
-  // Per depth slot the picks' texels, then chunks of the per-sample and
-  // per-(pipeline, sample) values, in one loop.
-  const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
-  const std::size_t pipeline_chunks = (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
-  pool.ParallelFor(depth_slots + sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t job = begin; job < end; ++job) {
-      if (job < depth_slots) {
-        for (std::uint32_t k = 0; k < edges; ++k) {
-          edge_texels[job * edges + k] = batch.depths[job * count + picks[k]];
-        }
-      } else if (job < depth_slots + sample_chunks) {
-        const std::size_t lo = (job - depth_slots) * kUploadChunk, n = std::min(kUploadChunk, count - lo);
-        for (std::size_t i = lo; i < lo + n; ++i) {
-          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
-                        static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
-        }
-      } else {
-        const std::size_t lo = (job - depth_slots - sample_chunks) * kUploadChunk;
-        std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
-                    std::min(kUploadChunk, pipeline_samples - lo) * sizeof(float));
-      }
-    }
-  });
-  for (Binding b : {kCoverage, kPipelineFloats, kEdgeSamples, kEdgeTexels}) {
-    DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
-  }
-  return Status::Ok();
-}
-
-Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
-  const std::size_t count = batch.count, frames = batch.frames.size();
-  const SampleArrays& samples = batch.samples;
   // Per frame. The frame's planes are read from the sample arrays at its
   // first sample in the batch: the reference then starts from the very
   // values the host's would.
@@ -359,20 +331,53 @@ Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& po
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
   }
-  auto* rays = static_cast<double*>(buffers[kRays].mapped());
+  auto* edge_texels = static_cast<float*>(buffers[kEdgeTexels].mapped());
+  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
   auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
+  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
+  // Per depth slot the picks' texels, then chunks of the per-sample and
+  // per-(pipeline, sample) values, in one loop.
+  const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
+  const std::size_t pipeline_chunks = device_produces() ? 0 : (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
+  pool.ParallelFor(depth_slots + sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t job = begin; job < end; ++job) {
+      if (job < depth_slots) {
+        for (std::uint32_t k = 0; k < edges; ++k) {
+          edge_texels[job * edges + k] = batch.depths[job * count + picks[k]];
+        }
+      } else if (job < depth_slots + sample_chunks) {
+        const std::size_t lo = (job - depth_slots) * kUploadChunk, n = std::min(kUploadChunk, count - lo);
+        std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
+        for (std::size_t i = lo; i < lo + n; ++i) {
+          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
+                        static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
+        }
+      } else {
+        const std::size_t lo = (job - depth_slots - sample_chunks) * kUploadChunk;
+        std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
+                    std::min(kUploadChunk, pipeline_samples - lo) * sizeof(float));
+      }
+    }
+  });
+  for (Binding b :
+       {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kEdgeSamples, kEdgeTexels}) {
+    DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
+  }
+  return Status::Ok();
+}
+
+Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
+  const std::size_t count = batch.count;
+  auto* rays = static_cast<double*>(buffers[kRays].mapped());
   pool.ParallelFor((count + kUploadChunk - 1) / kUploadChunk, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
       std::memcpy(rays + lo, batch.ray_x.data() + lo, n * sizeof(double));
       std::memcpy(rays + count + lo, batch.ray_y.data() + lo, n * sizeof(double));
       std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
-      std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
     }
   });
-  for (Binding b : {kFrames, kFrameDepths, kFrameConstants, kRays, kEyeDepths}) {
-    DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
-  }
+  DB_RETURN_IF_ERROR(buffers[kRays].FlushHostWrites());
   return Status::Ok();
 }
 
@@ -432,11 +437,19 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
   L::JudgePass constants = PassConstants(batch, positions);
   pass->Bind(commands, store_pipeline.get());
   const auto slots = static_cast<std::uint32_t>(depth_slots);
+  if (device_produces()) {
+    pass->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, (batch.count + kWorkgroupSize - 1) / kWorkgroupSize, static_cast<std::uint32_t>(pipelines),
+                  1);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  }
   // Every slice whole, then the picks (disjoint elements: no barrier between).
+  constants.phase = 1;
   pass->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
   if (edges > 0) {
-    constants.phase = 1;
+    constants.phase = 2;
     pass->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, (edges + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
   }

@@ -127,10 +127,12 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // stored texels, their decode and the reference.
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
+  // (A judge on the device produces float32 depths itself.)
+  const bool host_produces = for_host || model_ != ProductionModel::kFloat32;
   for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(pipelines * count);
   produced_.resize(for_host ? pipelines * count : 0);
-  batch.pipeline_floats.resize(pipelines * count);
-  pool.ParallelFor(pipelines * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  batch.pipeline_floats.resize(host_produces ? pipelines * count : 0);
+  pool.ParallelFor(host_produces ? pipelines * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t k = job / chunks;
       const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);

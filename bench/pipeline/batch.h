@@ -42,10 +42,11 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 
 // Who a batch is built for. kHostJudge: everything, the stored texels
 // and the reference included. kDeviceJudge: where every judge works on its
-// device (bench/device_judge/), which stores the texels and computes the
-// reference itself from the pipelines' floats: the batch's stored depths
-// (depths, codes) hold only the stored-value picks' (the samples whose
-// pick is not kEyeDepth), and its reference is empty.
+// device (bench/device_judge/), which produces the depths (in float32),
+// stores the texels and computes the reference itself: the batch's stored
+// depths (depths, codes) hold only the stored-value picks' (the samples
+// whose pick is not kEyeDepth), its reference is empty, and so are its
+// pipeline floats unless depths are produced exactly (ProductionModel).
 enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge };
 
 class BatchBuilder {

@@ -8,7 +8,8 @@
 // its encoding: what the format stores (DB_JUDGE_STORES_*) |
 // DB_CONVENTION_* bits << 4 | hardware convention index << 8 | 1 << 12
 // for a far plane at infinity | pipeline << 16; then per depth slot its
-// texel: DB_JUDGE_TEXEL_* | unorm bits << 8.
+// texel: DB_JUDGE_TEXEL_* | unorm bits << 8; then per pipeline its first
+// depth slot.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and
@@ -31,12 +32,17 @@ layout(std430, set = 0, binding = 5) readonly buffer FrameDepths { double frame_
 layout(std430, set = 0, binding = 6) readonly buffer FrameConstants { uint frame_constants[]; };
 // Per sample: the eye depth (the near plane for a stored-value pick).
 layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_depths[]; };
-// Per (pipeline, sample): the float32 the pipeline produced.
+// Per (pipeline, sample): the float32 the pipeline produced (uploaded, or
+// written by the storage pass).
+#ifdef DB_STORE_PASS
+layout(std430, set = 0, binding = 8) buffer PipelineFloats { uint pipeline_float_bits[]; };
+#else
 layout(std430, set = 0, binding = 8) readonly buffer PipelineFloats { uint pipeline_float_bits[]; };
+#endif
 // Per (depth slot, sample): the value a texture fetch returns, in the
 // backend's buffer, laid out as the positions are. The storage pass
 // (store.comp) writes them; the others read them.
-#ifdef DB_TEXELS_WRITABLE
+#ifdef DB_STORE_PASS
 layout(std430, set = 0, binding = 9) writeonly buffer Texels { uint texel_bits[]; };
 #else
 layout(std430, set = 0, binding = 9) readonly buffer Texels { uint texel_bits[]; };

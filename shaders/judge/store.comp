@@ -1,12 +1,14 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
-// Storage on the device (bench/device_judge/device_judge.h): every depth
-// slot's texels, made from its pipeline's float32 as the format stores it
-// and as a texture fetch returns it (encode.cc's StoreFloats), written
+// Production and storage on the device (bench/device_judge/device_judge.h):
+// the float32 each pipeline produces from a sample's eye depth and its
+// frame's float32 constants (encode.cc's Float32PipelineFloats), and every
+// depth slot's texels, made from its pipeline's float as the format stores
+// it and as a texture fetch returns it (encode.cc's StoreFloats), written
 // straight into the buffer the reconstruction pass reads. The host then
-// uploads the pipelines' floats alone (the reference reads them anyway),
-// not a texel per depth slot and sample.
+// uploads per sample its eye depth, not a float per pipeline nor a texel
+// per depth slot.
 //
 // Every step is integer arithmetic on the bits, or float64 arithmetic that
 // is exact or rounded once (a product), so that each texel equals the
@@ -14,37 +16,106 @@
 // float widths is left to the device, whose rounding of them Vulkan does
 // not fix and whose handling of float32 subnormals differs (bindings.glsl).
 //
-// Phase 0: workgroup row y writes depth slot y's whole slice (the lead and
-// the padding as zeros), all but the stored-value picks. Phase 1:
-// invocation k writes the k-th pick of every slot, from the texels the
-// host made for it (the picks are a few per cent of the samples, and their
-// values depend on the format alone, or on the frame's far plane).
+// Phase 0 (where depths are produced in float32; exact production stays
+// with the host, which uploads the floats): workgroup row y computes
+// pipeline y's floats. Phase 1: row y writes depth slot y's whole slice
+// (the lead and the padding as zeros), all but the stored-value picks.
+// Phase 2: invocation k writes the k-th pick of every slot, from the
+// texels the host made for it (the picks are a few per cent of the
+// samples, and their values depend on the format alone, or on the
+// frame's far plane).
 #include "../../shared/compat.h"
+#include "../../shared/params.h"
 #include "../../shared/judge.h"
 
 layout(local_size_x = 64) in;
 
-#define DB_TEXELS_WRITABLE
+#define DB_STORE_PASS
 #include "bindings.glsl"
 
-// The float32 nearest to a double in [2^-126, 1] (a unorm fetch), ties to
-// even, from the double's bits.
-uint float_bits_of_unit(double x) {
-  uvec2 words = unpackDouble2x32(x);  // x: low word, y: high word
-  uint64_t bits = (uint64_t(words.y) << 32) | uint64_t(words.x);
-  if (bits == 0ul) {
-    return 0u;
+// The float32 nearest to a double, ties to even, as bits: from the
+// double's bits, subnormal results and overflow to infinity included (a
+// NaN becomes the quiet NaN 0x7fc00000).
+uint float_bits_of(double x) {
+  uint64_t bits = doubleBitsToUint64(x);
+  uint sign = uint(bits >> 63) << 31u;
+  int exponent = int((bits >> 52) & 0x7fful);
+  uint64_t fraction = bits & 0xffffffffffffful;
+  if (exponent == 0x7ff) {
+    return fraction != 0ul ? 0x7fc00000u : sign | 0x7f800000u;
   }
-  // 52 fraction bits to 23: 29 to drop; the exponent moves from a bias of
-  // 1023 to 127.
-  uint64_t exponent = (bits >> 52) - 1023ul + 127ul;
-  uint64_t kept = (exponent << 23) | ((bits >> 29) & 0x7ffffful);
-  uint64_t dropped = bits & 0x1ffffffful;
-  const uint64_t halfway = 0x10000000ul;
+  if (exponent == 0) {
+    return sign;  // zero, or a double subnormal: far below float32's least
+  }
+  // A normal float keeps 23 of the 52 fraction bits (the exponent's bias
+  // goes from 1023 to 127); a subnormal one keeps the significand's bits
+  // from 2^-149 up.
+  int unbiased = exponent - 1023;
+  uint64_t kept;
+  int drop;
+  uint64_t significand;
+  if (unbiased >= -126) {
+    if (unbiased > 127) {
+      return sign | 0x7f800000u;
+    }
+    significand = fraction;
+    drop = 29;
+    kept = (uint64_t(unbiased + 127) << 23) | (fraction >> 29);
+  } else {
+    significand = fraction | 0x10000000000000ul;  // the implicit bit
+    drop = -97 - unbiased;                        // value / 2^-149 = significand * 2^(unbiased + 97)
+    if (drop > 54) {
+      return sign;  // below half the least subnormal
+    }
+    kept = significand >> uint(drop);
+  }
+  uint64_t dropped = significand & ((1ul << uint(drop)) - 1ul);
+  uint64_t halfway = 1ul << uint(drop - 1);
   if (dropped > halfway || (dropped == halfway && (kept & 1ul) != 0ul)) {
-    kept += 1ul;  // a carry into the exponent is the next binade's first float
+    kept += 1ul;  // a carry moves to the next binade, or to infinity
   }
-  return uint(kept);
+  return sign | uint(kept);
+}
+
+// Float32 arithmetic on float32 values held as doubles: the operation in
+// float64, then rounded once to float32. That is the float32 result: 53
+// bits are at least twice 24 and two, so the second rounding never
+// differs from a direct one (a product is even exact in float64).
+double f32(double x) { return float_value(float_bits_of(x)); }
+double f32_mul(double a, double b) {
+  precise double r = a * b;
+  return f32(r);
+}
+double f32_add(double a, double b) {
+  precise double r = a + b;
+  return f32(r);
+}
+double f32_div(double a, double b) {
+  precise double r = a / b;
+  return f32(r);
+}
+
+// Float32PipelineFloats for pipeline `pipeline`'s encoding and sample i.
+uint pipeline_float(uint pipeline, uint i) {
+  uint encoding = run_layout[pass.cells + run_layout[pass.cells + 2u * pass.depth_slots + pipeline]];
+  uint stores = encoding & 0xfu;
+  uint convention = (encoding >> 4u) & 0xfu;
+  uint hardware = (encoding >> 8u) & 0xfu;
+  double z = f32(eye_depths[i]);
+  uint fc = frame_of(i) * DB_JUDGE_FRAME_WORDS;
+  if (stores == DB_JUDGE_STORES_WINDOW_DEPTH) {
+    double a = float_value(frame_constants[fc + 2u + 2u * hardware]);
+    double b = float_value(frame_constants[fc + 3u + 2u * hardware]);
+    double window = f32_div(f32_add(f32_mul(a, z), b), z);
+    if ((convention & DB_CONVENTION_CLIP_MINUS_ONE) != 0u) {
+      window = f32_add(f32_mul(window, 0.5lf), 0.5lf);
+    }
+    return float_bits_of(window);
+  }
+  if (stores == DB_JUDGE_STORES_LINEAR) {
+    return float_bits_of(f32_div(z, float_value(frame_constants[fc + 1u])));
+  }
+  return float_bits_of(-z);
 }
 
 // encode.cc's unorm storing: the value clamped to [0, 1] (NaN to 0),
@@ -130,12 +201,19 @@ uint fetched_bits(uint slot, uint value_bits) {
   double inverse = wide ? packDouble2x32(uvec2(0x10000010u, 0x3e700000u))
                         : packDouble2x32(uvec2(0x00100010u, 0x3ef00010u));
   precise double fetched = double(unorm_code(value_bits, scale)) * inverse;
-  return float_bits_of_unit(fetched);
+  return float_bits_of(fetched);
 }
 
 void main() {
   uint slot = gl_WorkGroupID.y;
-  if (pass.phase != 0u) {
+  if (pass.phase == 0u) {
+    uint i = gl_GlobalInvocationID.x;
+    if (i < pass.count) {
+      pipeline_float_bits[slot * pass.count + i] = pipeline_float(slot, i);  // (row y: pipeline y)
+    }
+    return;
+  }
+  if (pass.phase == 2u) {
     uint k = gl_GlobalInvocationID.x;
     if (k < pass.edges) {
       texel_bits[slot * pass.slice_length + pass.lead + edge_samples[k]] = edge_texel_bits[slot * pass.edges + k];
@@ -153,7 +231,7 @@ void main() {
   }
   uint i = element - pass.lead;
   if ((coverage[i] & 0x100u) != 0u) {
-    return;  // a stored-value pick: phase 1 writes it
+    return;  // a stored-value pick: phase 2 writes it
   }
   uint pipeline = run_layout[pass.cells + slot] >> 16u;
   texel_bits[at] = fetched_bits(slot, pipeline_float_bits[pipeline * pass.count + i]);
