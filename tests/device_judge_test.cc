@@ -267,7 +267,24 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   const Sampler sampler(5, domain);
   ThreadPool pool(2);
   Batch batch;
-  BatchBuilder(sampler, layout.encodings).Build(7, count, batch, pool, BatchFor::kDeviceJudge);
+  const BatchBuilder builder(sampler, layout.encodings);
+  builder.Build(7, count, batch, pool, BatchFor::kDeviceJudge);
+  // The picks, listed apart, are the samples whose pick is a stored value,
+  // with the texels a batch for the host judge stores for them.
+  std::vector<std::uint32_t> picked;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (batch.samples.pick[i] != DepthPick::kEyeDepth) picked.push_back(i);
+  }
+  ASSERT_EQ(batch.picks, picked);
+  Batch for_host;
+  builder.Build(7, count, for_host, pool, BatchFor::kHostJudge);
+  ASSERT_EQ(for_host.pick_depths, batch.pick_depths);
+  for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
+    for (std::size_t k = 0; k < picked.size(); ++k) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(for_host.depths[slot * count + picked[k]]),
+                std::bit_cast<std::uint32_t>(batch.pick_depths[slot * picked.size() + k]));
+    }
+  }
   for (std::size_t at = 0; at < batch.pipeline_floats.size(); ++at) batch.pipeline_floats[at] = values[at % count];
   std::vector<CellAccumulator> accumulators(layout.cells.size());
   const Status judged = (*judge)->Judge(batch, accumulators, {}, pool);
@@ -275,13 +292,14 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   auto texels = (*judge)->LastTexels();
   ASSERT_TRUE(texels.ok()) << texels.status().message();
   ASSERT_EQ(texels->size(), layout.encodings.size() * count);
-  std::size_t differing = 0, picks = 0;
+  std::size_t differing = 0;
   for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
     const Format format = layout.encodings[slot].format;
+    std::size_t k = 0;  // picks before sample i
     for (std::uint32_t i = 0; i < count; ++i) {
-      const bool pick = batch.samples.pick[i] != DepthPick::kEyeDepth;
-      picks += pick && slot == 0 ? 1 : 0;
-      const float expected = pick ? batch.depths[slot * count + i] : StoreFloat(format, values[i]).fetched;
+      const bool pick = k < batch.picks.size() && batch.picks[k] == i;
+      const float expected =
+          pick ? batch.pick_depths[slot * batch.picks.size() + k++] : StoreFloat(format, values[i]).fetched;
       const float device = (*texels)[slot * count + i];
       if (std::bit_cast<std::uint32_t>(expected) != std::bit_cast<std::uint32_t>(device) && differing++ < 5) {
         ADD_FAILURE() << fmt::format("{}, sample {} (pick {}): {:a} stored as {:a} on the host, {:a} on the device",
@@ -290,7 +308,7 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
     }
   }
   EXPECT_EQ(differing, 0u);
-  EXPECT_GT(picks, 0u);  // both phases ran
+  EXPECT_GT(batch.picks.size(), 0u);  // both phases ran
   EXPECT_TRUE(context->TakeValidationMessages().empty());
 }
 

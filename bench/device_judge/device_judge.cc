@@ -120,7 +120,6 @@ struct DeviceJudge::State {
   std::uint32_t last_count = 0;    // samples of the last batch judged
   DevicePositions last_positions;  // the backend's buffers for it
   std::uint32_t edges = 0;         // stored-value picks of the batch uploaded last
-  std::vector<std::uint32_t> edge_scratch;
   bool exact_production = false;
   bool record_distances = true;
 
@@ -289,22 +288,17 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     DB_RETURN_IF_ERROR(Grow(binding, bytes));
   }
 
-  // The stored-value picks, and what each slot's texel is for them (the
-  // batch holds theirs alone where it was built for this judge).
+  // The stored-value picks and each slot's texel for them.
   const SampleArrays& samples = batch.samples;
-  if (batch.depths.size() != slot_samples) {
-    return InvalidArgument(fmt::format("a batch of {} samples with {} stored depths, for {} depth slots", count,
-                                       batch.depths.size(), depth_slots));
+  if (batch.pick_depths.size() != depth_slots * batch.picks.size()) {
+    return InvalidArgument(fmt::format("a batch with {} stored-value picks and {} texels for them, for {} depth slots",
+                                       batch.picks.size(), batch.pick_depths.size(), depth_slots));
   }
-  std::vector<std::uint32_t>& picks = edge_scratch;
-  picks.clear();
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (samples.pick[i] != DepthPick::kEyeDepth) picks.push_back(i);
-  }
-  edges = static_cast<std::uint32_t>(picks.size());
+  edges = static_cast<std::uint32_t>(batch.picks.size());
   DB_RETURN_IF_ERROR(Grow(kEdgeSamples, edges * sizeof(std::uint32_t)));
   DB_RETURN_IF_ERROR(Grow(kEdgeTexels, depth_slots * edges * sizeof(float)));
-  std::memcpy(buffers[kEdgeSamples].mapped(), picks.data(), edges * sizeof(std::uint32_t));
+  std::memcpy(buffers[kEdgeSamples].mapped(), batch.picks.data(), edges * sizeof(std::uint32_t));
+  std::memcpy(buffers[kEdgeTexels].mapped(), batch.pick_depths.data(), depth_slots * edges * sizeof(float));
   // Per frame. The frame's planes are read from the sample arrays at its
   // first sample in the batch: the reference then starts from the very
   // values the host's would.
@@ -331,29 +325,23 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
   }
-  auto* edge_texels = static_cast<float*>(buffers[kEdgeTexels].mapped());
   auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
   auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
   auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
-  // Per depth slot the picks' texels, then chunks of the per-sample and
-  // per-(pipeline, sample) values, in one loop.
+  // Chunks of the per-sample and per-(pipeline, sample) values, in one loop.
   const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
   const std::size_t pipeline_chunks = device_produces() ? 0 : (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
-  pool.ParallelFor(depth_slots + sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor(sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
-      if (job < depth_slots) {
-        for (std::uint32_t k = 0; k < edges; ++k) {
-          edge_texels[job * edges + k] = batch.depths[job * count + picks[k]];
-        }
-      } else if (job < depth_slots + sample_chunks) {
-        const std::size_t lo = (job - depth_slots) * kUploadChunk, n = std::min(kUploadChunk, count - lo);
+      if (job < sample_chunks) {
+        const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
         std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
         for (std::size_t i = lo; i < lo + n; ++i) {
           coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
                         static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
         }
       } else {
-        const std::size_t lo = (job - depth_slots - sample_chunks) * kUploadChunk;
+        const std::size_t lo = (job - sample_chunks) * kUploadChunk;
         std::memcpy(pipeline_floats + lo, batch.pipeline_floats.data() + lo,
                     std::min(kUploadChunk, pipeline_samples - lo) * sizeof(float));
       }

@@ -120,6 +120,13 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       edge_counts_[c] = listed;
     }
   });
+  edge_offsets_.resize(chunks);
+  batch.picks.clear();
+  for (std::size_t c = 0; c < chunks; ++c) {
+    edge_offsets_[c] = static_cast<std::uint32_t>(batch.picks.size());
+    batch.picks.insert(batch.picks.end(), edge_samples_.begin() + c * kChunk,
+                       edge_samples_.begin() + c * kChunk + edge_counts_[c]);
+  }
 
   // Encodings, in chunks of samples, each loop over arrays: per pipeline
   // (shared by a convention's formats) the mapping's float32 constants, the
@@ -179,6 +186,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
 
   batch.depths.resize(slots * count);
   batch.codes.resize(slots * count);
+  batch.pick_depths.resize(slots * batch.picks.size());
   batch.reference.Resize(for_host ? slots * count : 0);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
@@ -200,13 +208,18 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         }
       }
       const std::size_t chunk = job % chunks;
-      for (const std::uint32_t i : std::span(edge_samples_.data() + chunk * kChunk, edge_counts_[chunk])) {
+      float* pick_depths = batch.pick_depths.data() + s * batch.picks.size() + edge_offsets_[chunk];
+      for (std::uint32_t k = 0; k < edge_counts_[chunk]; ++k) {
+        const std::uint32_t i = edge_samples_[chunk * kChunk + k];
         const DepthPick pick = samples.pick[i];
         const StoredDepth edge =
             per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
                       : edges[static_cast<int>(pick)];
-        batch.codes[s * count + i] = edge.code;
-        batch.depths[s * count + i] = edge.fetched;
+        pick_depths[k] = edge.fetched;
+        if (for_host) {
+          batch.codes[s * count + i] = edge.code;
+          batch.depths[s * count + i] = edge.fetched;
+        }
       }
       if (for_host) ReferenceChunk(batch, s, lo, n);
     }

@@ -31,6 +31,12 @@ struct Batch : ShaderInputs {
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
   // count + sample].
   std::vector<float> pipeline_floats;
+  // The samples that pick a stored value (a DepthPick other than
+  // kEyeDepth), in order, and their fetched texels, [depth slot *
+  // picks.size() + k], kept apart for a judge that stores the others on
+  // its device.
+  std::vector<std::uint32_t> picks;
+  std::vector<float> pick_depths;
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 };
@@ -44,9 +50,9 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 // and the reference included. kDeviceJudge: where every judge works on its
 // device (bench/device_judge/), which produces the depths (in float32),
 // stores the texels and computes the reference itself: the batch's stored
-// depths (depths, codes) hold only the stored-value picks' (the samples
-// whose pick is not kEyeDepth), its reference is empty, and so are its
-// pipeline floats unless depths are produced exactly (ProductionModel).
+// depths (depths, codes) are not filled (pick_depths are), its reference
+// is empty, and so are its pipeline floats unless depths are produced
+// exactly (ProductionModel).
 enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge };
 
 class BatchBuilder {
@@ -89,8 +95,8 @@ class BatchBuilder {
   // pipeline's float denotes (the produced depth).
   mutable std::vector<double> mapping_a_, mapping_b_, produced_;
   // The samples that pick a stored value, [chunk * kChunk + k] for k below
-  // edge_counts_[chunk].
-  mutable std::vector<std::uint32_t> edge_samples_, edge_counts_;
+  // edge_counts_[chunk]; the picks of the chunks before it.
+  mutable std::vector<std::uint32_t> edge_samples_, edge_counts_, edge_offsets_;
 };
 
 }  // namespace depthbench
