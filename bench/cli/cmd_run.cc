@@ -76,10 +76,9 @@ void PrintRasterAgreement(const Results& results, std::span<Backend* const> back
   for (const Backend* backend : backends) {
     const std::vector<RasterAgreement> agreement = backend->raster_agreement();
     if (agreement.empty()) continue;
-    out << fmt::format(
-        "\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
-        "the largest difference in codes, ulps for float formats):\n",
-        backend->name());
+    out << fmt::format("\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
+                       "the largest difference in codes, ulps for float formats):\n",
+                       backend->name());
     for (std::size_t slot = 0; slot < agreement.size() && slot < layout.encodings.size(); ++slot) {
       const RasterAgreement& a = agreement[slot];
       const Encoding e = layout.encodings[slot];
@@ -187,12 +186,10 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                               "bind at once); default {}, or {} when a GPU judges (the fastest measured)",
                               kHostBatch, kDeviceJudgeBatch))
       ->check(CLI::Range(64u, 1u << 22));
-  cmd->add_option(
-         "--judge", flags->judge,
-         "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
-         "'device' (binned on the GPU where they are, histograms read back; needs float64, 64-bit "
-         "atomics and subgroup ballots), or 'auto' (default): the device for a GPU, the host for lavapipe. Same "
-         "results either way")
+  cmd->add_option("--judge", flags->judge,
+                  "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
+                  "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "
+                  "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
       ->check(CLI::IsMember({"auto", "host", "device"}))
       ->type_name("WHERE")
       ->group("Backends");

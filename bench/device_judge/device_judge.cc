@@ -197,10 +197,10 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   if (production == ProductionModel::kRaster) {
     return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
   }
-  if (!context->shader_float64() || !context->int64_atomics() || !context->subgroup_ballot()) {
+  if (!context->shader_float64() || !context->int64_atomics()) {
     return Unavailable(fmt::format(
-        "Vulkan device '{}' lacks float64 arithmetic, 64-bit atomics on storage buffers or subgroup ballots in "
-        "compute shaders, which the device judge needs; judge on the host (--judge host)",
+        "Vulkan device '{}' lacks float64 arithmetic or 64-bit atomics on storage buffers, which the device judge "
+        "needs; judge on the host (--judge host)",
         context->properties().name));
   }
   auto state = std::make_unique<State>();

@@ -51,7 +51,7 @@ class DeviceJudge {
   // compute form with the cells of `layout`, for depths produced by
   // `production` (kFloat32 or kExact). Unavailable, saying why, for
   // another backend, form or production, or a device without float64
-  // arithmetic, 64-bit atomics and subgroup ballots. `record_distances`: whether natural
+  // arithmetic and 64-bit atomics. `record_distances`: whether natural
   // samples also go to their camera-distance band
   // (CellAccumulator::records_distances).
   static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,

@@ -2,7 +2,6 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
-#extension GL_KHR_shader_subgroup_ballot : require
 // The judge on the device (bench/device_judge/device_judge.h): compares the
 // positions a reconstruction pass left in device memory with the reference
 // (reference.comp, run just before) and counts the errors into histograms
@@ -52,25 +51,6 @@ uint64_t sample_index(uint i) {
   return first + uint64_t(i);
 }
 
-// Adds one to counts[address] for every invocation that calls it. The
-// invocations of a subgroup that share an address add once, together:
-// neighbouring samples of a cell often fall in the same bin, and atomics
-// on one address wait for each other. Each pass of the loop takes the
-// first active invocation's address, and those that share it leave; that
-// stays right whatever the device runs together.
-void add_one(uint address) {
-  for (;;) {
-    uint first = subgroupBroadcastFirst(address);
-    if (address == first) {
-      uint sharing = subgroupBallotBitCount(subgroupBallot(true));
-      if (subgroupElect()) {
-        atomicAdd(counts[address], sharing);
-      }
-      return;
-    }
-  }
-}
-
 // One value of metric m in slot `slot` of accumulator k: a cell's 0 total,
 // 1 arith, 2 absolute; a depth slot's 0 storage, 1 production.
 void record(uint k, uint slot, uint m, double square, uint64_t index) {
@@ -82,7 +62,7 @@ void record(uint k, uint slot, uint m, double square, uint64_t index) {
   // above every number's).
   bool candidate = square > 0.0lf;
   if (pass.phase == 0u) {
-    add_one(at * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m]));
+    atomicAdd(counts[at * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m])], 1u);
     if (candidate && bits > maxima[max_at]) {
       atomicMax(maxima[max_at], bits);
     }

@@ -141,8 +141,8 @@ std::optional<std::uint32_t> ChooseComputeQueueFamily(const std::vector<VkQueueF
   int best = -1;
   for (std::uint32_t i = 0; i < families.size(); ++i) {
     if ((families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
-    const int score =
-        ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0 ? 2 : 0) + (families[i].timestampValidBits > 0 ? 1 : 0);
+    const int score = ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0 ? 2 : 0) +
+                      (families[i].timestampValidBits > 0 ? 1 : 0);
     if (score > best) {
       best = score;
       chosen = i;
@@ -447,18 +447,8 @@ Status VulkanContext::CreateDevice() {
   vkGetPhysicalDeviceFeatures2(physical_device_, &supported);
   const VkPhysicalDeviceFeatures& core = supported.features;
   shader_float64_ = core.shaderFloat64 == VK_TRUE;
-  // The device judge (bench/device_judge/) counts with 64-bit atomics, and
-  // merges a subgroup's counts with ballots.
+  // The device judge (bench/device_judge/) counts with 64-bit atomics.
   int64_atomics_ = core.shaderInt64 == VK_TRUE && api12 && features12.shaderBufferInt64Atomics == VK_TRUE;
-  VkPhysicalDeviceSubgroupProperties subgroup{};
-  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
-  VkPhysicalDeviceProperties2 with_subgroup{};
-  with_subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-  with_subgroup.pNext = &subgroup;
-  vkGetPhysicalDeviceProperties2(physical_device_, &with_subgroup);
-  constexpr VkSubgroupFeatureFlags kBallot = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
-  subgroup_ballot_ = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
-                     (subgroup.supportedOperations & kBallot) == kBallot;
   raster_features_ = {.graphics_queue = properties_.queue_graphics,
                       .dynamic_rendering = api13 && features13.dynamicRendering == VK_TRUE,
                       .multi_viewport = core.multiViewport == VK_TRUE,
@@ -585,9 +575,9 @@ Expected<DeviceObject<VkDeviceMemory>> VulkanContext::AllocateDeviceLocal(
     const VkMemoryRequirements& requirements) const {
   // Device-local first, as an engine places its render targets; a device
   // without it (none known) still runs.
-  DB_ASSIGN_OR_RETURN(
-      const std::uint32_t type,
-      FindMemoryType(requirements.memoryTypeBits, {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VkMemoryPropertyFlags{0}}));
+  DB_ASSIGN_OR_RETURN(const std::uint32_t type,
+                      FindMemoryType(requirements.memoryTypeBits,
+                                     {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VkMemoryPropertyFlags{0}}));
   VkMemoryAllocateInfo allocate_info{};
   allocate_info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   allocate_info.allocationSize = requirements.size;
@@ -627,9 +617,9 @@ Expected<VulkanImage> VulkanContext::CreateImage(VkFormat format, VkExtent2D ext
   image_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   image_info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkImage handle = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkCreateImage(device_, &image_info, nullptr, &handle),
-              fmt::format("vkCreateImage of format {} {}x{}", static_cast<int>(format), extent.width, extent.height)));
+  DB_RETURN_IF_ERROR(CheckVk(vkCreateImage(device_, &image_info, nullptr, &handle),
+                             fmt::format("vkCreateImage of format {} {}x{}", static_cast<int>(format), extent.width,
+                                         extent.height)));
   VulkanImage image;
   image.extent = extent;
   image.aspect = aspect;

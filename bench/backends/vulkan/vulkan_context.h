@@ -213,9 +213,6 @@ class VulkanContext {
   // Whether shaders may use 64-bit integers and their atomics on storage
   // buffers (enabled wherever the device has them).
   bool int64_atomics() const { return int64_atomics_; }
-  // Whether compute shaders have subgroup ballots (Vulkan 1.1's subgroup
-  // properties).
-  bool subgroup_ballot() const { return subgroup_ballot_; }
   const RasterFeatures& raster_features() const { return raster_features_; }
 
   bool validation_enabled() const { return validation_enabled_; }
@@ -262,7 +259,6 @@ class VulkanContext {
   VkQueue queue_ = VK_NULL_HANDLE;
   bool shader_float64_ = false;
   bool int64_atomics_ = false;
-  bool subgroup_ballot_ = false;
   RasterFeatures raster_features_;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
 };
