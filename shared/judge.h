@@ -63,6 +63,6 @@ struct JudgePass {
   uint depth_slots;  // slices of the reference buffers, and the depth slots' accumulators
   uint accumulators;  // cells, or cells + depth_slots when the encodings' errors are recorded too
   uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
-  uint edges;             // the storage pass's stored-value picks
+  uint picks;             // the storage pass's stored-value picks
   uint unused;
 };

@@ -71,8 +71,8 @@ enum Binding : std::uint32_t {
   kFirstNonFinite,
   kMaxima,
   kUnwritten,
-  kEdgeSamples,
-  kEdgeTexels,
+  kPickSamples,
+  kPickTexels,
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
@@ -119,7 +119,7 @@ struct DeviceJudge::State {
   std::size_t pipelines = 0;
   std::uint32_t last_count = 0;    // samples of the last batch judged
   DevicePositions last_positions;  // the backend's buffers for it
-  std::uint32_t edges = 0;         // stored-value picks of the batch uploaded last
+  std::uint32_t picks = 0;         // stored-value picks of the batch uploaded last
   bool exact_production = false;
   bool record_distances = true;
 
@@ -294,11 +294,11 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     return InvalidArgument(fmt::format("a batch with {} stored-value picks and {} texels for them, for {} depth slots",
                                        batch.picks.size(), batch.pick_depths.size(), depth_slots));
   }
-  edges = static_cast<std::uint32_t>(batch.picks.size());
-  DB_RETURN_IF_ERROR(Grow(kEdgeSamples, edges * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(Grow(kEdgeTexels, depth_slots * edges * sizeof(float)));
-  std::memcpy(buffers[kEdgeSamples].mapped(), batch.picks.data(), edges * sizeof(std::uint32_t));
-  std::memcpy(buffers[kEdgeTexels].mapped(), batch.pick_depths.data(), depth_slots * edges * sizeof(float));
+  picks = static_cast<std::uint32_t>(batch.picks.size());
+  DB_RETURN_IF_ERROR(Grow(kPickSamples, picks * sizeof(std::uint32_t)));
+  DB_RETURN_IF_ERROR(Grow(kPickTexels, depth_slots * picks * sizeof(float)));
+  std::memcpy(buffers[kPickSamples].mapped(), batch.picks.data(), picks * sizeof(std::uint32_t));
+  std::memcpy(buffers[kPickTexels].mapped(), batch.pick_depths.data(), depth_slots * picks * sizeof(float));
   // Per frame. The frame's planes are read from the sample arrays at its
   // first sample in the batch: the reference then starts from the very
   // values the host's would.
@@ -348,7 +348,7 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     }
   });
   for (Binding b :
-       {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kEdgeSamples, kEdgeTexels}) {
+       {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kPickSamples, kPickTexels}) {
     DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
   }
   return Status::Ok();
@@ -389,8 +389,8 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       first_bytes(),
       maxima_bytes(),
       unwritten_bytes(),
-      std::max<VkDeviceSize>(edges * sizeof(std::uint32_t), 16),
-      std::max<VkDeviceSize>(depth_slots * edges * sizeof(float), 16)};
+      std::max<VkDeviceSize>(picks * sizeof(std::uint32_t), 16),
+      std::max<VkDeviceSize>(depth_slots * picks * sizeof(float), 16)};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -416,7 +416,7 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
                       .depth_slots = static_cast<std::uint32_t>(depth_slots),
                       .accumulators = static_cast<std::uint32_t>(accumulators()),
                       .exact_production = exact_production ? 1u : 0u,
-                      .edges = edges,
+                      .picks = picks,
                       .unused = 0};
 }
 
@@ -436,10 +436,10 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
   constants.phase = 1;
   pass->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
-  if (edges > 0) {
+  if (picks > 0) {
     constants.phase = 2;
     pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, (edges + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
+    vkCmdDispatch(commands, (picks + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
   }
   // The reconstruction pass (the backend's, queued next) and the reference read them.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,

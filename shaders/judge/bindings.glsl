@@ -65,11 +65,11 @@ layout(std430, set = 0, binding = 13) buffer FirstNonFinite { uint64_t first_non
 layout(std430, set = 0, binding = 14) buffer Maxima { uint64_t maxima[]; };
 // Per cell: samples with a component the reconstruction never wrote.
 layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
-// The stored-value picks (store.comp's phase 1): the samples, and per
+// The stored-value picks (store.comp's phase 2): the samples, and per
 // (depth slot, pick) the fetched value's bits the host made, a slice of
-// pass.edges values per slot.
-layout(std430, set = 0, binding = 16) readonly buffer EdgeSamples { uint edge_samples[]; };
-layout(std430, set = 0, binding = 17) readonly buffer EdgeTexels { uint edge_texel_bits[]; };
+// pass.picks values per slot.
+layout(std430, set = 0, binding = 16) readonly buffer PickSamples { uint pick_samples[]; };
+layout(std430, set = 0, binding = 17) readonly buffer PickTexels { uint pick_texel_bits[]; };
 
 layout(push_constant) uniform Pass { JudgePass pass; };
 

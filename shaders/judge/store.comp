@@ -215,8 +215,8 @@ void main() {
   }
   if (pass.phase == 2u) {
     uint k = gl_GlobalInvocationID.x;
-    if (k < pass.edges) {
-      texel_bits[slot * pass.slice_length + pass.lead + edge_samples[k]] = edge_texel_bits[slot * pass.edges + k];
+    if (k < pass.picks) {
+      texel_bits[slot * pass.slice_length + pass.lead + pick_samples[k]] = pick_texel_bits[slot * pass.picks + k];
     }
     return;
   }
