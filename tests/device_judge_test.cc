@@ -285,6 +285,16 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
                 std::bit_cast<std::uint32_t>(batch.pick_depths[slot * picked.size() + k]));
     }
   }
+  // A batch for the device judge holds no texels (the storage pass makes
+  // them), so a run that reads the host's is refused, saying why.
+  EXPECT_EQ(batch.depth_slots, layout.encodings.size());
+  EXPECT_TRUE(batch.depths.empty());
+  EXPECT_TRUE(batch.codes.empty());
+  std::vector<float> scratch;
+  auto host_texels = (*vulkan)->Run(batch, std::vector<std::uint32_t>{0}, scratch);
+  ASSERT_FALSE(host_texels.ok());
+  EXPECT_NE(host_texels.status().message().find("0 stored depths"), std::string::npos)
+      << host_texels.status().message();
   for (std::size_t at = 0; at < batch.pipeline_floats.size(); ++at) batch.pipeline_floats[at] = values[at % count];
   std::vector<CellAccumulator> accumulators(layout.cells.size());
   const Status judged = (*judge)->Judge(batch, accumulators, {}, pool);

@@ -184,8 +184,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
     }
   });
 
-  batch.depths.resize(slots * count);
-  batch.codes.resize(slots * count);
+  batch.depth_slots = static_cast<std::uint32_t>(slots);
+  batch.depths.resize(for_host ? slots * count : 0);
+  batch.codes.resize(for_host ? slots * count : 0);
   batch.pick_depths.resize(slots * batch.picks.size());
   batch.reference.Resize(for_host ? slots * count : 0);
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {

@@ -23,8 +23,12 @@ struct ShaderInputs {
   std::vector<f32::FrameParams> frame_params;  // [frame]
   std::vector<f32::DepthParams> depth_params;  // [frame * kHardwareConventionCount + convention]
   std::vector<std::uint32_t> pixels;           // [sample]: x | y << 16
-  std::vector<float> depths;                   // [depth slot * count + sample]: fetched values
-  std::vector<std::uint32_t> codes;            // [depth slot * count + sample]: the texel bits fetched
+  // The run's depth slots (its encodings). Where the host stores the
+  // texels, depths and codes hold depth_slots * count values; where a
+  // device stores them itself (bench/device_judge/), both are empty.
+  std::uint32_t depth_slots = 0;
+  std::vector<float> depths;         // [depth slot * count + sample]: fetched values
+  std::vector<std::uint32_t> codes;  // [depth slot * count + sample]: the texel bits fetched
   // The raster pipeline's geometry (empty unless the domain's production
   // is ProductionModel::kRaster): [sample].
   std::vector<f32::RasterSample> raster;

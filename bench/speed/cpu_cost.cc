@@ -60,6 +60,7 @@ CpuCostInput MakeCpuCostInput(std::span<const Cell> cells, std::uint32_t samples
   for (std::uint32_t i = 0; i < samples; ++i) {
     batch.pixels[i] = (i % frame.width) | ((first_row + i / frame.width) << 16);
   }
+  batch.depth_slots = static_cast<std::uint32_t>(input.layout.encodings.size());
   batch.depths.resize(input.layout.encodings.size() * std::size_t{samples});
   for (std::size_t s = 0; s < input.layout.encodings.size(); ++s) {
     const Encoding encoding = input.layout.encodings[s];

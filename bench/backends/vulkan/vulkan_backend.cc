@@ -96,7 +96,7 @@ enum Binding : std::uint32_t {
 };
 using BindingBytes = std::array<VkDeviceSize, kBindingCount>;
 
-std::size_t DepthSlotsOf(const ShaderInputs& batch) { return batch.depths.size() / batch.count; }
+std::size_t DepthSlotsOf(const ShaderInputs& batch) { return batch.depth_slots; }
 
 // Bytes each binding holds for a batch of `cells` cells.
 BindingBytes BytesFor(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) {
@@ -246,7 +246,9 @@ class VulkanBackend final : public Backend {
   // The buffers a judge on the device reads, for slices `slices` of `cells` cells.
   DevicePositions OnDevice(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const;
   // What either form would read out of bounds.
-  Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
+  // `host_texels`: whether the run reads the batch's texels (depths), or a
+  // TexelWriter stores them on the device.
+  Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which, bool host_texels = true) const;
   // What the compute form's device cannot address or dispatch.
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
@@ -471,7 +473,7 @@ Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& 
     return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
   }
   if (batch.count == 0 || which.empty()) return DevicePositions{};
-  DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
+  DB_RETURN_IF_ERROR(CheckBatch(batch, which, write_texels == nullptr).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
   positions_access_ = HostAccess::kNone;
   Expected<SliceLayout> slices = RunCompute(batch, which, pool, /*wait=*/false, write_texels);
@@ -496,24 +498,26 @@ Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const Shad
   return Status::Ok();
 }
 
-Status VulkanBackend::CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which) const {
+Status VulkanBackend::CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                 bool host_texels) const {
   const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
+  // (Texels the device stores are not read from the batch, whatever it holds.)
+  const std::size_t depths = std::size_t{batch.depth_slots} * batch.count;
   if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
-      batch.pixels.size() < batch.count || batch.depths.size() % batch.count != 0) {
-    return InvalidArgument(
-        fmt::format("batch of {} samples has {} frame parameters, {} depth parameters, {} "
-                    "pixels and {} stored depths; it needs {}, {}, {} and a multiple of {}",
-                    batch.count, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(),
-                    batch.depths.size(), frames, frames * kHardwareConventionCount, batch.count, batch.count));
+      batch.pixels.size() < batch.count || (host_texels && batch.depths.size() != depths)) {
+    return InvalidArgument(fmt::format(
+        "batch of {} samples in {} depth slots has {} frame parameters, {} depth parameters, {} "
+        "pixels and {} stored depths; it needs {}, {}, {} and {}",
+        batch.count, batch.depth_slots, batch.frame_params.size(), batch.depth_params.size(), batch.pixels.size(),
+        batch.depths.size(), frames, frames * kHardwareConventionCount, batch.count, depths));
   }
   for (std::uint32_t index : which) {
     if (index >= cells_.size()) {
       return InvalidArgument(fmt::format("cell index {} out of range; {} cells prepared", index, cells_.size()));
     }
-    const std::size_t depths_needed = (std::size_t{cells_[index].depth_slot} + 1) * batch.count;
-    if (batch.depths.size() < depths_needed) {
-      return InvalidArgument(fmt::format("cell {} reads {} stored depths; the batch has {}", cells_[index].cell.Name(),
-                                         depths_needed, batch.depths.size()));
+    if (cells_[index].depth_slot >= batch.depth_slots) {
+      return InvalidArgument(fmt::format("cell {} reads depth slot {}; the batch has {}", cells_[index].cell.Name(),
+                                         cells_[index].depth_slot, batch.depth_slots));
     }
   }
   return Status::Ok();
