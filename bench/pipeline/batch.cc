@@ -107,25 +107,25 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // The samples of each chunk that pick a stored value (a few percent),
   // listed once for every depth slot's loop below: [chunk * kChunk + k].
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
-  edge_samples_.resize(chunks * kChunk);
-  edge_counts_.resize(chunks);
+  pick_samples_.resize(chunks * kChunk);
+  pick_counts_.resize(chunks);
   pool.ParallelFor(chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t c = begin; c < end; ++c) {
-      std::uint32_t* list = edge_samples_.data() + c * kChunk;
+      std::uint32_t* list = pick_samples_.data() + c * kChunk;
       std::uint32_t listed = 0;
       for (std::size_t i = c * kChunk; i < std::min<std::size_t>(count, (c + 1) * kChunk); ++i) {
         list[listed] = static_cast<std::uint32_t>(i);
         listed += batch.samples.pick[i] != DepthPick::kEyeDepth ? 1 : 0;
       }
-      edge_counts_[c] = listed;
+      pick_counts_[c] = listed;
     }
   });
-  edge_offsets_.resize(chunks);
+  pick_offsets_.resize(chunks);
   batch.picks.clear();
   for (std::size_t c = 0; c < chunks; ++c) {
-    edge_offsets_[c] = static_cast<std::uint32_t>(batch.picks.size());
-    batch.picks.insert(batch.picks.end(), edge_samples_.begin() + c * kChunk,
-                       edge_samples_.begin() + c * kChunk + edge_counts_[c]);
+    pick_offsets_[c] = static_cast<std::uint32_t>(batch.picks.size());
+    batch.picks.insert(batch.picks.end(), pick_samples_.begin() + c * kChunk,
+                       pick_samples_.begin() + c * kChunk + pick_counts_[c]);
   }
 
   // Encodings, in chunks of samples, each loop over arrays: per pipeline
@@ -209,9 +209,9 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         }
       }
       const std::size_t chunk = job % chunks;
-      float* pick_depths = batch.pick_depths.data() + s * batch.picks.size() + edge_offsets_[chunk];
-      for (std::uint32_t k = 0; k < edge_counts_[chunk]; ++k) {
-        const std::uint32_t i = edge_samples_[chunk * kChunk + k];
+      float* pick_depths = batch.pick_depths.data() + s * batch.picks.size() + pick_offsets_[chunk];
+      for (std::uint32_t k = 0; k < pick_counts_[chunk]; ++k) {
+        const std::uint32_t i = pick_samples_[chunk * kChunk + k];
         const DepthPick pick = samples.pick[i];
         const StoredDepth edge =
             per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)

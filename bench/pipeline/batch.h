@@ -95,8 +95,8 @@ class BatchBuilder {
   // pipeline's float denotes (the produced depth).
   mutable std::vector<double> mapping_a_, mapping_b_, produced_;
   // The samples that pick a stored value, [chunk * kChunk + k] for k below
-  // edge_counts_[chunk]; the picks of the chunks before it.
-  mutable std::vector<std::uint32_t> edge_samples_, edge_counts_, edge_offsets_;
+  // pick_counts_[chunk]; the picks of the chunks before it.
+  mutable std::vector<std::uint32_t> pick_samples_, pick_counts_, pick_offsets_;
 };
 
 }  // namespace depthbench
