@@ -295,6 +295,15 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   ASSERT_FALSE(host_texels.ok());
   EXPECT_NE(host_texels.status().message().find("0 stored depths"), std::string::npos)
       << host_texels.status().message();
+  // Nor may a cell read a depth slot past the batch's, texels or not.
+  Batch one_slot = for_host;
+  one_slot.depth_slots = 1;
+  one_slot.depths.resize(count);
+  const auto last = static_cast<std::uint32_t>(layout.cells.size() - 1);
+  ASSERT_GT(layout.cells[last].depth_slot, 0u);
+  auto past = (*vulkan)->Run(one_slot, std::vector<std::uint32_t>{last}, scratch);
+  ASSERT_FALSE(past.ok());
+  EXPECT_NE(past.status().message().find("reads depth slot"), std::string::npos) << past.status().message();
   for (std::size_t at = 0; at < batch.pipeline_floats.size(); ++at) batch.pipeline_floats[at] = values[at % count];
   std::vector<CellAccumulator> accumulators(layout.cells.size());
   const Status judged = (*judge)->Judge(batch, accumulators, {}, pool);
