@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstddef>
 #include <cstring>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
@@ -49,7 +51,7 @@ static_assert(L::DB_JUDGE_STORES_WINDOW_DEPTH == static_cast<unsigned>(DepthInpu
 // a cell's, and a depth slot's (its third is unused).
 constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal, Metric::kArith, Metric::kAbsolute};
 constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
-constexpr std::uint32_t kWorkgroupSize = 64;  // judge.comp's local_size_x
+constexpr std::uint32_t kWorkgroupSize = 64;  // store.comp's and reference.comp's local_size_x
 constexpr std::size_t kUploadChunk = 16384;   // samples per job of the uploads
 
 // The storage buffers of the three passes, by binding number
@@ -103,6 +105,41 @@ std::uint32_t TexelWord(Format format) {
 
 }  // namespace
 
+// The judge's workgroup shape (judge.comp's specialization constants):
+// its invocations, the consecutive samples of one accumulator it judges,
+// the entries of its table of bins in shared memory, and whether it adds
+// bins there first.
+struct JudgeGroups {
+  std::uint32_t invocations = 0;
+  std::uint32_t samples = 0;
+  std::uint32_t table_entries = 0;
+  VkBool32 use_table = VK_FALSE;
+};
+
+// With the table: as large as the device allows, up to 256 invocations,
+// 16384 samples (below 2^15, the count an entry holds) and 4096 entries
+// (16 KiB, the shared memory every Vulkan device has). Larger groups merge
+// more of their bins before the device's counters see them: on the
+// typical domain, groups of 2048 samples added one bin to the counters for
+// each 4.7 the shader recorded, groups of 16384 one for each 23. Without:
+// a sample per invocation, in groups of 64.
+JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, JudgeBinMerge bins) {
+  if (bins == JudgeBinMerge::kAuto) {
+    bins = device.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? JudgeBinMerge::kDeviceCounters : JudgeBinMerge::kWorkgroupTable;
+  }
+  if (bins == JudgeBinMerge::kDeviceCounters) {
+    return {.invocations = 64, .samples = 64, .table_entries = 1, .use_table = VK_FALSE};
+  }
+  const VkPhysicalDeviceLimits& limits = device.limits;
+  JudgeGroups groups{
+      .invocations = std::min({256u, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]}),
+      .samples = 16384,
+      .table_entries = 4096,
+      .use_table = VK_TRUE};
+  while (groups.table_entries * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) groups.table_entries /= 2;
+  return groups;
+}
+
 struct DeviceJudge::State {
   Backend* backend = nullptr;
   std::shared_ptr<VulkanContext> context;
@@ -122,6 +159,7 @@ struct DeviceJudge::State {
   std::uint32_t picks = 0;         // stored-value picks of the batch uploaded last
   bool exact_production = false;
   bool record_distances = true;
+  JudgeGroups judge_groups;
 
   std::size_t cell_count() const { return every_cell.size(); }
   // The cells' accumulators, then the depth slots'.
@@ -191,7 +229,8 @@ DeviceJudge::DeviceJudge(std::unique_ptr<State> state) : state_(std::move(state)
 DeviceJudge::~DeviceJudge() = default;
 
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, const RunLayout& layout,
-                                                           ProductionModel production, bool record_distances) {
+                                                           ProductionModel production, bool record_distances,
+                                                           JudgeBinMerge bins) {
   std::shared_ptr<VulkanContext> context = ContextOf(backend);
   if (context == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
   if (production == ProductionModel::kRaster) {
@@ -222,12 +261,22 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   }
   DB_RETURN_IF_ERROR(StoreInto(ComputePass::Create(context, bindings, sizeof(L::JudgePass)), state->pass));
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
-  const VkSpecializationInfo none{};
-  for (auto [name, pipeline] :
-       {std::pair{"store.comp", &state->store_pipeline}, std::pair{"reference.comp", &state->reference_pipeline},
-        std::pair{"judge.comp", &state->judge_pipeline}}) {
+  state->judge_groups = ChooseJudgeGroups(context->properties(), bins);
+  static_assert(sizeof(JudgeGroups) == 4 * sizeof(std::uint32_t));
+  const std::array<VkSpecializationMapEntry, 4> group_entries = {{
+      {0, offsetof(JudgeGroups, invocations), sizeof(std::uint32_t)},
+      {1, offsetof(JudgeGroups, samples), sizeof(std::uint32_t)},
+      {2, offsetof(JudgeGroups, table_entries), sizeof(std::uint32_t)},
+      {3, offsetof(JudgeGroups, use_table), sizeof(VkBool32)},
+  }};
+  const VkSpecializationInfo judge_shape{static_cast<std::uint32_t>(group_entries.size()), group_entries.data(),
+                                         sizeof(JudgeGroups), &state->judge_groups};
+  for (auto [name, pipeline, specialization] :
+       {std::tuple{"store.comp", &state->store_pipeline, VkSpecializationInfo{}},
+        std::tuple{"reference.comp", &state->reference_pipeline, VkSpecializationInfo{}},
+        std::tuple{"judge.comp", &state->judge_pipeline, judge_shape}}) {
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
-    DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, none, "the device judge"), *pipeline));
+    DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, specialization, "the device judge"), *pipeline));
   }
 
   // What stays the same for the whole run: which depth slot each cell
@@ -465,10 +514,11 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   pass->Bind(commands, judge_pipeline.get());
   const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
+  const std::uint32_t groups_per_row = (batch.count + judge_groups.samples - 1) / judge_groups.samples;
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, groups, rows, 1);
+    vkCmdDispatch(commands, groups_per_row, rows, 1);
     // Phase 1 reads the maxima phase 0 raised; the copy below reads both.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,

@@ -45,6 +45,15 @@
 
 namespace depthbench {
 
+// Where the judge adds each sample's bins. kWorkgroupTable: first into a
+// table in each workgroup's shared memory, then the table's totals into
+// the device's counters (far fewer global atomic additions on bins that
+// neighbouring samples share); kDeviceCounters: straight into the
+// device's counters. kAuto: the table on a GPU, the counters on a CPU
+// device (lavapipe, where the table made a run slower). Either gives the
+// same counts.
+enum class JudgeBinMerge : std::uint8_t { kAuto, kWorkgroupTable, kDeviceCounters };
+
 class DeviceJudge {
  public:
   // A judge on the device of `backend`, a Vulkan backend prepared for the
@@ -55,7 +64,8 @@ class DeviceJudge {
   // samples also go to their camera-distance band
   // (CellAccumulator::records_distances).
   static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,
-                                                       ProductionModel production, bool record_distances);
+                                                       ProductionModel production, bool record_distances,
+                                                       JudgeBinMerge bins = JudgeBinMerge::kAuto);
   ~DeviceJudge();
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;

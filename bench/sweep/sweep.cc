@@ -68,13 +68,15 @@ void CopyEncodingMetrics(const CellStats& from, CellStats& to) {
 // The judge on the device of `backend`, where `site` asks for one; null
 // where the outputs are judged on the host.
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudgeFor(JudgeSite site, Backend& backend, const RunLayout& layout,
-                                                      bool record_distances, ProductionModel production) {
+                                                      bool record_distances, ProductionModel production,
+                                                      JudgeBinMerge bins) {
   if (site == JudgeSite::kHost) return std::unique_ptr<DeviceJudge>();
   const bool gpu = backend.device().kind == "gpu";
   if (site == JudgeSite::kAuto && (!gpu || PassKindOf(production) != PassKind::kCompute)) {
     return std::unique_ptr<DeviceJudge>();
   }
-  Expected<std::unique_ptr<DeviceJudge>> judge = DeviceJudge::Create(backend, layout, production, record_distances);
+  Expected<std::unique_ptr<DeviceJudge>> judge =
+      DeviceJudge::Create(backend, layout, production, record_distances, bins);
   if (!judge.ok() && site == JudgeSite::kAuto) return std::unique_ptr<DeviceJudge>();
   return judge;
 }
@@ -166,10 +168,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // host, below.
   std::vector<std::unique_ptr<DeviceJudge>> device_judges(backends.size());
   for (std::size_t b = 0; b < backends.size(); ++b) {
-    DB_RETURN_IF_ERROR(
-        StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band, options.domain.production),
-                  device_judges[b])
-            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
+    DB_RETURN_IF_ERROR(StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band,
+                                                options.domain.production, options.device_bins),
+                                 device_judges[b])
+                           .WithContext("judging on the " + backends[b]->name() + " backend's device"));
     if (device_judges[b] != nullptr) run.backends[b].judge = "device";
   }
   // A batch no backend can take whole is cut to what the smallest takes.

@@ -13,6 +13,7 @@
 #include "bench/backends/backend.h"
 #include "bench/base/isa.h"
 #include "bench/base/thread_pool.h"
+#include "bench/device_judge/device_judge.h"
 #include "bench/pipeline/batch.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
@@ -67,6 +68,8 @@ struct SweepOptions {
   std::uint64_t flush_every = std::uint64_t{1} << 31;
   // kDevice fails for a backend that cannot judge on its device.
   JudgeSite judge = JudgeSite::kAuto;
+  // Where a judge on a device adds its bins (tests pick each way).
+  JudgeBinMerge device_bins = JudgeBinMerge::kAuto;
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

@@ -13,6 +13,15 @@
 // run, one sample per invocation; rows past the cells record the storage
 // and production errors of each depth slot (shared/judge.h).
 //
+// A workgroup judges kGroupSamples consecutive samples of one
+// accumulator. In phase 0 it adds their bins into a table in shared memory
+// first (open addressing on the bin's place in the accumulator), and only
+// the table's totals into the device's counters at its end: neighbouring
+// samples fall into few bins, and global atomic additions on one address
+// wait for each other. A bin the table has no room for goes to the
+// device's counter at once. Integer additions in any order give the same
+// counts.
+//
 // Two phases over the same batch: phase 0 adds bins and counts and raises
 // each slot's largest square (a 64-bit atomic maximum on its bits: squares
 // are never negative, so their bits order as they do); phase 1 finds, for
@@ -21,7 +30,14 @@
 #include "../../shared/compat.h"
 #include "../../shared/judge.h"
 
-layout(local_size_x = 64) in;
+// The workgroup's shape, which the host chooses for the device
+// (device_judge.cc's JudgeGroups): its invocations, the consecutive
+// samples of one accumulator it judges, and the entries of its table of
+// bins (a power of two).
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint kGroupSamples = 16384u;
+layout(constant_id = 2) const uint kTableEntries = 4096u;
+layout(constant_id = 3) const bool kUseTable = true;  // false: bins go straight to the device's counters
 
 #include "bindings.glsl"
 
@@ -30,6 +46,40 @@ layout(local_size_x = 64) in;
 const uint kUnwrittenBits = 0x7fa00badu;
 const int kLowestOctave[3] = int[3](-56, -56, -48);  // stats.h's kLowestOctave of total, arith, absolute
 const uint kNoSlot = 0xffffffffu;
+
+// The workgroup's table of bins, one word per entry: 0 while empty, else
+// the bin's place in the accumulator plus one (slot * DB_JUDGE_SLOT_UINTS
+// + metric * DB_JUDGE_BINS + bin + 1, below 2^17) over 15 bits that count
+// this workgroup's samples in it (at most one per sample: the host keeps
+// kGroupSamples below 2^15).
+const uint kTableProbes = 16u;
+const uint kCountBits = 15u;
+shared uint table[kTableEntries];
+
+// One more sample in bin `key` of accumulator k.
+void add_to_bin(uint k, uint key) {
+  if (!kUseTable) {
+    atomicAdd(counts[k * DB_JUDGE_SLOTS * DB_JUDGE_SLOT_UINTS + key], 1u);
+    return;
+  }
+  uint tag = key + 1u;
+  uint home = (key * 2654435761u) >> (32u - uint(findMSB(kTableEntries)));  // Knuth's multiplicative hash
+  for (uint probe = 0u; probe < kTableProbes; ++probe) {
+    uint entry = (home + probe) & (kTableEntries - 1u);
+    uint held = table[entry];
+    if (held == 0u) {
+      held = atomicCompSwap(table[entry], 0u, (tag << kCountBits) | 1u);
+      if (held == 0u) {
+        return;
+      }
+    }
+    if ((held >> kCountBits) == tag) {
+      atomicAdd(table[entry], 1u);
+      return;
+    }
+  }
+  atomicAdd(counts[k * DB_JUDGE_SLOTS * DB_JUDGE_SLOT_UINTS + key], 1u);
+}
 
 // The dense bin of a square (stats.h's DenseBinsOfSquares): 0 for zero,
 // subnormal or NaN, else floor(4 log2 sqrt(q)) from q's exponent and a
@@ -62,7 +112,7 @@ void record(uint k, uint slot, uint m, double square, uint64_t index) {
   // above every number's).
   bool candidate = square > 0.0lf;
   if (pass.phase == 0u) {
-    atomicAdd(counts[at * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m])], 1u);
+    add_to_bin(k, slot * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m]));
     if (candidate && bits > maxima[max_at]) {
       atomicMax(maxima[max_at], bits);
     }
@@ -112,12 +162,8 @@ void record_encoding(uint k, uint s, uint i) {
   record(k, band, 1u, reference[4u * slot_samples + r], index);
 }
 
-void main() {
-  uint i = gl_GlobalInvocationID.x;
-  uint k = gl_WorkGroupID.y;
-  if (i >= pass.count) {
-    return;
-  }
+// Sample i of accumulator k.
+void judge(uint k, uint i) {
   if (k >= pass.cells) {
     record_encoding(k, k - pass.cells, i);
     return;
@@ -176,6 +222,33 @@ void main() {
     count(k, band, status, holdable, is_nan, index);
     if (distance != kNoSlot) {
       count(k, distance, status, holdable, is_nan, index);
+    }
+  }
+}
+
+void main() {
+  uint k = gl_WorkGroupID.y;
+  uint lane = gl_LocalInvocationID.x;
+  bool tabling = kUseTable && pass.phase == 0u;  // phase 0 through the table
+  if (tabling) {
+    for (uint entry = lane; entry < kTableEntries; entry += gl_WorkGroupSize.x) {
+      table[entry] = 0u;
+    }
+    barrier();
+  }
+  uint first = gl_WorkGroupID.x * kGroupSamples;
+  uint end = min(first + kGroupSamples, pass.count);
+  for (uint i = first + lane; i < end; i += gl_WorkGroupSize.x) {
+    judge(k, i);
+  }
+  if (tabling) {
+    barrier();
+    for (uint entry = lane; entry < kTableEntries; entry += gl_WorkGroupSize.x) {
+      uint held = table[entry];
+      if (held != 0u) {
+        uint key = (held >> kCountBits) - 1u;
+        atomicAdd(counts[k * DB_JUDGE_SLOTS * DB_JUDGE_SLOT_UINTS + key], held & ((1u << kCountBits) - 1u));
+      }
     }
   }
 }
