@@ -102,6 +102,17 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, JudgeBi
   // The results say where each was judged.
   EXPECT_EQ(host->run.backends.at(0).judge, "host");
   EXPECT_EQ(device->run.backends.at(0).judge, "device");
+  // And where the time went. Here the build of a batch overlaps the
+  // judging of the one before: the main thread's spans (building, waiting
+  // for the judging) are disjoint within the wall clock, and so are the
+  // judging thread's; the device's passes are waited for within the
+  // judging, and on lavapipe take most of it.
+  const StageSeconds& t = device->run.stages;
+  EXPECT_LE(t.build + t.build_waited, device->run.seconds);
+  EXPECT_LE(t.judging, device->run.seconds);
+  EXPECT_GT(t.device_waited, 0.0);
+  EXPECT_LE(t.device_waited, t.judging);
+  EXPECT_GT(t.build_waited, 0.0);
   Reached reached;
   for (std::size_t c = 0; c < host->cells.size(); ++c) {
     const CellStats& a = host->cells[c].stats;

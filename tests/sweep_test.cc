@@ -299,7 +299,35 @@ TEST(SweepTest, ResultsSurviveTheJsonRoundTrip) {
   ExpectSameStats(original, *read);
   EXPECT_EQ(read->run.seed, 9u);
   EXPECT_EQ(read->run.domain.near, original.run.domain.near);
+  EXPECT_EQ(read->run.stages.build, original.run.stages.build);
+  EXPECT_EQ(read->run.stages.judging, original.run.stages.judging);
   std::filesystem::remove(path);
+  // Files written before the stage times were recorded still read.
+  nlohmann::json old = ToJson(original);
+  old["run"].erase("stage_seconds");
+  auto older = ResultsFromJson(old, "old.json");
+  ASSERT_TRUE(older.ok()) << older.status().message();
+  EXPECT_TRUE(older->run.stages.empty());
+}
+
+// Where the host judges, the build and the judging take turns on the
+// main thread: their times are disjoint spans of the run's wall clock,
+// and together most of it (the rest is the set-up inside the clock and
+// the last flush). Merged shards add them up.
+TEST(SweepTest, StageTimesShareOutTheWallClock) {
+  const Results whole = RunCpu(7, 200000, {});
+  const StageSeconds& t = whole.run.stages;
+  EXPECT_GT(t.build, 0.0);
+  EXPECT_GT(t.judging, 0.0);
+  EXPECT_LE(t.build + t.judging, whole.run.seconds);
+  EXPECT_GE(t.build + t.judging, 0.5 * whole.run.seconds);
+  EXPECT_EQ(t.build_waited, 0.0);   // nothing overlaps
+  EXPECT_EQ(t.device_waited, 0.0);  // no device judges
+  const Results a = RunCpu(7, 2000, {1, 2}), b = RunCpu(7, 2000, {2, 2});
+  auto merged = MergeResults({a, b});
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  EXPECT_EQ(merged->run.stages.build, a.run.stages.build + b.run.stages.build);
+  EXPECT_EQ(merged->run.stages.judging, a.run.stages.judging + b.run.stages.judging);
 }
 
 TEST(SweepTest, BadResultsFilesNameTheFieldThatIsWrong) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -160,6 +161,7 @@ struct DeviceJudge::State {
   bool exact_production = false;
   bool record_distances = true;
   JudgeGroups judge_groups;
+  double waited = 0.0;  // seconds Judge spent waiting for the device's passes
 
   std::size_t cell_count() const { return every_cell.size(); }
   // The cells' accumulators, then the depth slots'.
@@ -580,8 +582,12 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   DB_ASSIGN_OR_RETURN(const DevicePositions positions,
                       RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool, store));
   DB_RETURN_IF_ERROR(s.UploadForReference(batch, pool));
+  // Queued, then waited for: the reference's and the judge's passes, after
+  // the storage and reconstruction passes already queued.
+  const auto submitted = std::chrono::steady_clock::now();
   DB_RETURN_IF_ERROR(
       s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
+  s.waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - submitted).count();
   DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
   s.last_count = batch.count;
   s.last_positions = positions;
@@ -590,6 +596,8 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   for (CellAccumulator& a : encodings) a.Count(batch.count);
   return Status::Ok();
 }
+
+double DeviceJudge::waited_seconds() const { return state_->waited; }
 
 Expected<ReferenceArrays> DeviceJudge::LastReference() const {
   const State& s = *state_;

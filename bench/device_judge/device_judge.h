@@ -82,6 +82,10 @@ class DeviceJudge {
   // The most samples one batch may have: the widest binding (the
   // reference of every depth slot) within the device's limit.
   std::uint64_t MaxBatchSamples() const;
+  // Seconds Judge has spent waiting for the device to finish its passes,
+  // since this judge was made: with the host's time around Judge, it says
+  // which side a batch waits for.
+  double waited_seconds() const;
   // The reference the device computed for the last batch Judge was given,
   // in the host's layout (for tests and diagnosis).
   Expected<ReferenceArrays> LastReference() const;

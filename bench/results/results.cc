@@ -227,6 +227,11 @@ json ToJson(const Results& results) {
                                        {"domain", DomainToJson(run.domain)},
                                        {"backends", backends},
                                        {"seconds", run.seconds},
+                                       {"stage_seconds",
+                                        {{"build", run.stages.build},
+                                         {"judging", run.stages.judging},
+                                         {"build_waited", run.stages.build_waited},
+                                         {"device_waited", run.stages.device_waited}}},
                                        {"reconstructions", run.reconstructions}}},
                                      {"cells", cells}});
 }
@@ -365,6 +370,13 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   run.samples_per_frame = static_cast<std::uint32_t>(per_frame);
   DB_ASSIGN_OR_RETURN(run.seconds, r.Number("seconds"));
   DB_ASSIGN_OR_RETURN(run.reconstructions, r.Unsigned("reconstructions"));
+  if (r.Has("stage_seconds")) {
+    DB_ASSIGN_OR_RETURN(JsonReader stages, r.Field("stage_seconds"));
+    DB_ASSIGN_OR_RETURN(run.stages.build, stages.Number("build"));
+    DB_ASSIGN_OR_RETURN(run.stages.judging, stages.Number("judging"));
+    DB_ASSIGN_OR_RETURN(run.stages.build_waited, stages.Number("build_waited"));
+    DB_ASSIGN_OR_RETURN(run.stages.device_waited, stages.Number("device_waited"));
+  }
   DB_RETURN_IF_ERROR(r.ForEach("shards", [&](const JsonReader& s) -> Status {
     DB_ASSIGN_OR_RETURN(std::string text, s.String());
     Expected<Shard> shard = ParseShard(text);
@@ -530,6 +542,11 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
       merged.run.shards.push_back(s);
     }
     merged.run.seconds += part.run.seconds;
+    StageSeconds& stages = merged.run.stages;
+    stages.build += part.run.stages.build;
+    stages.judging += part.run.stages.judging;
+    stages.build_waited += part.run.stages.build_waited;
+    stages.device_waited += part.run.stages.device_waited;
     merged.run.reconstructions += part.run.reconstructions;
     merged.run.samples_judged += part.run.samples_judged;
     merged.run.partial = merged.run.partial || part.run.partial;

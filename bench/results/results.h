@@ -57,6 +57,20 @@ struct BackendRecord {
   std::string judge = "host";
 };
 
+// Where a sweep's wall time went, in seconds (summed over merged shards).
+// The build and the judging take turns where the host judges; where every
+// backend judges on its device, the host builds the next batch while the
+// devices take the last one, and the slower stage sets the pace: the
+// other then waits.
+struct StageSeconds {
+  double build = 0.0;          // the batches built: samples, frames' constants, stored depths, reference
+  double judging = 0.0;        // the backends run and their outputs judged, on the host or on their devices
+  double build_waited = 0.0;   // the build waiting for the judging of the batch before
+  double device_waited = 0.0;  // the judging waiting for a device to finish its passes (device judge)
+
+  bool empty() const { return build == 0.0 && judging == 0.0; }
+};
+
 struct RunInfo {
   std::string version;
   std::string commit;
@@ -75,6 +89,7 @@ struct RunInfo {
   // figures are of the first samples_judged samples of its shards only.
   bool partial = false;
   std::uint64_t samples_judged = 0;  // of the shards held, summed over merged parts
+  StageSeconds stages;               // (absent from results written before 2026-12)
 };
 
 struct CellResult {

@@ -63,6 +63,13 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions), run.seconds,
                        SiCount(run.reconstructions / run.seconds));
   }
+  if (!run.stages.empty()) {
+    const StageSeconds& t = run.stages;
+    out << fmt::format("time: building batches {:.2f} s, running and judging {:.2f} s", t.build, t.judging);
+    if (t.device_waited > 0) out << fmt::format(" (waiting for the device {:.2f} s)", t.device_waited);
+    if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s for the judging", t.build_waited);
+    out << "\n";
+  }
   out << "bits lost = log2(relative error / 2^-24), from 0 (float32's own rounding) to 24 (nothing left); relative "
          "to the distance from the camera\n\n";
 }

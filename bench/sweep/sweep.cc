@@ -33,6 +33,10 @@ std::string SweepProgress::Describe() const {
 }
 namespace {
 
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // The first error any worker reports.
 class FirstError {
  public:
@@ -237,6 +241,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // serves it: the sweep's pool, or where it overlaps the next build, a
   // pool of its own.
   const auto judge_batch = [&](const Batch& batch, ThreadPool& stage_pool) -> Status {
+    const auto judging_started = std::chrono::steady_clock::now();
     const std::uint32_t count = batch.count;
     for (std::size_t b = 0; b < backends.size(); ++b) {
       Backend& backend = *backends[b];
@@ -286,6 +291,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       }
     }
     DB_RETURN_IF_ERROR(flush_devices(true));
+    run.stages.judging += SecondsSince(judging_started);
     for (std::size_t k = 0; k < accumulators.size(); ++k) {
       if (accumulators[k].pending() >= flush_every) accumulators[k].FlushInto(stats[k]);
     }
@@ -294,7 +300,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     }
     progress.samples_done += count;
     progress.reconstructions_done += static_cast<std::uint64_t>(count) * cell_count * backends.size();
-    progress.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    progress.seconds = SecondsSince(started);
     if (options.progress) options.progress(progress);
     return Status::Ok();
   };
@@ -308,17 +314,25 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   if (overlap) stage_pool = std::make_unique<ThreadPool>(stage_threads);
   std::array<Batch, 2> batches;  // (the second only where the stages overlap)
   std::future<Status> judging;   // the stage of the batch before, while it runs
-  const auto finish_judging = [&]() -> Status { return judging.valid() ? judging.get() : Status::Ok(); };
+  const auto finish_judging = [&]() -> Status {
+    if (!judging.valid()) return Status::Ok();
+    const auto waiting = std::chrono::steady_clock::now();
+    Status judged = judging.get();
+    run.stages.build_waited += SecondsSince(waiting);
+    return judged;
+  };
   std::size_t turn = 0;
   // On SIGINT or SIGTERM the sweep stops between batches and returns what it
   // judged (base/interrupt.h); the caller marks it partial.
   for (std::uint64_t first = begin; first < end && !Interrupted(); first += batch_size, turn = overlap ? turn ^ 1 : 0) {
     const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(batch_size, end - first));
     Batch& batch = batches[turn];
+    const auto building = std::chrono::steady_clock::now();
     builder.Build(first, count, batch, pool, built_for);
     if (renderer != nullptr) {
       DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer, builder, batch, pool));
     }
+    run.stages.build += SecondsSince(building);
     if (!overlap) {
       DB_RETURN_IF_ERROR(judge_batch(batch, pool));
       continue;
@@ -352,7 +366,10 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       results.cells.push_back({layout.cells[c].cell, backends[b]->name(), std::move(stats[k])});
     }
   }
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  for (const auto& judge : device_judges) {
+    if (judge != nullptr) run.stages.device_waited += judge->waited_seconds();
+  }
+  run.seconds = SecondsSince(started);
   run.reconstructions = progress.reconstructions_done;
   run.samples_judged = progress.samples_done;
   run.partial = progress.samples_done < progress.samples_total;

@@ -67,6 +67,8 @@ for ((r = 1; r <= runs; ++r)); do
             printf "%.1f", u == "G" ? v * 1000 : u == "M" ? v : u == "k" ? v / 1000 : v / 1e6}') ||
       { echo "no 'verified in' line in the output of run ${arguments[i]}:" >&2; cat "$log" >&2; exit 1; }
     rates[i]+="$rate "
+    # Where the time went (the build, the judging, the waits), run by run.
+    grep '^time:' "$log" >&2 || true
     peaks[i]+="$(awk '/Maximum resident set size/ {printf "%.0f ", $6 / 1024}' "$log")"
   done
 done
