@@ -311,6 +311,24 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   EXPECT_EQ(batch.depth_slots, layout.encodings.size());
   EXPECT_TRUE(batch.depths.empty());
   EXPECT_TRUE(batch.codes.empty());
+  // Where the device produces the depths too (float32 production), the
+  // batch holds of its samples only what was drawn, the host judge's
+  // batch's, and the same rays; not what the reference derives from the
+  // frame and the ray.
+  {
+    const Sampler float32_sampler(5, TypicalDomain());
+    const BatchBuilder float32_builder(float32_sampler, layout.encodings);
+    Batch lean, full;
+    float32_builder.Build(7, count, lean, pool, BatchFor::kDeviceJudge);
+    float32_builder.Build(7, count, full, pool, BatchFor::kHostJudge);
+    EXPECT_TRUE(lean.samples.near.empty());
+    EXPECT_TRUE(lean.samples.inverse_distance_sq.empty());
+    EXPECT_EQ(full.samples.near.size(), count);
+    EXPECT_EQ(lean.samples.eye_depth, full.samples.eye_depth);
+    EXPECT_EQ(lean.samples.coverage, full.samples.coverage);
+    EXPECT_EQ(lean.ray_x, full.ray_x);
+    EXPECT_EQ(lean.ray_z, full.ray_z);
+  }
   std::vector<float> scratch;
   auto host_texels = (*vulkan)->Run(batch, std::vector<std::uint32_t>{0}, scratch);
   ASSERT_FALSE(host_texels.ok());

@@ -27,14 +27,15 @@ nlohmann::json ReadJson(const std::string& path) {
 // merge of the shards and the whole run, though the sweep is the same:
 //   started_at: each process's own clock when it started (merge keeps the
 //               first shard's);
-//   seconds:    wall time, of one process against the sum of the shards'.
+//   seconds, stage_seconds: wall time and its stages, of one process
+//               against the sum of the shards'.
 // run.shards differs too (the four shards against 1/1); the test checks it
 // by itself. Everything else (version, commit, host, seed, samples, domain,
 // cells, backends with their devices and shader hashes, the counts judged)
 // and every cell's histograms, maxima with their samples and counts must
 // be equal.
 nlohmann::json WithoutRunSpecificFields(nlohmann::json results) {
-  for (const char* field : {"started_at", "seconds", "shards"}) results["run"].erase(field);
+  for (const char* field : {"started_at", "seconds", "stage_seconds", "shards"}) results["run"].erase(field);
   return results;
 }
 
@@ -45,8 +46,8 @@ TEST(ShardedSweep, ShardsRunAtOnceMergeToTheWholeRun) {
   // shards of unequal size (5000 and 5001 samples), and batches of 1024
   // give each shard several batches and a short last one. One thread each:
   // the five processes share the machine's cores.
-  const std::vector<std::string> sweep = {"run", "--samples", "20001", "--seed", "5", "--batch", "1024",
-                                          "--threads", "1", "--quiet"};
+  const std::vector<std::string> sweep = {"run",     "--samples", "20001",     "--seed", "5",
+                                          "--batch", "1024",      "--threads", "1",      "--quiet"};
   const auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = sweep;
     args.insert(args.end(), extra.begin(), extra.end());

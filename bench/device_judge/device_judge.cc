@@ -350,9 +350,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   DB_RETURN_IF_ERROR(Grow(kPickTexels, depth_slots * picks * sizeof(float)));
   std::memcpy(buffers[kPickSamples].mapped(), batch.picks.data(), picks * sizeof(std::uint32_t));
   std::memcpy(buffers[kPickTexels].mapped(), batch.pick_depths.data(), depth_slots * picks * sizeof(float));
-  // Per frame. The frame's planes are read from the sample arrays at its
-  // first sample in the batch: the reference then starts from the very
-  // values the host's would.
+  // Per frame. The frame's planes are those the host's reference reads
+  // for each of its samples (PlanesOf).
   auto* frame_words = static_cast<std::uint32_t*>(buffers[kFrames].mapped());
   auto* frame_depths = static_cast<double*>(buffers[kFrameDepths].mapped());
   auto* frame_constants = static_cast<std::uint32_t*>(buffers[kFrameConstants].mapped());
@@ -360,15 +359,15 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     const glm::dvec3& camera = batch.frames[f].camera_position;  // float32 values (sampler.h)
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
     frame_words[4 * f + 3] = batch.distance_bands[f];
-    const std::size_t i = f == 0 ? 0 : f * kSamplesPerFrame - batch.first_offset;
+    const FramePlanes planes = PlanesOf(batch.frames[f]);
     double* depths = frame_depths + f * L::DB_JUDGE_FRAME_DEPTHS;
-    depths[0] = samples.near[i];
-    depths[1] = samples.far[i];
-    depths[2] = samples.depth_limit[i];
-    depths[3] = samples.interest_min[i];
-    depths[4] = samples.interest_max[i];
+    depths[0] = planes.near;
+    depths[1] = planes.far;
+    depths[2] = planes.depth_limit;
+    depths[3] = planes.interest_min;
+    depths[4] = planes.interest_max;
     std::uint32_t* words = frame_constants + f * L::DB_JUDGE_FRAME_WORDS;
-    words[0] = samples.ratio_band[i];
+    words[0] = planes.ratio_band;
     words[1] = std::bit_cast<std::uint32_t>(batch.frame_params[f].camera_position.w);
     for (int c = 0; c < kHardwareConventionCount; ++c) {
       const f32::DepthParams& depth = batch.depth_params[f * kHardwareConventionCount + c];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 
 #include "bench/pipeline/bands.h"
 #include "bench/pipeline/encode.h"
@@ -82,12 +83,24 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.raster.assign(raster ? count : 0, f32::RasterSample{});
   batch.pixels.resize(count);
   for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
-  batch.samples.Resize(count);
+  // (A judge on the device produces float32 depths itself, and computes
+  // from the frame and the ray what the reference needs beyond what was
+  // drawn.)
+  const bool host_produces = for_host || model_ != ProductionModel::kFloat32;
+  const SampleFields fields = host_produces ? SampleFields::kAll : SampleFields::kDrawn;
+  batch.samples.Resize(count, fields);
   pool.ParallelFor(
       count,
       [&](std::size_t begin, std::size_t end, unsigned) {
+        std::uint32_t rays_of = std::numeric_limits<std::uint32_t>::max();  // the frame `rays` is of
+        PixelRays rays;
         for (std::size_t i = begin; i < end; ++i) {
-          const Frame& frame = batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))];
+          const std::uint32_t frame_index = batch.FrameOf(static_cast<std::uint32_t>(i));
+          const Frame& frame = batch.frames[frame_index];
+          if (frame_index != rays_of) {
+            rays = PixelRays(frame);
+            rays_of = frame_index;
+          }
           PixelSample sample = sampler_.SampleAt(first + i, frame);
           if (raster) {
             const RasterGeometry geometry = MakeRasterGeometry(frame, sample);
@@ -95,11 +108,15 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
             if (geometry.rendered_depth) sample.eye_depth = *geometry.rendered_depth;
           }
           batch.pixels[i] = sample.x | (sample.y << 16);
-          const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);
+          const glm::dvec3 ray = rays.At(sample.x, sample.y);
           batch.ray_x[i] = ray.x;
           batch.ray_y[i] = ray.y;
           batch.ray_z[i] = ray.z;
-          batch.samples.Set(i, frame, sample, ray);
+          if (fields == SampleFields::kAll) {
+            batch.samples.Set(i, frame, sample, ray);
+          } else {
+            batch.samples.SetDrawn(i, frame, sample);
+          }
         }
       },
       256);
@@ -134,9 +151,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // stored texels, their decode and the reference.
   const SampleArrays& samples = batch.samples;
   const std::size_t pipelines = pipeline_slots_.size();
-  // (A judge on the device produces float32 depths itself.)
-  const bool host_produces = for_host || model_ != ProductionModel::kFloat32;
-  for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(pipelines * count);
+  for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(host_produces ? pipelines * count : 0);
   produced_.resize(for_host ? pipelines * count : 0);
   batch.pipeline_floats.resize(host_produces ? pipelines * count : 0);
   pool.ParallelFor(host_produces ? pipelines * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {

@@ -52,7 +52,8 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 // stores the texels and computes the reference itself: the batch's stored
 // depths (depths, codes) are not filled (pick_depths are), its reference
 // is empty, and so are its pipeline floats unless depths are produced
-// exactly (ProductionModel).
+// exactly (ProductionModel), when its samples also hold only what was
+// drawn (SampleFields::kDrawn).
 enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge };
 
 class BatchBuilder {

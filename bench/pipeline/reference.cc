@@ -32,47 +32,71 @@ ReferenceSample ReferenceArrays::Get(std::size_t at) const {
           joint_band[at], status[at],        stored_holdable[at] != 0};
 }
 
-void SampleArrays::Resize(std::size_t n) {
-  pick.resize(n);
-  for (auto* v :
-       {&eye_depth, &near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq, &inverse_distance_sq}) {
-    v->resize(n);
-  }
-  depth_band.resize(n);
-  ratio_band.resize(n);
-  coverage.resize(n);
+FramePlanes PlanesOf(const Frame& frame) {
+  return {.near = frame.near,
+          .far = frame.finite() ? frame.far : 0.0,
+          .depth_limit = frame.depth_limit,
+          .interest_min = frame.depth_restricted ? frame.eye_depth_min : frame.near,
+          .interest_max = frame.depth_restricted ? frame.eye_depth_max : INFINITY,
+          .ratio_band = static_cast<std::uint8_t>(RatioBand(frame.ratio()))};
 }
 
-void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
-  const bool eye = sample.pick == DepthPick::kEyeDepth;
+void SampleArrays::Resize(std::size_t n, SampleFields fields) {
+  pick.resize(n);
+  eye_depth.resize(n);
+  coverage.resize(n);
+  const std::size_t rest = fields == SampleFields::kAll ? n : 0;
+  for (auto* v : {&near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq, &inverse_distance_sq}) {
+    v->resize(rest);
+  }
+  depth_band.resize(rest);
+  ratio_band.resize(rest);
+}
+
+void SampleArrays::SetDrawn(std::size_t i, const Frame& frame, const PixelSample& sample) {
   pick[i] = sample.pick;
-  eye_depth[i] = eye ? sample.eye_depth : frame.near;
-  near[i] = frame.near;
-  far[i] = frame.finite() ? frame.far : 0.0;
-  depth_limit[i] = frame.depth_limit;
-  interest_min[i] = frame.depth_restricted ? frame.eye_depth_min : frame.near;
-  interest_max[i] = frame.depth_restricted ? frame.eye_depth_max : INFINITY;
-  ray_length_sq[i] = glm::dot(ray, ray);
-  inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
-  depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
-  ratio_band[i] = static_cast<std::uint8_t>(RatioBand(frame.ratio()));
+  eye_depth[i] = sample.pick == DepthPick::kEyeDepth ? sample.eye_depth : frame.near;
   coverage[i] = sample.coverage;
 }
 
-glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
+  SetDrawn(i, frame, sample);
+  const FramePlanes planes = PlanesOf(frame);
+  near[i] = planes.near;
+  far[i] = planes.far;
+  depth_limit[i] = planes.depth_limit;
+  interest_min[i] = planes.interest_min;
+  interest_max[i] = planes.interest_max;
+  ray_length_sq[i] = glm::dot(ray, ray);
+  inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
+  depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
+  ratio_band[i] = planes.ratio_band;
+}
+
+PixelRays::PixelRays(const Frame& frame)
+    : tan_x_(static_cast<long double>(frame.aspect) * static_cast<long double>(frame.tan_half_fov_y)),
+      tan_y_(frame.tan_half_fov_y),
+      resolution_{static_cast<long double>(frame.width), static_cast<long double>(frame.height), 1.0L / frame.width,
+                  1.0L / frame.height} {
+  for (int column = 0; column < 3; ++column) {
+    for (int row = 0; row < 3; ++row) rotation_[column][row] = frame.rotation[column][row];
+  }
+}
+
+glm::dvec3 PixelRays::At(std::uint32_t x, std::uint32_t y) const {
   using L = long double;
-  const L tan_y = frame.tan_half_fov_y;
-  const L tan_x = static_cast<L>(frame.aspect) * tan_y;
-  const ld::vec4 resolution(frame.width, frame.height, 1.0L / frame.width, 1.0L / frame.height);
+  const ld::vec4 resolution(resolution_[0], resolution_[1], resolution_[2], resolution_[3]);
   const ld::vec2 ndc = ld::ndc_from_uv(ld::uv_from_pixel(static_cast<L>(x), static_cast<L>(y), resolution));
-  const ld::vec3 view(ndc.x * tan_x, ndc.y * tan_y, -1.0L);
-  const glm::dmat3& r = frame.rotation;
+  const ld::vec3 view(ndc.x * tan_x_, ndc.y * tan_y_, -1.0L);
   glm::dvec3 ray;
   for (int row = 0; row < 3; ++row) {
-    ray[row] = static_cast<double>(r[0][row] * view.x + r[1][row] * view.y + r[2][row] * view.z);
+    ray[row] =
+        static_cast<double>(rotation_[0][row] * view.x + rotation_[1][row] * view.y + rotation_[2][row] * view.z);
   }
   return ray;
 }
+
+glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) { return PixelRays(frame).At(x, y); }
 
 namespace {
 

@@ -61,6 +61,21 @@ struct ReferenceArrays {
   ReferenceSample Get(std::size_t at) const;
 };
 
+// What every sample of a frame repeats in SampleArrays: its planes, the
+// eye depths the domain is about, and its far/near band.
+struct FramePlanes {
+  double near = 0.0, far = 0.0;                   // far 0 when infinite
+  double depth_limit = 0.0;                       // the largest eye depth
+  double interest_min = 0.0, interest_max = 0.0;  // near..inf when unrestricted
+  std::uint8_t ratio_band = 0;
+};
+FramePlanes PlanesOf(const Frame& frame);
+
+// Which of SampleArrays' fields a batch fills. kAll: every one. kDrawn:
+// only what the sampler drew (pick, eye depth, coverage), for a judge on a
+// device that derives the rest from the frame and the ray itself.
+enum class SampleFields : std::uint8_t { kAll, kDrawn };
+
 // What the reference needs of each sample, whatever the encoding.
 struct SampleArrays {
   std::vector<DepthPick> pick;
@@ -74,13 +89,29 @@ struct SampleArrays {
   std::vector<std::uint8_t> ratio_band;            // the frame's far/near band
   std::vector<Coverage> coverage;                  // natural, or the coverage kind (bands.h)
 
-  void Resize(std::size_t n);
-  // Fills entry i for a sample of `frame` whose ray is `ray`.
+  // Sizes the arrays `fields` fills to n samples, the others to none.
+  void Resize(std::size_t n, SampleFields fields = SampleFields::kAll);
+  // Fills entry i for a sample of `frame` whose ray is `ray`: every field,
+  // or what was drawn only.
   void Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray);
+  void SetDrawn(std::size_t i, const Frame& frame, const PixelSample& sample);
 };
 
-// World-space ray through the pixel centre at unit eye depth:
-// R * (ndc.x * tan_x, ndc.y * tan_y, -1).
+// World-space rays through a frame's pixel centres at unit eye depth,
+// R * (ndc.x * tan_x, ndc.y * tan_y, -1), computed in long double and
+// rounded to double. What every pixel of the frame shares is computed
+// once.
+class PixelRays {
+ public:
+  PixelRays() = default;
+  explicit PixelRays(const Frame& frame);
+  glm::dvec3 At(std::uint32_t x, std::uint32_t y) const;
+
+ private:
+  long double tan_x_ = 0, tan_y_ = 0;
+  long double resolution_[4] = {0, 0, 0, 0};  // width, height, 1 / width, 1 / height
+  long double rotation_[3][3] = {};           // [column][row], as glm::dmat3
+};
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
 // The references of samples [first, first + n) under an encoding whose
