@@ -65,9 +65,9 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   }
   if (!run.stages.empty()) {
     const StageSeconds& t = run.stages;
-    out << fmt::format("time: building batches {:.2f} s, running and judging {:.2f} s", t.build, t.judging);
-    if (t.device_waited > 0) out << fmt::format(" (waiting for the device {:.2f} s)", t.device_waited);
-    if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s for the judging", t.build_waited);
+    out << fmt::format("time: build {:.2f} s, run and judge {:.2f} s", t.build, t.judging);
+    if (t.device_waited > 0) out << fmt::format(" ({:.2f} s waiting for the device)", t.device_waited);
+    if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s", t.build_waited);
     out << "\n";
   }
   out << "bits lost = log2(relative error / 2^-24), from 0 (float32's own rounding) to 24 (nothing left); relative "
