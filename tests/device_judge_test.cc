@@ -103,12 +103,13 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, JudgeBi
   EXPECT_EQ(host->run.backends.at(0).judge, "host");
   EXPECT_EQ(device->run.backends.at(0).judge, "device");
   // And where the time went. Here the build of a batch overlaps the
-  // judging of the one before: the main thread's spans (building, waiting
+  // judging of the one before: the main thread's spans (set-up, building, waiting
   // for the judging) are disjoint within the wall clock, and so are the
   // judging thread's; the device's passes are waited for within the
   // judging, and on lavapipe take most of it.
   const StageSeconds& t = device->run.stages;
-  EXPECT_LE(t.build + t.build_waited, device->run.seconds);
+  EXPECT_LE(t.setup + t.build + t.build_waited, device->run.seconds);
+  EXPECT_GT(t.setup, 0.0);  // the judge's shaders compiled
   EXPECT_LE(t.judging, device->run.seconds);
   EXPECT_GT(t.device_waited, 0.0);
   EXPECT_LE(t.device_waited, t.judging);

@@ -228,7 +228,8 @@ json ToJson(const Results& results) {
                                        {"backends", backends},
                                        {"seconds", run.seconds},
                                        {"stage_seconds",
-                                        {{"build", run.stages.build},
+                                        {{"setup", run.stages.setup},
+                                         {"build", run.stages.build},
                                          {"judging", run.stages.judging},
                                          {"build_waited", run.stages.build_waited},
                                          {"device_waited", run.stages.device_waited}}},
@@ -372,6 +373,7 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   DB_ASSIGN_OR_RETURN(run.reconstructions, r.Unsigned("reconstructions"));
   if (r.Has("stage_seconds")) {
     DB_ASSIGN_OR_RETURN(JsonReader stages, r.Field("stage_seconds"));
+    DB_ASSIGN_OR_RETURN(run.stages.setup, stages.Number("setup"));
     DB_ASSIGN_OR_RETURN(run.stages.build, stages.Number("build"));
     DB_ASSIGN_OR_RETURN(run.stages.judging, stages.Number("judging"));
     DB_ASSIGN_OR_RETURN(run.stages.build_waited, stages.Number("build_waited"));
@@ -543,6 +545,7 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
     }
     merged.run.seconds += part.run.seconds;
     StageSeconds& stages = merged.run.stages;
+    stages.setup += part.run.stages.setup;
     stages.build += part.run.stages.build;
     stages.judging += part.run.stages.judging;
     stages.build_waited += part.run.stages.build_waited;

@@ -63,8 +63,9 @@ struct BackendRecord {
 // devices take the last one, and the slower stage sets the pace: the
 // other then waits.
 struct StageSeconds {
-  double build = 0.0;          // the batches built: samples, frames' constants, stored depths, reference
-  double judging = 0.0;        // the backends run and their outputs judged, on the host or on their devices
+  double setup = 0.0;    // within the clock, before the first batch: the device judges made, their shaders compiled
+  double build = 0.0;    // the batches built: samples, frames' constants, stored depths, reference
+  double judging = 0.0;  // the backends run and their outputs judged, on the host or on their devices
   double build_waited = 0.0;   // the build waiting for the judging of the batch before
   double device_waited = 0.0;  // the judging waiting for a device to finish its passes (device judge)
 

@@ -65,7 +65,7 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   }
   if (!run.stages.empty()) {
     const StageSeconds& t = run.stages;
-    out << fmt::format("time: build {:.2f} s, run and judge {:.2f} s", t.build, t.judging);
+    out << fmt::format("time: setup {:.2f} s, build {:.2f} s, run and judge {:.2f} s", t.setup, t.build, t.judging);
     if (t.device_waited > 0) out << fmt::format(" ({:.2f} s waiting for the device)", t.device_waited);
     if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s", t.build_waited);
     out << "\n";

@@ -310,6 +310,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   // judging stage on a thread of its own with a small pool for its uploads
   // (they are copies into device memory; the build has most of the cores).
   // Otherwise the host's judge needs the pool, and the stages take turns.
+  run.stages.setup = SecondsSince(started);
   std::unique_ptr<ThreadPool> stage_pool;
   if (overlap) stage_pool = std::make_unique<ThreadPool>(stage_threads);
   std::array<Batch, 2> batches;  // (the second only where the stages overlap)
