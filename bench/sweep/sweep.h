@@ -39,13 +39,16 @@ enum class JudgeSite { kAuto, kHost, kDevice };
 
 // Default batch sizes, the fastest measured. On the host, a batch's
 // arrays and the accumulators they reach stay in cache. With the judge on
-// an H200 (reports/device-judge/h200.txt, section 7), where the host
-// builds one batch while the device judges the last, 131072 ran at 3.69
-// and 3.81 G reconstructions/s, against 3.26 and 3.52 at 65536 and 3.75
-// and 3.78 at 262144: fewer batches wait on fewer round trips, and past
-// that the arrays leave the host's caches.
+// an H200 (reports/device-judge/h200.txt, section 11), where the host
+// builds one batch while the device judges the last, 262144 beat 131072
+// in each of four interleaved pairs (6.48 against 4.55 G
+// reconstructions/s, 4.76 against 4.22, 4.45 against 3.82, and 3.34
+// against 2.68 on the wide domain) for at most 18 MiB more at the peak;
+// 524288 was no faster and took 290 MiB. Each batch pays a fixed cost
+// (the backend's and the judge's queueing, the maxima read back), and
+// both stages' per-batch work took less time in larger batches.
 inline constexpr std::uint32_t kHostBatch = 16384;
-inline constexpr std::uint32_t kDeviceJudgeBatch = 131072;
+inline constexpr std::uint32_t kDeviceJudgeBatch = 262144;
 
 struct SweepOptions {
   std::uint64_t seed = 1;
