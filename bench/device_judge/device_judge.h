@@ -31,7 +31,8 @@
 // and the statistics equal). That needs the device's float64 add,
 // multiply, divide and fma to round as IEEE 754 says, which Vulkan does not
 // promise; docs/device-judge.md says what a device that differs would
-// change. The sampler and the depth production stay with the host.
+// change. The sampler stays with the host (docs/device-judge.md says what
+// moving it would take).
 #pragma once
 
 #include <memory>
