@@ -16,7 +16,11 @@
 # Each configuration runs RUNS times (default 3), the configurations in
 # turn (A B C ... A B C ...), so that the drift of a shared machine's speed
 # falls on all of them alike. A row gives the median rate, the range of
-# the runs, and the largest peak.
+# the runs, and the largest peak. Last, for scale, the bare reconstruction
+# kernel on the same Vulkan device (`depthbench speed`: its fastest
+# memory-bound full-screen pass, divide/reversed/d32_sfloat reading a
+# 3840x2160 depth image, nothing judged), and each Vulkan row's median as
+# a share of it.
 set -euo pipefail
 build=${1:-build}
 runs=${2:-3}
@@ -73,12 +77,30 @@ for ((r = 1; r <= runs; ++r)); do
   done
 done
 
-printf '%-40s %22s %12s\n' "" "M reconstructions/s" "peak MiB"
-printf '%-40s %22s %12s\n' "" "median (min-max)" "(largest)"
+# The bare kernel (see the top): lavapipe's in its quick form, whose
+# fewer repetitions are plenty at a CPU's pace.
+echo "speed: the bare reconstruction kernel on ${device:-lavapipe}" >&2
+kernel_json=$(mktemp)
+trap 'rm -f "$log" "$kernel_json"' EXIT
+"$depthbench" speed --quiet ${device:+--device "$device"} ${device:---quick} --variant divide --convention reversed \
+  --format d32f --resolution 3840x2160 --json "$kernel_json" >"$log" 2>&1 || { cat "$log" >&2; exit 1; }
+kernel=$(python3 -c '
+import json, sys
+passes = [p for p in json.load(open(sys.argv[1]))["gpu"] if p["regime"] == "memory"]
+print("%.1f" % (1e3 / min(p["ns_per_reconstruction"] for p in passes)))' "$kernel_json") ||
+  { echo "no memory-bound pass in the speed results" >&2; exit 1; }
+
+printf '%-40s %22s %12s %10s\n' "" "M reconstructions/s" "peak MiB" "of kernel"
+printf '%-40s %22s %12s %10s\n' "" "median (min-max)" "(largest)" ""
 for i in "${!labels[@]}"; do
   summary=$(tr ' ' '\n' <<<"${rates[i]}" | grep . | sort -g |
     awk '{v[NR] = $1} END {m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
                            printf "%.1f (%.1f-%.1f)", m, v[1], v[NR]}')
   peak=$(tr ' ' '\n' <<<"${peaks[i]}" | grep . | sort -g | tail -1)
-  printf '%-40s %22s %12s\n' "${labels[i]}" "$summary" "$peak"
+  share=""
+  if [[ ${arguments[i]} == *"--backend vulkan"* ]]; then
+    share=$(awk -v m="${summary%% *}" -v k="$kernel" 'BEGIN {printf "%.2f%%", 100 * m / k}')
+  fi
+  printf '%-40s %22s %12s %10s\n' "${labels[i]}" "$summary" "$peak" "$share"
 done
+printf '%-40s %22s\n' "bare kernel (speed, memory-bound)" "$kernel"
