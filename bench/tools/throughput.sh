@@ -82,7 +82,9 @@ done
 echo "speed: the bare reconstruction kernel on ${device:-lavapipe}" >&2
 kernel_json=$(mktemp)
 trap 'rm -f "$log" "$kernel_json"' EXIT
-"$depthbench" speed --quiet ${device:+--device "$device"} ${device:---quick} --variant divide --convention reversed \
+quick=()
+[[ -z $device ]] && quick=(--quick)
+"$depthbench" speed --quiet ${device:+--device "$device"} "${quick[@]}" --variant divide --convention reversed \
   --format d32f --resolution 3840x2160 --json "$kernel_json" >"$log" 2>&1 || { cat "$log" >&2; exit 1; }
 kernel=$(python3 -c '
 import json, sys
