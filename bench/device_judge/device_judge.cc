@@ -83,6 +83,17 @@ enum Binding : std::uint32_t {
 // into host-readable buffers: each batch's maxima and the unwritten counts
 // after the batch, the histograms and counts at a flush.
 bool DeviceOnly(Binding b) { return b >= kReference && b <= kUnwritten; }
+// What the host writes for every batch: one buffer per lane (below), so
+// that it writes the next batch's while the device reads the last's.
+bool PerBatch(Binding b) { return b != kLayout && b != kPositions && b != kTexels && !DeviceOnly(b); }
+
+// Two batches in flight: while the device runs one lane's passes, the host
+// writes the other's inputs. Each lane has its own uploads, descriptor
+// set, maxima readback, and two submission slots of the pass (the storage
+// pass, queued before the backend's, and the reference and judge after).
+constexpr std::uint32_t kLanes = 2;
+constexpr std::uint32_t StoreSlot(std::uint32_t lane) { return 2 * lane; }
+constexpr std::uint32_t JudgeSlot(std::uint32_t lane) { return 2 * lane + 1; }
 
 // What the reference pass needs of a depth slot's encoding
 // (bindings.glsl's Layout): what the format stores, the convention's bits
@@ -148,9 +159,22 @@ struct DeviceJudge::State {
   DeviceObject<VkPipeline> store_pipeline;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
-  std::array<VulkanBuffer, kBindingCount> buffers;  // (kPositions and kTexels unused: the backend owns them)
-  VulkanBuffer batch_readback;                      // the maxima, then the unwritten counts
-  VulkanBuffer flush_readback;                      // the counts, then the first non-finite indices
+  // [lane][binding]: lane 0 holds the bindings every lane shares (kPositions
+  // and kTexels unused: the backend owns them); PerBatch ones are per lane.
+  std::array<std::array<VulkanBuffer, kBindingCount>, kLanes> lane_buffers;
+  std::array<VulkanBuffer, kLanes> batch_readbacks;  // the maxima, then the unwritten counts
+  // A lane's batch queued on the device and not yet joined to the
+  // accumulators: its samples, where its maxima go, and its order.
+  struct Pending {
+    bool queued = false;
+    std::uint32_t count = 0;
+    std::span<CellAccumulator> cells, encodings;
+    std::uint64_t order = 0;
+  };
+  std::array<Pending, kLanes> pending;
+  std::uint32_t lane = 0;       // the lane of the batch being uploaded
+  std::uint64_t batches = 0;    // queued so far
+  VulkanBuffer flush_readback;  // the counts, then the first non-finite indices
   std::vector<std::uint32_t> every_cell;
   std::vector<Cell> run_cells;
   std::size_t depth_slots = 0;
@@ -179,9 +203,14 @@ struct DeviceJudge::State {
   VkDeviceSize maxima_bytes() const { return 2 * maxima() * sizeof(std::uint64_t); }
   VkDeviceSize unwritten_bytes() const { return cell_count() * sizeof(std::uint32_t); }
 
+  VulkanBuffer& Buffer(Binding b) { return lane_buffers[PerBatch(b) ? lane : 0][b]; }
+  const VulkanBuffer& Buffer(Binding b) const { return lane_buffers[PerBatch(b) ? lane : 0][b]; }
   Status Grow(Binding binding, VkDeviceSize bytes) {
+    bytes = std::max<VkDeviceSize>(bytes, 16);
+    // A buffer every lane shares is replaced only with nothing in flight.
+    if (!PerBatch(binding) && Buffer(binding).size() < bytes) DB_RETURN_IF_ERROR(FinishAll());
     return context->GrowHostBuffer(
-        buffers[binding], std::max<VkDeviceSize>(bytes, 16),
+        Buffer(binding), bytes,
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
         DeviceOnly(binding) ? HostAccess::kNone : HostAccess::kUpload);
   }
@@ -192,7 +221,7 @@ struct DeviceJudge::State {
     VkDeviceSize offset = 0;
     for (const auto& [binding, bytes] : sources) {
       const VkBufferCopy region{0, offset, bytes};
-      vkCmdCopyBuffer(commands, buffers[binding].handle(), readback.handle(), 1, &region);
+      vkCmdCopyBuffer(commands, Buffer(binding).handle(), readback.handle(), 1, &region);
       offset += bytes;
     }
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -201,9 +230,9 @@ struct DeviceJudge::State {
   // Empties the counts on the device: zeros, and no index for the first
   // non-finite finding.
   void RecordClear(VkCommandBuffer commands) const {
-    vkCmdFillBuffer(commands, buffers[kCounts].handle(), 0, VK_WHOLE_SIZE, 0u);
-    vkCmdFillBuffer(commands, buffers[kFirstNonFinite].handle(), 0, VK_WHOLE_SIZE, 0xffffffffu);
-    vkCmdFillBuffer(commands, buffers[kUnwritten].handle(), 0, VK_WHOLE_SIZE, 0u);
+    vkCmdFillBuffer(commands, Buffer(kCounts).handle(), 0, VK_WHOLE_SIZE, 0u);
+    vkCmdFillBuffer(commands, Buffer(kFirstNonFinite).handle(), 0, VK_WHOLE_SIZE, 0xffffffffu);
+    vkCmdFillBuffer(commands, Buffer(kUnwritten).handle(), 0, VK_WHOLE_SIZE, 0u);
   }
   Status UploadForStorage(const Batch& batch, ThreadPool& pool);
   Status UploadForReference(const Batch& batch, ThreadPool& pool);
@@ -211,7 +240,17 @@ struct DeviceJudge::State {
   L::JudgePass PassConstants(const Batch& batch, const DevicePositions& positions) const;
   void RecordStore(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
   void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions, bool encodings) const;
-  Status MergeMaxima(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
+  Status MergeMaxima(std::uint32_t lane, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
+  // Waits for `lane`'s batch, if one is queued, and joins its maxima and
+  // samples to the accumulators it was given.
+  Status Finish(std::uint32_t lane);
+  // Finishes every lane's batch, the earlier first (an equal maximum keeps
+  // the earlier batch's index).
+  Status FinishAll() {
+    const std::uint32_t first = pending[0].order <= pending[1].order ? 0 : 1;
+    DB_RETURN_IF_ERROR(Finish(first));
+    return Finish(1 - first);
+  }
   // Device accumulator k's host accumulator (null where none is kept) and
   // the host's numbers of its metrics.
   std::pair<CellAccumulator*, std::span<const Metric>> HostOf(std::size_t k, std::span<CellAccumulator> cells,
@@ -261,7 +300,9 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   }
-  DB_RETURN_IF_ERROR(StoreInto(ComputePass::Create(context, bindings, sizeof(L::JudgePass)), state->pass));
+  DB_RETURN_IF_ERROR(StoreInto(
+      ComputePass::Create(context, bindings, sizeof(L::JudgePass), VK_SHADER_STAGE_COMPUTE_BIT, kLanes, 2 * kLanes),
+      state->pass));
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
   state->judge_groups = ChooseJudgeGroups(context->properties(), bins);
   static_assert(sizeof(JudgeGroups) == 4 * sizeof(std::uint32_t));
@@ -284,7 +325,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   // What stays the same for the whole run: which depth slot each cell
   // reads, each slot's encoding and texel, and the counters, empty.
   DB_RETURN_IF_ERROR(state->Grow(kLayout, state->layout_words() * sizeof(std::uint32_t)));
-  auto* words = static_cast<std::uint32_t*>(state->buffers[kLayout].mapped());
+  auto* words = static_cast<std::uint32_t*>(state->Buffer(kLayout).mapped());
   for (std::size_t k = 0; k < layout.cells.size(); ++k) words[k] = layout.cells[k].depth_slot;
   for (std::size_t s = 0; s < state->depth_slots; ++s) {
     words[state->cell_count() + s] = EncodingWord(layout.encodings[s], pipeline_of_slot[s]);
@@ -293,14 +334,16 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   for (std::uint32_t s = static_cast<std::uint32_t>(state->depth_slots); s-- > 0;) {
     words[state->accumulators() + state->depth_slots + pipeline_of_slot[s]] = s;  // the pipeline's first slot
   }
-  DB_RETURN_IF_ERROR(state->buffers[kLayout].FlushHostWrites());
+  DB_RETURN_IF_ERROR(state->Buffer(kLayout).FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kMaxima, state->maxima_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kUnwritten, state->unwritten_bytes()));
-  DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->maxima_bytes() + state->unwritten_bytes(),
-                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
-                               state->batch_readback));
+  for (VulkanBuffer& readback : state->batch_readbacks) {
+    DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->maxima_bytes() + state->unwritten_bytes(),
+                                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
+                                 readback));
+  }
   DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->counts_bytes() + state->first_bytes(),
                                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
                                state->flush_readback));
@@ -348,13 +391,13 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   picks = static_cast<std::uint32_t>(batch.picks.size());
   DB_RETURN_IF_ERROR(Grow(kPickSamples, picks * sizeof(std::uint32_t)));
   DB_RETURN_IF_ERROR(Grow(kPickTexels, depth_slots * picks * sizeof(float)));
-  std::memcpy(buffers[kPickSamples].mapped(), batch.picks.data(), picks * sizeof(std::uint32_t));
-  std::memcpy(buffers[kPickTexels].mapped(), batch.pick_depths.data(), depth_slots * picks * sizeof(float));
+  std::memcpy(Buffer(kPickSamples).mapped(), batch.picks.data(), picks * sizeof(std::uint32_t));
+  std::memcpy(Buffer(kPickTexels).mapped(), batch.pick_depths.data(), depth_slots * picks * sizeof(float));
   // Per frame. The frame's planes are those the host's reference reads
   // for each of its samples (PlanesOf).
-  auto* frame_words = static_cast<std::uint32_t*>(buffers[kFrames].mapped());
-  auto* frame_depths = static_cast<double*>(buffers[kFrameDepths].mapped());
-  auto* frame_constants = static_cast<std::uint32_t*>(buffers[kFrameConstants].mapped());
+  auto* frame_words = static_cast<std::uint32_t*>(Buffer(kFrames).mapped());
+  auto* frame_depths = static_cast<double*>(Buffer(kFrameDepths).mapped());
+  auto* frame_constants = static_cast<std::uint32_t*>(Buffer(kFrameConstants).mapped());
   for (std::size_t f = 0; f < frames; ++f) {
     const glm::dvec3& camera = batch.frames[f].camera_position;  // float32 values (sampler.h)
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
@@ -375,9 +418,9 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
   }
-  auto* coverage = static_cast<std::uint32_t*>(buffers[kCoverage].mapped());
-  auto* eye_depths = static_cast<double*>(buffers[kEyeDepths].mapped());
-  auto* pipeline_floats = static_cast<float*>(buffers[kPipelineFloats].mapped());
+  auto* coverage = static_cast<std::uint32_t*>(Buffer(kCoverage).mapped());
+  auto* eye_depths = static_cast<double*>(Buffer(kEyeDepths).mapped());
+  auto* pipeline_floats = static_cast<float*>(Buffer(kPipelineFloats).mapped());
   // Chunks of the per-sample and per-(pipeline, sample) values, in one loop.
   const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
   const std::size_t pipeline_chunks = device_produces() ? 0 : (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
@@ -399,14 +442,14 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   });
   for (Binding b :
        {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kPickSamples, kPickTexels}) {
-    DB_RETURN_IF_ERROR(buffers[b].FlushHostWrites());
+    DB_RETURN_IF_ERROR(Buffer(b).FlushHostWrites());
   }
   return Status::Ok();
 }
 
 Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
   const std::size_t count = batch.count;
-  auto* rays = static_cast<double*>(buffers[kRays].mapped());
+  auto* rays = static_cast<double*>(Buffer(kRays).mapped());
   pool.ParallelFor((count + kUploadChunk - 1) / kUploadChunk, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
@@ -415,7 +458,7 @@ Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& po
       std::memcpy(rays + 2 * count + lo, batch.ray_z.data() + lo, n * sizeof(double));
     }
   });
-  DB_RETURN_IF_ERROR(buffers[kRays].FlushHostWrites());
+  DB_RETURN_IF_ERROR(Buffer(kRays).FlushHostWrites());
   return Status::Ok();
 }
 
@@ -445,12 +488,12 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
     const VkBuffer backends = b == kPositions ? positions.buffer : b == kTexels ? positions.texels : VK_NULL_HANDLE;
-    infos[b] = {backends != VK_NULL_HANDLE ? backends : buffers[b].handle(), 0, bytes[b]};
+    infos[b] = {backends != VK_NULL_HANDLE ? backends : Buffer(static_cast<Binding>(b)).handle(), 0, bytes[b]};
     writes[b].dstBinding = b;
     writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[b].pBufferInfo = &infos[b];
   }
-  pass->WriteDescriptors(writes);
+  pass->WriteDescriptors(writes, lane);
 }
 
 L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DevicePositions& positions) const {
@@ -472,8 +515,16 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
 
 void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,
                                      const DevicePositions& positions) const {
+  // Everything queued before (the last batch's judge reading the
+  // positions, texels, reference and maxima this batch rewrites, and its
+  // copies) finishes first.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                          VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
   L::JudgePass constants = PassConstants(batch, positions);
-  pass->Bind(commands, store_pipeline.get());
+  pass->Bind(commands, store_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   const auto slots = static_cast<std::uint32_t>(depth_slots);
   if (device_produces()) {
     pass->PushConstants(commands, &constants, sizeof(constants));
@@ -500,12 +551,12 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                                 bool encodings) const {
   // This batch's maxima start at nothing: zero squares, no index.
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
-  vkCmdFillBuffer(commands, buffers[kMaxima].handle(), 0, half, 0u);
-  vkCmdFillBuffer(commands, buffers[kMaxima].handle(), half, half, 0xffffffffu);
+  vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), 0, half, 0u);
+  vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), half, half, 0xffffffffu);
   L::JudgePass constants = PassConstants(batch, positions);
   const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
   // The reference of every (depth slot, sample).
-  pass->Bind(commands, reference_pipeline.get());
+  pass->Bind(commands, reference_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   pass->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(depth_slots), 1);
   // The fills, the reference, and the reconstruction pass's positions (an
@@ -513,7 +564,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  pass->Bind(commands, judge_pipeline.get());
+  pass->Bind(commands, judge_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
   const std::uint32_t groups_per_row = (batch.count + judge_groups.samples - 1) / judge_groups.samples;
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
@@ -525,15 +576,17 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);
   }
-  RecordReadback(commands, {{kMaxima, maxima_bytes()}, {kUnwritten, unwritten_bytes()}}, batch_readback);
+  RecordReadback(commands, {{kMaxima, maxima_bytes()}, {kUnwritten, unwritten_bytes()}}, batch_readbacks[lane]);
 }
 
 // A batch's maxima join the accumulators' as the host judge's Record does:
 // a larger square replaces the slot's maximum and index; an equal one
 // keeps the earlier batch's, whose indices are smaller.
-Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const {
-  DB_RETURN_IF_ERROR(batch_readback.InvalidateForHostReads());
-  const auto* words = static_cast<const std::uint64_t*>(batch_readback.mapped());
+Status DeviceJudge::State::MergeMaxima(std::uint32_t from, std::span<CellAccumulator> cells,
+                                       std::span<CellAccumulator> encodings) const {
+  const VulkanBuffer& readback = batch_readbacks[from];
+  DB_RETURN_IF_ERROR(readback.InvalidateForHostReads());
+  const auto* words = static_cast<const std::uint64_t*>(readback.mapped());
   const auto* unwritten = reinterpret_cast<const std::uint32_t*>(words + 2 * maxima());
   for (std::size_t k = 0; k < cell_count(); ++k) {
     if (unwritten[k] == 0) continue;
@@ -558,6 +611,19 @@ Status DeviceJudge::State::MergeMaxima(std::span<CellAccumulator> cells, std::sp
   return Status::Ok();
 }
 
+Status DeviceJudge::State::Finish(std::uint32_t which) {
+  Pending& batch = pending[which];
+  if (!batch.queued) return Status::Ok();
+  batch.queued = false;
+  const auto waiting = std::chrono::steady_clock::now();
+  DB_RETURN_IF_ERROR(pass->Wait(JudgeSlot(which)));
+  waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - waiting).count();
+  DB_RETURN_IF_ERROR(MergeMaxima(which, batch.cells, batch.encodings));
+  for (CellAccumulator& a : batch.cells) a.Count(batch.count);
+  for (CellAccumulator& a : batch.encodings) a.Count(batch.count);
+  return Status::Ok();
+}
+
 std::uint64_t DeviceJudge::MaxBatchSamples() const {
   const State& s = *state_;
   // Per sample: five doubles per depth slot (the reference), three (the ray).
@@ -571,35 +637,39 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
   const ValidationScope validation(*s.context);
+  // This batch goes to the lane the batch before last used, whose work is
+  // long done; the last batch's may still run on the device meanwhile.
+  s.lane = static_cast<std::uint32_t>(s.batches % kLanes);
+  DB_RETURN_IF_ERROR(s.Finish(s.lane));
   // The storage pass's inputs first: queued before the backend's pass, it
   // makes the texels from them. The reference's go in while both run.
   DB_RETURN_IF_ERROR(s.UploadForStorage(batch, pool));
   const auto store = [&](const DevicePositions& on_device) {
     s.Bind(on_device, batch);
-    return s.pass->SubmitWithoutWaiting([&](VkCommandBuffer commands) { s.RecordStore(commands, batch, on_device); });
+    return s.pass->SubmitWithoutWaiting([&](VkCommandBuffer commands) { s.RecordStore(commands, batch, on_device); },
+                                        StoreSlot(s.lane));
   };
   DB_ASSIGN_OR_RETURN(const DevicePositions positions,
                       RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool, store));
   DB_RETURN_IF_ERROR(s.UploadForReference(batch, pool));
-  // Queued, then waited for: the reference's and the judge's passes, after
-  // the storage and reconstruction passes already queued.
-  const auto submitted = std::chrono::steady_clock::now();
-  DB_RETURN_IF_ERROR(
-      s.pass->Submit([&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }));
-  s.waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - submitted).count();
-  DB_RETURN_IF_ERROR(validation.Check("judging on the device"));
+  // The reference's and the judge's passes, after the storage and
+  // reconstruction passes already queued; this batch joins the
+  // accumulators once the next one is queued (or at Flush).
+  DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
+      [&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }, JudgeSlot(s.lane)));
+  s.pending[s.lane] = {
+      .queued = true, .count = batch.count, .cells = cells, .encodings = encodings, .order = s.batches++};
   s.last_count = batch.count;
   s.last_positions = positions;
-  DB_RETURN_IF_ERROR(s.MergeMaxima(cells, encodings));
-  for (CellAccumulator& a : cells) a.Count(batch.count);
-  for (CellAccumulator& a : encodings) a.Count(batch.count);
-  return Status::Ok();
+  DB_RETURN_IF_ERROR(s.Finish(1 - s.lane));
+  return validation.Check("judging on the device");
 }
 
 double DeviceJudge::waited_seconds() const { return state_->waited; }
 
 Expected<ReferenceArrays> DeviceJudge::LastReference() const {
-  const State& s = *state_;
+  State& s = *state_;
+  DB_RETURN_IF_ERROR(s.FinishAll());
   const std::size_t slot_samples = s.depth_slots * s.last_count;
   const VkDeviceSize doubles = 5 * slot_samples * sizeof(double), words = slot_samples * sizeof(std::uint32_t);
   DB_ASSIGN_OR_RETURN(
@@ -627,7 +697,8 @@ Expected<ReferenceArrays> DeviceJudge::LastReference() const {
 }
 
 Expected<std::vector<float>> DeviceJudge::LastTexels() const {
-  const State& s = *state_;
+  State& s = *state_;
+  DB_RETURN_IF_ERROR(s.FinishAll());
   const std::size_t count = s.last_count, slots = count == 0 ? 0 : s.depth_slots;
   DB_ASSIGN_OR_RETURN(VulkanBuffer readback,
                       s.context->CreateHostBuffer(std::max<std::size_t>(slots * count * sizeof(float), 16),
@@ -653,6 +724,7 @@ Expected<std::vector<float>> DeviceJudge::LastTexels() const {
 Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) {
   State& s = *state_;
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
+  DB_RETURN_IF_ERROR(s.FinishAll());
   // The counts come back and are cleared on the device in one submission.
   const ValidationScope validation(*s.context);
   DB_RETURN_IF_ERROR(s.pass->Submit([&s](VkCommandBuffer commands) {

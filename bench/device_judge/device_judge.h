@@ -73,22 +73,28 @@ class DeviceJudge {
 
   // Stores the texels of `batch` (built for either judge: BatchFor; only
   // its stored-value picks' texels are read), runs every cell of the
-  // layout on it and judges the outputs on the device. Each batch's maxima go straight into `cells` (one accumulator
-  // per cell, in layout order) and, unless it is empty, `encodings` (one
-  // per depth slot: the storage and production errors, which the device
-  // then records too); they also count the batch's samples. The counts
-  // stay on the device until Flush. `pool` writes the uploads.
+  // layout on it and judges the outputs on the device. It returns once the
+  // batch is queued there and the batch before it is finished: the device
+  // runs one batch while the host writes the next one's inputs. A
+  // finished batch's maxima go into `cells` (one accumulator per cell, in
+  // layout order) and, unless it is empty, `encodings` (one per depth
+  // slot: the storage and production errors, which the device then
+  // records too), which also count its samples: the accumulators of the
+  // last call must outlive the next call or Flush, which finishes the
+  // last batch. The counts stay on the device until Flush. `pool` writes
+  // the uploads.
   Status Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
                ThreadPool& pool);
   // The most samples one batch may have: the widest binding (the
   // reference of every depth slot) within the device's limit.
   std::uint64_t MaxBatchSamples() const;
-  // Seconds Judge has spent waiting for the device to finish its passes,
-  // since this judge was made: with the host's time around Judge, it says
-  // which side a batch waits for.
+  // Seconds spent waiting for the device to finish a batch's passes, since
+  // this judge was made: with the host's time around Judge, it says which
+  // side a batch waits for.
   double waited_seconds() const;
   // The reference the device computed for the last batch Judge was given,
-  // in the host's layout (for tests and diagnosis).
+  // in the host's layout (for tests and diagnosis; it finishes the batches
+  // in flight).
   Expected<ReferenceArrays> LastReference() const;
   // The texels the storage pass wrote for the last batch (each depth
   // slot's fetched values, [depth slot * count + sample]), read from the

@@ -46,19 +46,21 @@ Expected<DeviceObject<VkShaderModule>> CreateShaderModule(VkDevice device, std::
 
 Expected<std::unique_ptr<ComputePass>> ComputePass::Create(std::shared_ptr<VulkanContext> context,
                                                            std::span<const VkDescriptorSetLayoutBinding> bindings,
-                                                           std::uint32_t push_constant_bytes,
-                                                           VkShaderStageFlags stages, std::uint32_t sets) {
+                                                           std::uint32_t push_constant_bytes, VkShaderStageFlags stages,
+                                                           std::uint32_t sets, std::uint32_t slots) {
   if (context == nullptr) return InvalidArgument("a compute pass needs a Vulkan context");
   std::unique_ptr<ComputePass> pass(new ComputePass(std::move(context), stages));
   DB_RETURN_IF_ERROR(pass->CreateLayout(bindings, push_constant_bytes, sets));
-  DB_RETURN_IF_ERROR(pass->CreateCommandObjects());
+  DB_RETURN_IF_ERROR(pass->CreateCommandObjects(std::max(slots, 1u)));
   return pass;
 }
 
 ComputePass::~ComputePass() {
-  // Nothing is left in flight: the command buffer is not pending.
-  (void)Wait();
-  if (command_buffer_ != VK_NULL_HANDLE) vkFreeCommandBuffers(device(), context_->command_pool(), 1, &command_buffer_);
+  // Nothing is left in flight: no command buffer is pending.
+  for (std::uint32_t slot = 0; slot < pending_.size(); ++slot) (void)Wait(slot);
+  for (VkCommandBuffer& commands : command_buffers_) {
+    if (commands != VK_NULL_HANDLE) vkFreeCommandBuffers(device(), context_->command_pool(), 1, &commands);
+  }
 }
 
 Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings,
@@ -115,19 +117,23 @@ Status ComputePass::CreateLayout(std::span<const VkDescriptorSetLayoutBinding> b
   return Status::Ok();
 }
 
-Status ComputePass::CreateCommandObjects() {
+Status ComputePass::CreateCommandObjects(std::uint32_t slots) {
+  command_buffers_.assign(slots, VK_NULL_HANDLE);
+  pending_.assign(slots, false);
   VkCommandBufferAllocateInfo command_info{};
   command_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   command_info.commandPool = context_->command_pool();
   command_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   command_info.commandBufferCount = 1;
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkAllocateCommandBuffers(device(), &command_info, &command_buffer_), "vkAllocateCommandBuffers"));
-  VkFenceCreateInfo fence_info{};
-  fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  VkFence handle = VK_NULL_HANDLE;
-  DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device(), &fence_info, nullptr, &handle), "vkCreateFence"));
-  fence_ = DeviceObject<VkFence>(device(), handle, vkDestroyFence);
+  for (VkCommandBuffer& commands : command_buffers_) {
+    DB_RETURN_IF_ERROR(
+        CheckVk(vkAllocateCommandBuffers(device(), &command_info, &commands), "vkAllocateCommandBuffers"));
+    VkFenceCreateInfo fence_info{};
+    fence_info.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+    VkFence handle = VK_NULL_HANDLE;
+    DB_RETURN_IF_ERROR(CheckVk(vkCreateFence(device(), &fence_info, nullptr, &handle), "vkCreateFence"));
+    fences_.emplace_back(device(), handle, vkDestroyFence);
+  }
   return Status::Ok();
 }
 
@@ -167,38 +173,38 @@ void ComputePass::Bind(VkCommandBuffer commands, VkPipeline pipeline, VkPipeline
 }
 
 void ComputePass::PushConstants(VkCommandBuffer commands, const void* data, std::uint32_t bytes) const {
-  vkCmdPushConstants(commands, pipeline_layout_.get(), stages_, 0,
-                     std::min(bytes, push_constant_bytes_), data);
+  vkCmdPushConstants(commands, pipeline_layout_.get(), stages_, 0, std::min(bytes, push_constant_bytes_), data);
 }
 
-Status ComputePass::Submit(const std::function<void(VkCommandBuffer)>& record) {
-  DB_RETURN_IF_ERROR(SubmitWithoutWaiting(record));
-  return Wait();
+Status ComputePass::Submit(const std::function<void(VkCommandBuffer)>& record, std::uint32_t slot) {
+  DB_RETURN_IF_ERROR(SubmitWithoutWaiting(record, slot));
+  return Wait(slot);
 }
 
-Status ComputePass::SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record) {
-  DB_RETURN_IF_ERROR(Wait());
+Status ComputePass::SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record, std::uint32_t slot) {
+  DB_RETURN_IF_ERROR(Wait(slot));
+  VkCommandBuffer commands = command_buffers_[slot];
   VkCommandBufferBeginInfo begin_info{};
   begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(command_buffer_, &begin_info), "vkBeginCommandBuffer"));
-  record(command_buffer_);
-  DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(command_buffer_), "vkEndCommandBuffer"));
-  const VkFence fence = fence_.get();
+  DB_RETURN_IF_ERROR(CheckVk(vkBeginCommandBuffer(commands, &begin_info), "vkBeginCommandBuffer"));
+  record(commands);
+  DB_RETURN_IF_ERROR(CheckVk(vkEndCommandBuffer(commands), "vkEndCommandBuffer"));
+  const VkFence fence = fences_[slot].get();
   DB_RETURN_IF_ERROR(CheckVk(vkResetFences(device(), 1, &fence), "vkResetFences"));
   VkSubmitInfo submit{};
   submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &command_buffer_;
+  submit.pCommandBuffers = &commands;
   DB_RETURN_IF_ERROR(CheckVk(vkQueueSubmit(context_->queue(), 1, &submit, fence), "vkQueueSubmit"));
-  pending_ = true;
+  pending_[slot] = true;
   return Status::Ok();
 }
 
-Status ComputePass::Wait() {
-  if (!pending_) return Status::Ok();
-  pending_ = false;
-  const VkFence fence = fence_.get();
+Status ComputePass::Wait(std::uint32_t slot) {
+  if (!pending_[slot]) return Status::Ok();
+  pending_[slot] = false;
+  const VkFence fence = fences_[slot].get();
   const Status waited = CheckVk(
       vkWaitForFences(device(), 1, &fence, VK_TRUE, std::numeric_limits<std::uint64_t>::max()), "vkWaitForFences");
   // A wait that failed may leave the work running: drain the queue, so that

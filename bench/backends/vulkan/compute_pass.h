@@ -47,10 +47,13 @@ class ComputePass {
  public:
   // `stages`: those that read the push constants. `sets`: how many sets of
   // the layout to hold (a pass that binds different resources per draw).
-  static Expected<std::unique_ptr<ComputePass>> Create(
-      std::shared_ptr<VulkanContext> context, std::span<const VkDescriptorSetLayoutBinding> bindings,
-      std::uint32_t push_constant_bytes, VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT,
-      std::uint32_t sets = 1);
+  // `slots`: how many submissions may be in flight at once, each with its
+  // own command buffer and fence (the submitting calls name theirs).
+  static Expected<std::unique_ptr<ComputePass>> Create(std::shared_ptr<VulkanContext> context,
+                                                       std::span<const VkDescriptorSetLayoutBinding> bindings,
+                                                       std::uint32_t push_constant_bytes,
+                                                       VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT,
+                                                       std::uint32_t sets = 1, std::uint32_t slots = 1);
   ~ComputePass();
   ComputePass(const ComputePass&) = delete;
   ComputePass& operator=(const ComputePass&) = delete;
@@ -76,33 +79,41 @@ class ComputePass {
   // Pushes `bytes` of push constants (at most what Create reserved).
   void PushConstants(VkCommandBuffer commands, const void* data, std::uint32_t bytes) const;
 
-  // Records commands through `record`, submits them and waits for the
-  // device. Should the wait fail, the queue is drained before returning.
-  Status Submit(const std::function<void(VkCommandBuffer)>& record);
+  // Records commands through `record` into slot `slot`'s command buffer
+  // (first waiting for its last submission), submits them and waits for
+  // the device. Should the wait fail, the queue is drained before
+  // returning.
+  Status Submit(const std::function<void(VkCommandBuffer)>& record, std::uint32_t slot = 0);
   // The same, returning once the work is queued: the host may meanwhile
   // write other memory, and a later submission to the queue may wait for
-  // it with a barrier. This pass's descriptors and the resources its
-  // commands use stay untouched until Wait().
-  Status SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record);
-  // Waits for the work SubmitWithoutWaiting queued, if any (at once if the
-  // device has finished it). Should the wait fail, the queue is drained.
-  Status Wait();
+  // it with a barrier. The descriptors and resources the commands use stay
+  // untouched until Wait(slot).
+  Status SubmitWithoutWaiting(const std::function<void(VkCommandBuffer)>& record, std::uint32_t slot = 0);
+  // Waits for the work SubmitWithoutWaiting queued in `slot`, if any (at
+  // once if the device has finished it). Should the wait fail, the queue
+  // is drained.
+  Status Wait(std::uint32_t slot = 0);
+  // Whether `slot` holds work not yet waited for.
+  bool pending(std::uint32_t slot = 0) const { return pending_[slot]; }
 
  private:
   ComputePass(std::shared_ptr<VulkanContext> context, VkShaderStageFlags stages)
       : context_(std::move(context)), stages_(stages) {}
   Status CreateLayout(std::span<const VkDescriptorSetLayoutBinding> bindings, std::uint32_t push_constant_bytes,
                       std::uint32_t sets);
-  Status CreateCommandObjects();
+  Status CreateCommandObjects(std::uint32_t slots);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   DeviceObject<VkDescriptorSetLayout> set_layout_;
   DeviceObject<VkPipelineLayout> pipeline_layout_;
   DeviceObject<VkDescriptorPool> pool_;
   std::vector<VkDescriptorSet> sets_;  // freed with the pool
-  DeviceObject<VkFence> fence_;
-  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;  // from the context's pool; freed by the destructor
-  bool pending_ = false;                             // queued by SubmitWithoutWaiting and not waited for
+  // Per slot: its fence, its command buffer (from the context's pool;
+  // freed by the destructor), and whether it was queued by
+  // SubmitWithoutWaiting and not waited for.
+  std::vector<DeviceObject<VkFence>> fences_;
+  std::vector<VkCommandBuffer> command_buffers_;
+  std::vector<bool> pending_;
   VkShaderStageFlags stages_;
   std::uint32_t push_constant_bytes_ = 0;
 };
