@@ -313,7 +313,7 @@ TEST(SweepTest, ResultsSurviveTheJsonRoundTrip) {
 // Where the host judges, the build and the judging take turns on the
 // main thread: their times are disjoint spans of the run's wall clock,
 // and with the set-up before the first batch, most of it (the rest is
-// the last flush). Merged shards add them up.
+// the host accumulators' last flush). Merged shards add them up.
 TEST(SweepTest, StageTimesShareOutTheWallClock) {
   const Results whole = RunCpu(7, 200000, {});
   const StageSeconds& t = whole.run.stages;

@@ -344,8 +344,11 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   }
   DB_RETURN_IF_ERROR(finish_judging());
 
-  // The last flush, on the pool: each accumulator is its own.
+  // The last flush, on the pool: each accumulator is its own. The
+  // devices' is judging too: it finishes their last batch.
+  const auto last_flush = std::chrono::steady_clock::now();
   DB_RETURN_IF_ERROR(flush_devices(false));
+  run.stages.judging += SecondsSince(last_flush);
   pool.ParallelFor(slot_count + accumulators.size(), [&](std::size_t lo, std::size_t hi, unsigned) {
     for (std::size_t k = lo; k < hi; ++k) {
       if (k < slot_count) {
