@@ -20,6 +20,7 @@
 
 #ifdef __cplusplus
 
+#include <bit>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -33,6 +34,11 @@
 // A named integer constant: `const uint` in both languages.
 #define DB_CONST_UINT(name, value) [[maybe_unused]] constexpr std::uint32_t name = value;
 #define DB_MUL(m, v) ((m) * (v))
+// The double with these high and low 32 bits, exactly.
+#define DB_DOUBLE_BITS(high, low) std::bit_cast<double>(std::uint64_t{high} << 32 | (low))
+// Keeps a compiler from fusing this variable's products into adds: C++
+// is built with -ffp-contract=off, GLSL and HLSL need the qualifier.
+#define DB_PRECISE
 
 #elif defined(DB_HLSL)
 
@@ -40,6 +46,8 @@
 #define DB_STATIC_ASSERT(condition, message)
 #define DB_CONST_UINT(name, value) static const uint name = value;
 #define DB_MUL(m, v) mul(m, v)
+#define DB_DOUBLE_BITS(high, low) asdouble(low, high)
+#define DB_PRECISE precise
 #define real float
 #define vec2 float2
 #define vec3 float3
@@ -52,6 +60,8 @@
 #define DB_STATIC_ASSERT(condition, message)
 #define DB_CONST_UINT(name, value) const uint name = value;
 #define DB_MUL(m, v) ((m) * (v))
+#define DB_DOUBLE_BITS(high, low) packDouble2x32(uvec2(low, high))
+#define DB_PRECISE precise
 #define real float
 
 #endif

@@ -29,6 +29,8 @@ DB_CONST_UINT(DB_JUDGE_FRAME_DEPTHS, 5u)
 DB_CONST_UINT(DB_JUDGE_HARDWARE_CONVENTIONS, 8u)
 DB_CONST_UINT(DB_JUDGE_FRAME_WORDS, 18u)  // 2 + 2 * DB_JUDGE_HARDWARE_CONVENTIONS
 DB_CONST_UINT(DB_JUDGE_DEPTH_BANDS, 10u)
+// The sample pass's inputs: doubles per frame (shared/draw.h's DrawFrame).
+DB_CONST_UINT(DB_JUDGE_FRAME_DRAWS, 16u)
 // What a depth slot's format stores (bench/pipeline/cells.h's DepthInput).
 DB_CONST_UINT(DB_JUDGE_STORES_WINDOW_DEPTH, 0u)
 DB_CONST_UINT(DB_JUDGE_STORES_LINEAR, 1u)
@@ -57,12 +59,12 @@ struct JudgePass {
   uint first_index_lo;
   uint first_index_hi;
   uint phase;             // judge: 0 bins, counts and maxima, 1 the index of each maximum; storage: 0 the
-                          // pipelines' floats, 1 the texels, 2 the stored-value picks'
+                          // pipelines' floats, 1 the texels
   uint record_distances;  // 1: natural samples also go to their camera-distance band
   uint cells;
-  uint depth_slots;  // slices of the reference buffers, and the depth slots' accumulators
-  uint accumulators;  // cells, or cells + depth_slots when the encodings' errors are recorded too
+  uint depth_slots;       // slices of the reference buffers, and the depth slots' accumulators
+  uint accumulators;      // cells, or cells + depth_slots when the encodings' errors are recorded too
   uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
-  uint picks;             // the storage pass's stored-value picks
-  uint unused;
+  uint seed_lo;           // the sampler's seed (the sample pass's)
+  uint seed_hi;
 };

@@ -145,7 +145,9 @@ TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
 }
 
 // One batch of `domain` (every cell it allows), its reference computed by
-// the host (in `batch`) and by the device (returned).
+// the host (in `batch`) and by the device (returned), which draws the
+// samples itself where it can (float32 production: BatchFor::kDeviceDraws),
+// so that the comparison covers its draw too.
 struct TwoReferences {
   RunLayout layout;
   Batch batch;
@@ -163,8 +165,11 @@ void ComputeBothReferences(const Domain& domain, TwoReferences& out) {
   const BatchBuilder builder(sampler, out.layout.encodings);
   ThreadPool pool(2);
   builder.Build(1000000037, 6000, out.batch, pool);  // a batch that starts inside a frame
+  Batch frames_only;
+  if (builder.DevicesCanDraw()) builder.Build(1000000037, 6000, frames_only, pool, BatchFor::kDeviceDraws);
   std::vector<CellAccumulator> accumulators(out.layout.cells.size());
-  ASSERT_TRUE((*judge)->Judge(out.batch, accumulators, {}, pool).ok());
+  const Status judged = (*judge)->Judge(frames_only.drawn_on_device ? frames_only : out.batch, accumulators, {}, pool);
+  ASSERT_TRUE(judged.ok()) << judged.message();
   auto device = (*judge)->LastReference();
   ASSERT_TRUE(device.ok()) << device.status().message();
   out.device = std::move(device).value();
@@ -291,20 +296,24 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   Batch batch;
   const BatchBuilder builder(sampler, layout.encodings);
   builder.Build(7, count, batch, pool, BatchFor::kDeviceJudge);
-  // The picks, listed apart, are the samples whose pick is a stored value,
-  // with the texels a batch for the host judge stores for them.
-  std::vector<std::uint32_t> picked;
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (batch.samples.pick[i] != DepthPick::kEyeDepth) picked.push_back(i);
-  }
-  ASSERT_EQ(batch.picks, picked);
+  // The stored-value picks' texels, per frame and slot, are those a batch
+  // for the host judge stores for each pick.
+  const std::size_t slots = layout.encodings.size();
+  ASSERT_EQ(batch.edge_texels.size(), batch.frames.size() * slots * 4);
+  const auto edge_texel = [&](std::size_t slot, std::uint32_t i) {
+    const auto pick = static_cast<std::size_t>(batch.samples.pick[i]);
+    return batch.edge_texels[(batch.FrameOf(i) * slots + slot) * 4 + pick - 1];
+  };
   Batch for_host;
   builder.Build(7, count, for_host, pool, BatchFor::kHostJudge);
-  ASSERT_EQ(for_host.pick_depths, batch.pick_depths);
-  for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
-    for (std::size_t k = 0; k < picked.size(); ++k) {
-      ASSERT_EQ(std::bit_cast<std::uint32_t>(for_host.depths[slot * count + picked[k]]),
-                std::bit_cast<std::uint32_t>(batch.pick_depths[slot * picked.size() + k]));
+  ASSERT_EQ(for_host.edge_texels, batch.edge_texels);
+  std::size_t picks = 0;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (batch.samples.pick[i] == DepthPick::kEyeDepth) continue;
+    ++picks;
+    for (std::size_t slot = 0; slot < slots; ++slot) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(for_host.depths[slot * count + i]),
+                std::bit_cast<std::uint32_t>(edge_texel(slot, i)));
     }
   }
   // A batch for the device judge holds no texels (the storage pass makes
@@ -329,6 +338,19 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
     EXPECT_EQ(lean.samples.coverage, full.samples.coverage);
     EXPECT_EQ(lean.ray_x, full.ray_x);
     EXPECT_EQ(lean.ray_z, full.ray_z);
+    // Where the device draws the samples, the batch holds none of them.
+    Batch frames_only;
+    ASSERT_TRUE(float32_builder.DevicesCanDraw());
+    float32_builder.Build(7, count, frames_only, pool, BatchFor::kDeviceDraws);
+    EXPECT_TRUE(frames_only.drawn_on_device);
+    EXPECT_EQ(frames_only.seed, 5u);
+    EXPECT_TRUE(frames_only.samples.pick.empty());
+    EXPECT_TRUE(frames_only.pixels.empty());
+    EXPECT_TRUE(frames_only.ray_x.empty());
+    EXPECT_EQ(frames_only.frames.size(), lean.frames.size());
+    EXPECT_EQ(frames_only.edge_texels, lean.edge_texels);
+    // Exact production needs the host's floats: no device draws there.
+    EXPECT_FALSE(builder.DevicesCanDraw());
   }
   std::vector<float> scratch;
   auto host_texels = (*vulkan)->Run(batch, std::vector<std::uint32_t>{0}, scratch);
@@ -354,11 +376,9 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   std::size_t differing = 0;
   for (std::size_t slot = 0; slot < layout.encodings.size(); ++slot) {
     const Format format = layout.encodings[slot].format;
-    std::size_t k = 0;  // picks before sample i
     for (std::uint32_t i = 0; i < count; ++i) {
-      const bool pick = k < batch.picks.size() && batch.picks[k] == i;
-      const float expected =
-          pick ? batch.pick_depths[slot * batch.picks.size() + k++] : StoreFloat(format, values[i]).fetched;
+      const bool pick = batch.samples.pick[i] != DepthPick::kEyeDepth;
+      const float expected = pick ? edge_texel(slot, i) : StoreFloat(format, values[i]).fetched;
       const float device = (*texels)[slot * count + i];
       if (std::bit_cast<std::uint32_t>(expected) != std::bit_cast<std::uint32_t>(device) && differing++ < 5) {
         ADD_FAILURE() << fmt::format("{}, sample {} (pick {}): {:a} stored as {:a} on the host, {:a} on the device",
@@ -367,7 +387,7 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
     }
   }
   EXPECT_EQ(differing, 0u);
-  EXPECT_GT(batch.picks.size(), 0u);  // both phases ran
+  EXPECT_GT(picks, 0u);  // both kinds of texel were stored
   EXPECT_TRUE(context->TakeValidationMessages().empty());
 }
 

@@ -30,6 +30,7 @@ struct RunFlags {
   unsigned threads = 0;
   std::uint32_t batch = 0;  // by the judge (SweepOptions::batch_size)
   std::string judge = "auto";
+  std::string draw = "auto";
   bool quiet = false;
   DomainFlags domain;
   CellFlags cells;
@@ -76,9 +77,10 @@ void PrintRasterAgreement(const Results& results, std::span<Backend* const> back
   for (const Backend* backend : backends) {
     const std::vector<RasterAgreement> agreement = backend->raster_agreement();
     if (agreement.empty()) continue;
-    out << fmt::format("\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
-                       "the largest difference in codes, ulps for float formats):\n",
-                       backend->name());
+    out << fmt::format(
+        "\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
+        "the largest difference in codes, ulps for float formats):\n",
+        backend->name());
     for (std::size_t slot = 0; slot < agreement.size() && slot < layout.encodings.size(); ++slot) {
       const RasterAgreement& a = agreement[slot];
       const Encoding e = layout.encodings[slot];
@@ -97,6 +99,7 @@ Expected<int> Run(const RunFlags& f) {
   options.threads = f.threads;
   options.batch_size = f.batch;
   options.judge = f.judge == "host" ? JudgeSite::kHost : f.judge == "device" ? JudgeSite::kDevice : JudgeSite::kAuto;
+  options.device_draws = f.draw == "auto";
   if (!f.shard.empty()) {
     DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
@@ -191,6 +194,13 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "
                   "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
       ->check(CLI::IsMember({"auto", "host", "device"}))
+      ->type_name("WHERE")
+      ->group("Backends");
+  cmd->add_option("--draw", flags->draw,
+                  "where the samples are drawn when every backend judges on its device: 'auto' (default): on the "
+                  "device too, where depths are produced in float32, so that the host makes only the frames; "
+                  "'host'. The same samples either way")
+      ->check(CLI::IsMember({"auto", "host"}))
       ->type_name("WHERE")
       ->group("Backends");
   cmd->add_flag("--quiet", flags->quiet, "no progress line");

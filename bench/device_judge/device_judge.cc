@@ -37,6 +37,7 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
 static_assert(sizeof(L::JudgePass) == 56);
+static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9);  // shared/draw.h's DrawFrame, its rotation's nine
 static_assert(L::DB_JUDGE_TEXEL_UNORM == static_cast<unsigned>(TexelKind::kUnorm) &&
               L::DB_JUDGE_TEXEL_FLOAT32 == static_cast<unsigned>(TexelKind::kFloat32) &&
               L::DB_JUDGE_TEXEL_FLOAT16 == static_cast<unsigned>(TexelKind::kFloat16));
@@ -74,8 +75,9 @@ enum Binding : std::uint32_t {
   kFirstNonFinite,
   kMaxima,
   kUnwritten,
-  kPickSamples,
-  kPickTexels,
+  kEdgeTexels,
+  kFrameDraws,
+  kPixels,  // the backend's
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
@@ -85,7 +87,7 @@ enum Binding : std::uint32_t {
 bool DeviceOnly(Binding b) { return b >= kReference && b <= kUnwritten; }
 // What the host writes for every batch: one buffer per lane (below), so
 // that it writes the next batch's while the device reads the last's.
-bool PerBatch(Binding b) { return b != kLayout && b != kPositions && b != kTexels && !DeviceOnly(b); }
+bool PerBatch(Binding b) { return b != kLayout && b != kPositions && b != kTexels && b != kPixels && !DeviceOnly(b); }
 
 // Two batches in flight: while the device runs one lane's passes, the host
 // writes the other's inputs. Each lane has its own uploads, descriptor
@@ -156,6 +158,7 @@ struct DeviceJudge::State {
   Backend* backend = nullptr;
   std::shared_ptr<VulkanContext> context;
   std::unique_ptr<ComputePass> pass;
+  DeviceObject<VkPipeline> sample_pipeline;
   DeviceObject<VkPipeline> store_pipeline;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
@@ -181,7 +184,6 @@ struct DeviceJudge::State {
   std::size_t pipelines = 0;
   std::uint32_t last_count = 0;    // samples of the last batch judged
   DevicePositions last_positions;  // the backend's buffers for it
-  std::uint32_t picks = 0;         // stored-value picks of the batch uploaded last
   bool exact_production = false;
   bool record_distances = true;
   JudgeGroups judge_groups;
@@ -315,7 +317,8 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   const VkSpecializationInfo judge_shape{static_cast<std::uint32_t>(group_entries.size()), group_entries.data(),
                                          sizeof(JudgeGroups), &state->judge_groups};
   for (auto [name, pipeline, specialization] :
-       {std::tuple{"store.comp", &state->store_pipeline, VkSpecializationInfo{}},
+       {std::tuple{"sample.comp", &state->sample_pipeline, VkSpecializationInfo{}},
+        std::tuple{"store.comp", &state->store_pipeline, VkSpecializationInfo{}},
         std::tuple{"reference.comp", &state->reference_pipeline, VkSpecializationInfo{}},
         std::tuple{"judge.comp", &state->judge_pipeline, judge_shape}}) {
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
@@ -371,6 +374,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   }
   for (const auto& [binding, bytes] : std::initializer_list<std::pair<Binding, std::size_t>>{
            {kFrames, frames * 4 * sizeof(std::uint32_t)},
+           {kFrameDraws, frames * L::DB_JUDGE_FRAME_DRAWS * sizeof(double)},
+           {kEdgeTexels, frames * depth_slots * 4 * sizeof(float)},
            {kFrameDepths, frames * L::DB_JUDGE_FRAME_DEPTHS * sizeof(double)},
            {kFrameConstants, frames * L::DB_JUDGE_FRAME_WORDS * sizeof(std::uint32_t)},
            {kRays, 3 * count * sizeof(double)},
@@ -382,19 +387,19 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     DB_RETURN_IF_ERROR(Grow(binding, bytes));
   }
 
-  // The stored-value picks and each slot's texel for them.
+  // What each frame and slot stores for the stored-value picks.
   const SampleArrays& samples = batch.samples;
-  if (batch.pick_depths.size() != depth_slots * batch.picks.size()) {
-    return InvalidArgument(fmt::format("a batch with {} stored-value picks and {} texels for them, for {} depth slots",
-                                       batch.picks.size(), batch.pick_depths.size(), depth_slots));
+  const std::size_t drawn = batch.drawn_on_device ? 0 : count;
+  if (batch.edge_texels.size() != frames * depth_slots * 4 || samples.pick.size() != drawn) {
+    return InvalidArgument(
+        fmt::format("a batch of {} samples in {} frames with {} drawn samples and {} edge texels, for {} depth slots",
+                    count, frames, samples.pick.size(), batch.edge_texels.size(), depth_slots));
   }
-  picks = static_cast<std::uint32_t>(batch.picks.size());
-  DB_RETURN_IF_ERROR(Grow(kPickSamples, picks * sizeof(std::uint32_t)));
-  DB_RETURN_IF_ERROR(Grow(kPickTexels, depth_slots * picks * sizeof(float)));
-  std::memcpy(Buffer(kPickSamples).mapped(), batch.picks.data(), picks * sizeof(std::uint32_t));
-  std::memcpy(Buffer(kPickTexels).mapped(), batch.pick_depths.data(), depth_slots * picks * sizeof(float));
+  std::memcpy(Buffer(kEdgeTexels).mapped(), batch.edge_texels.data(), batch.edge_texels.size() * sizeof(float));
   // Per frame. The frame's planes are those the host's reference reads
-  // for each of its samples (PlanesOf).
+  // for each of its samples (PlanesOf); what the sample pass draws from
+  // is the host sampler's (DrawFrameOf).
+  auto* frame_draws = static_cast<double*>(Buffer(kFrameDraws).mapped());
   auto* frame_words = static_cast<std::uint32_t*>(Buffer(kFrames).mapped());
   auto* frame_depths = static_cast<double*>(Buffer(kFrameDepths).mapped());
   auto* frame_constants = static_cast<std::uint32_t*>(Buffer(kFrameConstants).mapped());
@@ -409,6 +414,15 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     depths[2] = planes.depth_limit;
     depths[3] = planes.interest_min;
     depths[4] = planes.interest_max;
+    const draw::DrawFrame draw = DrawFrameOf(batch.frames[f]);
+    double* draws = frame_draws + f * L::DB_JUDGE_FRAME_DRAWS;
+    for (const double value : {draw.eye_depth_min, draw.eye_depth_max, draw.log2_eye_depth_span, draw.tan_x, draw.tan_y,
+                               static_cast<double>(draw.width), static_cast<double>(draw.height)}) {
+      *draws++ = value;
+    }
+    for (int column = 0; column < 3; ++column) {
+      for (int row = 0; row < 3; ++row) *draws++ = draw.rotation[column][row];
+    }
     std::uint32_t* words = frame_constants + f * L::DB_JUDGE_FRAME_WORDS;
     words[0] = planes.ratio_band;
     words[1] = std::bit_cast<std::uint32_t>(batch.frame_params[f].camera_position.w);
@@ -422,7 +436,7 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   auto* eye_depths = static_cast<double*>(Buffer(kEyeDepths).mapped());
   auto* pipeline_floats = static_cast<float*>(Buffer(kPipelineFloats).mapped());
   // Chunks of the per-sample and per-(pipeline, sample) values, in one loop.
-  const std::size_t sample_chunks = (count + kUploadChunk - 1) / kUploadChunk;
+  const std::size_t sample_chunks = (drawn + kUploadChunk - 1) / kUploadChunk;
   const std::size_t pipeline_chunks = device_produces() ? 0 : (pipeline_samples + kUploadChunk - 1) / kUploadChunk;
   pool.ParallelFor(sample_chunks + pipeline_chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
@@ -430,8 +444,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
         const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
         std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
         for (std::size_t i = lo; i < lo + n; ++i) {
-          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) |
-                        static_cast<std::uint32_t>(samples.pick[i] != DepthPick::kEyeDepth) << 8;
+          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) | static_cast<std::uint32_t>(samples.pick[i])
+                                                                              << 8;
         }
       } else {
         const std::size_t lo = (job - sample_chunks) * kUploadChunk;
@@ -441,13 +455,14 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
     }
   });
   for (Binding b :
-       {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kPickSamples, kPickTexels}) {
+       {kFrames, kFrameDepths, kFrameConstants, kCoverage, kEyeDepths, kPipelineFloats, kEdgeTexels, kFrameDraws}) {
     DB_RETURN_IF_ERROR(Buffer(b).FlushHostWrites());
   }
   return Status::Ok();
 }
 
 Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
+  if (batch.drawn_on_device) return Status::Ok();  // the sample pass wrote the rays
   const std::size_t count = batch.count;
   auto* rays = static_cast<double*>(Buffer(kRays).mapped());
   pool.ParallelFor((count + kUploadChunk - 1) / kUploadChunk, [&](std::size_t begin, std::size_t end, unsigned) {
@@ -482,12 +497,16 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       first_bytes(),
       maxima_bytes(),
       unwritten_bytes(),
-      std::max<VkDeviceSize>(picks * sizeof(std::uint32_t), 16),
-      std::max<VkDeviceSize>(depth_slots * picks * sizeof(float), 16)};
+      std::max<VkDeviceSize>(frames * depth_slots * 4 * sizeof(float), 16),
+      std::max<VkDeviceSize>(frames * L::DB_JUDGE_FRAME_DRAWS * sizeof(double), 16),
+      positions.pixel_bytes};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    const VkBuffer backends = b == kPositions ? positions.buffer : b == kTexels ? positions.texels : VK_NULL_HANDLE;
+    const VkBuffer backends = b == kPositions ? positions.buffer
+                              : b == kTexels  ? positions.texels
+                              : b == kPixels  ? positions.pixels
+                                              : VK_NULL_HANDLE;
     infos[b] = {backends != VK_NULL_HANDLE ? backends : Buffer(static_cast<Binding>(b)).handle(), 0, bytes[b]};
     writes[b].dstBinding = b;
     writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -509,8 +528,8 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
                       .depth_slots = static_cast<std::uint32_t>(depth_slots),
                       .accumulators = static_cast<std::uint32_t>(accumulators()),
                       .exact_production = exact_production ? 1u : 0u,
-                      .picks = picks,
-                      .unused = 0};
+                      .seed_lo = static_cast<std::uint32_t>(batch.seed),
+                      .seed_hi = static_cast<std::uint32_t>(batch.seed >> 32)};
 }
 
 void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,
@@ -524,6 +543,15 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
   L::JudgePass constants = PassConstants(batch, positions);
+  const std::uint32_t slice_groups = (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize;
+  if (batch.drawn_on_device) {
+    // The samples first: every later pass reads them.
+    pass->Bind(commands, sample_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
+    pass->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, slice_groups, 1, 1);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  }
   pass->Bind(commands, store_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   const auto slots = static_cast<std::uint32_t>(depth_slots);
   if (device_produces()) {
@@ -533,15 +561,10 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
-  // Every slice whole, then the picks (disjoint elements: no barrier between).
+  // Every slice whole.
   constants.phase = 1;
   pass->PushConstants(commands, &constants, sizeof(constants));
-  vkCmdDispatch(commands, (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
-  if (picks > 0) {
-    constants.phase = 2;
-    pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, (picks + kWorkgroupSize - 1) / kWorkgroupSize, slots, 1);
-  }
+  vkCmdDispatch(commands, slice_groups, slots, 1);
   // The reconstruction pass (the backend's, queued next) and the reference read them.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);

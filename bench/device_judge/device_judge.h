@@ -5,10 +5,16 @@
 // bins it on the host's cores, against a reference the host computed; on a
 // GPU that readback and those cores are what the device waits for. Here the
 // reconstruction pass leaves its positions in device memory and the host
-// uploads only what the device starts from: per frame its planes and
-// float32 constants, per sample the ray, the eye depth and the coverage
-// kind, per pipeline and sample the float it produced, and the texels of
-// the few stored-value picks. Three passes run on the device:
+// uploads only what the device starts from: per frame its planes, float32
+// constants, what the draw of its samples needs, and what each depth slot
+// stores for the stored-value picks; per sample, unless the device draws
+// the samples itself (BatchFor::kDeviceDraws), the ray, the eye depth and
+// the coverage kind; and per pipeline and sample the float it produced,
+// where depths are produced exactly. Up to four passes run on the device:
+//   - shaders/judge/sample.comp (where the device draws), queued first,
+//     draws every sample from (seed, index) as the host's sampler would
+//     (shared/draw.h) and writes its pixel into the buffer the
+//     reconstruction pass reads, and its eye depth, coverage and ray;
 //   - shaders/judge/store.comp, queued before the reconstruction pass,
 //     stores every pipeline float in each depth slot's format and writes
 //     what a fetch returns into the buffer that pass reads its texels from
@@ -31,8 +37,7 @@
 // and the statistics equal). That needs the device's float64 add,
 // multiply, divide and fma to round as IEEE 754 says, which Vulkan does not
 // promise; docs/device-judge.md says what a device that differs would
-// change. The sampler stays with the host (docs/device-judge.md says what
-// moving it would take).
+// change. The frames stay with the host.
 #pragma once
 
 #include <memory>
@@ -71,8 +76,9 @@ class DeviceJudge {
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;
 
-  // Stores the texels of `batch` (built for either judge: BatchFor; only
-  // its stored-value picks' texels are read), runs every cell of the
+  // Draws the samples of `batch` where it was built for that
+  // (BatchFor::kDeviceDraws), stores its texels (of the host's, only the
+  // stored-value picks' edge texels are read), runs every cell of the
   // layout on it and judges the outputs on the device. It returns once the
   // batch is queued there and the batch before it is finished: the device
   // runs one batch while the host writes the next one's inputs. A

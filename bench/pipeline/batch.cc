@@ -50,10 +50,17 @@ BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> en
   }
 }
 
+bool BatchBuilder::DevicesCanDraw() const {
+  return dynamic_cast<const Sampler*>(&sampler_) != nullptr && model_ == ProductionModel::kFloat32;
+}
+
 void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
                          BatchFor judge) const {
   const std::size_t slots = encodings_.size();
   const bool for_host = judge == BatchFor::kHostJudge;
+  const bool device_draws = judge == BatchFor::kDeviceDraws && DevicesCanDraw();
+  batch.drawn_on_device = device_draws;
+  batch.seed = device_draws ? static_cast<const Sampler&>(sampler_).seed() : 0;
   batch.first_index = first;
   batch.count = count;
   batch.first_offset = static_cast<std::uint32_t>(first % kSamplesPerFrame);
@@ -79,27 +86,29 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
 
   // Samples: pixel, ray and depth pick; for the raster pipeline, the
   // geometry drawn, whose point under the pixel is the truth.
+  // (None where the device draws them.)
   const bool raster = model_ == ProductionModel::kRaster;
+  const std::uint32_t drawn = device_draws ? 0 : count;
   batch.raster.assign(raster ? count : 0, f32::RasterSample{});
-  batch.pixels.resize(count);
-  for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(count);
+  batch.pixels.resize(drawn);
+  for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(drawn);
   // (A judge on the device produces float32 depths itself, and computes
   // from the frame and the ray what the reference needs beyond what was
   // drawn.)
   const bool host_produces = for_host || model_ != ProductionModel::kFloat32;
   const SampleFields fields = host_produces ? SampleFields::kAll : SampleFields::kDrawn;
-  batch.samples.Resize(count, fields);
+  batch.samples.Resize(drawn, fields);
   pool.ParallelFor(
-      count,
+      drawn,
       [&](std::size_t begin, std::size_t end, unsigned) {
-        std::uint32_t rays_of = std::numeric_limits<std::uint32_t>::max();  // the frame `rays` is of
-        PixelRays rays;
+        std::uint32_t draw_of = std::numeric_limits<std::uint32_t>::max();  // the frame `draw` is of
+        draw::DrawFrame draw;
         for (std::size_t i = begin; i < end; ++i) {
           const std::uint32_t frame_index = batch.FrameOf(static_cast<std::uint32_t>(i));
           const Frame& frame = batch.frames[frame_index];
-          if (frame_index != rays_of) {
-            rays = PixelRays(frame);
-            rays_of = frame_index;
+          if (frame_index != draw_of) {
+            draw = DrawFrameOf(frame);
+            draw_of = frame_index;
           }
           PixelSample sample = sampler_.SampleAt(first + i, frame);
           if (raster) {
@@ -108,7 +117,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
             if (geometry.rendered_depth) sample.eye_depth = *geometry.rendered_depth;
           }
           batch.pixels[i] = sample.x | (sample.y << 16);
-          const glm::dvec3 ray = rays.At(sample.x, sample.y);
+          const glm::dvec3 ray = draw::draw_pixel_ray(sample.x, sample.y, draw);
           batch.ray_x[i] = ray.x;
           batch.ray_y[i] = ray.y;
           batch.ray_z[i] = ray.z;
@@ -121,12 +130,38 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       },
       256);
 
+  // What each frame and depth slot stores for the stored-value picks: the
+  // edges of a hardware or linear format are the same in every frame;
+  // view z's depend on the frame's far plane.
+  std::vector<std::array<StoredDepth, 4>> fixed_edges(frames == 0 ? 0 : slots);
+  for (std::size_t s = 0; s < fixed_edges.size(); ++s) {
+    for (int pick = 1; pick <= 4; ++pick) {
+      fixed_edges[s][pick - 1] = EncodeEdge(encodings_[s], batch.frames.front(), static_cast<DepthPick>(pick));
+    }
+  }
+  edges_.resize(frames * slots * 4);
+  batch.edge_texels.resize(edges_.size());
+  pool.ParallelFor(frames, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t f = begin; f < end; ++f) {
+      for (std::size_t s = 0; s < slots; ++s) {
+        const bool per_frame = Info(encodings_[s].format).stores == DepthInput::kViewZ;
+        for (int pick = 1; pick <= 4; ++pick) {
+          const std::size_t at = (f * slots + s) * 4 + pick - 1;
+          edges_[at] = per_frame ? EncodeEdge(encodings_[s], batch.frames[f], static_cast<DepthPick>(pick))
+                                 : fixed_edges[s][pick - 1];
+          batch.edge_texels[at] = edges_[at].fetched;
+        }
+      }
+    }
+  });
+
   // The samples of each chunk that pick a stored value (a few percent),
-  // listed once for every depth slot's loop below: [chunk * kChunk + k].
+  // listed once for every depth slot's loop below, where the host stores
+  // the texels: [chunk * kChunk + k].
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
-  pick_samples_.resize(chunks * kChunk);
-  pick_counts_.resize(chunks);
-  pool.ParallelFor(chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pick_samples_.resize(for_host ? chunks * kChunk : 0);
+  pick_counts_.resize(for_host ? chunks : 0);
+  pool.ParallelFor(for_host ? chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t c = begin; c < end; ++c) {
       std::uint32_t* list = pick_samples_.data() + c * kChunk;
       std::uint32_t listed = 0;
@@ -137,13 +172,6 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       pick_counts_[c] = listed;
     }
   });
-  pick_offsets_.resize(chunks);
-  batch.picks.clear();
-  for (std::size_t c = 0; c < chunks; ++c) {
-    pick_offsets_[c] = static_cast<std::uint32_t>(batch.picks.size());
-    batch.picks.insert(batch.picks.end(), pick_samples_.begin() + c * kChunk,
-                       pick_samples_.begin() + c * kChunk + pick_counts_[c]);
-  }
 
   // Encodings, in chunks of samples, each loop over arrays: per pipeline
   // (shared by a convention's formats) the mapping's float32 constants, the
@@ -202,42 +230,22 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.depth_slots = static_cast<std::uint32_t>(slots);
   batch.depths.resize(for_host ? slots * count : 0);
   batch.codes.resize(for_host ? slots * count : 0);
-  batch.pick_depths.resize(slots * batch.picks.size());
   batch.reference.Resize(for_host ? slots * count : 0);
-  pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor(for_host ? slots * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
-      const std::size_t s = job / chunks;
-      const Encoding encoding = encodings_[s];
-      const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
+      const std::size_t s = job / chunks, chunk = job % chunks;
+      const std::size_t lo = chunk * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
       const std::size_t at = s * count + lo;
-      if (for_host) {
-        StoreFloats(encoding.format, batch.pipeline_floats.data() + pipeline_of_slot_[s] * count + lo, n,
-                    batch.codes.data() + at, batch.depths.data() + at);
-      }
-      // Stored-value picks: the edges of a hardware or linear format are
-      // the same in every frame; view z's depend on the frame's far plane.
-      const bool per_frame = Info(encoding.format).stores == DepthInput::kViewZ;
-      std::array<StoredDepth, kDepthPicks> edges{};
-      if (!per_frame) {
-        for (int pick = 0; pick < kDepthPicks; ++pick) {
-          edges[pick] = EncodeEdge(encoding, batch.frames.front(), static_cast<DepthPick>(pick));
-        }
-      }
-      const std::size_t chunk = job % chunks;
-      float* pick_depths = batch.pick_depths.data() + s * batch.picks.size() + pick_offsets_[chunk];
+      StoreFloats(encodings_[s].format, batch.pipeline_floats.data() + pipeline_of_slot_[s] * count + lo, n,
+                  batch.codes.data() + at, batch.depths.data() + at);
       for (std::uint32_t k = 0; k < pick_counts_[chunk]; ++k) {
         const std::uint32_t i = pick_samples_[chunk * kChunk + k];
-        const DepthPick pick = samples.pick[i];
-        const StoredDepth edge =
-            per_frame ? EncodeEdge(encoding, batch.frames[batch.FrameOf(static_cast<std::uint32_t>(i))], pick)
-                      : edges[static_cast<int>(pick)];
-        pick_depths[k] = edge.fetched;
-        if (for_host) {
-          batch.codes[s * count + i] = edge.code;
-          batch.depths[s * count + i] = edge.fetched;
-        }
+        const StoredDepth& edge =
+            edges_[(batch.FrameOf(i) * slots + s) * 4 + static_cast<std::size_t>(samples.pick[i]) - 1];
+        batch.codes[s * count + i] = edge.code;
+        batch.depths[s * count + i] = edge.fetched;
       }
-      if (for_host) ReferenceChunk(batch, s, lo, n);
+      ReferenceChunk(batch, s, lo, n);
     }
   });
 }

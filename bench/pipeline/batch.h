@@ -31,12 +31,15 @@ struct Batch : ShaderInputs {
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
   // count + sample].
   std::vector<float> pipeline_floats;
-  // The samples that pick a stored value (a DepthPick other than
-  // kEyeDepth), in order, and their fetched texels, [depth slot *
-  // picks.size() + k], kept apart for a judge that stores the others on
-  // its device.
-  std::vector<std::uint32_t> picks;
-  std::vector<float> pick_depths;
+  // What a fetch returns for each stored-value pick (a DepthPick other
+  // than kEyeDepth) in each frame and depth slot, [(frame * depth slots +
+  // slot) * 4 + pick - 1], for a judge that stores the other texels on its
+  // device.
+  std::vector<float> edge_texels;
+  // BatchFor::kDeviceDraws: the samples are drawn on the device, from this
+  // seed (the sampler's); the batch holds its frames alone.
+  bool drawn_on_device = false;
+  std::uint64_t seed = 0;
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
 };
@@ -50,17 +53,25 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 // and the reference included. kDeviceJudge: where every judge works on its
 // device (bench/device_judge/), which produces the depths (in float32),
 // stores the texels and computes the reference itself: the batch's stored
-// depths (depths, codes) are not filled (pick_depths are), its reference
+// depths (depths, codes) are not filled (edge_texels are), its reference
 // is empty, and so are its pipeline floats unless depths are produced
 // exactly (ProductionModel), when its samples also hold only what was
-// drawn (SampleFields::kDrawn).
-enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge };
+// drawn (SampleFields::kDrawn). kDeviceDraws: as kDeviceJudge, and the
+// device draws the samples too (shaders/judge/sample.comp): the batch
+// holds its frames, their shader constants and edge texels, and nothing
+// per sample. It needs the random Sampler and float32 production
+// (BatchBuilder::DevicesCanDraw); elsewhere it builds as kDeviceJudge.
+enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge, kDeviceDraws };
 
 class BatchBuilder {
  public:
   // `isa`: what the decode and reference loops are compiled for
   // (bench/base/isa.h). Depth is produced as the source says (domain.h).
   BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa = Isa::kWidest);
+
+  // Whether a device can draw this builder's samples: they come from the
+  // random Sampler (not a list) and their depths are produced in float32.
+  bool DevicesCanDraw() const;
 
   // Fills `batch` with samples [first, first + count).
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
@@ -96,8 +107,11 @@ class BatchBuilder {
   // pipeline's float denotes (the produced depth).
   mutable std::vector<double> mapping_a_, mapping_b_, produced_;
   // The samples that pick a stored value, [chunk * kChunk + k] for k below
-  // pick_counts_[chunk]; the picks of the chunks before it.
-  mutable std::vector<std::uint32_t> pick_samples_, pick_counts_, pick_offsets_;
+  // pick_counts_[chunk] (for the host judge).
+  mutable std::vector<std::uint32_t> pick_samples_, pick_counts_;
+  // What each frame and depth slot stores for each stored-value pick, laid
+  // out as Batch::edge_texels.
+  mutable std::vector<StoredDepth> edges_;
 };
 
 }  // namespace depthbench

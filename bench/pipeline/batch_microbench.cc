@@ -1,7 +1,8 @@
 // Google Benchmark of the host's share of a sweep: BatchBuilder::Build over
 // the default run's batches (the typical domain, every cell: 28 depth
-// slots), for the host's judge (texels and reference included) or for a
-// judge on the device (what the host still does then: bench/device_judge/). items_per_second is
+// slots), for the host's judge (texels and reference included), for a
+// judge on the device (what the host still does then: bench/device_judge/)
+// and for one that draws the samples too (the frames alone). items_per_second is
 // samples built per second; times the 106 cells it bounds the
 // reconstructions per second a sweep can verify on any device. The
 // argument is the number of threads.
@@ -44,6 +45,11 @@ BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge)
+    ->RangeMultiplier(2)
+    ->Range(1, 16)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_draws, BatchFor::kDeviceDraws)
     ->RangeMultiplier(2)
     ->Range(1, 16)
     ->UseRealTime()

@@ -73,30 +73,9 @@ void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sam
   ratio_band[i] = planes.ratio_band;
 }
 
-PixelRays::PixelRays(const Frame& frame)
-    : tan_x_(static_cast<long double>(frame.aspect) * static_cast<long double>(frame.tan_half_fov_y)),
-      tan_y_(frame.tan_half_fov_y),
-      resolution_{static_cast<long double>(frame.width), static_cast<long double>(frame.height), 1.0L / frame.width,
-                  1.0L / frame.height} {
-  for (int column = 0; column < 3; ++column) {
-    for (int row = 0; row < 3; ++row) rotation_[column][row] = frame.rotation[column][row];
-  }
+glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+  return draw::draw_pixel_ray(x, y, DrawFrameOf(frame));
 }
-
-glm::dvec3 PixelRays::At(std::uint32_t x, std::uint32_t y) const {
-  using L = long double;
-  const ld::vec4 resolution(resolution_[0], resolution_[1], resolution_[2], resolution_[3]);
-  const ld::vec2 ndc = ld::ndc_from_uv(ld::uv_from_pixel(static_cast<L>(x), static_cast<L>(y), resolution));
-  const ld::vec3 view(ndc.x * tan_x_, ndc.y * tan_y_, -1.0L);
-  glm::dvec3 ray;
-  for (int row = 0; row < 3; ++row) {
-    ray[row] =
-        static_cast<double>(rotation_[0][row] * view.x + rotation_[1][row] * view.y + rotation_[2][row] * view.z);
-  }
-  return ray;
-}
-
-glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) { return PixelRays(frame).At(x, y); }
 
 namespace {
 

@@ -97,21 +97,9 @@ struct SampleArrays {
   void SetDrawn(std::size_t i, const Frame& frame, const PixelSample& sample);
 };
 
-// World-space rays through a frame's pixel centres at unit eye depth,
-// R * (ndc.x * tan_x, ndc.y * tan_y, -1), computed in long double and
-// rounded to double. What every pixel of the frame shares is computed
-// once.
-class PixelRays {
- public:
-  PixelRays() = default;
-  explicit PixelRays(const Frame& frame);
-  glm::dvec3 At(std::uint32_t x, std::uint32_t y) const;
-
- private:
-  long double tan_x_ = 0, tan_y_ = 0;
-  long double resolution_[4] = {0, 0, 0, 0};  // width, height, 1 / width, 1 / height
-  long double rotation_[3][3] = {};           // [column][row], as glm::dmat3
-};
+// The world-space ray through pixel (x, y)'s centre at unit eye depth,
+// R * (ndc.x * tan_x, ndc.y * tan_y, -1), in float64 as a device draws it
+// too (shared/draw.h's draw_pixel_ray).
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
 // The references of samples [first, first + n) under an encoding whose

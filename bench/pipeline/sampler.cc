@@ -12,13 +12,9 @@ namespace depthbench {
 namespace {
 
 // Random streams. Frame values are drawn with the frame index as counter,
-// sample values with the sample index; the two never share a stream number.
+// sample values (shared/draw.h's DB_DRAW_*_STREAM, 0 to 5) with the sample
+// index; the two never share a stream number.
 enum Stream : std::uint32_t {
-  kPickStream = 0,
-  kDepthStream = 1,  // and 2 (53-bit uniform)
-  kPixelKindStream = 3,
-  kPixelXStream = 4,
-  kPixelYStream = 5,
   kFrameFov = 1000,
   kFrameAspect = 1002,
   kFrameNear = 1004,
@@ -71,12 +67,7 @@ std::uint32_t Sampler::Bits(std::uint32_t state, std::uint32_t stream) {
   return f32::random_bits_from_state(state, stream);
 }
 
-double Sampler::Unit(std::uint32_t state, std::uint32_t stream) {
-  // 27 + 26 bits from two consecutive streams.
-  std::uint64_t hi = Bits(state, stream) >> 5;
-  std::uint64_t lo = Bits(state, stream + 1) >> 6;
-  return static_cast<double>((hi << 26) | lo) * 0x1.0p-53;
-}
+double Sampler::Unit(std::uint32_t state, std::uint32_t stream) { return draw::draw_unit(state, stream); }
 
 FrameUnits Sampler::FrameUnitsAt(std::uint64_t i) const {
   FrameUnits u;
@@ -95,14 +86,8 @@ FrameUnits Sampler::FrameUnitsAt(std::uint64_t i) const {
 }
 
 SampleUnits Sampler::SampleUnitsAt(std::uint64_t index) const {
-  SampleUnits u;
-  const std::uint32_t state = State(index);
-  u.pick = Unit(state, kPickStream);
-  u.depth = Unit(state, kDepthStream);
-  u.pixel_kind = Unit(state, kPixelKindStream);
-  u.x = Bits(state, kPixelXStream) * 0x1.0p-32;
-  u.y = Bits(state, kPixelYStream) * 0x1.0p-32;
-  return u;
+  const draw::DrawUnits u = draw::draw_units(State(index));
+  return {.pick = u.pick, .depth = u.depth, .pixel_kind = u.pixel_kind, .x = u.x, .y = u.y};
 }
 
 Frame Sampler::FrameAt(std::uint64_t frame_index) const {
@@ -123,7 +108,7 @@ void CompleteFrame(Frame& f, const std::optional<Range>& eye_depth) {
     f.eye_depth_min = std::clamp(eye_depth->min, f.near, f.depth_limit);
     f.eye_depth_max = std::clamp(eye_depth->max, f.eye_depth_min, f.depth_limit);
   }
-  f.log_eye_depth_span = std::log(f.eye_depth_max / f.eye_depth_min);
+  f.log2_eye_depth_span = std::log2(f.eye_depth_max / f.eye_depth_min);
 }
 
 Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_index) {
@@ -173,56 +158,37 @@ Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_i
   return f;
 }
 
+// shared/draw.h numbers picks and coverage kinds as sampler.h and bands.h do.
+static_assert(static_cast<int>(DepthPick::kStoredZero) == 1 && static_cast<int>(DepthPick::kStoredBeforeOne) == 4);
+static_assert(static_cast<unsigned>(Coverage::kStoredZero) == draw::DB_COVERAGE_STORED_ZERO &&
+              static_cast<unsigned>(Coverage::kStoredBeforeOne) == draw::DB_COVERAGE_STORED_ZERO + 3 &&
+              static_cast<unsigned>(Coverage::kNearDoubling) == draw::DB_COVERAGE_NEAR_DOUBLING &&
+              static_cast<unsigned>(Coverage::kFarDoubling) == draw::DB_COVERAGE_FAR_DOUBLING &&
+              static_cast<unsigned>(Coverage::kCornerPixel) == draw::DB_COVERAGE_CORNER_PIXEL &&
+              static_cast<unsigned>(Coverage::kEdgePixel) == draw::DB_COVERAGE_EDGE_PIXEL);
+
+draw::DrawFrame DrawFrameOf(const Frame& frame) {
+  draw::DrawFrame f;
+  f.eye_depth_min = frame.eye_depth_min;
+  f.eye_depth_max = frame.eye_depth_max;
+  f.log2_eye_depth_span = frame.log2_eye_depth_span;
+  f.tan_x = frame.aspect * frame.tan_half_fov_y;
+  f.tan_y = frame.tan_half_fov_y;
+  f.width = frame.width;
+  f.height = frame.height;
+  f.rotation = frame.rotation;
+  return f;
+}
+
 PixelSample SampleFromUnits(const SampleUnits& u, const Frame& frame, std::uint64_t index) {
-  PixelSample s;
-  s.index = index;
-
-  // Depth: three quarters log-uniform eye depth (the natural distribution),
-  // the rest drawn on purpose where reconstructions break: stored values at
-  // the ends of the format, the first and the last doubling of depth.
-  const double pick = u.pick;
-  const double lo = frame.eye_depth_min, hi = frame.eye_depth_max;
-  if (pick < 0.05) {
-    static constexpr DepthPick kEdges[4] = {DepthPick::kStoredZero, DepthPick::kStoredOne, DepthPick::kStoredAfterZero,
-                                            DepthPick::kStoredBeforeOne};
-    static constexpr Coverage kKinds[4] = {Coverage::kStoredZero, Coverage::kStoredOne, Coverage::kStoredAfterZero,
-                                           Coverage::kStoredBeforeOne};
-    const int edge = std::min(3, static_cast<int>(pick / 0.05 * 4.0));
-    s.pick = kEdges[edge];
-    s.coverage = kKinds[edge];
-  } else if (pick < 0.15) {  // near band: the first doubling of depth
-    s.eye_depth = std::min(hi, lo * std::exp2(u.depth));
-    s.coverage = Coverage::kNearDoubling;
-  } else if (pick < 0.25) {  // far band: the last doubling
-    s.eye_depth = std::max(lo, hi * std::exp2(-u.depth));
-    s.coverage = Coverage::kFarDoubling;
-  } else {
-    s.eye_depth = std::min(hi, lo * std::exp(u.depth * frame.log_eye_depth_span));
-  }
-
-  // Pixel: mostly uniform over the render target (natural), with its exact
-  // corners and edges drawn on purpose.
-  const double kind = u.pixel_kind;
-  auto scaled = [](double unit, std::uint32_t n) {
-    return std::min(n - 1, static_cast<std::uint32_t>(std::floor(unit * n)));
-  };
-  const std::uint32_t w = frame.width, h = frame.height;
-  const bool natural_depth = s.coverage == Coverage::kNatural;
-  if (kind < 0.04) {
-    int corner = std::min(3, static_cast<int>(kind / 0.04 * 4.0));
-    s.x = (corner & 1) ? w - 1 : 0;
-    s.y = (corner & 2) ? h - 1 : 0;
-    if (natural_depth) s.coverage = Coverage::kCornerPixel;
-  } else if (kind < 0.08) {
-    int edge = std::min(3, static_cast<int>((kind - 0.04) / 0.04 * 4.0));
-    s.x = edge < 2 ? (edge == 0 ? 0 : w - 1) : scaled(u.x, w);
-    s.y = edge < 2 ? scaled(u.y, h) : (edge == 2 ? 0 : h - 1);
-    if (natural_depth) s.coverage = Coverage::kEdgePixel;
-  } else {
-    s.x = scaled(u.x, w);
-    s.y = scaled(u.y, h);
-  }
-  return s;
+  const draw::DrawnSample drawn = draw::draw_sample(
+      {.pick = u.pick, .depth = u.depth, .pixel_kind = u.pixel_kind, .x = u.x, .y = u.y}, DrawFrameOf(frame));
+  return {.index = index,
+          .x = drawn.x,
+          .y = drawn.y,
+          .pick = static_cast<DepthPick>(drawn.pick),
+          .eye_depth = drawn.eye_depth,
+          .coverage = static_cast<Coverage>(drawn.coverage)};
 }
 
 }  // namespace depthbench

@@ -14,6 +14,7 @@
 
 #include "bench/pipeline/bands.h"
 #include "bench/pipeline/domain.h"
+#include "bench/pipeline/draw.h"
 
 namespace depthbench {
 
@@ -35,10 +36,10 @@ struct Frame {
   double depth_limit = 0.0;
   double eye_depth_min = 0.0;  // eye-depth range samples are drawn from
   double eye_depth_max = 0.0;
-  double log_eye_depth_span = 0.0;  // log(eye_depth_max / eye_depth_min)
-  bool depth_restricted = false;    // the domain names an eye-depth range of interest
-  glm::dvec3 camera_position{0.0};  // float32-representable components
-  glm::dmat3 rotation{1.0};         // columns: the camera's x, y, z axes in world space
+  double log2_eye_depth_span = 0.0;  // log2(eye_depth_max / eye_depth_min)
+  bool depth_restricted = false;     // the domain names an eye-depth range of interest
+  glm::dvec3 camera_position{0.0};   // float32-representable components
+  glm::dmat3 rotation{1.0};          // columns: the camera's x, y, z axes in world space
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   double volume_depth = 0.0;  // eye depth of the light-volume surface (volume_ray)
@@ -98,7 +99,10 @@ struct SampleUnits {
   double pixel_kind = 0, x = 0, y = 0;
 };
 Frame FrameFromUnits(const Domain& domain, const FrameUnits& units, std::uint64_t frame_index);
+// The sample these units draw in `frame` (shared/draw.h).
 PixelSample SampleFromUnits(const SampleUnits& units, const Frame& frame, std::uint64_t index);
+// What the draw of a sample and of its ray needs of its frame.
+draw::DrawFrame DrawFrameOf(const Frame& frame);
 // Fills the fields that follow from the others (tan_half_fov_y, depth
 // limits and the eye-depth range), as the sampler does; `eye_depth` is the
 // domain's range of interest, if any.

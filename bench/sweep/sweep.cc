@@ -189,15 +189,19 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     if (judge != nullptr) batch_size = std::min(batch_size, judge->MaxBatchSamples());
   }
   // The host stores the texels and computes the reference only where it judges.
+  // Where every backend judges on its device, the devices also draw the
+  // samples when they can (BatchBuilder::DevicesCanDraw).
   const bool host_judges = std::find(device_judges.begin(), device_judges.end(), nullptr) != device_judges.end();
-  const BatchFor built_for = host_judges ? BatchFor::kHostJudge : BatchFor::kDeviceJudge;
+  const BatchFor built_for = host_judges                                        ? BatchFor::kHostJudge
+                             : options.device_draws && builder.DevicesCanDraw() ? BatchFor::kDeviceDraws
+                                                                                : BatchFor::kDeviceJudge;
   // Where every backend judges on its device, the host builds the next
   // batch while the devices take the last one (below): the threads are
   // shared out between the two stages, a quarter (at most 4) to the
   // devices' copies, so that neither stage's threads wait for a core. On
   // an H200's 16 cores 12 + 4 ran 3.49 G/s against 3.05 for 16 + 4, one
   // run each (reports/device-judge/h200.txt, section 7).
-  const bool overlap = built_for == BatchFor::kDeviceJudge;
+  const bool overlap = built_for != BatchFor::kHostJudge;
   const unsigned threads = ThreadPool::ThreadCount(options.threads);
   const unsigned stage_threads = overlap ? std::clamp(threads / 4, 1u, 4u) : 0u;
   ThreadPool pool(std::max(1u, threads - stage_threads));

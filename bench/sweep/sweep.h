@@ -73,6 +73,10 @@ struct SweepOptions {
   JudgeSite judge = JudgeSite::kAuto;
   // Where a judge on a device adds its bins (tests pick each way).
   JudgeBinMerge device_bins = JudgeBinMerge::kAuto;
+  // Where every backend judges on its device: whether the devices draw
+  // the samples too, where they can (BatchFor::kDeviceDraws), or the host
+  // draws them. The same samples either way.
+  bool device_draws = true;
   std::function<void(const SweepProgress&)> progress;  // called after every batch
 };
 

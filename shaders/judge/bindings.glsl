@@ -18,11 +18,17 @@ layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[];
 layout(std430, set = 0, binding = 1) readonly buffer Positions { uint position_bits[]; };
 // Per frame: the camera (float32 bits) and its camera-distance band.
 layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
-// Per sample: the world-space ray at unit eye depth, x then y then z
-// slices of `count` values.
-layout(std430, set = 0, binding = 3) readonly buffer Rays { double rays[]; };
-// Per sample: the coverage kind | 1 << 8 for a stored-value pick.
-layout(std430, set = 0, binding = 4) readonly buffer Coverage { uint coverage[]; };
+// What was drawn of each sample: uploaded, or written by the sample pass
+// (sample.comp). The world-space ray at unit eye depth, x then y then z
+// slices of `count` values; the coverage kind | the depth pick << 8 (0 for
+// an eye depth, else the stored value: sampler.h's DepthPick).
+#ifdef DB_SAMPLE_PASS
+#define DB_DRAWN_ACCESS writeonly
+#else
+#define DB_DRAWN_ACCESS readonly
+#endif
+layout(std430, set = 0, binding = 3) DB_DRAWN_ACCESS buffer Rays { double rays[]; };
+layout(std430, set = 0, binding = 4) DB_DRAWN_ACCESS buffer Coverage { uint coverage[]; };
 // Per frame, five doubles: near, far (0 for an infinite far plane), the
 // largest eye depth, and the eye depths of interest (lowest, highest).
 layout(std430, set = 0, binding = 5) readonly buffer FrameDepths { double frame_depths[]; };
@@ -31,7 +37,7 @@ layout(std430, set = 0, binding = 5) readonly buffer FrameDepths { double frame_
 // convention.
 layout(std430, set = 0, binding = 6) readonly buffer FrameConstants { uint frame_constants[]; };
 // Per sample: the eye depth (the near plane for a stored-value pick).
-layout(std430, set = 0, binding = 7) readonly buffer EyeDepths { double eye_depths[]; };
+layout(std430, set = 0, binding = 7) DB_DRAWN_ACCESS buffer EyeDepths { double eye_depths[]; };
 // Per (pipeline, sample): the float32 the pipeline produced (uploaded, or
 // written by the storage pass).
 #ifdef DB_STORE_PASS
@@ -65,11 +71,19 @@ layout(std430, set = 0, binding = 13) buffer FirstNonFinite { uint64_t first_non
 layout(std430, set = 0, binding = 14) buffer Maxima { uint64_t maxima[]; };
 // Per cell: samples with a component the reconstruction never wrote.
 layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
-// The stored-value picks (store.comp's phase 2): the samples, and per
-// (depth slot, pick) the fetched value's bits the host made, a slice of
-// pass.picks values per slot.
-layout(std430, set = 0, binding = 16) readonly buffer PickSamples { uint pick_samples[]; };
-layout(std430, set = 0, binding = 17) readonly buffer PickTexels { uint pick_texel_bits[]; };
+// Per (frame, depth slot, stored-value pick): the value a fetch returns
+// (its bits, as the host stored it), at (frame * depth_slots + slot) * 4 +
+// pick - 1.
+layout(std430, set = 0, binding = 16) readonly buffer EdgeTexels { uint edge_texel_bits[]; };
+// Per frame, DB_JUDGE_FRAME_DRAWS doubles: what the sample pass draws from
+// (shared/draw.h's DrawFrame): the eye-depth range and its log2 span,
+// tan_x, tan_y, width, height, and the rotation's columns.
+layout(std430, set = 0, binding = 17) readonly buffer FrameDraws { double frame_draws[]; };
+// The pixels the reconstruction pass reads (the Vulkan backend's: x | y <<
+// 16 at element lead + i), written by the sample pass.
+#ifdef DB_SAMPLE_PASS
+layout(std430, set = 0, binding = 18) writeonly buffer Pixels { uint pixel_bits[]; };
+#endif
 
 layout(push_constant) uniform Pass { JudgePass pass; };
 

@@ -19,11 +19,10 @@
 // Phase 0 (where depths are produced in float32; exact production stays
 // with the host, which uploads the floats): workgroup row y computes
 // pipeline y's floats. Phase 1: row y writes depth slot y's whole slice
-// (the lead and the padding as zeros), all but the stored-value picks.
-// Phase 2: invocation k writes the k-th pick of every slot, from the
-// texels the host made for it (the picks are a few per cent of the
-// samples, and their values depend on the format alone, or on the
-// frame's far plane).
+// (the lead and the padding as zeros); a stored-value pick's texel comes
+// from the table the host made for the frame (the picks are a few per
+// cent of the samples, and their values depend on the format alone, or on
+// the frame's far plane).
 #include "../../shared/compat.h"
 #include "../../shared/params.h"
 #include "../../shared/judge.h"
@@ -213,13 +212,6 @@ void main() {
     }
     return;
   }
-  if (pass.phase == 2u) {
-    uint k = gl_GlobalInvocationID.x;
-    if (k < pass.picks) {
-      texel_bits[slot * pass.slice_length + pass.lead + pick_samples[k]] = pick_texel_bits[slot * pass.picks + k];
-    }
-    return;
-  }
   uint element = gl_GlobalInvocationID.x;
   if (element >= pass.slice_length) {
     return;
@@ -230,8 +222,10 @@ void main() {
     return;
   }
   uint i = element - pass.lead;
-  if ((coverage[i] & 0x100u) != 0u) {
-    return;  // a stored-value pick: phase 2 writes it
+  uint pick = coverage[i] >> 8u;
+  if (pick != 0u) {
+    texel_bits[at] = edge_texel_bits[(frame_of(i) * pass.depth_slots + slot) * 4u + pick - 1u];
+    return;
   }
   uint pipeline = run_layout[pass.cells + slot] >> 16u;
   texel_bits[at] = fetched_bits(slot, pipeline_float_bits[pipeline * pass.count + i]);

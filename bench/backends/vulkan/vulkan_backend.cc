@@ -463,7 +463,9 @@ DevicePositions VulkanBackend::OnDevice(const ShaderInputs& batch, const SliceLa
                          slices.lead,
                          slices.length,
                          buffers_[kStoredDepths].handle(),
-                         DepthSlotsOf(batch) * slices.length * sizeof(float)};
+                         DepthSlotsOf(batch) * slices.length * sizeof(float),
+                         buffers_[kPixels].handle(),
+                         std::size_t{slices.length} * sizeof(std::uint32_t)};
 }
 
 Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
@@ -501,10 +503,12 @@ Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const Shad
 Status VulkanBackend::CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                  bool host_texels) const {
   const std::size_t frames = std::size_t{batch.FrameOf(batch.count - 1)} + 1;
-  // (Texels the device stores are not read from the batch, whatever it holds.)
+  // (Texels the device stores are not read from the batch, whatever it
+  // holds; nor are pixels where it has none.)
   const std::size_t depths = std::size_t{batch.depth_slots} * batch.count;
+  const bool device_pixels = !host_texels && batch.pixels.empty();
   if (batch.frame_params.size() < frames || batch.depth_params.size() < frames * kHardwareConventionCount ||
-      batch.pixels.size() < batch.count || (host_texels && batch.depths.size() != depths)) {
+      (!device_pixels && batch.pixels.size() < batch.count) || (host_texels && batch.depths.size() != depths)) {
     return InvalidArgument(fmt::format(
         "batch of {} samples in {} depth slots has {} frame parameters, {} depth parameters, {} "
         "pixels and {} stored depths; it needs {}, {}, {} and {}",
@@ -582,19 +586,20 @@ Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slice
     std::memcpy(to + std::size_t{slices.lead} * 4, samples, std::size_t{batch.count} * 4);
     std::memset(to + end * 4, 0, (slices.length - end) * 4);
   };
-  // Slice 0 of the pixels, then each depth slot's texels: on the pool's
-  // threads where there is one (at a GPU's rate one thread's copies are a
-  // visible share of a batch).
+  // Slice 0 of the pixels (unless the device writes them), then each
+  // depth slot's texels: on the pool's threads where there is one (at a
+  // GPU's rate one thread's copies are a visible share of a batch).
+  const std::size_t pixel_slices = texels || !batch.pixels.empty() ? 1 : 0;
   const auto put = [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t k = begin; k < end; ++k) {
-      if (k == 0) {
+      if (k < pixel_slices) {
         put_slice(kPixels, 0, batch.pixels.data());
       } else {
-        put_slice(kStoredDepths, k - 1, batch.depths.data() + (k - 1) * batch.count);
+        put_slice(kStoredDepths, k - pixel_slices, batch.depths.data() + (k - pixel_slices) * batch.count);
       }
     }
   };
-  const std::size_t slices_to_put = 1 + (texels ? DepthSlotsOf(batch) : 0);
+  const std::size_t slices_to_put = pixel_slices + (texels ? DepthSlotsOf(batch) : 0);
   if (pool != nullptr) {
     pool->ParallelFor(slices_to_put, put);
   } else {

@@ -47,13 +47,17 @@ struct DevicePositions {
   // slot s's sample i at s * slice_length + lead + i.
   VkBuffer texels = VK_NULL_HANDLE;
   VkDeviceSize texel_bytes = 0;
+  // The pixels the pass read (x | y << 16), sample i at lead + i.
+  VkBuffer pixels = VK_NULL_HANDLE;
+  VkDeviceSize pixel_bytes = 0;
 };
 // Where the texels come from when a judge on the device stores them
 // itself: called once the backend's buffers are ready for the batch and
 // before its pass is queued, with the buffers that pass writes (the
 // positions) and reads (the texels, which the writer fills whole, the lead
-// and padding as zeros). It queues work on the device's queue that writes
-// the texels and ends with a barrier before later compute reads.
+// and padding as zeros; and the pixels where the batch has none, which
+// the writer then fills whole too). It queues work on the device's queue
+// that writes them and ends with a barrier before later compute reads.
 using TexelWriter = std::function<Status(const DevicePositions&)>;
 // Runs the listed cells as Backend::Run does, but leaves their positions on
 // the device for a judge there (bench/device_judge/), valid until the
