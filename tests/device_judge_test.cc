@@ -90,11 +90,11 @@ struct Reached {
   }
 };
 
-void ExpectSameStatistics(const Domain& domain, const std::string& name, JudgeBinMerge bins = JudgeBinMerge::kAuto) {
+void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJudgeTuning tuning = {}) {
   SCOPED_TRACE(name);
   auto host = DeviceJudgeTest::Sweep(DeviceJudgeTest::Options(domain), JudgeSite::kHost);
   SweepOptions on_device = DeviceJudgeTest::Options(domain);
-  on_device.device_bins = bins;
+  on_device.device_tuning = tuning;
   auto device = DeviceJudgeTest::Sweep(on_device, JudgeSite::kDevice);
   ASSERT_TRUE(host.ok()) << host.status().message();
   ASSERT_TRUE(device.ok()) << device.status().message();
@@ -133,15 +133,19 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, JudgeBi
 // Either way of adding bins on the device (lavapipe's default is the
 // device's counters; a GPU's, the workgroup's table first). In the wide
 // domain the table overflows for about a seventh of the bins, so its
-// fallback to the device's counters runs too.
+// fallback to the device's counters runs too. And either way of finding
+// the index of each maximum: from the candidates phase 0 lists, or, with
+// no room for one, by judging every accumulator again.
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
-  ExpectSameStatistics(WideDomain(), "wide, device counters", JudgeBinMerge::kDeviceCounters);
-  ExpectSameStatistics(WideDomain(), "wide, workgroup table", JudgeBinMerge::kWorkgroupTable);
+  ExpectSameStatistics(WideDomain(), "wide, device counters", {.bins = JudgeBinMerge::kDeviceCounters});
+  ExpectSameStatistics(WideDomain(), "wide, workgroup table, no candidates",
+                       {.bins = JudgeBinMerge::kWorkgroupTable, .candidates_per_row = 0});
 }
 
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
-  ExpectSameStatistics(ExtremesDomain(), "extremes, device counters", JudgeBinMerge::kDeviceCounters);
-  ExpectSameStatistics(ExtremesDomain(), "extremes, workgroup table", JudgeBinMerge::kWorkgroupTable);
+  ExpectSameStatistics(ExtremesDomain(), "extremes, device counters, no candidates",
+                       {.bins = JudgeBinMerge::kDeviceCounters, .candidates_per_row = 0});
+  ExpectSameStatistics(ExtremesDomain(), "extremes, workgroup table", {.bins = JudgeBinMerge::kWorkgroupTable});
 }
 
 // One batch of `domain` (every cell it allows), its reference computed by

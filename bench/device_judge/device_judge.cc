@@ -78,13 +78,15 @@ enum Binding : std::uint32_t {
   kEdgeTexels,
   kFrameDraws,
   kPixels,  // the backend's
+  kCandidates,
+  kCandidateCounts,
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
 // across the bus would cost the device its speed); transfers copy them
 // into host-readable buffers: each batch's maxima and the unwritten counts
 // after the batch, the histograms and counts at a flush.
-bool DeviceOnly(Binding b) { return b >= kReference && b <= kUnwritten; }
+bool DeviceOnly(Binding b) { return (b >= kReference && b <= kUnwritten) || b >= kCandidates; }
 // What the host writes for every batch: one buffer per lane (below), so
 // that it writes the next batch's while the device reads the last's.
 bool PerBatch(Binding b) { return b != kLayout && b != kPositions && b != kTexels && b != kPixels && !DeviceOnly(b); }
@@ -128,6 +130,7 @@ struct JudgeGroups {
   std::uint32_t samples = 0;
   std::uint32_t table_entries = 0;
   VkBool32 use_table = VK_FALSE;
+  std::uint32_t candidates_per_row = 0;
 };
 
 // With the table: as large as the device allows, up to 256 invocations,
@@ -137,19 +140,25 @@ struct JudgeGroups {
 // typical domain, groups of 2048 samples added one bin to the counters for
 // each 4.7 the shader recorded, groups of 16384 one for each 23. Without:
 // a sample per invocation, in groups of 64.
-JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, JudgeBinMerge bins) {
+JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeTuning tuning) {
+  JudgeBinMerge bins = tuning.bins;
   if (bins == JudgeBinMerge::kAuto) {
     bins = device.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? JudgeBinMerge::kDeviceCounters : JudgeBinMerge::kWorkgroupTable;
   }
   if (bins == JudgeBinMerge::kDeviceCounters) {
-    return {.invocations = 64, .samples = 64, .table_entries = 1, .use_table = VK_FALSE};
+    return {.invocations = 64,
+            .samples = 64,
+            .table_entries = 1,
+            .use_table = VK_FALSE,
+            .candidates_per_row = tuning.candidates_per_row};
   }
   const VkPhysicalDeviceLimits& limits = device.limits;
   JudgeGroups groups{
       .invocations = std::min({256u, limits.maxComputeWorkGroupInvocations, limits.maxComputeWorkGroupSize[0]}),
       .samples = 16384,
       .table_entries = 4096,
-      .use_table = VK_TRUE};
+      .use_table = VK_TRUE,
+      .candidates_per_row = tuning.candidates_per_row};
   while (groups.table_entries * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) groups.table_entries /= 2;
   return groups;
 }
@@ -204,6 +213,10 @@ struct DeviceJudge::State {
   VkDeviceSize first_bytes() const { return counted_slots() * sizeof(std::uint64_t); }
   VkDeviceSize maxima_bytes() const { return 2 * maxima() * sizeof(std::uint64_t); }
   VkDeviceSize unwritten_bytes() const { return cell_count() * sizeof(std::uint32_t); }
+  VkDeviceSize candidates_bytes() const {
+    return accumulators() * judge_groups.candidates_per_row * 4 * sizeof(std::uint32_t);
+  }
+  VkDeviceSize candidate_counts_bytes() const { return accumulators() * sizeof(std::uint32_t); }
 
   VulkanBuffer& Buffer(Binding b) { return lane_buffers[PerBatch(b) ? lane : 0][b]; }
   const VulkanBuffer& Buffer(Binding b) const { return lane_buffers[PerBatch(b) ? lane : 0][b]; }
@@ -273,7 +286,7 @@ DeviceJudge::~DeviceJudge() = default;
 
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, const RunLayout& layout,
                                                            ProductionModel production, bool record_distances,
-                                                           JudgeBinMerge bins) {
+                                                           DeviceJudgeTuning tuning) {
   std::shared_ptr<VulkanContext> context = ContextOf(backend);
   if (context == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
   if (production == ProductionModel::kRaster) {
@@ -306,13 +319,14 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
       ComputePass::Create(context, bindings, sizeof(L::JudgePass), VK_SHADER_STAGE_COMPUTE_BIT, kLanes, 2 * kLanes),
       state->pass));
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
-  state->judge_groups = ChooseJudgeGroups(context->properties(), bins);
-  static_assert(sizeof(JudgeGroups) == 4 * sizeof(std::uint32_t));
-  const std::array<VkSpecializationMapEntry, 4> group_entries = {{
+  state->judge_groups = ChooseJudgeGroups(context->properties(), tuning);
+  static_assert(sizeof(JudgeGroups) == 5 * sizeof(std::uint32_t));
+  const std::array<VkSpecializationMapEntry, 5> group_entries = {{
       {0, offsetof(JudgeGroups, invocations), sizeof(std::uint32_t)},
       {1, offsetof(JudgeGroups, samples), sizeof(std::uint32_t)},
       {2, offsetof(JudgeGroups, table_entries), sizeof(std::uint32_t)},
       {3, offsetof(JudgeGroups, use_table), sizeof(VkBool32)},
+      {4, offsetof(JudgeGroups, candidates_per_row), sizeof(std::uint32_t)},
   }};
   const VkSpecializationInfo judge_shape{static_cast<std::uint32_t>(group_entries.size()), group_entries.data(),
                                          sizeof(JudgeGroups), &state->judge_groups};
@@ -342,6 +356,8 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kMaxima, state->maxima_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kUnwritten, state->unwritten_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kCandidates, state->candidates_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kCandidateCounts, state->candidate_counts_bytes()));
   for (VulkanBuffer& readback : state->batch_readbacks) {
     DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->maxima_bytes() + state->unwritten_bytes(),
                                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
@@ -499,7 +515,9 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       unwritten_bytes(),
       std::max<VkDeviceSize>(frames * depth_slots * 4 * sizeof(float), 16),
       std::max<VkDeviceSize>(frames * L::DB_JUDGE_FRAME_DRAWS * sizeof(double), 16),
-      positions.pixel_bytes};
+      positions.pixel_bytes,
+      std::max<VkDeviceSize>(candidates_bytes(), 16),
+      candidate_counts_bytes()};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -572,10 +590,12 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
 
 void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions,
                                 bool encodings) const {
-  // This batch's maxima start at nothing: zero squares, no index.
+  // This batch's maxima start at nothing: zero squares, no index, no
+  // candidate for one.
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
   vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), 0, half, 0u);
   vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), half, half, 0xffffffffu);
+  vkCmdFillBuffer(commands, Buffer(kCandidateCounts).handle(), 0, VK_WHOLE_SIZE, 0u);
   L::JudgePass constants = PassConstants(batch, positions);
   const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
   // The reference of every (depth slot, sample).
@@ -594,7 +614,8 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, groups_per_row, rows, 1);
-    // Phase 1 reads the maxima phase 0 raised; the copy below reads both.
+    // Phase 1 reads the maxima and candidates phase 0 left; the copy below
+    // reads both phases' maxima.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT);

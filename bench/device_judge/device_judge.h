@@ -60,6 +60,16 @@ namespace depthbench {
 // same counts.
 enum class JudgeBinMerge : std::uint8_t { kAuto, kWorkgroupTable, kDeviceCounters };
 
+// How the judge works on its device; any choice records the same figures
+// (tests run each way).
+struct DeviceJudgeTuning {
+  JudgeBinMerge bins = JudgeBinMerge::kAuto;
+  // How many candidates for the index of its maximum each accumulator
+  // lists per batch (shaders/judge/judge.comp); one with more is judged
+  // again whole. 0: every accumulator is.
+  std::uint32_t candidates_per_row = 4096;
+};
+
 class DeviceJudge {
  public:
   // A judge on the device of `backend`, a Vulkan backend prepared for the
@@ -71,7 +81,7 @@ class DeviceJudge {
   // (CellAccumulator::records_distances).
   static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,
                                                        ProductionModel production, bool record_distances,
-                                                       JudgeBinMerge bins = JudgeBinMerge::kAuto);
+                                                       DeviceJudgeTuning tuning = {});
   ~DeviceJudge();
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;

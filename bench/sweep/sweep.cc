@@ -73,14 +73,14 @@ void CopyEncodingMetrics(const CellStats& from, CellStats& to) {
 // where the outputs are judged on the host.
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudgeFor(JudgeSite site, Backend& backend, const RunLayout& layout,
                                                       bool record_distances, ProductionModel production,
-                                                      JudgeBinMerge bins) {
+                                                      DeviceJudgeTuning tuning) {
   if (site == JudgeSite::kHost) return std::unique_ptr<DeviceJudge>();
   const bool gpu = backend.device().kind == "gpu";
   if (site == JudgeSite::kAuto && (!gpu || PassKindOf(production) != PassKind::kCompute)) {
     return std::unique_ptr<DeviceJudge>();
   }
   Expected<std::unique_ptr<DeviceJudge>> judge =
-      DeviceJudge::Create(backend, layout, production, record_distances, bins);
+      DeviceJudge::Create(backend, layout, production, record_distances, tuning);
   if (!judge.ok() && site == JudgeSite::kAuto) return std::unique_ptr<DeviceJudge>();
   return judge;
 }
@@ -173,7 +173,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   std::vector<std::unique_ptr<DeviceJudge>> device_judges(backends.size());
   for (std::size_t b = 0; b < backends.size(); ++b) {
     DB_RETURN_IF_ERROR(StoreInto(DeviceJudgeFor(options.judge, *backends[b], layout, !only_distance_band,
-                                                options.domain.production, options.device_bins),
+                                                options.domain.production, options.device_tuning),
                                  device_judges[b])
                            .WithContext("judging on the " + backends[b]->name() + " backend's device"));
     if (device_judges[b] != nullptr) run.backends[b].judge = "device";

@@ -71,8 +71,8 @@ struct SweepOptions {
   std::uint64_t flush_every = std::uint64_t{1} << 31;
   // kDevice fails for a backend that cannot judge on its device.
   JudgeSite judge = JudgeSite::kAuto;
-  // Where a judge on a device adds its bins (tests pick each way).
-  JudgeBinMerge device_bins = JudgeBinMerge::kAuto;
+  // How a judge on a device works (tests pick each way).
+  DeviceJudgeTuning device_tuning;
   // Where every backend judges on its device: whether the devices draw
   // the samples too, where they can (BatchFor::kDeviceDraws), or the host
   // draws them. The same samples either way.

@@ -85,6 +85,13 @@ layout(std430, set = 0, binding = 17) readonly buffer FrameDraws { double frame_
 layout(std430, set = 0, binding = 18) writeonly buffer Pixels { uint pixel_bits[]; };
 #endif
 
+// The judge's candidates for the index of each maximum: per accumulator,
+// judge.comp's kCandidatesPerRow entries (the maximum's place, the sample,
+// its square's bits: low word, high word), and how many phase 0 listed
+// (more than fit, when the row overflowed).
+layout(std430, set = 0, binding = 19) buffer Candidates { uvec4 candidates[]; };
+layout(std430, set = 0, binding = 20) buffer CandidateCounts { uint candidate_counts[]; };
+
 layout(push_constant) uniform Pass { JudgePass pass; };
 
 uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }

@@ -26,7 +26,12 @@
 // each slot's largest square (a 64-bit atomic maximum on its bits: squares
 // are never negative, so their bits order as they do); phase 1 finds, for
 // each slot whose largest square this batch reached, the smallest index
-// that reached it, as the host keeps the first sample on a tie.
+// that reached it, as the host keeps the first sample on a tie. A sample
+// whose square equals the final maximum found the running maximum no
+// larger when it raised it, so phase 0 lists every sample that raised or
+// met it (a few dozen per slot) as a candidate, and phase 1 reads the
+// candidates instead of judging every sample again; an accumulator with
+// more candidates than its list holds is judged again whole.
 #include "../../shared/compat.h"
 #include "../../shared/judge.h"
 
@@ -38,6 +43,8 @@ layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint kGroupSamples = 16384u;
 layout(constant_id = 2) const uint kTableEntries = 4096u;
 layout(constant_id = 3) const bool kUseTable = true;  // false: bins go straight to the device's counters
+// Candidates listed per accumulator (device_judge.h's DeviceJudgeTuning).
+layout(constant_id = 4) const uint kCandidatesPerRow = 4096u;
 
 #include "bindings.glsl"
 
@@ -101,9 +108,10 @@ uint64_t sample_index(uint i) {
   return first + uint64_t(i);
 }
 
-// One value of metric m in slot `slot` of accumulator k: a cell's 0 total,
-// 1 arith, 2 absolute; a depth slot's 0 storage, 1 production.
-void record(uint k, uint slot, uint m, double square, uint64_t index) {
+// One value of metric m in slot `slot` of accumulator k for sample i: a
+// cell's 0 total, 1 arith, 2 absolute; a depth slot's 0 storage, 1
+// production.
+void record(uint k, uint slot, uint m, double square, uint i) {
   uint at = k * DB_JUDGE_SLOTS + slot;
   uint64_t bits = doubleBitsToUint64(square);
   uint max_at = at * DB_JUDGE_METRICS + m;
@@ -113,12 +121,33 @@ void record(uint k, uint slot, uint m, double square, uint64_t index) {
   bool candidate = square > 0.0lf;
   if (pass.phase == 0u) {
     add_to_bin(k, slot * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m]));
-    if (candidate && bits > maxima[max_at]) {
-      atomicMax(maxima[max_at], bits);
+    // (A stale read is never above the maximum, which only grows.)
+    if (candidate && bits >= maxima[max_at] && bits >= atomicMax(maxima[max_at], bits)) {
+      uint listed = atomicAdd(candidate_counts[k], 1u);
+      if (listed < kCandidatesPerRow) {
+        candidates[k * kCandidatesPerRow + listed] = uvec4(max_at, i, unpackUint2x32(bits));
+      }
     }
   } else if (candidate && bits == maxima[max_at]) {
-    atomicMin(maxima[pass.accumulators * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + max_at], index);
+    atomicMin(maxima[pass.accumulators * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + max_at], sample_index(i));
   }
+}
+
+// Phase 1 over accumulator k's candidates, where they all were listed:
+// true when it was.
+bool search_candidates(uint k) {
+  uint listed = candidate_counts[k];
+  if (listed > kCandidatesPerRow) {
+    return false;
+  }
+  uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  for (uint j = gl_WorkGroupID.x * gl_WorkGroupSize.x + gl_LocalInvocationID.x; j < listed; j += stride) {
+    uvec4 c = candidates[k * kCandidatesPerRow + j];
+    if (packUint2x32(c.zw) == maxima[c.x]) {
+      atomicMin(maxima[pass.accumulators * DB_JUDGE_SLOTS * DB_JUDGE_METRICS + c.x], sample_index(c.y));
+    }
+  }
+  return true;
 }
 
 // A sample the judge does not measure: counted by cause.
@@ -157,9 +186,8 @@ void record_encoding(uint k, uint s, uint i) {
   }
   uint slot_samples = pass.depth_slots * pass.count;
   uint band = band_slot(info, coverage[i] & 0xffu);
-  uint64_t index = sample_index(i);
-  record(k, band, 0u, reference[3u * slot_samples + r], index);
-  record(k, band, 1u, reference[4u * slot_samples + r], index);
+  record(k, band, 0u, reference[3u * slot_samples + r], i);
+  record(k, band, 1u, reference[4u * slot_samples + r], i);
 }
 
 // Sample i of accumulator k.
@@ -204,20 +232,20 @@ void judge(uint k, uint i) {
   uint status = (info >> 8u) & 0xffu;
   bool holdable = ((info >> 16u) & 1u) != 0u;
   bool finite = absolute_sq < 1.0lf / 0.0lf;  // false for NaN
-  uint64_t index = sample_index(i);
   if (status == DB_JUDGE_STATUS_JUDGED && finite) {
-    record(k, band, 0u, total_sq, index);
-    record(k, band, 2u, absolute_sq, index);
+    record(k, band, 0u, total_sq, i);
+    record(k, band, 2u, absolute_sq, i);
     if (distance != kNoSlot) {
-      record(k, distance, 0u, total_sq, index);
+      record(k, distance, 0u, total_sq, i);
     }
     if (holdable) {
-      record(k, band, 1u, arith_sq, index);
+      record(k, band, 1u, arith_sq, i);
       if (distance != kNoSlot) {
-        record(k, distance, 1u, arith_sq, index);
+        record(k, distance, 1u, arith_sq, i);
       }
     }
   } else {
+    uint64_t index = sample_index(i);
     bool is_nan = absolute_sq != absolute_sq;
     count(k, band, status, holdable, is_nan, index);
     if (distance != kNoSlot) {
@@ -229,6 +257,9 @@ void judge(uint k, uint i) {
 void main() {
   uint k = gl_WorkGroupID.y;
   uint lane = gl_LocalInvocationID.x;
+  if (pass.phase == 1u && search_candidates(k)) {
+    return;
+  }
   bool tabling = kUseTable && pass.phase == 0u;  // phase 0 through the table
   if (tabling) {
     for (uint entry = lane; entry < kTableEntries; entry += gl_WorkGroupSize.x) {
