@@ -67,4 +67,5 @@ struct JudgePass {
   uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
   uint seed_lo;           // the sampler's seed (the sample pass's)
   uint seed_hi;
+  uint row_order;  // where the judge's order of accumulators starts in the run's layout
 };

@@ -1,6 +1,7 @@
 #include "bench/base/thread_pool.h"
 
 #include <algorithm>
+#include <cstring>
 
 namespace depthbench {
 
@@ -20,6 +21,14 @@ ThreadPool::~ThreadPool() {
   }
   wake_.notify_all();
   for (auto& t : workers_) t.join();
+}
+
+void ThreadPool::Copy(void* to, const void* from, std::size_t bytes) {
+  constexpr std::size_t kChunk = std::size_t{256} << 10;
+  ParallelFor((bytes + kChunk - 1) / kChunk, [&](std::size_t begin, std::size_t end, unsigned) {
+    const std::size_t lo = begin * kChunk, hi = std::min(bytes, end * kChunk);
+    std::memcpy(static_cast<std::byte*>(to) + lo, static_cast<const std::byte*>(from) + lo, hi - lo);
+  });
 }
 
 void ThreadPool::ParallelFor(std::size_t n, const std::function<void(std::size_t, std::size_t, unsigned)>& fn,

@@ -31,6 +31,9 @@ class ThreadPool {
   // smallest chunk worth a thread.
   void ParallelFor(std::size_t n, const std::function<void(std::size_t, std::size_t, unsigned)>& fn,
                    std::size_t grain = 1);
+  // memcpy in chunks on every thread: where `to` is memory a device reads
+  // across the bus, one thread's writes are slower than the bus.
+  void Copy(void* to, const void* from, std::size_t bytes);
 
  private:
   void WorkerLoop(unsigned worker);

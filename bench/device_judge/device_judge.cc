@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <tuple>
 #include <vector>
 
@@ -36,7 +37,7 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_DEGENERATE == static_cast<unsigned>(ReferenceStatus::kDegenerate) &&
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
-static_assert(sizeof(L::JudgePass) == 56);
+static_assert(sizeof(L::JudgePass) == 60);
 static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9);  // shared/draw.h's DrawFrame, its rotation's nine
 static_assert(L::DB_JUDGE_TEXEL_UNORM == static_cast<unsigned>(TexelKind::kUnorm) &&
               L::DB_JUDGE_TEXEL_FLOAT32 == static_cast<unsigned>(TexelKind::kFloat32) &&
@@ -202,7 +203,8 @@ struct DeviceJudge::State {
   // The cells' accumulators, then the depth slots'.
   std::size_t accumulators() const { return cell_count() + depth_slots; }
   std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
-  std::size_t layout_words() const { return cell_count() + 2 * depth_slots + pipelines; }
+  std::size_t row_order_at() const { return cell_count() + 2 * depth_slots + pipelines; }
+  std::size_t layout_words() const { return row_order_at() + accumulators(); }
   // Whether the storage pass produces the pipelines' floats (float32
   // production) or the host uploads them (exact production, which rounds
   // with MPFR where a tie needs it).
@@ -351,6 +353,16 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   for (std::uint32_t s = static_cast<std::uint32_t>(state->depth_slots); s-- > 0;) {
     words[state->accumulators() + state->depth_slots + pipeline_of_slot[s]] = s;  // the pipeline's first slot
   }
+  // The judge's rows: the cells that read one depth slot one after the
+  // other, so that the workgroups running at once share the slot's
+  // reference in the device's cache; then the depth slots' own
+  // accumulators, in order (a run that does not record them dispatches
+  // the cells' rows alone).
+  std::uint32_t* row_order = words + state->row_order_at();
+  std::iota(row_order, row_order + state->accumulators(), 0u);
+  std::stable_sort(row_order, row_order + state->cell_count(), [&](std::uint32_t a, std::uint32_t b) {
+    return layout.cells[a].depth_slot < layout.cells[b].depth_slot;
+  });
   DB_RETURN_IF_ERROR(state->Buffer(kLayout).FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
@@ -411,15 +423,16 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
         fmt::format("a batch of {} samples in {} frames with {} drawn samples and {} edge texels, for {} depth slots",
                     count, frames, samples.pick.size(), batch.edge_texels.size(), depth_slots));
   }
-  std::memcpy(Buffer(kEdgeTexels).mapped(), batch.edge_texels.data(), batch.edge_texels.size() * sizeof(float));
+  pool.Copy(Buffer(kEdgeTexels).mapped(), batch.edge_texels.data(), batch.edge_texels.size() * sizeof(float));
   // Per frame. The frame's planes are those the host's reference reads
   // for each of its samples (PlanesOf); what the sample pass draws from
-  // is the host sampler's (DrawFrameOf).
+  // is the host sampler's (DrawFrameOf). On the pool's threads, as the
+  // copies are.
   auto* frame_draws = static_cast<double*>(Buffer(kFrameDraws).mapped());
   auto* frame_words = static_cast<std::uint32_t*>(Buffer(kFrames).mapped());
   auto* frame_depths = static_cast<double*>(Buffer(kFrameDepths).mapped());
   auto* frame_constants = static_cast<std::uint32_t*>(Buffer(kFrameConstants).mapped());
-  for (std::size_t f = 0; f < frames; ++f) {
+  const auto write_frame = [&](std::size_t f) {
     const glm::dvec3& camera = batch.frames[f].camera_position;  // float32 values (sampler.h)
     for (int c = 0; c < 3; ++c) frame_words[4 * f + c] = std::bit_cast<std::uint32_t>(static_cast<float>(camera[c]));
     frame_words[4 * f + 3] = batch.distance_bands[f];
@@ -447,7 +460,13 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
       words[2 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.x);
       words[3 + 2 * c] = std::bit_cast<std::uint32_t>(depth.coefficients.y);
     }
-  }
+  };
+  pool.ParallelFor(
+      frames,
+      [&](std::size_t begin, std::size_t end, unsigned) {
+        for (std::size_t f = begin; f < end; ++f) write_frame(f);
+      },
+      256);
   auto* coverage = static_cast<std::uint32_t*>(Buffer(kCoverage).mapped());
   auto* eye_depths = static_cast<double*>(Buffer(kEyeDepths).mapped());
   auto* pipeline_floats = static_cast<float*>(Buffer(kPipelineFloats).mapped());
@@ -547,7 +566,8 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
                       .accumulators = static_cast<std::uint32_t>(accumulators()),
                       .exact_production = exact_production ? 1u : 0u,
                       .seed_lo = static_cast<std::uint32_t>(batch.seed),
-                      .seed_hi = static_cast<std::uint32_t>(batch.seed >> 32)};
+                      .seed_hi = static_cast<std::uint32_t>(batch.seed >> 32),
+                      .row_order = static_cast<std::uint32_t>(row_order_at())};
 }
 
 void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,

@@ -9,7 +9,8 @@
 // DB_CONVENTION_* bits << 4 | hardware convention index << 8 | 1 << 12
 // for a far plane at infinity | pipeline << 16; then per depth slot its
 // texel: DB_JUDGE_TEXEL_* | unorm bits << 8; then per pipeline its first
-// depth slot.
+// depth slot; then, from pass.row_order, the accumulator each workgroup
+// row of the judge takes.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and

@@ -255,7 +255,7 @@ void judge(uint k, uint i) {
 }
 
 void main() {
-  uint k = gl_WorkGroupID.y;
+  uint k = run_layout[pass.row_order + gl_WorkGroupID.y];
   uint lane = gl_LocalInvocationID.x;
   if (pass.phase == 1u && search_candidates(k)) {
     return;

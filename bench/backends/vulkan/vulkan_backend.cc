@@ -573,8 +573,17 @@ Status VulkanBackend::Upload(const ShaderInputs& batch, const SliceLayout& slice
   for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
     DB_RETURN_IF_ERROR(EnsureCapacity(static_cast<Binding>(binding), bytes[binding]));
   }
-  std::memcpy(buffers_[kFrames].mapped(), batch.frame_params.data(), bytes[kFrames]);
-  std::memcpy(buffers_[kDepthParams].mapped(), batch.depth_params.data(), bytes[kDepthParams]);
+  // The frames' constants, 1.6 kB per frame: at a GPU's rate one thread's
+  // copies are a visible share of a batch, so the pool's threads copy.
+  const auto copy = [pool](void* to, const void* from, std::size_t n) {
+    if (pool != nullptr) {
+      pool->Copy(to, from, n);
+    } else {
+      std::memcpy(to, from, n);
+    }
+  };
+  copy(buffers_[kFrames].mapped(), batch.frame_params.data(), bytes[kFrames]);
+  copy(buffers_[kDepthParams].mapped(), batch.depth_params.data(), bytes[kDepthParams]);
   std::memcpy(buffers_[kCellSlices].mapped(), cell_slices.data(), bytes[kCellSlices]);
   // The per-sample inputs, slice by slice; the lead and the padding are
   // zeros (the shader reconstructs them too, into positions nobody reads).
