@@ -90,11 +90,13 @@ struct Reached {
   }
 };
 
-void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJudgeTuning tuning = {}) {
+void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJudgeTuning tuning = {},
+                          bool device_draws = true) {
   SCOPED_TRACE(name);
   auto host = DeviceJudgeTest::Sweep(DeviceJudgeTest::Options(domain), JudgeSite::kHost);
   SweepOptions on_device = DeviceJudgeTest::Options(domain);
   on_device.device_tuning = tuning;
+  on_device.device_draws = device_draws;
   auto device = DeviceJudgeTest::Sweep(on_device, JudgeSite::kDevice);
   ASSERT_TRUE(host.ok()) << host.status().message();
   ASSERT_TRUE(device.ok()) << device.status().message();
@@ -135,9 +137,12 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
 // domain the table overflows for about a seventh of the bins, so its
 // fallback to the device's counters runs too. And either way of finding
 // the index of each maximum: from the candidates phase 0 lists, or, with
-// no room for one, by judging every accumulator again.
+// no room for one, by judging every accumulator again. And either way of
+// drawing the samples: on the device (the default) or on the host
+// (`run --draw host`).
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
-  ExpectSameStatistics(WideDomain(), "wide, device counters", {.bins = JudgeBinMerge::kDeviceCounters});
+  ExpectSameStatistics(WideDomain(), "wide, device counters, drawn on the host",
+                       {.bins = JudgeBinMerge::kDeviceCounters}, /*device_draws=*/false);
   ExpectSameStatistics(WideDomain(), "wide, workgroup table, no candidates",
                        {.bins = JudgeBinMerge::kWorkgroupTable, .candidates_per_row = 0});
 }

@@ -27,7 +27,7 @@ struct Batch : ShaderInputs {
   std::vector<std::uint8_t> distance_bands;  // [frame]: DistanceBand of the camera
   std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
   SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
-  ReferenceArrays reference;                 // [depth slot * count + sample]; empty for BatchFor::kDeviceJudge
+  ReferenceArrays reference;                 // [depth slot * count + sample]; empty where a device judges (BatchFor)
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
   // count + sample].
   std::vector<float> pipeline_floats;

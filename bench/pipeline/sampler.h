@@ -57,7 +57,6 @@ enum class DepthPick : std::uint8_t {
   kStoredAfterZero,  // the smallest stored value above 0
   kStoredBeforeOne,  // the largest stored value below 1
 };
-inline constexpr int kDepthPicks = static_cast<int>(DepthPick::kStoredBeforeOne) + 1;  // the last one
 
 struct PixelSample {
   std::uint64_t index = 0;
