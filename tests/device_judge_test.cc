@@ -116,6 +116,33 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
   EXPECT_GT(t.device_waited, 0.0);
   EXPECT_LE(t.device_waited, t.judging);
   EXPECT_GT(t.build_waited, 0.0);
+  // The device's own clock, pass by pass, in the order they run: each
+  // interval lies on the device's timeline apart from the others, within
+  // the run; the judge's and the reconstruction's always take some time,
+  // and so does the sample pass where the device draws.
+  std::vector<std::string> names;
+  double device_total = 0.0;
+  for (const auto& [pass, seconds] : t.device_passes) {
+    names.push_back(pass);
+    EXPECT_GE(seconds, 0.0) << pass;
+    device_total += seconds;
+  }
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"idle", "sample", "store", "reconstruction", "reference", "judge", "maxima"}));
+  EXPECT_LE(device_total, device->run.seconds);
+  const auto seconds_of = [&](const std::string& pass) {
+    return std::find_if(t.device_passes.begin(), t.device_passes.end(), [&](const auto& p) { return p.first == pass; })
+        ->second;
+  };
+  EXPECT_GT(seconds_of("judge"), 0.0);
+  EXPECT_GT(seconds_of("reconstruction"), 0.0);
+  if (device_draws) {
+    EXPECT_GT(seconds_of("sample"), 0.0);
+  }
+  // They reach the results file and come back from it, in order.
+  auto read = ResultsFromJson(ToJson(*device), "device.json");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->run.stages.device_passes, t.device_passes);
   Reached reached;
   for (std::size_t c = 0; c < host->cells.size(); ++c) {
     const CellStats& a = host->cells[c].stats;

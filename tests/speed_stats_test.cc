@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bench/backends/vulkan/timestamps.h"
 #include "bench/speed/timing_stats.h"
 #include "bench/speed/trade.h"
 

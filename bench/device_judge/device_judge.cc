@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <vector>
 
@@ -15,6 +16,7 @@
 
 #include "bench/backends/vulkan/compute_pass.h"
 #include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/backends/vulkan/timestamps.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/base/resources.h"
 
@@ -164,6 +166,22 @@ JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeT
   return groups;
 }
 
+namespace {
+
+// Where each batch's timestamps are written: at the start of the storage
+// submission (once everything queued before has finished), after the
+// sample pass, at its end, at the start of the judge's submission, after
+// the reference, after each judge phase. The passes' times are the
+// intervals between them, named by PassNames: the reconstruction's is the
+// backend's pass, queued between the two submissions, with any time the
+// device waits for the judge's submission; "idle" is the time from the
+// batch before's end to this one's start.
+enum Mark : std::uint32_t { kStoreStart, kSampled, kStored, kJudgeStart, kReferenced, kJudged, kMaximaFound, kMarks };
+constexpr std::array<const char*, kMarks> kPassNames = {"idle",      "sample", "store", "reconstruction",
+                                                        "reference", "judge",  "maxima"};
+
+}  // namespace
+
 struct DeviceJudge::State {
   Backend* backend = nullptr;
   std::shared_ptr<VulkanContext> context;
@@ -198,6 +216,16 @@ struct DeviceJudge::State {
   bool record_distances = true;
   JudgeGroups judge_groups;
   double waited = 0.0;  // seconds Judge spent waiting for the device's passes
+  // Each lane's batch writes kMarks timestamps (Mark), where the device's
+  // queue writes them; Finish adds the intervals into pass_seconds.
+  TimestampQueries clock;
+  std::array<double, kMarks> pass_seconds{};
+  std::optional<std::uint64_t> last_end;  // the timestamp the last finished batch ended at
+  std::uint32_t Query(std::uint32_t lane_of, std::uint32_t mark) const { return lane_of * kMarks + mark; }
+  void RecordMark(VkCommandBuffer commands, Mark mark) const {
+    if (clock.count() > 0) clock.RecordWrite(commands, Query(lane, mark));
+  }
+  Status AddPassSeconds(std::uint32_t lane_of);
 
   std::size_t cell_count() const { return every_cell.size(); }
   // The cells' accumulators, then the depth slots'.
@@ -320,6 +348,10 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   DB_RETURN_IF_ERROR(StoreInto(
       ComputePass::Create(context, bindings, sizeof(L::JudgePass), VK_SHADER_STAGE_COMPUTE_BIT, kLanes, 2 * kLanes),
       state->pass));
+  // Where the queue writes no timestamps, the passes go untimed.
+  if (TimestampQueries::Supported(*context).ok()) {
+    DB_ASSIGN_OR_RETURN(state->clock, TimestampQueries::Create(*context, kLanes * kMarks));
+  }
   DB_ASSIGN_OR_RETURN(const std::filesystem::path shaders, DataPath("shaders"));
   state->judge_groups = ChooseJudgeGroups(context->properties(), tuning);
   static_assert(sizeof(JudgeGroups) == 5 * sizeof(std::uint32_t));
@@ -572,6 +604,8 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
 
 void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,
                                      const DevicePositions& positions) const {
+  if (clock.count() > 0) clock.RecordReset(commands, Query(lane, 0), kMarks);
+  RecordMark(commands, kStoreStart);
   // Everything queued before (the last batch's judge reading the
   // positions, texels, reference and maxima this batch rewrites, and its
   // copies) finishes first.
@@ -590,6 +624,7 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
+  RecordMark(commands, kSampled);
   pass->Bind(commands, store_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   const auto slots = static_cast<std::uint32_t>(depth_slots);
   if (device_produces()) {
@@ -606,10 +641,12 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
   // The reconstruction pass (the backend's, queued next) and the reference read them.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  RecordMark(commands, kStored);
 }
 
 void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions,
                                 bool encodings) const {
+  RecordMark(commands, kJudgeStart);
   // This batch's maxima start at nothing: zero squares, no index, no
   // candidate for one.
   const VkDeviceSize half = maxima() * sizeof(std::uint64_t);
@@ -622,6 +659,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
   pass->Bind(commands, reference_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   pass->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(depth_slots), 1);
+  RecordMark(commands, kReferenced);
   // The fills, the reference, and the reconstruction pass's positions (an
   // earlier submission to the same queue), before the judge reads.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -634,6 +672,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, groups_per_row, rows, 1);
+    RecordMark(commands, phase == 0 ? kJudged : kMaximaFound);
     // Phase 1 reads the maxima and candidates phase 0 left; the copy below
     // reads both phases' maxima.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -682,9 +721,21 @@ Status DeviceJudge::State::Finish(std::uint32_t which) {
   const auto waiting = std::chrono::steady_clock::now();
   DB_RETURN_IF_ERROR(pass->Wait(JudgeSlot(which)));
   waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - waiting).count();
+  DB_RETURN_IF_ERROR(AddPassSeconds(which));
   DB_RETURN_IF_ERROR(MergeMaxima(which, batch.cells, batch.encodings));
   for (CellAccumulator& a : batch.cells) a.Count(batch.count);
   for (CellAccumulator& a : batch.encodings) a.Count(batch.count);
+  return Status::Ok();
+}
+
+Status DeviceJudge::State::AddPassSeconds(std::uint32_t lane_of) {
+  if (clock.count() == 0) return Status::Ok();
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps, clock.Read(Query(lane_of, 0), kMarks));
+  // Pass k is the interval that ends at mark k; idle, the first, begins
+  // where the batch before ended.
+  if (last_end) pass_seconds[0] += clock.IntervalNs(*last_end, stamps[kStoreStart]) * 1e-9;
+  for (std::uint32_t k = 1; k < kMarks; ++k) pass_seconds[k] += clock.IntervalNs(stamps[k - 1], stamps[k]) * 1e-9;
+  last_end = stamps[kMaximaFound];
   return Status::Ok();
 }
 
@@ -730,6 +781,13 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
 }
 
 double DeviceJudge::waited_seconds() const { return state_->waited; }
+
+std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
+  std::vector<std::pair<std::string, double>> out;
+  if (state_->clock.count() == 0) return out;
+  for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(kPassNames[k], state_->pass_seconds[k]);
+  return out;
+}
 
 Expected<ReferenceArrays> DeviceJudge::LastReference() const {
   State& s = *state_;

@@ -42,6 +42,9 @@
 
 #include <memory>
 #include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "bench/backends/backend.h"
 #include "bench/base/status.h"
@@ -108,6 +111,14 @@ class DeviceJudge {
   // this judge was made: with the host's time around Judge, it says which
   // side a batch waits for.
   double waited_seconds() const;
+  // The device's seconds in each of its passes for the batches finished so
+  // far, by name, in the order they run: "idle" (from one batch's end to
+  // the next one's start: the device waiting for the host), "sample",
+  // "store", "reconstruction" (the backend's pass, with any wait for the
+  // judge's submission after it), "reference", "judge" (phase 0: the
+  // histograms) and "maxima" (phase 1). Empty where the device's queue
+  // writes no timestamps.
+  std::vector<std::pair<std::string, double>> pass_seconds() const;
   // The reference the device computed for the last batch Judge was given,
   // in the host's layout (for tests and diagnosis; it finishes the batches
   // in flight).

@@ -19,6 +19,15 @@ std::uint64_t Shard::Begin(std::uint64_t total) const {
 std::uint64_t Shard::End(std::uint64_t total) const {
   return static_cast<std::uint64_t>(static_cast<unsigned __int128>(total) * index / count);
 }
+void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
+  auto it = std::find_if(device_passes.begin(), device_passes.end(), [&](const auto& p) { return p.first == name; });
+  if (it == device_passes.end()) {
+    device_passes.emplace_back(name, seconds);
+  } else {
+    it->second += seconds;
+  }
+}
+
 std::string Shard::ToString() const { return fmt::format("{}/{}", index, count); }
 
 Expected<Shard> ParseShard(std::string_view text) {
@@ -168,6 +177,10 @@ json ToJson(const Results& results) {
   }
   json run_cells = json::array();
   for (const Cell& c : run.cells) run_cells.push_back(c.Name());
+  json device_passes = json::array();
+  for (const auto& [name, seconds] : run.stages.device_passes) {
+    device_passes.push_back({{"pass", name}, {"seconds", seconds}});
+  }
 
   json cells = json::array();
   for (const CellResult& c : results.cells) {
@@ -232,7 +245,8 @@ json ToJson(const Results& results) {
                                          {"build", run.stages.build},
                                          {"judging", run.stages.judging},
                                          {"build_waited", run.stages.build_waited},
-                                         {"device_waited", run.stages.device_waited}}},
+                                         {"device_waited", run.stages.device_waited},
+                                         {"device_passes", device_passes}}},
                                        {"reconstructions", run.reconstructions}}},
                                      {"cells", cells}});
 }
@@ -378,6 +392,14 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
     DB_ASSIGN_OR_RETURN(run.stages.judging, stages.Number("judging"));
     DB_ASSIGN_OR_RETURN(run.stages.build_waited, stages.Number("build_waited"));
     DB_ASSIGN_OR_RETURN(run.stages.device_waited, stages.Number("device_waited"));
+    if (stages.Has("device_passes")) {
+      DB_RETURN_IF_ERROR(stages.ForEach("device_passes", [&](const JsonReader& pass) -> Status {
+        DB_ASSIGN_OR_RETURN(std::string name, pass.String("pass"));
+        DB_ASSIGN_OR_RETURN(double seconds, pass.Number("seconds"));
+        run.stages.AddDevicePass(name, seconds);
+        return Status::Ok();
+      }));
+    }
   }
   DB_RETURN_IF_ERROR(r.ForEach("shards", [&](const JsonReader& s) -> Status {
     DB_ASSIGN_OR_RETURN(std::string text, s.String());
@@ -550,6 +572,7 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
     stages.judging += part.run.stages.judging;
     stages.build_waited += part.run.stages.build_waited;
     stages.device_waited += part.run.stages.device_waited;
+    for (const auto& [name, seconds] : part.run.stages.device_passes) stages.AddDevicePass(name, seconds);
     merged.run.reconstructions += part.run.reconstructions;
     merged.run.samples_judged += part.run.samples_judged;
     merged.run.partial = merged.run.partial || part.run.partial;

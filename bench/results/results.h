@@ -68,6 +68,12 @@ struct StageSeconds {
   double judging = 0.0;  // the backends run and their outputs judged, on the host or on their devices
   double build_waited = 0.0;   // the build waiting for the judging of the batch before
   double device_waited = 0.0;  // the judging waiting for a device to finish its passes (device judge)
+  // The devices' own seconds in each pass of the device judge, in the
+  // order the passes run (DeviceJudge::pass_seconds, summed over devices);
+  // empty where no device judged or none could time its passes.
+  std::vector<std::pair<std::string, double>> device_passes;
+  // Adds `seconds` to the pass called `name`, a new one going last.
+  void AddDevicePass(const std::string& name, double seconds);
 
   bool empty() const { return build == 0.0 && judging == 0.0; }
 };

@@ -69,6 +69,15 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     if (t.device_waited > 0) out << fmt::format(" ({:.2f} s waiting for the device)", t.device_waited);
     if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s", t.build_waited);
     out << "\n";
+    if (!t.device_passes.empty()) {
+      out << "device passes:";
+      const char* separator = " ";
+      for (const auto& [name, seconds] : t.device_passes) {
+        out << fmt::format("{}{} {:.3f} s", separator, name, seconds);
+        separator = ", ";
+      }
+      out << "\n";
+    }
   }
   out << "bits lost = log2(relative error / 2^-24), from 0 (float32's own rounding) to 24 (nothing left); relative "
          "to the distance from the camera\n\n";

@@ -76,17 +76,7 @@ GpuPassTimer::GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesyst
 Expected<std::unique_ptr<GpuPassTimer>> GpuPassTimer::Create(std::shared_ptr<VulkanContext> context,
                                                              std::filesystem::path shader_dir) {
   if (context == nullptr) return InvalidArgument("the GPU pass timer needs a Vulkan context");
-  const VulkanDeviceProperties& properties = context->properties();
-  if (properties.queue_timestamp_valid_bits == 0) {
-    return Unavailable(
-        fmt::format("Vulkan device '{}': its compute queue cannot write timestamps "
-                    "(timestampValidBits 0), so passes cannot be timed on it",
-                    properties.name));
-  }
-  if (!(properties.limits.timestampPeriod > 0.0f)) {
-    return Unavailable(fmt::format("Vulkan device '{}' reports timestampPeriod {}", properties.name,
-                                   properties.limits.timestampPeriod));
-  }
+  DB_RETURN_IF_ERROR(TimestampQueries::Supported(*context));
   DB_RETURN_IF_ERROR(CheckDirectory(shader_dir, "shader directory"));
   DB_RETURN_IF_ERROR(CheckDirectory(shader_dir / "speed", "speed shader directory"));
   std::unique_ptr<GpuPassTimer> timer(new GpuPassTimer(std::move(context), std::move(shader_dir)));
@@ -263,38 +253,21 @@ void GpuPassTimer::RecordPasses(VkCommandBuffer commands, VkPipeline pipeline, s
 Expected<std::vector<double>> GpuPassTimer::TimeGroups(ComputePass& pass, std::span<const Group> groups,
                                                        const Recorder& record) {
   const auto queries = static_cast<std::uint32_t>(2 * groups.size());
-  if (queries > query_capacity_) {
-    query_pool_.Reset();
-    query_capacity_ = 0;
-    VkQueryPoolCreateInfo pool_info{};
-    pool_info.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-    pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    pool_info.queryCount = queries;
-    VkQueryPool pool = VK_NULL_HANDLE;
-    DB_RETURN_IF_ERROR(CheckVk(vkCreateQueryPool(vk_device(), &pool_info, nullptr, &pool), "vkCreateQueryPool"));
-    query_pool_ = DeviceObject<VkQueryPool>(vk_device(), pool, vkDestroyQueryPool);
-    query_capacity_ = queries;
+  if (queries > queries_.count()) {
+    DB_ASSIGN_OR_RETURN(queries_, TimestampQueries::Create(*context_, queries));
   }
-  const VkQueryPool pool = query_pool_.get();
   DB_RETURN_IF_ERROR(pass.Submit([&](VkCommandBuffer commands) {
-    vkCmdResetQueryPool(commands, pool, 0, queries);
+    queries_.RecordReset(commands, 0, queries);
     for (std::uint32_t g = 0; g < groups.size(); ++g) {
-      // Bottom of pipe: written once everything recorded before has finished.
-      vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g);
+      queries_.RecordWrite(commands, 2 * g);
       record(commands, groups[g].pipeline, groups[g].passes);
-      vkCmdWriteTimestamp(commands, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, pool, 2 * g + 1);
+      queries_.RecordWrite(commands, 2 * g + 1);
     }
   }));
-  std::vector<std::uint64_t> stamps(queries);
-  DB_RETURN_IF_ERROR(
-      CheckVk(vkGetQueryPoolResults(vk_device(), pool, 0, queries, stamps.size() * sizeof(std::uint64_t), stamps.data(),
-                                    sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-              "vkGetQueryPoolResults"));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps, queries_.Read(0, queries));
   std::vector<double> ns_per_pass(groups.size());
   for (std::uint32_t g = 0; g < groups.size(); ++g) {
-    DB_ASSIGN_OR_RETURN(const double ns,
-                        CheckedTimestampIntervalNs(stamps[2 * g], stamps[2 * g + 1],
-                                                   device().queue_timestamp_valid_bits, timestamp_period_ns()));
+    const double ns = queries_.IntervalNs(stamps[2 * g], stamps[2 * g + 1]);
     ns_per_pass[g] = ns / groups[g].passes;
   }
   return ns_per_pass;
@@ -448,8 +421,7 @@ Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, st
   }};
   DB_ASSIGN_OR_RETURN(std::unique_ptr<ComputePass> probe,
                       ComputePass::Create(context_, bindings, sizeof(std::uint32_t)));
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
-                      CompileShader(shader_dir_ / "speed" / "bandwidth.comp"));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shader_dir_ / "speed" / "bandwidth.comp"));
   DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
                       probe->CreatePipeline(spirv, VkSpecializationInfo{}, "the bandwidth probe"));
 

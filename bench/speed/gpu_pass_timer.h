@@ -43,8 +43,9 @@
 #include <vulkan/vulkan.h>
 
 #include "bench/backends/vulkan/compute_pass.h"
-#include "bench/backends/vulkan/vulkan_formats.h"
+#include "bench/backends/vulkan/timestamps.h"
 #include "bench/backends/vulkan/vulkan_context.h"
+#include "bench/backends/vulkan/vulkan_formats.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/speed/depth_image.h"
@@ -149,8 +150,7 @@ class GpuPassTimer {
   // size pushed.
   std::unique_ptr<ComputePass> pass_;
   DeviceObject<VkSampler> sampler_;
-  DeviceObject<VkQueryPool> query_pool_;
-  std::uint32_t query_capacity_ = 0;
+  TimestampQueries queries_;  // grown as groups need
 
   std::map<Variant, std::vector<std::uint32_t>> spirv_;  // compiled once per variant
   std::map<std::tuple<Variant, Convention, std::uint32_t>, DeviceObject<VkPipeline>> pipelines_;

@@ -33,28 +33,6 @@ Expected<TimingSummary> SummarizeTimings(std::span<const double> values) {
   return s;
 }
 
-double TimestampIntervalNs(std::uint64_t begin, std::uint64_t end, std::uint32_t valid_bits, double period_ns) {
-  const std::uint64_t mask = valid_bits >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << valid_bits) - 1;
-  // Unsigned subtraction wraps modulo 2^64; the mask reduces it modulo
-  // 2^valid_bits, which is how a narrower counter wraps.
-  const std::uint64_t ticks = ((end & mask) - (begin & mask)) & mask;
-  return static_cast<double>(ticks) * period_ns;
-}
-
-Expected<double> CheckedTimestampIntervalNs(std::uint64_t begin, std::uint64_t end, std::uint32_t valid_bits,
-                                            double period_ns) {
-  if (valid_bits == 0) {
-    return InvalidArgument("the queue's timestampValidBits is 0: it cannot write timestamps");
-  }
-  if (valid_bits > 64) {
-    return InvalidArgument(fmt::format("timestampValidBits {} is above 64", valid_bits));
-  }
-  if (!(period_ns > 0.0) || !std::isfinite(period_ns)) {
-    return InvalidArgument(fmt::format("timestampPeriod {} is not a positive number of nanoseconds", period_ns));
-  }
-  return TimestampIntervalNs(begin, end, valid_bits, period_ns);
-}
-
 const char* OrderingName(Ordering ordering) {
   switch (ordering) {
     case Ordering::kFaster: return "faster";

@@ -32,19 +32,6 @@ double QuantileOfSorted(std::span<const double> sorted, double q);
 // InvalidArgument for an empty set or a value that is not finite.
 Expected<TimingSummary> SummarizeTimings(std::span<const double> values);
 
-// The nanoseconds between two timestamps of a queue whose timestamps have
-// `valid_bits` significant bits (1 to 64) and advance once every
-// `period_ns` nanoseconds (VkPhysicalDeviceLimits::timestampPeriod). Only
-// the low valid_bits of a timestamp count, so the difference is taken
-// modulo 2^valid_bits: a counter that wrapped once between the two still
-// gives the right interval.
-double TimestampIntervalNs(std::uint64_t begin, std::uint64_t end, std::uint32_t valid_bits, double period_ns);
-// The same for a pair of raw query results, checking what the device
-// reported: InvalidArgument when valid_bits is 0 (the queue cannot time) or
-// above 64, or when the period is not a positive finite number.
-Expected<double> CheckedTimestampIntervalNs(std::uint64_t begin, std::uint64_t end, std::uint32_t valid_bits,
-                                            double period_ns);
-
 // How one timed thing compares with another.
 enum class Ordering {
   kFaster,             // its median is lower by more than the spread

@@ -375,7 +375,9 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     }
   }
   for (const auto& judge : device_judges) {
-    if (judge != nullptr) run.stages.device_waited += judge->waited_seconds();
+    if (judge == nullptr) continue;
+    run.stages.device_waited += judge->waited_seconds();
+    for (const auto& [name, seconds] : judge->pass_seconds()) run.stages.AddDevicePass(name, seconds);
   }
   run.seconds = SecondsSince(started);
   run.reconstructions = progress.reconstructions_done;
