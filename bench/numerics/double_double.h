@@ -2,7 +2,8 @@
 // about 106 bits of significand. It is the `real` of the high-precision
 // instantiations of shared/: hp (exact shader constants, rounding decisions,
 // formula tests) and hp4, four lanes at once, where the reference decodes
-// stored depths. Near the far plane at far/near = 1e9 a decode can lose 30
+// stored depths and where the exact shader constants of four frames are
+// computed together. Near the far plane at far/near = 1e9 a decode can lose 30
 // bits to cancellation in any precision; the reference must stay far below
 // float32 rounding (2^-24) after that.
 //
@@ -28,7 +29,7 @@
 
 #include "bench/base/simd.h"
 
-#if defined(__FMA__)
+#if defined(__AVX__)  // and so wherever __FMA__ is
 #include <immintrin.h>
 #endif
 
@@ -208,6 +209,32 @@ inline float RoundToFloat(DoubleDouble a) {
   if (a.hi() != midpoint) return f;
   bool lo_points_to_other = (a.lo() > 0.0) == (static_cast<double>(other) > back);
   return lo_points_to_other ? other : f;
+}
+
+// RoundToFloat four lanes at a time, each lane bit for bit what the scalar
+// function gives (the shader constants of four frames are rounded at once).
+// float(hi) is already the answer unless lo is nonzero and hi lies exactly
+// halfway between two floats. In the range of normal floats (and up to
+// 2^128, where a halfway hi between the largest float and 2^128 rounds to
+// infinity) that shows in hi's bits: the 29 low fraction bits that a float
+// does not keep read 1000...0. Lanes that are halfway, or that lie outside
+// that range (float subnormals, infinities, NaN) with a nonzero lo, go
+// through the scalar function; in shader constants they are rare.
+inline Lanes<4>::Float RoundToFloat(DoubleDouble4 a) {
+  const Double4 hi = a.hi(), lo = a.lo();
+  Lanes<4>::Float f = __builtin_convertvector(hi, Lanes<4>::Float);
+  const Int4 bits = reinterpret_cast<Int4>(hi);
+  const Double4 magnitude = reinterpret_cast<Double4>(bits & 0x7fffffffffffffff);
+  const Int4 halfway = (bits & 0x1fffffff) == 0x10000000;
+  const Int4 in_range = (magnitude >= 0x1p-126) & (magnitude < 0x1p128);
+  const Int4 settled = (in_range & ~halfway) | (lo == 0.0);
+#if defined(__AVX__)
+  if (_mm256_movemask_pd(reinterpret_cast<__m256d>(settled)) == 0xf) return f;
+#endif
+  for (int k = 0; k < 4; ++k) {
+    if (!settled[k]) f[k] = RoundToFloat(DoubleDouble::FromParts(hi[k], lo[k]));
+  }
+  return f;
 }
 
 }  // namespace depthbench

@@ -10,9 +10,10 @@
 //   depthbench::hp   DoubleDouble (about 106 bits): the exact shader
 //                    constants, rounding decisions too close to call in
 //                    long double, and the formula tests;
-//   depthbench::hp4  the depth mapping with four DoubleDouble lanes: the
-//                    reference's decode of stored depths, four samples at
-//                    a time.
+//   depthbench::hp4  the parameter blocks and the depth mapping with four
+//                    DoubleDouble lanes: the reference's decode of stored
+//                    depths, four samples at a time, and the exact shader
+//                    constants of four frames at once.
 // The third compilation is GLSL (shaders/, through glslang at run time).
 #pragma once
 

@@ -73,15 +73,21 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.distance_bands.resize(frames);
   batch.frame_params.resize(frames);
   batch.depth_params.resize(frames * kHardwareConventionCount);
-  pool.ParallelFor(frames, [&](std::size_t begin, std::size_t end, unsigned) {
-    for (std::size_t f = begin; f < end; ++f) {
+  // Each chunk holds whole groups of the frames whose constants are
+  // computed at once (only the batch's last group may be short).
+  constexpr std::size_t kGroup = kShaderConstantsLanes;
+  pool.ParallelFor((frames + kGroup - 1) / kGroup, [&](std::size_t begin, std::size_t end, unsigned) {
+    const std::size_t first_f = begin * kGroup, end_f = std::min(frames, end * kGroup);
+    for (std::size_t f = first_f; f < end_f; ++f) {
       Frame& frame = batch.frames[f];
       frame = sampler_.FrameAt(first_frame + f);
       batch.distance_bands[f] = static_cast<std::uint8_t>(DistanceBand(frame.camera_distance()));
-      BuildShaderConstants(frame, sampler_.constants(), batch.frame_params[f],
-                           std::span<f32::DepthParams, kHardwareConventionCount>(
-                               batch.depth_params.data() + f * kHardwareConventionCount, kHardwareConventionCount));
     }
+    const std::size_t n = end_f - first_f;
+    BuildShaderConstants(
+        std::span<const Frame>(batch.frames).subspan(first_f, n), sampler_.constants(),
+        std::span(batch.frame_params).subspan(first_f, n),
+        std::span(batch.depth_params).subspan(first_f * kHardwareConventionCount, n * kHardwareConventionCount));
   });
 
   // Samples: pixel, ray and depth pick; for the raster pipeline, the

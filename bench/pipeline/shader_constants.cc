@@ -1,19 +1,74 @@
 #include "bench/pipeline/shader_constants.h"
 
+#include <algorithm>
+#include <array>
+
 namespace depthbench {
 namespace {
 
 using DD = DoubleDouble;
+using DD4 = DoubleDouble4;
 
 // The formulas below are written once for a `Real` that is DoubleDouble
-// (the exact constants: every conversion from double exact) or float (the
-// engine's: every conversion rounds, every operation rounds).
+// (the exact constants: every conversion from double exact), DoubleDouble4
+// (the same for four frames, one per lane: the arithmetic is branch-free, so
+// each lane computes what DoubleDouble computes) or float (the engine's:
+// every conversion rounds, every operation rounds).
+template <class Params>
+using RealOf = typename decltype(Params::lens)::value_type;
+
+// The frame parameters the formulas read, converted to `Real`. The far
+// plane is 0 where a frame has none, as FrameParams.camera_position.w
+// reads.
 template <class Real>
-glm::vec<3, Real> Rotate(const glm::dmat3& r, const glm::vec<3, Real>& v) {
-  glm::vec<3, Real> out;
-  for (int row = 0; row < 3; ++row) {
-    out[row] = Real(r[0][row]) * v.x + Real(r[1][row]) * v.y + Real(r[2][row]) * v.z;
+struct FrameValues {
+  Real tan_half_fov_y, aspect, near, far, volume_depth, width, height;
+  glm::vec<3, Real> camera_position;
+  glm::mat<3, 3, Real> rotation;
+};
+
+// The one list of those parameters: lift(get) is the Real that holds
+// get(frame) of the frame, or of each lane's frame.
+template <class Real, class Lift>
+FrameValues<Real> LiftFrameValues(Lift lift) {
+  FrameValues<Real> v;
+  v.tan_half_fov_y = lift([](const Frame& f) { return f.tan_half_fov_y; });
+  v.aspect = lift([](const Frame& f) { return f.aspect; });
+  v.near = lift([](const Frame& f) { return f.near; });
+  v.far = lift([](const Frame& f) { return f.finite() ? f.far : 0.0; });
+  v.volume_depth = lift([](const Frame& f) { return f.volume_depth; });
+  v.width = lift([](const Frame& f) { return f.width; });
+  v.height = lift([](const Frame& f) { return f.height; });
+  for (int k = 0; k < 3; ++k) v.camera_position[k] = lift([k](const Frame& f) { return f.camera_position[k]; });
+  for (int col = 0; col < 3; ++col) {
+    for (int row = 0; row < 3; ++row) {
+      v.rotation[col][row] = lift([col, row](const Frame& f) { return f.rotation[col][row]; });
+    }
   }
+  return v;
+}
+
+template <class Real>
+FrameValues<Real> ValuesOf(const Frame& frame) {
+  return LiftFrameValues<Real>([&](auto get) { return Real(get(frame)); });
+}
+
+// Lane k holds *frames[k]; every conversion to double is exact. The zero
+// added is the one DoubleDouble's constructor adds as it broadcasts: it
+// turns a -0 (a camera coordinate at the origin) into +0, and each lane
+// must hold what DoubleDouble(value) holds.
+FrameValues<DD4> ValuesOf(const std::array<const Frame*, 4>& frames) {
+  return LiftFrameValues<DD4>([&](auto get) {
+    Double4 lanes;
+    for (int k = 0; k < 4; ++k) lanes[k] = get(*frames[k]);
+    return DD4::FromParts(lanes + 0.0, Double4{});
+  });
+}
+
+template <class Real>
+glm::vec<3, Real> Rotate(const glm::mat<3, 3, Real>& r, const glm::vec<3, Real>& v) {
+  glm::vec<3, Real> out;
+  for (int row = 0; row < 3; ++row) out[row] = r[0][row] * v.x + r[1][row] * v.y + r[2][row] * v.z;
   return out;
 }
 
@@ -34,36 +89,32 @@ void ScreenAttribute(At at, glm::vec<4, Real>& origin, glm::vec<4, Real>& du, gl
   dv = Vec4<Real>(bottom_left - top_left);
 }
 
-// FrameParams (hp:: or f32::) from the frame's parameters, in that
+// FrameParams (hp::, hp4:: or f32::) from the frame's parameters, in that
 // instantiation's arithmetic.
 template <class Params>
-Params FrameParamsIn(const Frame& frame) {
-  using Real = typename decltype(Params::lens)::value_type;
+Params FrameParamsIn(const FrameValues<RealOf<Params>>& frame) {
+  using Real = RealOf<Params>;
   using Vec3 = glm::vec<3, Real>;
   using Vec4 = glm::vec<4, Real>;
-  const Real tan_y(frame.tan_half_fov_y);
-  const Real tan_x = Real(frame.aspect) * tan_y;
-  const Real far = frame.finite() ? Real(frame.far) : Real(0.0);
-  const glm::dmat3& r = frame.rotation;
-  const glm::dvec3& c = frame.camera_position;
+  const Real tan_y = frame.tan_half_fov_y;
+  const Real tan_x = frame.aspect * tan_y;
+  const Real far = frame.far;
+  const glm::mat<3, 3, Real>& r = frame.rotation;
+  const Vec3& c = frame.camera_position;
 
   Params p;
-  for (int col = 0; col < 3; ++col) {
-    p.camera_world[col] = Vec4(Real(r[col][0]), Real(r[col][1]), Real(r[col][2]), Real(0.0));
-  }
-  p.camera_world[3] = Vec4(Real(c.x), Real(c.y), Real(c.z), Real(1.0));
-  p.camera_position = Vec4(Real(c.x), Real(c.y), Real(c.z), far);
+  for (int col = 0; col < 3; ++col) p.camera_world[col] = Vec4(r[col][0], r[col][1], r[col][2], Real(0.0));
+  p.camera_world[3] = Vec4(c.x, c.y, c.z, Real(1.0));
+  p.camera_position = Vec4(c.x, c.y, c.z, far);
   // The view matrix: the transposed rotation, and -dot(axis, eye) per row.
   for (int axis = 0; axis < 3; ++axis) {
-    for (int k = 0; k < 3; ++k) p.world_view[k][axis] = Real(r[axis][k]);
-    p.world_view[3][axis] =
-        -(Real(r[axis][0]) * Real(c.x) + Real(r[axis][1]) * Real(c.y) + Real(r[axis][2]) * Real(c.z));
+    for (int k = 0; k < 3; ++k) p.world_view[k][axis] = r[axis][k];
+    p.world_view[3][axis] = -(r[axis][0] * c.x + r[axis][1] * c.y + r[axis][2] * c.z);
     p.world_view[axis][3] = Real(0.0);
   }
   p.world_view[3][3] = Real(1.0);
   p.lens = Vec4(tan_x, tan_y, Real(1.0) / tan_x, Real(1.0) / tan_y);
-  p.resolution =
-      Vec4(Real(frame.width), Real(frame.height), Real(1.0) / Real(frame.width), Real(1.0) / Real(frame.height));
+  p.resolution = Vec4(frame.width, frame.height, Real(1.0) / frame.width, Real(1.0) / frame.height);
 
   // View-space point of the pixel ray at eye depth `depth`.
   auto view_at = [&](Real depth) {
@@ -73,7 +124,7 @@ Params FrameParamsIn(const Frame& frame) {
   ScreenAttribute<Real>([&](Real x, Real y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin,
                         p.frustum_ray_du, p.frustum_ray_dv);
   // Pettineo 2009, light volume: the surface's view-space position.
-  ScreenAttribute<Real>(view_at(Real(frame.volume_depth)), p.volume_position_origin, p.volume_position_du,
+  ScreenAttribute<Real>(view_at(frame.volume_depth), p.volume_position_origin, p.volume_position_du,
                         p.volume_position_dv);
   // The eye-ray post 2011: the eye ray at w = 1 in view space and rotated to world space.
   ScreenAttribute<Real>(view_at(Real(1.0)), p.eye_ray_view_origin, p.eye_ray_view_du, p.eye_ray_view_dv);
@@ -82,30 +133,27 @@ Params FrameParamsIn(const Frame& frame) {
   return p;
 }
 
-float Round(DD x) { return RoundToFloat(x); }
-glm::vec4 Round(const hp::vec4& v) { return {Round(v.x), Round(v.y), Round(v.z), Round(v.w)}; }
-glm::mat4 Round(const hp::mat4& m) { return glm::mat4(Round(m[0]), Round(m[1]), Round(m[2]), Round(m[3])); }
-
-bool HasConstants(const Frame& frame, Convention convention) {
-  // Conventions with a finite far plane have no constants on frames that
-  // have none (infinite-only domains).
-  return frame.finite() || (Info(convention).bits & f32::DB_CONVENTION_INFINITE) != 0u;
+hp::vec2 NdcDepthCoefficients(DD near, DD far, std::uint32_t convention) {
+  return hp::ndc_depth_coefficients(near, far, convention);
+}
+hp4::vec2 NdcDepthCoefficients(DD4 near, DD4 far, std::uint32_t convention) {
+  return hp4::ndc_depth_coefficients(near, far, convention);
 }
 
-}  // namespace
+// DepthParams (hp:: or hp4::) of `convention` from the frame's near and far
+// planes (far 0 when infinite) and its FrameParams, in that instantiation's
+// arithmetic.
+template <class DepthParams, class FrameParams>
+DepthParams DepthParamsIn(RealOf<FrameParams> near, RealOf<FrameParams> far, const FrameParams& f,
+                          std::uint32_t convention) {
+  using Real = RealOf<FrameParams>;
+  using Vec4 = glm::vec<4, Real>;
+  const glm::vec<2, Real> ab = NdcDepthCoefficients(near, far, convention);
+  const Real a = ab.x, b = ab.y;
 
-hp::FrameParams BuildFrameParams(const Frame& frame) { return FrameParamsIn<hp::FrameParams>(frame); }
-
-hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
-  const ConventionInfo& info = Info(convention);
-  const DD near(frame.near);
-  const DD far = frame.finite() ? DD(frame.far) : DD(0.0);
-  hp::vec2 ab = hp::ndc_depth_coefficients(near, far, info.bits);
-  const DD a = ab.x, b = ab.y;
-
-  hp::DepthParams d;
-  d.coefficients = hp::vec4(a, b, DD(1.0) / b, -a / b);
-  d.convention = info.bits;
+  DepthParams d;
+  d.coefficients = Vec4(a, b, Real(1.0) / b, -a / b);
+  d.convention = convention;
   d.reserved0 = d.reserved1 = d.reserved2 = 0;
 
   // Inverse projection for view = (x/H, y/V, -1) * z and ndc_z = A + B/z:
@@ -116,48 +164,133 @@ hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, C
   // left matrix's entry first): adding a zero product is exact, so every
   // entry equals the full product's, at a fifth of the cost (this runs for
   // every frame and convention). tests/constants_test.cc holds them equal.
-  const hp::mat4& cw = f.camera_world;
+  const glm::mat<4, 4, Real>& cw = f.camera_world;
   d.inverse_view_projection[0] = cw[0] * f.lens.x;  // 1/H = tan_x
   d.inverse_view_projection[1] = cw[1] * f.lens.y;  // 1/V = tan_y
   d.inverse_view_projection[2] = cw[3] * d.coefficients.z;
-  d.inverse_view_projection[3] = cw[2] * DD(-1.0) + cw[3] * d.coefficients.w;
+  d.inverse_view_projection[3] = cw[2] * Real(-1.0) + cw[3] * d.coefficients.w;
   // The projection (EngineProjectionMatrix's layout: columns (H, 0, 0, 0),
   // (0, V, 0, 0), (0, 0, -A, -1), (0, 0, B, 0)) times the view.
-  const DD minus_a = -a, minus_one(-1.0);
+  const Real minus_a = -a, minus_one(-1.0);
   for (int c = 0; c < 4; ++c) {
-    const hp::vec4& v = f.world_view[c];
-    d.view_projection[c] = hp::vec4(f.lens.z * v.x, f.lens.w * v.y, minus_a * v.z + b * v.w, minus_one * v.z);
+    const Vec4& v = f.world_view[c];
+    d.view_projection[c] = Vec4(f.lens.z * v.x, f.lens.w * v.y, minus_a * v.z + b * v.w, minus_one * v.z);
   }
   return d;
 }
 
+// The members of FrameParams (of any instantiation) that hold reals:
+// visit(member) for each, where member(params) is that member of `params`.
+// One list for the rounding of one frame and of four.
+template <class Visit>
+void ForEachFrameParamsMember(Visit visit) {
+  visit([](auto& p) -> auto& { return p.camera_world; });
+  visit([](auto& p) -> auto& { return p.camera_position; });
+  visit([](auto& p) -> auto& { return p.lens; });
+  visit([](auto& p) -> auto& { return p.resolution; });
+  visit([](auto& p) -> auto& { return p.frustum_ray_origin; });
+  visit([](auto& p) -> auto& { return p.frustum_ray_du; });
+  visit([](auto& p) -> auto& { return p.frustum_ray_dv; });
+  visit([](auto& p) -> auto& { return p.volume_position_origin; });
+  visit([](auto& p) -> auto& { return p.volume_position_du; });
+  visit([](auto& p) -> auto& { return p.volume_position_dv; });
+  visit([](auto& p) -> auto& { return p.eye_ray_view_origin; });
+  visit([](auto& p) -> auto& { return p.eye_ray_view_du; });
+  visit([](auto& p) -> auto& { return p.eye_ray_view_dv; });
+  visit([](auto& p) -> auto& { return p.eye_ray_world_origin; });
+  visit([](auto& p) -> auto& { return p.eye_ray_world_du; });
+  visit([](auto& p) -> auto& { return p.eye_ray_world_dv; });
+  visit([](auto& p) -> auto& { return p.world_view; });
+}
+// The same for DepthParams; its uints are copied.
+template <class Visit>
+void ForEachDepthParamsMember(Visit visit) {
+  visit([](auto& p) -> auto& { return p.inverse_view_projection; });
+  visit([](auto& p) -> auto& { return p.view_projection; });
+  visit([](auto& p) -> auto& { return p.coefficients; });
+}
+
+float Round(DD x) { return RoundToFloat(x); }
+glm::vec4 Round(const hp::vec4& v) { return {Round(v.x), Round(v.y), Round(v.z), Round(v.w)}; }
+glm::mat4 Round(const hp::mat4& m) { return glm::mat4(Round(m[0]), Round(m[1]), Round(m[2]), Round(m[3])); }
+
+// Four lanes rounded at once: out(k) receives lane k's float32 values.
+template <class Out>
+void RoundLanes(const hp4::vec4& v, Out out) {
+  for (int i = 0; i < 4; ++i) {
+    const Lanes<4>::Float f = RoundToFloat(v[i]);
+    for (int k = 0; k < 4; ++k) out(k)[i] = f[k];
+  }
+}
+template <class Out>
+void RoundLanes(const hp4::mat4& m, Out out) {
+  for (int c = 0; c < 4; ++c) RoundLanes(m[c], [&](int k) -> glm::vec4& { return out(k)[c]; });
+}
+template <class Out>
+void RoundLanes(const hp4::FrameParams& p, Out out) {
+  ForEachFrameParamsMember([&](auto member) {
+    auto lane_member = [&](int k) -> auto& { return member(out(k)); };
+    RoundLanes(member(p), lane_member);
+  });
+}
+template <class Out>
+void RoundLanes(const hp4::DepthParams& p, Out out) {
+  ForEachDepthParamsMember([&](auto member) {
+    auto lane_member = [&](int k) -> auto& { return member(out(k)); };
+    RoundLanes(member(p), lane_member);
+  });
+  for (int k = 0; k < 4; ++k) {
+    out(k).convention = p.convention;
+    out(k).reserved0 = out(k).reserved1 = out(k).reserved2 = 0;
+  }
+}
+
+bool HasConstants(const Frame& frame, Convention convention) {
+  // Conventions with a finite far plane have no constants on frames that
+  // have none (infinite-only domains).
+  return frame.finite() || (Info(convention).bits & f32::DB_CONVENTION_INFINITE) != 0u;
+}
+
+// BuildShaderConstants under kExact for four frames at once, frames[k] in
+// lane k: frame_params[k] and depth_params[k * kHardwareConventionCount +
+// c] receive lane k's constants.
+void BuildExactConstants4(const std::array<const Frame*, 4>& frames, f32::FrameParams* frame_params,
+                          f32::DepthParams* depth_params) {
+  const FrameValues<DD4> values = ValuesOf(frames);
+  const hp4::FrameParams exact = FrameParamsIn<hp4::FrameParams>(values);
+  RoundLanes(exact, [&](int k) -> f32::FrameParams& { return frame_params[k]; });
+  for (int c = 0; c < kHardwareConventionCount; ++c) {
+    const auto convention = static_cast<Convention>(c);
+    auto out = [&](int k) -> f32::DepthParams& { return depth_params[k * kHardwareConventionCount + c]; };
+    // Lanes of frames without this convention's constants compute with far
+    // 0, which no other lane sees, and are then zeroed as one frame's are.
+    bool any = false;
+    for (int k = 0; k < 4; ++k) any = any || HasConstants(*frames[k], convention);
+    if (any) RoundLanes(DepthParamsIn<hp4::DepthParams>(values.near, values.far, exact, Info(convention).bits), out);
+    for (int k = 0; k < 4; ++k) {
+      if (!HasConstants(*frames[k], convention)) out(k) = f32::DepthParams{};
+    }
+  }
+}
+
+}  // namespace
+
+hp::FrameParams BuildFrameParams(const Frame& frame) { return FrameParamsIn<hp::FrameParams>(ValuesOf<DD>(frame)); }
+
+hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
+  return DepthParamsIn<hp::DepthParams>(DD(frame.near), frame.finite() ? DD(frame.far) : DD(0.0), f,
+                                        Info(convention).bits);
+}
+
 f32::FrameParams RoundToFloat(const hp::FrameParams& p) {
   f32::FrameParams o;
-  o.camera_world = Round(p.camera_world);
-  o.camera_position = Round(p.camera_position);
-  o.lens = Round(p.lens);
-  o.resolution = Round(p.resolution);
-  o.frustum_ray_origin = Round(p.frustum_ray_origin);
-  o.frustum_ray_du = Round(p.frustum_ray_du);
-  o.frustum_ray_dv = Round(p.frustum_ray_dv);
-  o.volume_position_origin = Round(p.volume_position_origin);
-  o.volume_position_du = Round(p.volume_position_du);
-  o.volume_position_dv = Round(p.volume_position_dv);
-  o.eye_ray_view_origin = Round(p.eye_ray_view_origin);
-  o.eye_ray_view_du = Round(p.eye_ray_view_du);
-  o.eye_ray_view_dv = Round(p.eye_ray_view_dv);
-  o.eye_ray_world_origin = Round(p.eye_ray_world_origin);
-  o.eye_ray_world_du = Round(p.eye_ray_world_du);
-  o.eye_ray_world_dv = Round(p.eye_ray_world_dv);
-  o.world_view = Round(p.world_view);
+  ForEachFrameParamsMember([&](auto member) { member(o) = Round(member(p)); });
   return o;
 }
 
 f32::DepthParams RoundToFloat(const hp::DepthParams& p) {
   f32::DepthParams o;
-  o.inverse_view_projection = Round(p.inverse_view_projection);
-  o.view_projection = Round(p.view_projection);
-  o.coefficients = Round(p.coefficients);
+  ForEachDepthParamsMember([&](auto member) { member(o) = Round(member(p)); });
   o.convention = p.convention;
   o.reserved0 = o.reserved1 = o.reserved2 = 0;
   return o;
@@ -193,7 +326,7 @@ glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention) {
 }
 
 f32::FrameParams EngineFrameParams(const Frame& frame) {
-  f32::FrameParams p = FrameParamsIn<f32::FrameParams>(frame);
+  f32::FrameParams p = FrameParamsIn<f32::FrameParams>(ValuesOf<float>(frame));
   p.world_view = EngineViewMatrix(frame);
   return p;
 }
@@ -220,6 +353,36 @@ void BuildShaderConstants(const Frame& frame, ConstantsModel model, f32::FramePa
     depth_params[c] = !HasConstants(frame, convention) ? f32::DepthParams{}
                       : exact                          ? RoundToFloat(BuildDepthParams(frame, exact_params, convention))
                                                        : EngineDepthParams(frame, convention);
+  }
+}
+
+void BuildShaderConstants(std::span<const Frame> frames, ConstantsModel model, std::span<f32::FrameParams> frame_params,
+                          std::span<f32::DepthParams> depth_params) {
+  constexpr std::size_t kLanes = kShaderConstantsLanes;
+  for (std::size_t first = 0; first < frames.size(); first += kLanes) {
+    const std::size_t lanes = std::min(kLanes, frames.size() - first);
+    f32::FrameParams* frame_out = frame_params.data() + first;
+    f32::DepthParams* depth_out = depth_params.data() + first * kHardwareConventionCount;
+    if (model != ConstantsModel::kExact) {
+      for (std::size_t k = 0; k < lanes; ++k) {
+        BuildShaderConstants(frames[first + k], model, frame_out[k],
+                             std::span<f32::DepthParams, kHardwareConventionCount>(
+                                 depth_out + k * kHardwareConventionCount, kHardwareConventionCount));
+      }
+    } else if (lanes == kLanes) {
+      BuildExactConstants4({&frames[first], &frames[first + 1], &frames[first + 2], &frames[first + 3]}, frame_out,
+                           depth_out);
+    } else {
+      // A short last group: its last frame again in the spare lanes, whose
+      // results are dropped.
+      std::array<const Frame*, kLanes> group;
+      for (std::size_t k = 0; k < kLanes; ++k) group[k] = &frames[first + std::min(k, lanes - 1)];
+      std::array<f32::FrameParams, kLanes> frame_lanes;
+      std::array<f32::DepthParams, kLanes * kHardwareConventionCount> depth_lanes;
+      BuildExactConstants4(group, frame_lanes.data(), depth_lanes.data());
+      std::copy_n(frame_lanes.begin(), lanes, frame_out);
+      std::copy_n(depth_lanes.begin(), lanes * kHardwareConventionCount, depth_out);
+    }
   }
 }
 

@@ -13,6 +13,7 @@
 // either way.
 #pragma once
 
+#include <cstddef>
 #include <span>
 
 #include "bench/numerics/formulas.h"
@@ -44,5 +45,16 @@ f32::DepthParams EngineDepthParams(const Frame& frame, Convention convention);
 // cells do not run on it).
 void BuildShaderConstants(const Frame& frame, ConstantsModel model, f32::FrameParams& frame_params,
                           std::span<f32::DepthParams, kHardwareConventionCount> depth_params);
+
+// BuildShaderConstants for each of `frames`, with bit for bit the same
+// results: frame i's in frame_params[i] and in depth_params from
+// i * kHardwareConventionCount on (the spans are as long as that asks).
+// Exact constants are computed for kShaderConstantsLanes frames at once, in
+// the lanes of DoubleDouble4 (a few times as fast as one by one: this is
+// most of a batch's frame work); a caller that splits its frames among
+// threads keeps the groups whole by splitting at multiples of it.
+inline constexpr std::size_t kShaderConstantsLanes = 4;
+void BuildShaderConstants(std::span<const Frame> frames, ConstantsModel model, std::span<f32::FrameParams> frame_params,
+                          std::span<f32::DepthParams> depth_params);
 
 }  // namespace depthbench
