@@ -9,8 +9,8 @@
 # lavapipe with either judge (--judge host: outputs read back and binned on
 # the host's cores; --judge device: binned where they are). With DEVICE (a
 # part of a Vulkan device's name, as --device takes it, "nvidia"): that
-# device with either judge at 10^7 and 10^8 samples, each in its default
-# batches. DEPTHBENCH names another program to run (a packed copy's
+# device with either judge at 10^7 and 10^8 samples, and with its own
+# judge at 10^9, each in its default batches. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
@@ -54,6 +54,10 @@ else
       arguments+=("--backend vulkan --device $device --judge $judge --samples $samples")
     done
   done
+  # And the device judge over a sweep long enough that a run's fixed
+  # costs (its set-up, its first and last batches) fade.
+  labels+=("$device, device judge, 1e9 samples")
+  arguments+=("--backend vulkan --device $device --judge device --samples 1e9")
 fi
 declare -a rates peaks  # per configuration: space-separated figures of its runs
 
@@ -72,7 +76,8 @@ for ((r = 1; r <= runs; ++r)); do
       { echo "no 'verified in' line in the output of run ${arguments[i]}:" >&2; cat "$log" >&2; exit 1; }
     rates[i]+="$rate "
     # Where the time went (the build, the judging, the waits), run by run.
-    grep '^time:' "$log" >&2 || true
+    # (and, where a device judged, its seconds per pass, over two lines).
+    awk '/^time:/ {print} /^device passes:/ {print; more = 1; next} more && /^  / {print} {more = 0}' "$log" >&2
     peaks[i]+="$(awk '/Maximum resident set size/ {printf "%.0f ", $6 / 1024}' "$log")"
   done
 done
