@@ -177,7 +177,7 @@ namespace {
 // submission (once everything queued before has finished), after the
 // sample pass, at its end, at the start of the judge's submission, after
 // the reference, after each judge phase. The passes' times are the
-// intervals between them, named by PassNames: the reconstruction's is the
+// intervals between them, named by kPassNames: the reconstruction's is the
 // backend's pass, queued between the two submissions, with any time the
 // device waits for the judge's submission; "idle" is the time from the
 // batch before's end to this one's start.
