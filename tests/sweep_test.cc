@@ -329,6 +329,16 @@ TEST(SweepTest, StageTimesShareOutTheWallClock) {
   ASSERT_TRUE(merged.ok()) << merged.status().message();
   EXPECT_EQ(merged->run.stages.build, a.run.stages.build + b.run.stages.build);
   EXPECT_EQ(merged->run.stages.judging, a.run.stages.judging + b.run.stages.judging);
+  EXPECT_TRUE(merged->run.stages.device_passes.empty());  // no device judged
+  // Devices' passes add up by name, in the order they first came; a pass
+  // one shard lacks keeps the other's time.
+  Results c = a, d = b;
+  c.run.stages.device_passes = {{"idle", 0.5}, {"judge", 2.0}};
+  d.run.stages.device_passes = {{"idle", 0.25}, {"sample", 1.0}, {"judge", 4.0}};
+  merged = MergeResults({c, d});
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  EXPECT_EQ(merged->run.stages.device_passes,
+            (std::vector<std::pair<std::string, double>>{{"idle", 0.75}, {"judge", 6.0}, {"sample", 1.0}}));
 }
 
 TEST(SweepTest, BadResultsFilesNameTheFieldThatIsWrong) {
