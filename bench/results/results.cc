@@ -19,15 +19,6 @@ std::uint64_t Shard::Begin(std::uint64_t total) const {
 std::uint64_t Shard::End(std::uint64_t total) const {
   return static_cast<std::uint64_t>(static_cast<unsigned __int128>(total) * index / count);
 }
-void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
-  auto it = std::find_if(device_passes.begin(), device_passes.end(), [&](const auto& p) { return p.first == name; });
-  if (it == device_passes.end()) {
-    device_passes.emplace_back(name, seconds);
-  } else {
-    it->second += seconds;
-  }
-}
-
 std::string Shard::ToString() const { return fmt::format("{}/{}", index, count); }
 
 Expected<Shard> ParseShard(std::string_view text) {
@@ -72,6 +63,15 @@ const CellResult* Results::Find(const Cell& cell, const std::string& backend) co
   for (const CellResult& c : cells)
     if (c.cell == cell && c.backend == backend) return &c;
   return nullptr;
+}
+
+void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
+  auto it = std::find_if(device_passes.begin(), device_passes.end(), [&](const auto& p) { return p.first == name; });
+  if (it == device_passes.end()) {
+    device_passes.emplace_back(name, seconds);
+  } else {
+    it->second += seconds;
+  }
 }
 
 // ---------------------------------------------------------------- writing
