@@ -30,13 +30,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const std::string& w : words) argv.push_back(w.c_str());
   argv.push_back(nullptr);  // as the C runtime passes it
 
-  depthbench::cli::CommandAction action;
-  const std::unique_ptr<CLI::App> app = depthbench::cli::MakeDepthbenchApp(action);
+  depthbench::cli::CommandLine line;
+  const std::unique_ptr<CLI::App> app = depthbench::cli::MakeDepthbenchApp(line);
   std::ostringstream out, err;  // keeps the fuzzer's own output readable
   const depthbench::cli::ParseOutcome parsed =
       depthbench::cli::ParseCommandLine(*app, static_cast<int>(words.size()), argv.data(), out, err);
   if (parsed.run) {
-    if (!action) std::abort();
+    if (!line.action) std::abort();
   } else if (parsed.exit_code == 0) {
     if (out.str().empty()) std::abort();  // help with nothing in it
   } else {

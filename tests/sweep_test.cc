@@ -281,7 +281,7 @@ TEST(SweepTest, AnAllNanCellShowsNoBitsFigure) {
   cell.stats.joint[JointBand(0, 0)].nan = 100;
   results.cells.resize(1);
   std::ostringstream out;
-  PrintResultsTable(results, out);
+  PrintResultsTable(results, TextOutput(out));
   const std::string table = out.str();
   const auto row = table.find(cell.cell.Name());
   ASSERT_NE(row, std::string::npos) << table;

@@ -18,8 +18,6 @@ void TextTable::AddSeparator() { rows_.emplace_back(); }
 
 namespace {
 
-std::size_t g_max_width = 120;
-
 // Words of `text` in lines of at most `width` columns (a longer word has a
 // line of its own).
 std::vector<std::string> Wrap(const std::string& text, std::size_t width) {
@@ -49,7 +47,7 @@ std::size_t DisplayWidth(std::string_view text) {
 
 class WrappedOutput::Buffer : public std::streambuf {
  public:
-  explicit Buffer(std::streambuf* target) : target_(target) {}
+  Buffer(std::streambuf* target, std::size_t max_width) : target_(target), max_width_(max_width) {}
   ~Buffer() override { Flush(); }
   void Flush() {
     if (!line_.empty()) Emit();
@@ -77,7 +75,7 @@ class WrappedOutput::Buffer : public std::streambuf {
     const bool newline = !line_.empty() && line_.back() == '\n';
     if (newline) line_.pop_back();
     std::string text;
-    const std::size_t limit = g_max_width;
+    const std::size_t limit = max_width_;
     // A line that holds a command to copy ("depthbench run --seed ...")
     // stays whole: a command broken across lines does not paste.
     const std::size_t command = line_.find("depthbench ");
@@ -101,11 +99,12 @@ class WrappedOutput::Buffer : public std::streambuf {
   }
 
   std::streambuf* target_;
+  std::size_t max_width_;
   std::string line_;
 };
 
-WrappedOutput::WrappedOutput(std::ostream& out)
-    : out_(out), original_(out.rdbuf()), buffer_(std::make_unique<Buffer>(original_)) {
+WrappedOutput::WrappedOutput(std::ostream& out, std::size_t max_width)
+    : out_(out), original_(out.rdbuf()), buffer_(std::make_unique<Buffer>(original_, max_width)) {
   out_.rdbuf(buffer_.get());
 }
 
@@ -115,12 +114,7 @@ WrappedOutput::~WrappedOutput() {
   out_.rdbuf(original_);
 }
 
-std::size_t TextTable::MaxWidth() { return g_max_width; }
-void TextTable::SetMaxWidth(std::size_t columns) { g_max_width = columns; }
-
 namespace {
-TextTable::Format g_format = TextTable::Format::kText;
-std::ostream* g_sink = nullptr;
 
 // A CSV field: quoted when it holds a comma, a quote or a line break.
 std::string CsvField(const std::string& text) {
@@ -138,12 +132,15 @@ std::string MarkdownCell(const std::string& text) {
 }
 }  // namespace
 
-void TextTable::SetFormat(Format format, std::ostream* sink) {
-  g_format = format;
-  g_sink = sink;
+void TextTable::Print(const TextOutput& out) const {
+  if (out.style.format == TableFormat::kText) {
+    PrintText(out.style.max_width, out.tables);
+  } else {
+    PrintForMachines(out.style.format, out.tables);
+  }
 }
 
-void TextTable::PrintForMachines(Format format, std::ostream& out) const {
+void TextTable::PrintForMachines(TableFormat format, std::ostream& out) const {
   std::vector<std::string> headers;
   for (const Column& c : columns_) headers.push_back(c.header);
   auto joined = [](const std::vector<std::string>& cells, auto field, const char* between) {
@@ -151,7 +148,7 @@ void TextTable::PrintForMachines(Format format, std::ostream& out) const {
     for (std::size_t c = 0; c < cells.size(); ++c) line += (c ? between : "") + field(cells[c]);
     return line;
   };
-  if (format == Format::kJson) {
+  if (format == TableFormat::kJson) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     for (const auto& row : rows_) {
       if (row.empty()) continue;
@@ -162,7 +159,7 @@ void TextTable::PrintForMachines(Format format, std::ostream& out) const {
     out << rows.dump() << "\n";
     return;
   }
-  if (format == Format::kCsv) {
+  if (format == TableFormat::kCsv) {
     out << joined(headers, CsvField, ",") << "\n";
     for (const auto& row : rows_)
       if (!row.empty()) out << joined(row, CsvField, ",") << "\n";
@@ -176,11 +173,7 @@ void TextTable::PrintForMachines(Format format, std::ostream& out) const {
   out << "\n";  // a blank line between tables
 }
 
-void TextTable::Print(std::ostream& out) const {
-  if (g_format != Format::kText) {
-    PrintForMachines(g_format, g_sink != nullptr ? *g_sink : out);
-    return;
-  }
+void TextTable::PrintText(std::size_t max_width, std::ostream& out) const {
   const std::size_t n = columns_.size();
   std::vector<std::size_t> width(n);
   for (std::size_t c = 0; c < n; ++c) {
@@ -199,7 +192,7 @@ void TextTable::Print(std::ostream& out) const {
     return sum + 2 * (count > 0 ? count - 1 : 0);
   };
   std::vector<std::string> left_out;
-  const std::size_t limit = g_max_width;
+  const std::size_t limit = max_width;
   if (limit > 0) {
     for (std::size_t c = n; c-- > 0 && total() > limit;) {
       if (!columns_[c].secondary) continue;

@@ -2,6 +2,7 @@
 // every subcommand. Numbers right-aligned, text left-aligned.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <ostream>
 #include <streambuf>
@@ -10,6 +11,36 @@
 #include <vector>
 
 namespace depthbench {
+
+// How tables are printed (--table-format): aligned text for people, or
+// every column, whole, as CSV (RFC 4180), a Markdown table or one line of
+// JSON (an array of objects keyed by header) per table.
+enum class TableFormat { kText, kCsv, kMarkdown, kJson };
+
+// The columns of a terminal that text fits by default.
+inline constexpr std::size_t kTerminalColumns = 120;
+
+// How a command prints its tables, and how wide its lines for people are.
+struct TableStyle {
+  TableFormat format = TableFormat::kText;
+  // The width text tables and wrapped lines fit; 0 for no limit (--wide).
+  std::size_t max_width = kTerminalColumns;
+};
+
+// Where a printer writes: lines for people to `text`, tables to `tables`,
+// in `style`. With the text format both are usually one stream; a machine
+// format sends the tables alone to standard output and the lines to
+// standard error. The streams belong to the caller and outlive the value.
+struct TextOutput {
+  // Lines and tables alike to `out`.
+  explicit TextOutput(std::ostream& out, TableStyle table_style = {}) : text(out), tables(out), style(table_style) {}
+  TextOutput(std::ostream& text_out, std::ostream& tables_out, TableStyle table_style)
+      : text(text_out), tables(tables_out), style(table_style) {}
+
+  std::ostream& text;
+  std::ostream& tables;
+  TableStyle style;
+};
 
 class TextTable {
  public:
@@ -27,41 +58,30 @@ class TextTable {
   explicit TextTable(std::vector<Column> columns) : columns_(std::move(columns)) {}
   void AddRow(std::vector<std::string> cells);
   void AddSeparator();
-  // Prints the table within `MaxWidth()` columns: secondary columns left
-  // out, then the wrapping column wrapped, as far as that takes; a line
-  // after the table names the columns left out.
-  void Print(std::ostream& out) const;
+  // Prints the table to `out.tables` in `out.style`. The text format fits
+  // the style's width: secondary columns left out, then the wrapping
+  // column wrapped, as far as that takes; a line after the table names the
+  // columns left out.
+  void Print(const TextOutput& out) const;
   bool empty() const { return rows_.empty(); }
 
-  // The width every table fits: 120 by default (a terminal of 120
-  // columns), 0 for no limit (the --wide flag).
-  static std::size_t MaxWidth();
-  static void SetMaxWidth(std::size_t columns);
-
-  // How every table is printed (--table-format): aligned text for people,
-  // or every column, whole, as CSV (RFC 4180), a Markdown table or one
-  // line of JSON (an array of objects keyed by header) per table. The
-  // machine formats go to `sink` (standard output), whatever stream Print
-  // is given, so that the lines for people can go elsewhere.
-  enum class Format { kText, kCsv, kMarkdown, kJson };
-  static void SetFormat(Format format, std::ostream* sink);
-
  private:
-  void PrintForMachines(Format format, std::ostream& out) const;
+  void PrintText(std::size_t max_width, std::ostream& out) const;
+  void PrintForMachines(TableFormat format, std::ostream& out) const;
 
   std::vector<Column> columns_;
   std::vector<std::vector<std::string>> rows_;  // an empty row is a separator
 };
 
-// While it lives, lines written to `out` that are wider than
-// TextTable::MaxWidth() are wrapped at spaces, continuation lines indented
+// While it lives, lines written to `out` that are wider than `max_width`
+// (0: no limit) are wrapped at spaces, continuation lines indented
 // two columns past the line's own indent (a word wider than the line stays
 // whole, and so does a line that holds a depthbench command with flags, so
 // that it can be copied). What the program prints for people goes through
 // one of these; tables already fit and pass unchanged.
 class WrappedOutput {
  public:
-  explicit WrappedOutput(std::ostream& out);
+  WrappedOutput(std::ostream& out, std::size_t max_width);
   ~WrappedOutput();
   WrappedOutput(const WrappedOutput&) = delete;
   WrappedOutput& operator=(const WrappedOutput&) = delete;

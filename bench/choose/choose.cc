@@ -446,23 +446,23 @@ std::string Limit(const CandidateVerdict& v) {
 
 }  // namespace
 
-void PrintChoice(const ChooseResult& r, std::ostream& out) {
+void PrintChoice(const ChooseResult& r, const TextOutput& out) {
   using Align = TextTable::Align;
-  out << fmt::format("scene '{}': {}\nbackend {} on {}; {:.1f} s\n", r.scene, r.requirement, r.backend, r.device,
-                     r.seconds);
-  out << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
-  if (!r.cost_note.empty()) out << "note: " << r.cost_note << "\n";
-  out << "\n";
+  out.text << fmt::format("scene '{}': {}\nbackend {} on {}; {:.1f} s\n", r.scene, r.requirement, r.backend, r.device,
+                          r.seconds);
+  out.text << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
+  if (!r.cost_note.empty()) out.text << "note: " << r.cost_note << "\n";
+  out.text << "\n";
   if (r.Met()) {
-    out << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+    out.text << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
     std::vector<std::string> tied;
     for (const CandidateVerdict& v : r.ranked)
       if (v.rank == 1 && &v != &r.ranked.front()) tied.push_back(v.cell.Name());
-    if (!tied.empty()) out << fmt::format("tied on cost with it: {}\n", fmt::join(tied, ", "));
-    out << "\n";
+    if (!tied.empty()) out.text << fmt::format("tied on cost with it: {}\n", fmt::join(tied, ", "));
+    out.text << "\n";
   }
-  for (const std::string& s : r.suggestions) out << s << "\n";
-  if (!r.suggestions.empty()) out << "\n";
+  for (const std::string& s : r.suggestions) out.text << s << "\n";
+  if (!r.suggestions.empty()) out.text << "\n";
   TextTable table({{"rank"},
                    {"candidate", Align::kLeft},
                    {"measured (upper)"},
@@ -481,7 +481,7 @@ void PrintChoice(const ChooseResult& r, std::ostream& out) {
          v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
   }
   table.Print(out);
-  out << fmt::format(
+  out.text << fmt::format(
       "measured: at the requirement's level and depth, with the upper end of its 95% interval where it differs "
       "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end (constant or depth: "
       "over eye depth, camera at the world origin; +camera: with what the scene's camera distance adds; "

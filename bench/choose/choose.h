@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/base/json_reader.h"
+#include "bench/base/text_table.h"
 #include "bench/choose/scene.h"
 #include "bench/fit/error_model.h"
 
@@ -106,7 +107,7 @@ struct ChooseResult {
 Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
                               const ChooseOptions& options);
 
-void PrintChoice(const ChooseResult& result, std::ostream& out);
+void PrintChoice(const ChooseResult& result, const TextOutput& out);
 nlohmann::json ChoiceToJson(const ChooseResult& result);
 
 }  // namespace depthbench

@@ -156,11 +156,10 @@ void CheckWholeNumbers(CLI::App& app) {
 // --variant-file, of every subcommand that runs variants: the files are
 // registered in the catalog once the command line is parsed, before the
 // command looks a variant up.
-std::vector<std::string> g_variant_files;
-void AddVariantFileOption(CLI::App& app) {
+void AddVariantFileOption(CLI::App& app, std::vector<std::string>& files) {
   for (const char* name : {"list", "run", "fit", "gate", "choose", "speed", "report"}) {
     app.get_subcommand(name)
-        ->add_option("--variant-file", g_variant_files,
+        ->add_option("--variant-file", files,
                      "a reconstruction function of your own, in GLSL (.glsl) or HLSL (.hlsl), run as one more "
                      "variant named after the file (repeatable). Its '// depthbench:' line declares what it reads "
                      "and its conventions (docs/variant-files.md). It runs on Vulkan only: with it, the default "
@@ -171,9 +170,6 @@ void AddVariantFileOption(CLI::App& app) {
 
 // Whether the chosen subcommand writes its JSON to standard output
 // (--json -).
-// --table-format (one program-wide setting, as --wide).
-std::string g_table_format = "text";
-
 bool WritesJsonToStandardOutput(const CLI::App& app) {
   for (const CLI::App* sub : app.get_subcommands()) {
     const CLI::Option* json = sub->get_option_no_throw("--json");
@@ -184,7 +180,15 @@ bool WritesJsonToStandardOutput(const CLI::App& app) {
 
 }  // namespace
 
-std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
+TableStyle CommandLine::table_style() const {
+  const std::map<std::string, TableFormat> formats{{"text", TableFormat::kText},
+                                                   {"csv", TableFormat::kCsv},
+                                                   {"markdown", TableFormat::kMarkdown},
+                                                   {"json", TableFormat::kJson}};
+  return {formats.at(table_format), wide ? 0 : kTerminalColumns};
+}
+
+std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandLine& line) {
   auto app = std::make_unique<CLI::App>(
       "depthbench: measures how precisely shader code reconstructs view- and world-space position "
       "from a depth buffer, for every variant, depth convention and storage format, on the GPU "
@@ -193,11 +197,11 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   app->require_subcommand(1);
   // Flags of the whole program, taken after a subcommand's name too.
   app->fallthrough();
-  app->add_flag_callback(
-      "--wide", [] { TextTable::SetMaxWidth(0); },
+  app->add_flag(
+      "--wide", line.wide,
       "print tables as wide as their contents; by default they fit 120 columns, leaving secondary columns out "
       "(a line after each table names them)");
-  app->add_option("--table-format", g_table_format,
+  app->add_option("--table-format", line.table_format,
                   "how tables are printed: text (aligned, for people; the default), or csv, markdown or json (every "
                   "column; the tables alone go to standard output, the lines around them to standard error)")
       ->check(CLI::IsMember({"text", "csv", "markdown", "json"}));
@@ -210,16 +214,16 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action) {
   app->footer(
       "Run 'depthbench SUBCOMMAND --help' for a subcommand's flags.\n"
       "Exit codes: 0 success, 1 a finding (a gate that fails, a fuzz finding), 2 could not run.");
-  AddListCommand(*app, action);
-  AddRunCommand(*app, action);
-  AddMergeCommand(*app, action);
-  AddSpeedCommand(*app, action);
-  AddGateCommand(*app, action);
-  AddFitCommand(*app, action);
-  AddChooseCommand(*app, action);
-  AddReportCommand(*app, action);
-  AddFuzzCommand(*app, action);
-  AddVariantFileOption(*app);
+  AddListCommand(*app, line.action);
+  AddRunCommand(*app, line.action);
+  AddMergeCommand(*app, line.action);
+  AddSpeedCommand(*app, line.action);
+  AddGateCommand(*app, line.action);
+  AddFitCommand(*app, line.action);
+  AddChooseCommand(*app, line.action);
+  AddReportCommand(*app, line.action);
+  AddFuzzCommand(*app, line.action);
+  AddVariantFileOption(*app, line.variant_files);
   NameOptionTypes(*app);
   DescribeStandardOutput(*app);
   CheckWholeNumbers(*app);
@@ -274,31 +278,28 @@ ParseOutcome ParseCommandLine(CLI::App& app, int argc, const char* const* argv, 
 int RunDepthbench(int argc, const char* const* argv) {
   // First of all: a signal that comes while the program starts is kept too.
   InstallInterruptHandlers();
-  // Lines for people fit 120 columns, unless --wide.
+  // Help and refusals fit 120 columns.
   std::streambuf* const standard_output = std::cout.rdbuf();
-  auto wrapped = std::make_unique<WrappedOutput>(std::cout);
-  CommandAction action;
-  g_variant_files.clear();
-  std::unique_ptr<CLI::App> app = MakeDepthbenchApp(action);
+  auto wrapped = std::make_unique<WrappedOutput>(std::cout, kTerminalColumns);
+  CommandLine line;
+  std::unique_ptr<CLI::App> app = MakeDepthbenchApp(line);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
-  if (Status registered = RegisterVariantFiles(g_variant_files); !registered.ok()) return ReportError(registered);
-  // Tables for machines: they alone on standard output.
-  std::ostream tables(standard_output);
-  if (g_table_format != "text") {
-    const std::map<std::string, TextTable::Format> formats{{"csv", TextTable::Format::kCsv},
-                                                           {"markdown", TextTable::Format::kMarkdown},
-                                                           {"json", TextTable::Format::kJson}};
-    TextTable::SetFormat(formats.at(g_table_format), &tables);
-  }
-  if (WritesJsonToStandardOutput(*app) || g_table_format != "text") {
+  if (Status registered = RegisterVariantFiles(line.variant_files); !registered.ok()) return ReportError(registered);
+  const TableStyle style = line.table_style();
+  const bool tables_for_machines = style.format != TableFormat::kText;
+  wrapped.reset();
+  if (WritesJsonToStandardOutput(*app) || tables_for_machines) {
     // Standard output carries the JSON or the tables alone (a user pipes
     // them); what is printed for people goes to standard error instead.
-    wrapped.reset();
     std::cout.rdbuf(std::cerr.rdbuf());
-    wrapped = std::make_unique<WrappedOutput>(std::cout);
   }
-  const int code = action ? ExitCode(action()) : kExitCannotRun;
+  // Lines for people fit the style's width (none with --wide).
+  wrapped = std::make_unique<WrappedOutput>(std::cout, style.max_width);
+  // Tables for machines: they alone on standard output.
+  std::ostream tables(standard_output);
+  const TextOutput output(std::cout, tables_for_machines ? tables : std::cout, style);
+  const int code = line.action ? ExitCode(line.action(CommandContext{output})) : kExitCannotRun;
   wrapped.reset();
   std::cout.rdbuf(standard_output);
   if (AbandonedThreads()) {

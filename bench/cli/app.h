@@ -6,16 +6,36 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "bench/base/text_table.h"
 #include "bench/cli/commands.h"
 
 namespace depthbench::cli {
 
-// The program's CLI11 app. When a parse chooses a subcommand, `action` is set
-// to the function that runs it; `action` must outlive the app.
-std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandAction& action);
+// What a parse of the command line decides: the subcommand to run and the
+// options of the whole program it runs with. The app writes into it while
+// it parses, and every parse has its own, so nothing one command line sets
+// is left behind for the next.
+struct CommandLine {
+  // The function that runs the chosen subcommand; empty until one is chosen.
+  CommandAction action;
+  // --variant-file, in the order given.
+  std::vector<std::string> variant_files;
+  // --table-format and --wide.
+  std::string table_format = "text";
+  bool wide = false;
+
+  // How the command prints its tables, as --table-format and --wide say.
+  TableStyle table_style() const;
+};
+
+// The program's CLI11 app, which parses into `line`; `line` must outlive
+// the app.
+std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandLine& line);
 
 // What a parse decided.
 struct ParseOutcome {

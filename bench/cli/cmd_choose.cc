@@ -1,6 +1,5 @@
 // depthbench choose: the cheapest reconstruction that meets a scene's
 // requirement.
-#include <iostream>
 
 #include <fmt/format.h>
 
@@ -25,7 +24,8 @@ struct ChooseFlags {
   std::string device, shaders;
 };
 
-Expected<int> RunChoose(const ChooseFlags& f) {
+Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(f.scene));
   ChooseOptions options;
   DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
@@ -41,7 +41,7 @@ Expected<int> RunChoose(const ChooseFlags& f) {
   Progress progress("choose", StderrIsTerminal());
   DB_ASSIGN_OR_RETURN(const ChooseResult choice, Choose(scene, *backend, costs, options));
   progress.Finish(fmt::format("{} candidates", choice.ranked.size()));
-  PrintChoice(choice, std::cout);
+  PrintChoice(choice, out);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ChoiceToJson(choice).dump(1) + "\n"));
   return choice.Met() ? kExitOk : kExitFinding;
 }
@@ -80,7 +80,8 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--backend", flags->backend, "the backend the scene's engine runs: vulkan (default) or cpu");
   cmd->add_option("--device", flags->device, "Vulkan device (part of its name); default lavapipe");
   cmd->add_option("--shaders", flags->shaders, "shader directory (default: the source tree's shaders/)");
-  cmd->callback([flags, &action] { action = [flags] { return RunChoose(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return RunChoose(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

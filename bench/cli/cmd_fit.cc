@@ -1,7 +1,6 @@
 // depthbench fit: error models per cell, and the precision lost as the
 // far/near ratio grows.
 #include <algorithm>
-#include <iostream>
 
 #include <fmt/format.h>
 
@@ -24,7 +23,8 @@ struct FitFlags {
   BackendFlags backends;
 };
 
-Expected<int> Fit(const FitFlags& f) {
+Expected<int> Fit(const FitFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   FitPlan plan;
   DB_ASSIGN_OR_RETURN(plan.samples_per_ratio, ParseCount(f.samples, "--samples"));
   plan.seed = f.seed;
@@ -54,7 +54,7 @@ Expected<int> Fit(const FitFlags& f) {
         LevelName(level), plan.samples_per_ratio, MinimumSamples(level), LevelName(level)));
   }
 
-  PrintPrecisionFits(fits, level, std::cout);
+  PrintPrecisionFits(fits, level, out);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, PrecisionFitsToJson(fits, plan).dump(1) + "\n"));
   return kExitOk;
 }
@@ -84,7 +84,7 @@ void AddFitCommand(CLI::App& app, CommandAction& action) {
   flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
-  cmd->callback([flags, &action] { action = [flags] { return Fit(*flags); }; });
+  cmd->callback([flags, &action] { action = [flags](const CommandContext& context) { return Fit(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

@@ -65,7 +65,7 @@ struct FindingGroup {
   const KnownFinding* known;
 };
 
-void PrintFindings(const std::vector<FindingGroup>& groups, std::ostream& out) {
+void PrintFindings(const std::vector<FindingGroup>& groups, const TextOutput& out) {
   using Align = TextTable::Align;
   TextTable table({{"finding", Align::kLeft},
                    {"backends", Align::kLeft},
@@ -86,7 +86,8 @@ void PrintFindings(const std::vector<FindingGroup>& groups, std::ostream& out) {
   table.Print(out);
 }
 
-Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
+Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends,
+                       const TextOutput& out) {
   DB_ASSIGN_OR_RETURN(const std::vector<KnownFinding> known, KnownFindings(f));
   CampaignOptions options;
   options.seconds = f.seconds;
@@ -117,19 +118,19 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
   DB_ASSIGN_OR_RETURN(const CampaignResult result, RunCampaign(options, backends));
   if (!f.quiet) progress.Finish(fmt::format("{} inputs", result.cases));
 
-  std::cout << fmt::format(
+  out.text << fmt::format(
       "fuzz: {} inputs ({} from the corpus, {} at the domain's extremes, {} random, {} mutated) through {} cells on "
       "{}: {} checks in {:.1f} s ({:.0f} inputs/s)\n",
       result.cases, result.from_corpus * kSamplesPerFrame, result.from_extremes * kSamplesPerFrame,
       result.from_random * kSamplesPerFrame, result.from_mutation * kSamplesPerFrame, options.cells.size(),
       backends.size() == 1 ? backends[0]->name() : "cpu and vulkan", result.checks, result.seconds,
       result.cases / std::max(result.seconds, 1e-9));
-  std::cout << fmt::format(
+  out.text << fmt::format(
       "invariants: finite output where the reference is finite; arithmetic error within "
       "{}x2^-24 x (depth + ray + world condition numbers)\n",
       kRoundings);
   if (result.findings.empty()) {
-    std::cout << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
+    out.text << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;
   }
   // Grouped by cell and kind (backends that agree merged), new ones first,
@@ -149,17 +150,17 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
   std::vector<FindingGroup> fresh, accepted;
   for (const FindingGroup& g : groups) (g.known == nullptr ? fresh : accepted).push_back(g);
   if (!fresh.empty()) {
-    std::cout << fmt::format(
+    out.text << fmt::format(
         "{} new shader findings (a NaN, an Inf or an error beyond the bound where exact arithmetic on the shader's "
         "inputs is fine; each shrunk):\n",
         fresh.size());
-    PrintFindings(fresh, std::cout);
+    PrintFindings(fresh, out);
   } else {
-    std::cout << "no new findings\n";
+    out.text << "no new findings\n";
   }
   if (!accepted.empty()) {
-    std::cout << fmt::format("\n{} known findings (the known-findings file says why each is accepted):\n",
-                             accepted.size());
+    out.text << fmt::format("\n{} known findings (the known-findings file says why each is accepted):\n",
+                            accepted.size());
     std::vector<const KnownFinding*> reasons;
     for (const FindingGroup& g : accepted) {
       if (std::find(reasons.begin(), reasons.end(), g.known) == reasons.end()) reasons.push_back(g.known);
@@ -169,14 +170,15 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
       for (const FindingGroup& g : accepted) {
         if (g.known == k) cells.push_back(g.first->cell.Name());
       }
-      std::cout << fmt::format("- {} {} in {} cells ({}): {}\n", Info(k->variant).name, FindingKindName(k->kind),
-                               cells.size(), fmt::join(cells, ", "), k->reason);
+      out.text << fmt::format("- {} {} in {} cells ({}): {}\n", Info(k->variant).name, FindingKindName(k->kind),
+                              cells.size(), fmt::join(cells, ", "), k->reason);
     }
   }
   return fresh.empty() ? kExitOk : kExitFinding;
 }
 
-Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends) {
+Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends,
+                     const TextOutput& out) {
   DB_ASSIGN_OR_RETURN(const Domain domain, f.domain.Apply(Domain{}));
   std::uint64_t random_samples = 0;
   if (!f.against_random.empty()) {
@@ -227,13 +229,14 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
     table.AddRow(row);
     if (!f.quiet) std::cerr << "  worst input of " << cell.Name() << ": " << DescribeCase(found.worst_case) << "\n";
   }
-  std::cout << fmt::format("worst-case search on {} ({}), {:.1f} s per cell, domain {}\n", backend.name(),
-                           backend.device().name, f.seconds, domain.Describe());
-  table.Print(std::cout);
+  out.text << fmt::format("worst-case search on {} ({}), {:.1f} s per cell, domain {}\n", backend.name(),
+                          backend.device().name, f.seconds, domain.Describe());
+  table.Print(out);
   return all_found ? kExitOk : kExitFinding;
 }
 
-Expected<int> Fuzz(const FuzzFlags& f) {
+Expected<int> Fuzz(const FuzzFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   if (!(f.seconds > 0)) return InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds));
   DB_ASSIGN_OR_RETURN(const std::vector<Cell> cells, f.cells.Select());
   if (!f.search && !f.out.empty()) {
@@ -245,7 +248,7 @@ Expected<int> Fuzz(const FuzzFlags& f) {
   BackendFlags backend_flags = f.backends;
   if (f.search && backend_flags.backends.size() > 1) backend_flags.backends = {"cpu"};
   DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make());
-  return f.search ? Search(f, cells, made.view()) : Campaign(f, cells, made.view());
+  return f.search ? Search(f, cells, made.view(), out) : Campaign(f, cells, made.view(), out);
 }
 
 }  // namespace
@@ -290,7 +293,8 @@ void AddFuzzCommand(CLI::App& app, CommandAction& action) {
   flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
-  cmd->callback([flags, &action] { action = [flags] { return Fuzz(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return Fuzz(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

@@ -1,7 +1,6 @@
 // depthbench gate: a fixed-seed sweep of every cell against committed
 // baselines; exit 1 when something got worse, for CI.
 #include <filesystem>
-#include <iostream>
 
 #include <fmt/format.h>
 
@@ -30,7 +29,8 @@ struct BaselineSlot {
   Baseline baseline;
 };
 
-Expected<int> Gate(const GateFlags& f) {
+Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   for (const auto& [path, what] : {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}}) {
     if (path.empty()) continue;
     DB_RETURN_IF_ERROR(CheckWritable(path, what));
@@ -118,8 +118,8 @@ Expected<int> Gate(const GateFlags& f) {
         run.baseline = s.baseline;
       } else if (f.update) {
         // A baseline of another plan or device is what --update replaces.
-        std::cout << fmt::format("note: '{}' is not comparable ({}); --update replaces it\n", s.path,
-                                 comparison.status().message());
+        out.text << fmt::format("note: '{}' is not comparable ({}); --update replaces it\n", s.path,
+                                comparison.status().message());
         run.comparison.backend = s.baseline.backend;
       } else {
         return comparison.status().WithContext(fmt::format("cannot judge against '{}'", s.path));
@@ -148,14 +148,14 @@ Expected<int> Gate(const GateFlags& f) {
     }
   }
 
-  PrintGateVerdict(runs, tolerance, std::cout);
+  PrintGateVerdict(runs, tolerance, out.text);
   if (!f.junit.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.junit, GateJUnit(runs)));
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, GateJson(runs, tolerance).dump(1) + "\n"));
   if (f.update) {
     for (std::size_t k = 0; k < slots.size(); ++k) {
       DB_RETURN_IF_ERROR(WriteBaseline(slots[k].path, runs[k].current));
-      std::cout << fmt::format("baseline written: {} ({} cells on {})\n", slots[k].path, runs[k].current.cells.size(),
-                               runs[k].current.device.name);
+      out.text << fmt::format("baseline written: {} ({} cells on {})\n", slots[k].path, runs[k].current.cells.size(),
+                              runs[k].current.device.name);
     }
     return kExitOk;
   }
@@ -198,7 +198,8 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--json", flags->json, "write the full comparison as JSON");
   cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer");
   cmd->add_option("--threads", flags->threads, kThreadsHelp);
-  cmd->callback([flags, &action] { action = [flags] { return Gate(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return Gate(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

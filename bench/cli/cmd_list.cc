@@ -1,7 +1,5 @@
 // depthbench list: the catalog (variants with their seeds, conventions,
 // formats, cells) and the Vulkan devices this machine has.
-#include <iostream>
-
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/vulkan_context.h"
@@ -21,40 +19,41 @@ const char* InputName(DepthInput input) {
   return "?";
 }
 
-Expected<int> List() {
+Expected<int> List(const CommandContext& context) {
+  const TextOutput& out = context.output;
   using Align = TextTable::Align;
   TextTable variants(
       {{"variant", Align::kLeft}, {"source", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
   for (const auto& v : AllVariants()) {
     variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input), std::string(v.idea)});
   }
-  std::cout << "Variants (their sources: docs/sources.md)\n";
-  variants.Print(std::cout);
+  out.text << "Variants (their sources: docs/sources.md)\n";
+  variants.Print(out);
 
   TextTable conventions({{"convention", Align::kLeft}, {"meaning", Align::kLeft}});
   for (const auto& c : AllConventions()) conventions.AddRow({std::string(c.name), std::string(c.description)});
-  std::cout << "\nDepth conventions\n";
-  conventions.Print(std::cout);
+  out.text << "\nDepth conventions\n";
+  conventions.Print(out);
 
   TextTable formats(
       {{"format", Align::kLeft}, {"short", Align::kLeft}, {"Vulkan", Align::kLeft}, {"stores", Align::kLeft}});
   for (const auto& f : AllFormats()) {
     formats.AddRow({std::string(f.name), std::string(f.short_name), std::string(f.vulkan_name), InputName(f.stores)});
   }
-  std::cout << "\nStorage formats\n";
-  formats.Print(std::cout);
-  std::cout << fmt::format("\n{} cells (variant/convention/format) per backend; backends: cpu, vulkan\n",
-                           AllCells().size());
+  out.text << "\nStorage formats\n";
+  formats.Print(out);
+  out.text << fmt::format("\n{} cells (variant/convention/format) per backend; backends: cpu, vulkan\n",
+                          AllCells().size());
 
-  std::cout << "\nVulkan devices\n";
+  out.text << "\nVulkan devices\n";
   auto devices = ListVulkanDevices();
   if (!devices.ok()) {
-    std::cout << "  none usable: " << devices.status().message() << "\n";
+    out.text << "  none usable: " << devices.status().message() << "\n";
     return kExitOk;
   }
   TextTable table({{"name", Align::kLeft}, {"type", Align::kLeft}, {"driver", Align::kLeft}, {"api", Align::kLeft}});
   for (const auto& d : *devices) table.AddRow({d.name, d.type, d.driver, d.api});
-  table.Print(std::cout);
+  table.Print(out);
   return kExitOk;
 }
 
@@ -63,7 +62,7 @@ Expected<int> List() {
 void AddListCommand(CLI::App& app, CommandAction& action) {
   CLI::App* cmd =
       app.add_subcommand("list", "List variants (with their seeds), conventions, formats and Vulkan devices");
-  cmd->callback([&action] { action = [] { return List(); }; });
+  cmd->callback([&action] { action = List; });
 }
 
 }  // namespace depthbench::cli

@@ -1,5 +1,4 @@
 // depthbench merge: adds up the results of the shards of one sweep.
-#include <iostream>
 
 #include <fmt/format.h>
 
@@ -17,7 +16,8 @@ struct MergeFlags {
   bool allow_partial = false;
 };
 
-Expected<int> Merge(const MergeFlags& f) {
+Expected<int> Merge(const MergeFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   DB_RETURN_IF_ERROR(CheckWritable(f.output, "--json"));
   // Every input is looked at before any is read (a missing last shard is
   // said at once).
@@ -37,8 +37,8 @@ Expected<int> Merge(const MergeFlags& f) {
         "a merge of the shards given",
         ShardList(missing), merged.run.shards.size(), merged.run.shards.front().count));
   }
-  PrintRunHeader(merged, std::cout);
-  PrintResultsTable(merged, std::cout);
+  PrintRunHeader(merged, out.text);
+  PrintResultsTable(merged, out);
   DB_RETURN_IF_ERROR(WriteResults(f.output, merged));
   return kExitOk;
 }
@@ -60,7 +60,8 @@ void AddMergeCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--json", flags->output, "where to write the merged results")->required();
   cmd->add_flag("--allow-partial", flags->allow_partial,
                 "merge even when shards are missing or an input was interrupted; the header and the file say so");
-  cmd->callback([flags, &action] { action = [flags] { return Merge(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return Merge(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

@@ -1,7 +1,6 @@
 // depthbench report: the nightly precision report (HTML page with plots,
 // Markdown summary, JSON document) and its history across runs.
 #include <filesystem>
-#include <iostream>
 #include <memory>
 
 #include <fmt/format.h>
@@ -57,7 +56,7 @@ Expected<std::vector<fs::path>> SpeedFiles(const ReportFlags& f) {
   return files;
 }
 
-Expected<int> RunReport(const ReportFlags& f) {
+Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   ReportPlan plan = f.quick ? ReportPlan::Quick() : ReportPlan::Nightly();
   if (!f.samples.empty()) {
     DB_ASSIGN_OR_RETURN(plan.fit.samples_per_ratio, ParseCount(f.samples, "--samples"));
@@ -164,7 +163,7 @@ Expected<int> RunReport(const ReportFlags& f) {
   if (history) DB_RETURN_IF_ERROR(history->Commit().WithContext("--history"));
   progress.end(fmt::format("{} (report.html, report.md, results.json)", out.string()));
 
-  std::cout << markdown;
+  context.output.text << markdown;
   return worse > 0 && f.fail_on_regression ? kExitFinding : kExitOk;
 }
 
@@ -219,7 +218,8 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
   flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
-  cmd->callback([flags, &action] { action = [flags] { return RunReport(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return RunReport(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

@@ -1,6 +1,5 @@
 // depthbench run: every selected cell on every selected backend against the
 // high-precision reference.
-#include <iostream>
 
 #include <fmt/format.h>
 
@@ -39,17 +38,17 @@ struct RunFlags {
 
 // Replays a reproducer file of depthbench fuzz: the same output, and
 // whether the finding still holds (exit 1) or is gone (exit 0).
-Expected<int> ReplayReproFile(const RunFlags& f, std::span<Backend* const> backends) {
+Expected<int> ReplayReproFile(const RunFlags& f, std::span<Backend* const> backends, std::ostream& out) {
   DB_ASSIGN_OR_RETURN(const ReproFile file, ReadReproFile(f.repro));
   const CaseSource source(file.fuzz_case);
   DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(source, 0, file.cells, backends));
   repro.origin = fmt::format("the case of {}", f.repro);
-  PrintRepro(repro, std::cout);
+  PrintRepro(repro, out);
   DB_ASSIGN_OR_RETURN(CaseChecker checker,
                       CaseChecker::Make(file.cells, std::vector<Backend*>(backends.begin(), backends.end()), 1));
   DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, 1));
   int failures = 0;
-  std::cout << "\n";
+  out << "\n";
   for (std::size_t c = 0; c < file.cells.size(); ++c) {
     for (std::size_t b = 0; b < backends.size(); ++b) {
       const Judgement& j = checker.At(c, b, 0);
@@ -63,7 +62,7 @@ Expected<int> ReplayReproFile(const RunFlags& f, std::span<Backend* const> backe
                                     j.arith, BitsLost(j.arith), j.bound, BitsLost(j.bound))
                               : fmt::format("holds: arithmetic error {:.3g} within the bound {:.3g}", j.arith, j.bound);
       failures += j.violates();
-      std::cout << fmt::format("{} on {}: {}\n", file.cells[c].Name(), backends[b]->name(), verdict);
+      out << fmt::format("{} on {}: {}\n", file.cells[c].Name(), backends[b]->name(), verdict);
     }
   }
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ReproToJson(repro).dump(1) + "\n"));
@@ -92,7 +91,8 @@ void PrintRasterAgreement(const Results& results, std::span<Backend* const> back
   }
 }
 
-Expected<int> Run(const RunFlags& f) {
+Expected<int> Run(const RunFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   SweepOptions options;
   DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
@@ -120,7 +120,7 @@ Expected<int> Run(const RunFlags& f) {
   DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
   const std::span<Backend* const> backends = made.view();
 
-  if (!f.repro.empty()) return ReplayReproFile(f, backends);
+  if (!f.repro.empty()) return ReplayReproFile(f, backends, out.text);
   if (!f.index.empty()) {  // one sample, in full
     char* end = nullptr;
     const unsigned long long index = std::strtoull(f.index.c_str(), &end, 10);
@@ -129,7 +129,7 @@ Expected<int> Run(const RunFlags& f) {
     }
     DB_ASSIGN_OR_RETURN(const Repro repro, Reproduce(options.seed, index, options.domain,
                                                      CellsForDomain(options.cells, options.domain), backends));
-    PrintRepro(repro, std::cout);
+    PrintRepro(repro, out.text);
     if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ReproToJson(repro).dump(1) + "\n"));
     return kExitOk;
   }
@@ -142,10 +142,10 @@ Expected<int> Run(const RunFlags& f) {
                                 ShortCount(static_cast<double>(results.run.reconstructions)), results.cells.size()));
   }
 
-  PrintRunHeader(results, std::cout);
-  PrintResultsTable(results, std::cout);
-  PrintRasterAgreement(results, backends, std::cout);
-  for (BandFamily family : splits) PrintBandTable(results, family, std::cout);
+  PrintRunHeader(results, out.text);
+  PrintResultsTable(results, out);
+  PrintRasterAgreement(results, backends, out.text);
+  for (BandFamily family : splits) PrintBandTable(results, family, out);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteResults(f.json, results));
   return kExitOk;
 }
@@ -207,7 +207,7 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
   flags->domain.Add(*cmd);
   flags->cells.Add(*cmd);
   flags->backends.Add(*cmd);
-  cmd->callback([flags, &action] { action = [flags] { return Run(*flags); }; });
+  cmd->callback([flags, &action] { action = [flags](const CommandContext& context) { return Run(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

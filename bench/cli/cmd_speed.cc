@@ -59,7 +59,8 @@ Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cell
   return RunSweep(sweep, backends);
 }
 
-Expected<int> Speed(const SpeedFlags& f) {
+Expected<int> Speed(const SpeedFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
   SpeedOptions options;
   DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select());
   options.resolutions.clear();
@@ -136,17 +137,17 @@ Expected<int> Speed(const SpeedFlags& f) {
   if (!accuracy.ok()) return accuracy.status().WithContext("accuracy results for the trade");
   DB_RETURN_IF_ERROR(AddTrade(results, *accuracy, source).WithContext("accuracy results for the trade"));
 
-  PrintSpeedHeader(results, std::cout);
-  PrintGpuTable(results, std::cout);
-  PrintStaticTable(results, std::cout);
-  PrintCpuTable(results, std::cout);
-  PrintTradeTable(results, std::cout);
-  PrintSkipped(results, std::cout);
+  PrintSpeedHeader(results, out.text);
+  PrintGpuTable(results, out);
+  PrintStaticTable(results, out);
+  PrintCpuTable(results, out);
+  PrintTradeTable(results, out);
+  PrintSkipped(results, out.text);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteSpeedResults(f.json, results));
   if (previous) {
     RankingComparison comparison;
     DB_RETURN_IF_ERROR(StoreInto(CompareRankings(*previous, results), comparison).WithContext("--compare"));
-    PrintRankingComparison(comparison, std::cout);
+    PrintRankingComparison(comparison, out.text);
     if (!comparison.contradictions.empty()) return kExitFinding;
   }
   return kExitOk;
@@ -206,7 +207,8 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
                   "(listed as not measured); a run that will take over a minute says how long first")
       ->type_name("SECONDS")
       ->check(CLI::NonNegativeNumber);
-  cmd->callback([flags, &action] { action = [flags] { return Speed(*flags); }; });
+  cmd->callback(
+      [flags, &action] { action = [flags](const CommandContext& context) { return Speed(*flags, context); }; });
 }
 
 }  // namespace depthbench::cli

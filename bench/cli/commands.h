@@ -7,13 +7,21 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/base/status.h"
+#include "bench/base/text_table.h"
 
 namespace depthbench::cli {
+
+// What a chosen subcommand runs with, made for that one run from its command
+// line: where and how it prints (the text for people, and its tables in the
+// style --table-format and --wide ask for).
+struct CommandContext {
+  const TextOutput& output;
+};
 
 // Runs a chosen subcommand: the exit code of a command that ran (kExitOk, or
 // kExitFinding for a finding), or the Status that says why it could not run,
 // which RunDepthbench reports (exit kExitCannotRun).
-using CommandAction = std::function<Expected<int>()>;
+using CommandAction = std::function<Expected<int>(const CommandContext&)>;
 
 void AddListCommand(CLI::App& app, CommandAction& action);
 void AddRunCommand(CLI::App& app, CommandAction& action);

@@ -310,7 +310,7 @@ nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const 
                                  {"fits", out}});
 }
 
-void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std::ostream& out) {
+void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, const TextOutput& out) {
   using Align = TextTable::Align;
   TextTable table({{"cell", Align::kLeft},
                    {"backend", Align::kLeft},
@@ -343,7 +343,7 @@ void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std:
                   predicted(f, "inf"), ratio_text(f.budget_ratio, "1e-3"), ratio_text(f.budget_ratio, "1e-6"),
                   f.holdout_points == 0 ? "-" : fmt::format("{:.2f} bit", f.holdout_max_miss)});
   }
-  out << fmt::format(
+  out.text << fmt::format(
       "{} bits lost of the total error at the far plane, from the fitted model chosen by BIC; f/n 1e-3 and 1e-6: "
       "the far/near ratio up to which the far plane meets a relative error of 1e-3 and 1e-6 ('always': up to 1e12, "
       "'never': not even "

@@ -21,6 +21,7 @@
 
 #include "bench/backends/backend.h"
 #include "bench/base/json_reader.h"
+#include "bench/base/text_table.h"
 #include "bench/fit/error_model.h"
 #include "bench/results/results.h"
 #include "bench/sweep/sweep.h"
@@ -103,6 +104,6 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
 
 nlohmann::json PrecisionFitsToJson(const std::vector<PrecisionFit>& fits, const FitPlan& plan);
 // The headline table: one row per cell and backend (total error, one level).
-void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, std::ostream& out);
+void PrintPrecisionFits(const std::vector<PrecisionFit>& fits, Level level, const TextOutput& out);
 
 }  // namespace depthbench

@@ -83,7 +83,7 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
          "to the distance from the camera\n\n";
 }
 
-void PrintResultsTable(const Results& results, std::ostream& out) {
+void PrintResultsTable(const Results& results, const TextOutput& out) {
   using Align = TextTable::Align;
   TextTable table({{"cell", Align::kLeft},
                    {"backend", Align::kLeft},
@@ -122,7 +122,8 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
          measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.max)), Count(all.nan), Count(all.inf),
          Count(all.stored_nonfinite)});
   }
-  out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
+  out.text
+      << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
          "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
          "three causes: prod (the depth the pipeline produced), stor (the format's rounding and fetch), shader (the\n"
          "variant's float32 arithmetic); the absolute error in world units ('<=': below the histogram's range of\n"
@@ -132,7 +133,7 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
   table.Print(out);
 }
 
-void PrintBandTable(const Results& results, BandFamily family, std::ostream& out) {
+void PrintBandTable(const Results& results, BandFamily family, const TextOutput& out) {
   std::set<int> bands;
   for (const CellResult& c : results.cells) {
     if (family == BandFamily::kDistance) {
@@ -165,8 +166,8 @@ void PrintBandTable(const Results& results, BandFamily family, std::ostream& out
     }
     table.AddRow(std::move(row));
   }
-  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under 4000)\n",
-                     title);
+  out.text << fmt::format(
+      "\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under 4000)\n", title);
   table.Print(out);
 }
 

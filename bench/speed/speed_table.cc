@@ -56,7 +56,7 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
          "an indistinguishable variant\n\n";
 }
 
-void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
+void PrintGpuTable(const SpeedResults& results, const TextOutput& out) {
   std::vector<Cell> cells;
   for (const GpuTiming& t : results.gpu) {
     if (std::find(cells.begin(), cells.end(), t.cell) == cells.end()) cells.push_back(t.cell);
@@ -113,28 +113,28 @@ void PrintGpuTable(const SpeedResults& results, std::ostream& out) {
       table.AddRow(row);
     }
     if (memory) {
-      out << "GPU time of a whole frame, memory-bound (one reconstruction per pixel: reading the depth image and "
-             "writing positions), in µs";
+      out.text << "GPU time of a whole frame, memory-bound (one reconstruction per pixel: reading the depth image and "
+                  "writing positions), in µs";
       if (results.bandwidth) {
-        out << fmt::format(
+        out.text << fmt::format(
             "; floor: the least time the pass's bytes take at the device's measured bandwidth ({} GB/s, see "
             "above): (bytes of a texel + 4 written) per pixel; bound: 'bandwidth' where the pass takes at most "
             "{}x its floor (it is bound by memory bandwidth), else how many times its floor it takes (bound by "
             "something else: arithmetic, latency, the texture path, or on a CPU device the code itself)\n",
             Readable(results.bandwidth->bytes_per_second() * 1e-9, 3), Readable(kBandwidthBoundFactor, 2));
       } else {
-        out << "; no floor: the device's bandwidth was not measured\n";
+        out.text << "; no floor: the device's bandwidth was not measured\n";
       }
     } else {
-      out << "Reconstructions per second when ALU-bound (" << results.run.alu_taps
-          << " per pixel), in 10^9: where the variants' arithmetic differs\n";
+      out.text << "Reconstructions per second when ALU-bound (" << results.run.alu_taps
+               << " per pixel), in 10^9: where the variants' arithmetic differs\n";
     }
     table.Print(out);
-    out << "\n";
+    out.text << "\n";
   }
 }
 
-void PrintStaticTable(const SpeedResults& results, std::ostream& out) {
+void PrintStaticTable(const SpeedResults& results, const TextOutput& out) {
   TextTable table({{"variant", Align::kLeft},
                    {"fdiv"},
                    {"fmul"},
@@ -154,24 +154,24 @@ void PrintStaticTable(const SpeedResults& results, std::ostream& out) {
                   Count(s.mix.fma), Count(s.mix.dot), Count(s.mix.matrix_vector), extended.empty() ? "-" : extended,
                   fmt::format("{}", s.mix.function_calls), fmt::format("{}", s.mix.total_instructions)});
   }
-  out << "Static cost: SPIR-V instructions of one reconstruction (lanes in parentheses where vector), counted "
-         "in the compiled module\n";
+  out.text << "Static cost: SPIR-V instructions of one reconstruction (lanes in parentheses where vector), counted "
+              "in the compiled module\n";
   table.Print(out);
-  out << "\n";
+  out.text << "\n";
 }
 
-void PrintCpuTable(const SpeedResults& results, std::ostream& out) {
+void PrintCpuTable(const SpeedResults& results, const TextOutput& out) {
   TextTable table({{"cell", Align::kLeft}, {"ns/recon"}, {"runs x samples"}});
   for (const CpuCost& c : results.cpu) {
     table.AddRow({c.cell.Name(), WithSpread(c.ns_per_reconstruction.median, c.ns_per_reconstruction.spread()),
                   fmt::format("{} x {}", c.runs_per_repetition, c.samples_per_run)});
   }
-  out << "CPU backend (" << results.run.cpu_compiler << ", 8 float32 lanes, one thread), ns per reconstruction\n";
+  out.text << "CPU backend (" << results.run.cpu_compiler << ", 8 float32 lanes, one thread), ns per reconstruction\n";
   table.Print(out);
-  out << "\n";
+  out.text << "\n";
 }
 
-void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
+void PrintTradeTable(const SpeedResults& results, const TextOutput& out) {
   if (results.trade.empty()) return;
   TextTable table({{"convention", Align::kLeft},
                    {"format", Align::kLeft},
@@ -197,13 +197,13 @@ void PrintTradeTable(const SpeedResults& results, std::ostream& out) {
                     p.on_cpu_front ? "*" : "", fmt::format("{}", p.nonfinite)});
     }
   }
-  out << fmt::format(
+  out.text << fmt::format(
       "The trade at {} and on the CPU: cost against p99.9 bits lost ({} backend, {}). GPU cost: the ALU-bound "
       "time of one reconstruction per pixel of a frame; * = on the Pareto front of its convention and format (no "
       "variant is as cheap, to the spread, and as accurate, to 1/4 bit, and better in one)\n",
       ResolutionName(results.run.trade_resolution), results.run.accuracy_backend, results.run.accuracy_source);
   table.Print(out);
-  out << "\n";
+  out.text << "\n";
 }
 
 void PrintSkipped(const SpeedResults& results, std::ostream& out) {
