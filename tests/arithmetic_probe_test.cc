@@ -64,7 +64,7 @@ std::string Validate(const std::vector<std::uint32_t>& m) {
 
 TEST(ArithmeticProbeTest, EveryVariantStaysValidAndLosesItsFreedoms) {
   for (const VariantInfo& variant : AllVariants()) {
-    auto compiled = CompileVariant(variant.id, VariantPass::kAccuracy, kShaders);
+    auto compiled = CompileVariant(variant, VariantPass::kAccuracy, kShaders);
     ASSERT_TRUE(compiled.ok()) << compiled.status().message();
     const Counts before = CountModule(*compiled);
     ASSERT_GT(before.fdiv32, 0) << variant.name << ": every variant divides (at least by w or by the resolution)";

@@ -56,7 +56,7 @@ class GpuPassTimerTest : public ::testing::Test {
   }
 
   TimingSummary Time(Variant variant, std::uint32_t taps, std::uint32_t repetitions) {
-    auto timing = timer_->TimePass(variant, taps, 1, repetitions);
+    auto timing = timer_->TimePass(Info(variant), taps, 1, repetitions);
     EXPECT_TRUE(timing.ok()) << timing.status().message();
     if (!timing.ok()) return {};
     EXPECT_EQ(timing->ns_per_pass.size(), repetitions);
@@ -88,9 +88,9 @@ TEST_F(GpuPassTimerTest, TimestampsAreInTheDevicesPeriod) {
   ASSERT_GT(period, 0.0);
   // Compile the pipeline first, so that the timed call below does device
   // work almost only.
-  ASSERT_TRUE(timer_->TimePass(Variant::kInverseVp, 64, 1, 3).ok());
+  ASSERT_TRUE(timer_->TimePass(Info(Variant::kInverseVp), 64, 1, 3).ok());
   const auto start = std::chrono::steady_clock::now();
-  auto timing = timer_->TimePass(Variant::kInverseVp, 64, 1, 10);
+  auto timing = timer_->TimePass(Info(Variant::kInverseVp), 64, 1, 10);
   const double host_ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(timing.ok()) << timing.status().message();
   double device_ns = 0.0;
@@ -140,13 +140,13 @@ void ExpectPassComputesFormula(const DepthImage& image, const std::vector<float>
 TEST_F(GpuPassTimerTest, PassesComputeTheFormulaOverTheRealImage) {
   // A hardware depth format (a sampled depth image) and a half-float colour one.
   const DepthImage d24 = Load({Convention::kReversed, Format::kX8D24Unorm}, {67, 45});
-  ASSERT_TRUE(timer_->TimePass(Variant::kPq, 1, 1, 3).ok());
+  ASSERT_TRUE(timer_->TimePass(Info(Variant::kPq), 1, 1, 3).ok());
   auto values = timer_->ReadResults();
   ASSERT_TRUE(values.ok()) << values.status().message();
   ExpectPassComputesFormula(d24, *values, Variant::kPq);
 
   const DepthImage r16f = Load({Convention::kLinear, Format::kR16Sfloat}, {40, 31});
-  ASSERT_TRUE(timer_->TimePass(Variant::kFrustumRay, 1, 1, 3).ok());
+  ASSERT_TRUE(timer_->TimePass(Info(Variant::kFrustumRay), 1, 1, 3).ok());
   values = timer_->ReadResults();
   ASSERT_TRUE(values.ok()) << values.status().message();
   ExpectPassComputesFormula(r16f, *values, Variant::kFrustumRay);
@@ -228,14 +228,14 @@ TEST_F(GpuPassTimerTest, BandwidthProbeIsTheHostsMemoryAndFloorsThePass) {
 
 TEST_F(GpuPassTimerTest, RefusesPairsThatDoNotExist) {
   Load({Convention::kLinear, Format::kR32Sfloat}, {16, 16});
-  auto divide = timer_->TimePass(Variant::kDivide, 1, 1, 3);
+  auto divide = timer_->TimePass(Info(Variant::kDivide), 1, 1, 3);
   ASSERT_FALSE(divide.ok());
   EXPECT_EQ(divide.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(divide.status().message().find("divide does not read r32_sfloat under the linear convention"),
             std::string::npos)
       << divide.status().message();
 
-  auto taps = timer_->TimePass(Variant::kFrustumRay, 0, 1, 3);
+  auto taps = timer_->TimePass(Info(Variant::kFrustumRay), 0, 1, 3);
   ASSERT_FALSE(taps.ok());
   EXPECT_NE(taps.status().message().find("taps 0 is outside 1 to 64"), std::string::npos);
 

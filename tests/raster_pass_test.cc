@@ -339,9 +339,11 @@ TEST_F(RasterPassTest, UserVariantsInBothLanguagesRunAsInTheComputeForm) {
   const std::filesystem::path examples = std::filesystem::path(DEPTHBENCH_SOURCE_DIR) / "bench" / "examples";
   for (const char* file : {"divide_subtract_first.glsl", "unity_world_position.hlsl"}) {
     SCOPED_TRACE(file);
-    auto user = RegisterVariantFile((examples / file).string());
-    ASSERT_TRUE(user.ok()) << user.status().message();
-    const RunLayout layout = MakeRunLayout(std::vector<Cell>{{*user, Convention::kStandard, Format::kD32Sfloat}});
+    auto catalogue = MakeCatalogue({(examples / file).string()});
+    ASSERT_TRUE(catalogue.ok()) << catalogue.status().message();
+    const Variant user = (*catalogue)->variants().back().id;
+    const RunLayout layout =
+        MakeRunLayout(std::vector<Cell>{(*catalogue)->MakeCell(user, Convention::kStandard, Format::kD32Sfloat)});
     Status status = raster_->Prepare(layout.cells, PassKind::kRaster);
     ASSERT_TRUE(status.ok()) << status.message();
     ASSERT_TRUE(compute_->Prepare(layout.cells, PassKind::kCompute).ok());
@@ -366,7 +368,6 @@ TEST_F(RasterPassTest, UserVariantsInBothLanguagesRunAsInTheComputeForm) {
       ++compared;
     }
     EXPECT_GT(compared, batch.count / 2);
-    ASSERT_TRUE(RegisterVariantFiles({}).ok());
   }
 }
 

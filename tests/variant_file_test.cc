@@ -47,7 +47,12 @@ class VariantFileTest : public ::testing::Test {
     ASSERT_TRUE(cpu.ok()) << cpu.status().message();
     cpu_ = std::move(cpu).value();
   }
-  void TearDown() override { ASSERT_TRUE(RegisterVariantFiles({}).ok()); }
+  // The variant of the shader file at `path`, in a catalogue of that file
+  // alone that the test keeps (it replaces the one before).
+  Expected<Variant> AddFile(const std::string& path) {
+    DB_ASSIGN_OR_RETURN(catalogue_, MakeCatalogue({path}));
+    return catalogue_->variants().back().id;
+  }
 
   // A shader file written for the test.
   std::string WriteShader(const std::string& name, const std::string& text) {
@@ -63,7 +68,7 @@ class VariantFileTest : public ::testing::Test {
     for (const Cell& cell : AllCells()) {
       if (cell.variant != same) continue;
       same_cells.push_back(cell);
-      user_cells.push_back({user, cell.convention, cell.format});
+      user_cells.push_back(catalogue_->MakeCell(user, cell.convention, cell.format));
     }
     ASSERT_FALSE(same_cells.empty());
     const RunLayout same_layout = MakeRunLayout(same_cells);
@@ -105,12 +110,13 @@ class VariantFileTest : public ::testing::Test {
   }
 
   std::unique_ptr<Backend> vulkan_, cpu_;
+  std::unique_ptr<const Catalogue> catalogue_;
 };
 
 TEST_F(VariantFileTest, UnityStyleHlslExampleIsInverseViewProjection) {
-  auto unity = RegisterVariantFile((kExamples / "unity_world_position.hlsl").string());
+  auto unity = AddFile((kExamples / "unity_world_position.hlsl").string());
   ASSERT_TRUE(unity.ok()) << unity.status().message();
-  EXPECT_EQ(Info(*unity).name, "unity_world_position");
+  EXPECT_EQ(catalogue_->Info(*unity).name, "unity_world_position");
   ExpectSamePositions(*unity, Variant::kInverseVp);
 }
 
@@ -128,7 +134,7 @@ vec3 reconstruct(vec2 uv, float depth) {
   return (db_ViewToWorld * vec4(view, 1.0)).xyz;
 }
 )");
-  auto variant = RegisterVariantFile(path);
+  auto variant = AddFile(path);
   ASSERT_TRUE(variant.ok()) << variant.status().message();
   ExpectSamePositions(*variant, Variant::kDivide);
 }
@@ -137,7 +143,7 @@ TEST_F(VariantFileTest, LinearDepthHlslIsFrustumRay) {
   const std::string path = WriteShader("ray.hlsl", R"(// depthbench: input=linear entry=FromRay
 float3 FromRay(float2 uv, float linearDepth) { return db_CameraPosition + db_FrustumRay * linearDepth; }
 )");
-  auto variant = RegisterVariantFile(path);
+  auto variant = AddFile(path);
   ASSERT_TRUE(variant.ok()) << variant.status().message();
   ExpectSamePositions(*variant, Variant::kFrustumRay);
 }
@@ -147,7 +153,7 @@ float3 FromRay(float2 uv, float linearDepth) { return db_CameraPosition + db_Fru
 // bits for divide at far/near 1e4, falls to 1.7 (float32's floor for a
 // chain of roundings); the production part, the same for both, stays.
 TEST_F(VariantFileTest, SubtractFirstExampleBeatsDivideNearTheFarPlane) {
-  auto edit = RegisterVariantFile((kExamples / "divide_subtract_first.glsl").string());
+  auto edit = AddFile((kExamples / "divide_subtract_first.glsl").string());
   ASSERT_TRUE(edit.ok()) << edit.status().message();
   SweepOptions options;
   options.seed = 3;
@@ -155,7 +161,7 @@ TEST_F(VariantFileTest, SubtractFirstExampleBeatsDivideNearTheFarPlane) {
   options.domain.camera_distance = {0.0, 0.0};
   options.domain.ratio = {1e4, 1e4};
   options.cells = {{Variant::kDivide, Convention::kStandard, Format::kD32Sfloat},
-                   {*edit, Convention::kStandard, Format::kD32Sfloat}};
+                   catalogue_->MakeCell(*edit, Convention::kStandard, Format::kD32Sfloat)};
   Backend* backends[] = {vulkan_.get()};
   auto results = RunSweep(options, backends);
   ASSERT_TRUE(results.ok()) << results.status().message();
@@ -179,9 +185,10 @@ TEST_F(VariantFileTest, CompileErrorsNameTheUsersLineAndNothingGenerated) {
   const std::string path = WriteShader(
       "broken.hlsl",
       "// depthbench: input=hardware\nfloat3 reconstruct(float2 uv, float depth) { return float3(uv, depth) }\n");
-  auto variant = RegisterVariantFile(path);
+  auto variant = AddFile(path);
   ASSERT_TRUE(variant.ok()) << variant.status().message();
-  auto compiled = CompileVariant(*variant, VariantPass::kAccuracy, fs::path(DEPTHBENCH_SOURCE_DIR) / "shaders");
+  auto compiled =
+      CompileVariant(catalogue_->Info(*variant), VariantPass::kAccuracy, fs::path(DEPTHBENCH_SOURCE_DIR) / "shaders");
   ASSERT_FALSE(compiled.ok());
   const std::string& message = compiled.status().message();
   EXPECT_NE(message.find("broken.hlsl:2: error:"), std::string::npos) << message;
@@ -189,34 +196,57 @@ TEST_F(VariantFileTest, CompileErrorsNameTheUsersLineAndNothingGenerated) {
 }
 
 TEST_F(VariantFileTest, CpuBackendSaysItCannotRunAShaderFile) {
-  auto unity = RegisterVariantFile((kExamples / "unity_world_position.hlsl").string());
+  auto unity = AddFile((kExamples / "unity_world_position.hlsl").string());
   ASSERT_TRUE(unity.ok());
-  const RunLayout layout = MakeRunLayout(std::vector<Cell>{{*unity, Convention::kReversed, Format::kD32Sfloat}});
+  const RunLayout layout =
+      MakeRunLayout(std::vector<Cell>{catalogue_->MakeCell(*unity, Convention::kReversed, Format::kD32Sfloat)});
   const Status status = cpu_->Prepare(layout.cells);
   EXPECT_EQ(status.code(), StatusCode::kUnavailable);
   EXPECT_NE(status.message().find("runs on Vulkan only"), std::string::npos) << status.message();
 }
 
 TEST_F(VariantFileTest, DeclarationsAreChecked) {
-  auto missing =
-      RegisterVariantFile(WriteShader("plain.glsl", "vec3 reconstruct(vec2 uv, float d) { return vec3(0); }\n"));
+  auto missing = AddFile(WriteShader("plain.glsl", "vec3 reconstruct(vec2 uv, float d) { return vec3(0); }\n"));
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("no '// depthbench:' line"), std::string::npos);
-  auto unknown = RegisterVariantFile(WriteShader("typo.glsl", "// depthbench: input=hardware handed=left\n"));
+  auto unknown = AddFile(WriteShader("typo.glsl", "// depthbench: input=hardware handed=left\n"));
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.status().message().find("typo.glsl:1: unknown key 'handed'"), std::string::npos)
       << unknown.status().message();
-  auto taken = RegisterVariantFile(WriteShader("divide.glsl", "// depthbench: input=hardware\n"));
+  auto taken = AddFile(WriteShader("divide.glsl", "// depthbench: input=hardware\n"));
   ASSERT_FALSE(taken.ok());
   EXPECT_NE(taken.status().message().find("'divide' is taken"), std::string::npos);
-  auto language = RegisterVariantFile(WriteShader("f.frag", "// depthbench: input=hardware\n"));
+  auto language = AddFile(WriteShader("f.frag", "// depthbench: input=hardware\n"));
   ASSERT_FALSE(language.ok());
-  // The same file twice is one variant.
+  // Two files may not declare one name.
   const std::string path = (kExamples / "divide_subtract_first.glsl").string();
-  auto first = RegisterVariantFile(path);
-  auto again = RegisterVariantFile(path);
-  ASSERT_TRUE(first.ok() && again.ok());
-  EXPECT_EQ(*first, *again);
+  auto twice =
+      MakeCatalogue({path, WriteShader("other.glsl", "// depthbench: input=hardware name=divide_subtract_first\n")});
+  ASSERT_FALSE(twice.ok());
+  EXPECT_NE(twice.status().message().find("is taken by another --variant-file"), std::string::npos)
+      << twice.status().message();
+  // The same file twice is one variant.
+  auto same = MakeCatalogue({path, path});
+  ASSERT_TRUE(same.ok()) << same.status().message();
+  EXPECT_EQ((*same)->variants().size(), static_cast<std::size_t>(kVariantCount) + 1);
+}
+
+// A catalogue belongs to the command that made it: one made with a file
+// leaves the built-in catalogue, and the next one made without it, as
+// they were.
+TEST_F(VariantFileTest, ACatalogueLeavesNothingForTheNext) {
+  auto with_file = MakeCatalogue({(kExamples / "divide_subtract_first.glsl").string()});
+  ASSERT_TRUE(with_file.ok()) << with_file.status().message();
+  EXPECT_TRUE((*with_file)->has_user_variants());
+  EXPECT_TRUE((*with_file)->ParseVariant("divide_subtract_first").ok());
+  auto without = MakeCatalogue({});
+  ASSERT_TRUE(without.ok());
+  for (const Catalogue* catalogue : {without->get(), &Catalogue::BuiltIn()}) {
+    EXPECT_FALSE(catalogue->has_user_variants());
+    EXPECT_EQ(catalogue->variants().size(), static_cast<std::size_t>(kVariantCount));
+    EXPECT_EQ(catalogue->Cells().size(), AllCells().size());
+    EXPECT_FALSE(catalogue->ParseVariant("divide_subtract_first").ok());
+  }
 }
 
 }  // namespace

@@ -174,13 +174,13 @@ const std::vector<OperationCost> kOperationCosts{
     {"other GLSL.std.450 (min, max, abs, clamp, floor, ...)", 1.0, "one issue slot"},
 };
 
-Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
+Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catalogue& catalogue) {
   std::filesystem::path dir = shader_dir;
   if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
   std::map<Variant, CandidateCost> by_variant;
-  for (const VariantInfo& v : AllVariants()) {
-    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileVariant(v.id, VariantPass::kAccuracy, dir));
-    DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, VariantFunctionName(v.id)));
+  for (const VariantInfo& v : catalogue.variants()) {
+    DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileVariant(v, VariantPass::kAccuracy, dir));
+    DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, VariantFunctionName(v)));
     by_variant[v.id] = {
         WeighedCost(mix), 0.0, kStaticCostUnit,
         "static model: the compiled shader's instructions, weighed per operation as choose --help lists"};
@@ -189,8 +189,8 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir) {
       [by_variant](const Cell& cell) -> std::optional<CandidateCost> { return by_variant.at(cell.variant); });
 }
 
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file) {
-  DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(speed_file));
+Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue) {
+  DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(speed_file, catalogue));
   // Per 1080p frame: what a frame budget is counted in.
   constexpr double kFramePixels = 1920.0 * 1080.0;
   const std::string unit = "µs per 1920x1080 frame on " + speed.run.device.name;
@@ -198,7 +198,7 @@ Expected<CostLookup> SpeedCostLookup(const std::string& speed_file) {
   for (const TradeFront& front : speed.trade) {
     for (const TradePoint& p : front.points) {
       if (!(p.gpu_ns_per_reconstruction > 0.0)) continue;
-      measured[Cell{p.variant, front.convention, front.format}] = {
+      measured[catalogue.MakeCell(p.variant, front.convention, front.format)] = {
           p.gpu_ns_per_reconstruction * kFramePixels * 1e-3, p.gpu_spread_ns * kFramePixels * 1e-3, unit, speed_file};
     }
   }
@@ -498,7 +498,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
     ranked.push_back({{"rank", v.rank},
                       {"tied", v.tied},
                       {"cell", v.cell.Name()},
-                      {"variant", Info(v.cell.variant).name},
+                      {"variant", v.cell.variant_info().name},
                       {"convention", Info(v.cell.convention).name},
                       {"format", Info(v.cell.format).name},
                       {"samples", v.samples},

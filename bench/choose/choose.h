@@ -45,10 +45,12 @@ struct OperationCost {
 };
 extern const std::vector<OperationCost> kOperationCosts;
 inline constexpr const char* kStaticCostUnit = "FMA-equivalent slots";
-Expected<CostLookup> StaticCostLookup(const std::string& shader_dir);
+// For every variant of `catalogue`.
+Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catalogue& catalogue = Catalogue::BuiltIn());
 // Measured GPU time per frame from a `depthbench speed --json` file
-// (ALU-bound regime), for the cells the file has.
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file);
+// (ALU-bound regime), for the cells the file has; its variant names are
+// looked up in `catalogue`.
+Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue = Catalogue::BuiltIn());
 
 // Where a ranking's costs come from: measured times when they cover every
 // candidate, else the static model for all (a ranking never mixes units).

@@ -128,12 +128,12 @@ std::string Requirement::Describe() const {
 std::vector<Cell> Scene::Candidates() const {
   CellFilter filter{variants, conventions, formats};
   std::vector<Cell> cells;
-  for (const Cell& c : AllCells())
+  for (const Cell& c : (catalogue != nullptr ? *catalogue : Catalogue::BuiltIn()).Cells())
     if (filter.Keeps(c)) cells.push_back(c);
   return CellsForDomain(cells, domain);
 }
 
-Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
+Expected<Scene> ParseScene(std::string_view text, const std::string& source, const Catalogue& catalogue) {
   SceneReader r(source);
   toml::table root;
   try {
@@ -144,6 +144,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   }
   DB_RETURN_IF_ERROR(r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "engine", "requirement", "cost"}));
   Scene scene;
+  scene.catalogue = &catalogue;
   scene.source = source;
   scene.name = root["name"].value_or(std::string(std::filesystem::path(source).stem()));
   Domain& d = scene.domain;
@@ -217,7 +218,9 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   DB_ASSIGN_OR_RETURN(const toml::table* engine, r.Table(root, "engine", false));
   if (engine != nullptr) {
     DB_RETURN_IF_ERROR(r.OnlyKeys(*engine, "engine", {"variants", "conventions", "formats"}));
-    DB_RETURN_IF_ERROR(r.Names<Variant>(*engine, "variants", "engine.variants", ParseVariant, scene.variants));
+    DB_RETURN_IF_ERROR(r.Names<Variant>(
+        *engine, "variants", "engine.variants", [&](std::string_view name) { return catalogue.ParseVariant(name); },
+        scene.variants));
     DB_RETURN_IF_ERROR(
         r.Names<Convention>(*engine, "conventions", "engine.conventions", ParseConvention, scene.conventions));
     DB_RETURN_IF_ERROR(r.Names<Format>(*engine, "formats", "engine.formats", ParseFormat, scene.formats));
@@ -288,9 +291,9 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source) {
   return scene;
 }
 
-Expected<Scene> LoadScene(const std::filesystem::path& path) {
+Expected<Scene> LoadScene(const std::filesystem::path& path, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(std::string text, ReadFile(path, kMaxSourceFileBytes));
-  return ParseScene(text, path.string());
+  return ParseScene(text, path.string(), catalogue);
 }
 
 }  // namespace depthbench

@@ -52,6 +52,9 @@ struct Requirement {
 };
 
 struct Scene {
+  // The catalogue `variants` are of (it outlives the scene); null: the
+  // built-in one.
+  const Catalogue* catalogue = nullptr;
   std::string source;  // the file it came from
   std::string name;
   Domain domain;
@@ -61,12 +64,14 @@ struct Scene {
   Requirement requirement;
   std::optional<double> max_cost;
 
-  // The catalog's cells this scene's engine can use and its domain allows.
+  // The catalogue's cells this scene's engine can use and its domain allows.
   std::vector<Cell> Candidates() const;
 };
 
 // Errors name the file, line and column, the field, and what is allowed.
-Expected<Scene> ParseScene(std::string_view text, const std::string& source);
-Expected<Scene> LoadScene(const std::filesystem::path& path);
+// Variant names are looked up in `catalogue`, which the scene then refers to.
+Expected<Scene> ParseScene(std::string_view text, const std::string& source,
+                           const Catalogue& catalogue = Catalogue::BuiltIn());
+Expected<Scene> LoadScene(const std::filesystem::path& path, const Catalogue& catalogue = Catalogue::BuiltIn());
 
 }  // namespace depthbench

@@ -153,9 +153,8 @@ void CheckWholeNumbers(CLI::App& app) {
   }
 }
 
-// --variant-file, of every subcommand that runs variants: the files are
-// registered in the catalog once the command line is parsed, before the
-// command looks a variant up.
+// --variant-file, of every subcommand that runs variants: once the command
+// line is parsed, the files make the catalogue the command runs with.
 void AddVariantFileOption(CLI::App& app, std::vector<std::string>& files) {
   for (const char* name : {"list", "run", "fit", "gate", "choose", "speed", "report"}) {
     app.get_subcommand(name)
@@ -285,7 +284,8 @@ int RunDepthbench(int argc, const char* const* argv) {
   std::unique_ptr<CLI::App> app = MakeDepthbenchApp(line);
   const ParseOutcome parsed = ParseCommandLine(*app, argc, argv, std::cout, std::cerr);
   if (!parsed.run) return parsed.exit_code;
-  if (Status registered = RegisterVariantFiles(line.variant_files); !registered.ok()) return ReportError(registered);
+  const Expected<std::unique_ptr<const Catalogue>> catalogue = MakeCatalogue(line.variant_files);
+  if (!catalogue.ok()) return ReportError(catalogue.status());
   const TableStyle style = line.table_style();
   const bool tables_for_machines = style.format != TableFormat::kText;
   wrapped.reset();
@@ -299,7 +299,7 @@ int RunDepthbench(int argc, const char* const* argv) {
   // Tables for machines: they alone on standard output.
   std::ostream tables(standard_output);
   const TextOutput output(std::cout, tables_for_machines ? tables : std::cout, style);
-  const int code = line.action ? ExitCode(line.action(CommandContext{output})) : kExitCannotRun;
+  const int code = line.action ? ExitCode(line.action(CommandContext{**catalogue, output})) : kExitCannotRun;
   wrapped.reset();
   std::cout.rdbuf(standard_output);
   if (AbandonedThreads()) {

@@ -15,7 +15,6 @@
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
-#include "bench/pipeline/user_variant.h"
 
 namespace depthbench::cli {
 
@@ -160,15 +159,17 @@ void CellFlags::Add(CLI::App& app) {
   app.add_option("--format", formats, "storage formats to run (default all)")->delimiter(',')->group("Cells");
 }
 
-Expected<std::vector<Cell>> CellFlags::Select() const {
+Expected<std::vector<Cell>> CellFlags::Select(const Catalogue& catalogue) const {
   CellFilter filter;
-  for (const auto& v : variants) DB_RETURN_IF_ERROR(StoreInto(ParseVariant(v), filter.variants.emplace_back()));
+  for (const auto& v : variants) {
+    DB_RETURN_IF_ERROR(StoreInto(catalogue.ParseVariant(v), filter.variants.emplace_back()));
+  }
   for (const auto& c : conventions) {
     DB_RETURN_IF_ERROR(StoreInto(ParseConvention(c), filter.conventions.emplace_back()));
   }
   for (const auto& f : formats) DB_RETURN_IF_ERROR(StoreInto(ParseFormat(f), filter.formats.emplace_back()));
   std::vector<Cell> cells;
-  for (const Cell& cell : AllCells())
+  for (const Cell& cell : catalogue.Cells())
     if (filter.Keeps(cell)) cells.push_back(cell);
   if (cells.empty()) {
     return InvalidArgument(
@@ -206,11 +207,11 @@ BackendSet::BackendSet(std::vector<std::unique_ptr<Backend>> owned) : owned_(std
   for (const auto& backend : owned_) pointers_.push_back(backend.get());
 }
 
-Expected<BackendSet> BackendFlags::Make() const {
+Expected<BackendSet> BackendFlags::Make(const Catalogue& catalogue) const {
   std::vector<std::unique_ptr<Backend>> out;
   BackendOptions options{device, shaders, validate};
   std::vector<std::string> names = backends;
-  if (AnyUserVariant() && backend_option != nullptr && backend_option->count() == 0 && names.size() > 1) {
+  if (catalogue.has_user_variants() && backend_option != nullptr && backend_option->count() == 0 && names.size() > 1) {
     names = {"vulkan"};
     std::cerr << "note: --variant-file: running on the vulkan backend alone (the cpu backend cannot run a "
                  "shader file; --backend chooses)\n";

@@ -46,7 +46,8 @@ struct DomainFlags {
 struct CellFlags {
   std::vector<std::string> variants, conventions, formats;
   void Add(CLI::App& app);
-  Expected<std::vector<Cell>> Select() const;  // the catalog's cells the filters keep
+  // The catalogue's cells the filters keep.
+  Expected<std::vector<Cell>> Select(const Catalogue& catalogue) const;
 };
 
 // The backends a command runs: owns them, and lists them, in the order the
@@ -71,7 +72,8 @@ struct BackendFlags {
   // runs one).
   const CLI::Option* backend_option = nullptr;
   void Add(CLI::App& app, bool allow_several = true);
-  Expected<BackendSet> Make() const;
+  // The backends for the variants of `catalogue`.
+  Expected<BackendSet> Make(const Catalogue& catalogue) const;
 };
 
 // "1e6", "1000000" -> a positive count.

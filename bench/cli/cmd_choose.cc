@@ -26,15 +26,15 @@ struct ChooseFlags {
 
 Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
-  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(f.scene));
+  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(f.scene, context.catalogue));
   ChooseOptions options;
   DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
   CostSources costs;
-  DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders));
+  DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders, context.catalogue));
   if (!f.speed.empty()) {
-    DB_ASSIGN_OR_RETURN(costs.measured, SpeedCostLookup(f.speed));
+    DB_ASSIGN_OR_RETURN(costs.measured, SpeedCostLookup(f.speed, context.catalogue));
     costs.measured_from = f.speed;
   }
   DB_ASSIGN_OR_RETURN(const std::unique_ptr<Backend> backend, MakeBackend(f.backend, {f.device, f.shaders, false}));

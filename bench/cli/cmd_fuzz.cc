@@ -238,7 +238,7 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
 Expected<int> Fuzz(const FuzzFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
   if (!(f.seconds > 0)) return InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds));
-  DB_ASSIGN_OR_RETURN(const std::vector<Cell> cells, f.cells.Select());
+  DB_ASSIGN_OR_RETURN(const std::vector<Cell> cells, f.cells.Select(context.catalogue));
   if (!f.search && !f.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(f.out, ec);
@@ -247,7 +247,7 @@ Expected<int> Fuzz(const FuzzFlags& f, const CommandContext& context) {
   }
   BackendFlags backend_flags = f.backends;
   if (f.search && backend_flags.backends.size() > 1) backend_flags.backends = {"cpu"};
-  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make(context.catalogue));
   return f.search ? Search(f, cells, made.view(), out) : Campaign(f, cells, made.view(), out);
 }
 

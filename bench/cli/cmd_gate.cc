@@ -48,7 +48,8 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
     std::error_code ec;
     slot.exists = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
     if (slot.exists) {
-      DB_RETURN_IF_ERROR(StoreInto(ReadBaseline(path), slot.baseline).WithContext("the baseline does not parse"));
+      DB_RETURN_IF_ERROR(
+          StoreInto(ReadBaseline(path, context.catalogue), slot.baseline).WithContext("the baseline does not parse"));
     } else if (!f.update) {
       return NotFound(fmt::format(
           "baseline '{}' does not exist; make one with: depthbench gate --update --baseline {} --backend cpu|vulkan",
@@ -83,7 +84,7 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   backend_flags.device = f.device;
   backend_flags.shaders = f.shaders;
   backend_flags.validate = f.validate;
-  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make(context.catalogue));
   const std::span<Backend* const> backends = made.view();
 
   // The gate's own sweep.
@@ -93,6 +94,7 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   options.samples = plan.samples;
   options.domain = plan.domain;
   options.threads = f.threads;
+  options.cells = context.catalogue.Cells();
   Progress progress("gate", StderrIsTerminal());
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
   DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
@@ -108,11 +110,12 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   std::vector<GateRun> runs;
   for (const BaselineSlot& s : slots) {
     GateRun run;
+    run.catalogue = &context.catalogue;
     run.current = BaselineFromResults(results, s.baseline.backend);
     run.shader_dir = f.shaders;
     run.baseline_path = s.path;
     if (s.exists) {
-      Expected<GateComparison> comparison = CompareWithBaseline(s.baseline, run.current, tolerance);
+      Expected<GateComparison> comparison = CompareWithBaseline(s.baseline, run.current, tolerance, context.catalogue);
       if (comparison.ok()) {
         run.comparison = std::move(comparison).value();
         run.baseline = s.baseline;

@@ -24,7 +24,7 @@ Expected<int> List(const CommandContext& context) {
   using Align = TextTable::Align;
   TextTable variants(
       {{"variant", Align::kLeft}, {"source", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
-  for (const auto& v : AllVariants()) {
+  for (const auto& v : context.catalogue.variants()) {
     variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input), std::string(v.idea)});
   }
   out.text << "Variants (their sources: docs/sources.md)\n";
@@ -43,7 +43,7 @@ Expected<int> List(const CommandContext& context) {
   out.text << "\nStorage formats\n";
   formats.Print(out);
   out.text << fmt::format("\n{} cells (variant/convention/format) per backend; backends: cpu, vulkan\n",
-                          AllCells().size());
+                          context.catalogue.Cells().size());
 
   out.text << "\nVulkan devices\n";
   auto devices = ListVulkanDevices();

@@ -71,8 +71,8 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   plan.fit.domain = plan.main_domain;
   plan.fit.domain.camera_distance = {0.0, 0.0};
   plan.shader_dir = f.backends.shaders;
-  DB_ASSIGN_OR_RETURN(std::vector<Cell> cells, f.cells.Select());
-  if (cells.size() != AllCells().size()) plan.cells = std::move(cells);
+  DB_ASSIGN_OR_RETURN(plan.cells, f.cells.Select(context.catalogue));
+  plan.catalogue = &context.catalogue;
   DB_ASSIGN_OR_RETURN(plan.speed_files, SpeedFiles(f));
   for (const fs::path& file : plan.speed_files) {
     DB_RETURN_IF_ERROR(CheckReadableFile(file, kMaxJsonFileBytes).WithContext("--speed"));
@@ -110,7 +110,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
     const fs::path path = f.history.empty() ? UserDataFolder() / "history.sqlite" : fs::path(f.history);
     DB_RETURN_IF_ERROR(StoreInto(History::Open(path), history).WithContext("--history"));
   }
-  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make(context.catalogue));
   const std::span<Backend* const> backends = made.view();
 
   const bool terminal = StderrIsTerminal();

@@ -104,7 +104,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
     DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
   DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}));
-  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select());
+  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
   std::vector<BandFamily> splits;
   for (const std::string& s : f.split) {
     if (s == "ratio")
@@ -117,7 +117,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
       return InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s));
   }
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
-  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make());
+  DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make(context.catalogue));
   const std::span<Backend* const> backends = made.view();
 
   if (!f.repro.empty()) return ReplayReproFile(f, backends, out.text);

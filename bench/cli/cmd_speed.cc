@@ -62,7 +62,8 @@ Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cell
 Expected<int> Speed(const SpeedFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
   SpeedOptions options;
-  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select());
+  DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
+  options.catalogue = &context.catalogue;
   options.resolutions.clear();
   for (const std::string& text : f.resolutions) {
     DB_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(text, "--resolution"));
@@ -97,11 +98,11 @@ Expected<int> Speed(const SpeedFlags& f, const CommandContext& context) {
   // Files given are read before the long work starts.
   std::optional<SpeedResults> previous;
   if (!f.compare.empty()) {
-    DB_RETURN_IF_ERROR(StoreInto(ReadSpeedResults(f.compare), previous).WithContext("--compare"));
+    DB_RETURN_IF_ERROR(StoreInto(ReadSpeedResults(f.compare, context.catalogue), previous).WithContext("--compare"));
   }
   std::optional<Results> given_accuracy;
   if (!f.results.empty()) {
-    DB_RETURN_IF_ERROR(StoreInto(ReadResults(f.results), given_accuracy).WithContext("--results"));
+    DB_RETURN_IF_ERROR(StoreInto(ReadResults(f.results, context.catalogue), given_accuracy).WithContext("--results"));
   }
 
   VulkanContextOptions context_options;

@@ -8,13 +8,16 @@
 
 #include "bench/base/status.h"
 #include "bench/base/text_table.h"
+#include "bench/pipeline/cells.h"
 
 namespace depthbench::cli {
 
 // What a chosen subcommand runs with, made for that one run from its command
-// line: where and how it prints (the text for people, and its tables in the
-// style --table-format and --wide ask for).
+// line: the variants it may run (the built-in ones and those of its
+// --variant-file), and where and how it prints (the text for people, and
+// its tables in the style --table-format and --wide ask for).
 struct CommandContext {
+  const Catalogue& catalogue;
   const TextOutput& output;
 };
 

@@ -701,7 +701,7 @@ Status DeviceJudge::State::MergeMaxima(std::uint32_t from, std::span<CellAccumul
     return InvalidArgument(fmt::format(
         "the {} shader did not write its output for {} samples (cell {}): it returns before writing, or writes "
         "another element; nothing it did not write is judged",
-        Info(run_cells[k].variant).name, unwritten[k], run_cells[k].Name()));
+        run_cells[k].variant_info().name, unwritten[k], run_cells[k].Name()));
   }
   for (std::size_t at = 0; at < maxima(); ++at) {
     if (words[at] == 0) continue;

@@ -107,7 +107,7 @@ json BaselineToJson(const Baseline& b) {
                                       {"cells", cells}});
 }
 
-Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
+Expected<Baseline> BaselineFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
   JsonReader top(j, source);
   DB_RETURN_IF_ERROR(top.CheckSchema(kBaselineSchema));
   Baseline b;
@@ -122,7 +122,7 @@ Expected<Baseline> BaselineFromJson(const json& j, const std::string& source) {
   DB_ASSIGN_OR_RETURN(JsonReader cells, top.Field("cells"));
   if (!cells.json().is_object()) return cells.Error("expected an object of cells");
   for (const auto& [name, bands_json] : cells.json().items()) {
-    Expected<Cell> cell = ParseCell(name);
+    Expected<Cell> cell = catalogue.ParseCell(name);
     if (!cell.ok()) return cells.Error(cell.status().message());
     DB_ASSIGN_OR_RETURN(JsonReader bands, cells.Field(name));
     if (!bands.json().is_object()) return bands.Error("expected an object of bands");
@@ -155,9 +155,9 @@ Status WriteBaseline(const std::filesystem::path& path, const Baseline& baseline
   return WriteFileAtomically(path, BaselineToJson(baseline).dump(1) + "\n");
 }
 
-Expected<Baseline> ReadBaseline(const std::filesystem::path& path) {
+Expected<Baseline> ReadBaseline(const std::filesystem::path& path, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(const nlohmann::json j, ReadJsonFile(path));
-  return BaselineFromJson(j, path.string());
+  return BaselineFromJson(j, path.string(), catalogue);
 }
 
 }  // namespace depthbench

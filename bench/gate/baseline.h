@@ -66,8 +66,10 @@ nlohmann::json SamplePlanToJson(const SamplePlan& plan);
 Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan);
 
 nlohmann::json BaselineToJson(const Baseline& baseline);
-Expected<Baseline> BaselineFromJson(const nlohmann::json& json, const std::string& source);
+// Cell names are checked against `catalogue`.
+Expected<Baseline> BaselineFromJson(const nlohmann::json& json, const std::string& source,
+                                    const Catalogue& catalogue = Catalogue::BuiltIn());
 Status WriteBaseline(const std::filesystem::path& path, const Baseline& baseline);
-Expected<Baseline> ReadBaseline(const std::filesystem::path& path);
+Expected<Baseline> ReadBaseline(const std::filesystem::path& path, const Catalogue& catalogue = Catalogue::BuiltIn());
 
 }  // namespace depthbench

@@ -77,7 +77,7 @@ void CompareCount(const char* what, std::uint64_t before, std::uint64_t after, s
 }  // namespace
 
 Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Baseline& run,
-                                             const GateTolerance& tolerance) {
+                                             const GateTolerance& tolerance, const Catalogue& catalogue) {
   if (baseline.backend != run.backend) {
     return InvalidArgument(
         fmt::format("the baseline was made on the {} backend, not {}", baseline.backend, run.backend));
@@ -107,7 +107,7 @@ Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Bas
   std::set<Cell> cells;
   for (const auto* side : {&baseline.cells, &run.cells}) {
     for (const auto& [name, figures] : *side) {
-      Expected<Cell> cell = ParseCell(name);
+      Expected<Cell> cell = catalogue.ParseCell(name);
       if (!cell.ok()) return cell.status();
       cells.insert(*cell);
     }

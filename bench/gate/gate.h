@@ -66,8 +66,9 @@ struct GateComparison {
 };
 
 // Why the two cannot be compared (another device, another sample plan), or
-// the comparison.
+// the comparison. Cell names are those of `catalogue`.
 Expected<GateComparison> CompareWithBaseline(const Baseline& baseline, const Baseline& run,
-                                             const GateTolerance& tolerance);
+                                             const GateTolerance& tolerance,
+                                             const Catalogue& catalogue = Catalogue::BuiltIn());
 
 }  // namespace depthbench

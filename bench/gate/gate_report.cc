@@ -20,7 +20,7 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
 
 // The command that replays the sample behind a worse band.
 std::string ReproFor(const GateRun& run, const std::string& cell_name, const BandChange& change) {
-  const Cell cell = ParseCell(cell_name).value();
+  const Cell cell = (run.catalogue != nullptr ? *run.catalogue : Catalogue::BuiltIn()).ParseCell(cell_name).value();
   // (NaN and Inf each: one can appear while the other goes.)
   const bool nonfinite = change.after.nan > change.before.nan || change.after.inf > change.before.inf;
   const std::uint64_t index = nonfinite ? change.after.first_nonfinite_index : change.after.worst_index;

@@ -16,6 +16,9 @@ namespace depthbench {
 inline constexpr JsonSchema kGateSchema{"depthbench.gate", 1, "a gate verdict of depthbench gate --json"};
 
 struct GateRun {
+  // The catalogue the cells' names are of (it outlives the run); null: the
+  // built-in one.
+  const Catalogue* catalogue = nullptr;
   GateComparison comparison;
   Baseline baseline;          // what the run was compared with
   Baseline current;           // what the run measured

@@ -5,6 +5,7 @@
 
 #include "bench/base/suggest.h"
 #include "bench/numerics/formulas.h"
+#include "bench/pipeline/user_variant.h"
 
 namespace depthbench {
 
@@ -43,71 +44,78 @@ std::string Suggest(std::string_view word, const Catalogue& catalogue) {
 
 }  // namespace
 
-namespace {
-// The variants in Variant order: the built-in ones, then the user's
-// (user_variant.cc appends them before a command uses the catalog).
-std::vector<VariantInfo>& Variants() {
-  static std::vector<VariantInfo> variants(catalog::kVariants.begin(), catalog::kVariants.end());
-  return variants;
-}
-}  // namespace
+const VariantInfo& Info(Variant v) { return catalog::kVariants.at(static_cast<std::size_t>(v)); }
 
-const VariantInfo& Info(Variant v) { return Variants()[static_cast<std::size_t>(v)]; }
-std::span<const VariantInfo> AllVariants() { return Variants(); }
-
-Variant AddVariant(const VariantInfo& info) {
-  std::vector<VariantInfo>& variants = Variants();
-  VariantInfo added = info;
-  added.id = static_cast<Variant>(variants.size());
-  variants.push_back(added);
-  return added.id;
-}
-
-void RemoveAddedVariants() {
-  std::vector<VariantInfo>& variants = Variants();
-  variants.erase(variants.begin() + kVariantCount, variants.end());
-}
-
-bool Reads(Variant v, Convention c, Format f) {
-  DepthInput input = Info(v).input;
+bool Reads(DepthInput input, Convention c, Format f) {
   return Info(f).stores == input && Info(c).hardware == (input == DepthInput::kHardware);
 }
 
+bool Reads(Variant v, Convention c, Format f) { return Reads(Info(v).input, c, f); }
+
+const VariantInfo& Cell::variant_info() const {
+  return catalogue != nullptr ? catalogue->Info(variant) : depthbench::Info(variant);
+}
+
 std::string Cell::Name() const {
-  return std::string(Info(variant).name) + "/" + std::string(Info(convention).name) + "/" +
+  return std::string(variant_info().name) + "/" + std::string(Info(convention).name) + "/" +
          std::string(Info(format).name);
 }
 
-std::vector<Cell> AllCells() {
+Catalogue::Catalogue() : variants_(catalog::kVariants.begin(), catalog::kVariants.end()) {}
+
+Catalogue::Catalogue(std::vector<UserVariant> user_variants)
+    : user_variants_(std::move(user_variants)), variants_(catalog::kVariants.begin(), catalog::kVariants.end()) {
+  // The vector holding the user's variants never changes again: the views
+  // into its strings stay valid for the catalogue's life.
+  for (const UserVariant& user : user_variants_) {
+    variants_.push_back(
+        {static_cast<Variant>(variants_.size()), user.name, user.source, user.input, user.idea, &user.shader});
+  }
+}
+
+Catalogue::~Catalogue() = default;
+
+const Catalogue& Catalogue::BuiltIn() {
+  static const Catalogue built_in;
+  return built_in;
+}
+
+const VariantInfo& Catalogue::Info(Variant v) const { return variants_.at(static_cast<std::size_t>(v)); }
+
+bool Catalogue::Reads(Variant v, Convention c, Format f) const { return depthbench::Reads(Info(v).input, c, f); }
+
+std::vector<Cell> Catalogue::Cells() const {
   std::vector<Cell> cells;
-  for (const auto& v : AllVariants())
+  for (const auto& v : variants_)
     for (const auto& c : kConventions)
       for (const auto& f : kFormats)
-        if (Reads(v.id, c.id, f.id)) cells.push_back({v.id, c.id, f.id});
+        if (Reads(v.id, c.id, f.id)) cells.push_back(MakeCell(v.id, c.id, f.id));
   return cells;
 }
+
+std::vector<Cell> AllCells() { return Catalogue::BuiltIn().Cells(); }
 
 std::vector<Encoding> AllEncodings() {
   std::vector<Encoding> encodings;
   for (const auto& c : kConventions)
     for (const auto& f : kFormats) {
-      const std::span<const VariantInfo> variants = AllVariants();
-      bool read = std::any_of(variants.begin(), variants.end(),
+      bool read = std::any_of(catalog::kVariants.begin(), catalog::kVariants.end(),
                               [&](const VariantInfo& v) { return Reads(v.id, c.id, f.id); });
       if (read) encodings.push_back({c.id, f.id});
     }
   return encodings;
 }
 
-Expected<Variant> ParseVariant(std::string_view name) {
+Expected<Variant> Catalogue::ParseVariant(std::string_view name) const {
   std::string key = Lower(name);
-  const std::span<const VariantInfo> variants = AllVariants();
-  for (const auto& v : variants)
+  for (const auto& v : variants_)
     if (v.name == key) return v.id;
   return InvalidArgument("unknown variant '" + std::string(name) +
-                         "'; allowed: " + JoinNames(variants, [](const VariantInfo& v) { return v.name; }) +
-                         Suggest(name, variants) + " (a variant from a shader file needs its --variant-file)");
+                         "'; allowed: " + JoinNames(variants_, [](const VariantInfo& v) { return v.name; }) +
+                         Suggest(name, variants_) + " (a variant from a shader file needs its --variant-file)");
 }
+
+Expected<Variant> ParseVariant(std::string_view name) { return Catalogue::BuiltIn().ParseVariant(name); }
 
 Expected<Convention> ParseConvention(std::string_view name) {
   std::string key = Lower(name);
@@ -132,7 +140,7 @@ Expected<Format> ParseFormat(std::string_view name) {
       Suggest(name, kFormats));
 }
 
-Expected<Cell> ParseCell(std::string_view name) {
+Expected<Cell> Catalogue::ParseCell(std::string_view name) const {
   auto first = name.find('/');
   auto second = first == std::string_view::npos ? first : name.find('/', first + 1);
   if (second == std::string_view::npos) {
@@ -143,11 +151,13 @@ Expected<Cell> ParseCell(std::string_view name) {
   DB_ASSIGN_OR_RETURN(Format f, ParseFormat(name.substr(second + 1)));
   if (!Reads(v, c, f)) {
     return InvalidArgument("cell '" + std::string(name) + "' does not exist: " + std::string(Info(v).name) +
-                           " does not read " + std::string(Info(f).name) + " under the " + std::string(Info(c).name) +
-                           " convention");
+                           " does not read " + std::string(depthbench::Info(f).name) + " under the " +
+                           std::string(depthbench::Info(c).name) + " convention");
   }
-  return Cell{v, c, f};
+  return MakeCell(v, c, f);
 }
+
+Expected<Cell> ParseCell(std::string_view name) { return Catalogue::BuiltIn().ParseCell(name); }
 
 bool CellFilter::Keeps(const Cell& cell) const {
   auto keeps = [](const auto& list, auto value) {

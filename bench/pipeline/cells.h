@@ -1,14 +1,18 @@
 // The catalog: reconstruction variants, depth conventions, storage formats,
 // and the one rule that says which variant reads which format under which
 // convention. A Cell is one (variant, convention, format) recipe; results
-// are kept per cell and per backend.
+// are kept per cell and per backend. The built-in variants are a constant
+// table; a command that runs the user's shader files as well builds a
+// Catalogue of its own (user_variant.h MakeCatalogue) and passes it down.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "bench/base/status.h"
@@ -32,11 +36,17 @@ enum class Variant : std::uint8_t {
   kReciprocal,
   kPq,
 };
-// The built-in variants; variants from the user's shader files follow
-// them (user_variant.h), so that a Variant is an index into AllVariants().
+// The built-in variants; a Catalogue's variants from the user's shader
+// files follow them, so that a Variant is an index into its catalogue.
 inline constexpr int kVariantCount = 8;
+// Variant ids are a byte; far more user variants than anyone passes on a
+// command line.
+inline constexpr int kMostUserVariants = 64;
+// Every id a variant of any catalogue can have is below this.
+inline constexpr int kMostVariants = kVariantCount + kMostUserVariants;
 
-struct UserShader;  // bench/pipeline/user_variant.h
+struct UserShader;   // bench/pipeline/user_variant.h
+struct UserVariant;  // bench/pipeline/user_variant.h
 
 struct VariantInfo {
   Variant id;
@@ -146,22 +156,21 @@ inline constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
 }};
 }  // namespace catalog
 
-// Built-in variants, then those registered from the user's files.
+// A built-in variant (below kVariantCount); any other is looked up in its
+// Catalogue (Cell::variant_info, Catalogue::Info).
 const VariantInfo& Info(Variant v);
 inline const ConventionInfo& Info(Convention c) { return catalog::kConventions[static_cast<int>(c)]; }
 inline const FormatInfo& Info(Format f) { return catalog::kFormats[static_cast<int>(f)]; }
-std::span<const VariantInfo> AllVariants();
-// Appends a variant after the built-in ones and returns its id (how
-// user_variant.cc registers the user's shader files); RemoveAddedVariants
-// drops every appended one.
-Variant AddVariant(const VariantInfo& info);
-void RemoveAddedVariants();
+// The built-in variants.
+inline std::span<const VariantInfo> AllVariants() { return catalog::kVariants; }
 inline std::span<const ConventionInfo> AllConventions() { return catalog::kConventions; }
 inline std::span<const FormatInfo> AllFormats() { return catalog::kFormats; }
 
-// The pairing rule, the one place that decides it: a variant reads a format
-// when the format stores the kind of depth the variant consumes, and the
+// The pairing rule, the one place that decides it: a variant that consumes
+// `input` reads a format when the format stores that kind of depth, and the
 // convention is a projective one exactly when that depth is hardware depth.
+bool Reads(DepthInput input, Convention c, Format f);
+// The rule for a built-in variant.
 bool Reads(Variant v, Convention c, Format f);
 
 // A depth buffer's content: what a convention and format make of a scene.
@@ -171,19 +180,73 @@ struct Encoding {
   friend bool operator==(const Encoding&, const Encoding&) = default;
 };
 
+class Catalogue;
+
 struct Cell {
   Variant variant;
   Convention convention;
   Format format;
+  // The catalogue that defines `variant`; it outlives the cell. Null stands
+  // for the built-in variants, which need none; a cell of a variant from
+  // the user's file always names its catalogue (Catalogue makes such cells).
+  const Catalogue* catalogue = nullptr;
+
   Encoding encoding() const { return {convention, format}; }
+  // The variant's name, input and, for a user's variant, shader file.
+  const VariantInfo& variant_info() const;
   std::string Name() const;  // "divide/standard/x8_d24_unorm"
-  friend bool operator==(const Cell&, const Cell&) = default;
-  friend auto operator<=>(const Cell&, const Cell&) = default;
+  // A cell is its recipe: cells of the same variant, convention and format
+  // are equal whichever pointer to their catalogue they hold (a command
+  // has one catalogue).
+  std::tuple<Variant, Convention, Format> recipe() const { return {variant, convention, format}; }
+  friend bool operator==(const Cell& a, const Cell& b) { return a.recipe() == b.recipe(); }
+  friend auto operator<=>(const Cell& a, const Cell& b) { return a.recipe() <=> b.recipe(); }
 };
 
+// The variants a command runs: the built-in ones, then those of the user's
+// shader files (user_variant.h MakeCatalogue), in Variant order, with the
+// cells and names they make. A command builds its own and passes it down;
+// nothing of it outlives the command. It does not change once built, and
+// the cells it makes point to it, so it is neither copied nor moved.
+class Catalogue {
+ public:
+  // The built-in variants alone.
+  Catalogue();
+  // The built-in variants, then `user_variants` in order: their names
+  // differ from each other and from the built-in ones, and there are at
+  // most kMostUserVariants (MakeCatalogue checks both).
+  explicit Catalogue(std::vector<UserVariant> user_variants);
+  ~Catalogue();
+  Catalogue(const Catalogue&) = delete;
+  Catalogue& operator=(const Catalogue&) = delete;
+
+  // One shared catalogue of the built-in variants, for callers that run no
+  // user's file (it never changes).
+  static const Catalogue& BuiltIn();
+
+  std::span<const VariantInfo> variants() const { return variants_; }
+  const VariantInfo& Info(Variant v) const;
+  bool has_user_variants() const { return variants_.size() > static_cast<std::size_t>(kVariantCount); }
+  bool Reads(Variant v, Convention c, Format f) const;
+  // The cell of this catalogue's variant `v` under `c` and `f`.
+  Cell MakeCell(Variant v, Convention c, Format f) const { return {v, c, f, this}; }
+  // Every valid cell, in catalog order.
+  std::vector<Cell> Cells() const;
+
+  // Lookup by name, with a message that lists the allowed names.
+  Expected<Variant> ParseVariant(std::string_view name) const;
+  Expected<Cell> ParseCell(std::string_view name) const;  // "variant/convention/format"
+
+ private:
+  std::vector<UserVariant> user_variants_;  // what the user's VariantInfo point into
+  std::vector<VariantInfo> variants_;
+};
+
+// The cells, names and lookups of the built-in catalogue (Catalogue::BuiltIn()).
 // Every valid cell, in catalog order.
 std::vector<Cell> AllCells();
-// Every encoding some cell reads, in catalog order.
+// Every encoding some variant reads, in catalog order (the user's variants
+// read the same kinds of depth, and so the same encodings).
 std::vector<Encoding> AllEncodings();
 
 // Lookup by name, with a message that lists the allowed names.

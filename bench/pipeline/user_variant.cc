@@ -1,7 +1,6 @@
 #include "bench/pipeline/user_variant.h"
 
 #include <algorithm>
-#include <deque>
 #include <optional>
 #include <sstream>
 
@@ -17,19 +16,6 @@ namespace {
 // comment is.
 constexpr int kDeclarationLines = 40;
 constexpr std::string_view kMarker = "// depthbench:";
-// Variant ids are a byte; far more than anyone passes on a command line.
-constexpr std::size_t kMostUserVariants = 64;
-
-// Storage that outlives the catalog's string_views and pointers: entries
-// are never moved (a deque grows at its end without moving).
-struct Registered {
-  UserShader shader;
-  std::string name, source, idea;
-};
-std::deque<Registered>& Store() {
-  static std::deque<Registered> store;
-  return store;
-}
 
 std::string Suggestion(std::string_view word, std::vector<std::string> names) { return DidYouMean(word, names); }
 
@@ -78,14 +64,16 @@ Status ApplyKey(std::string_view key, std::string_view value, UserShader& shader
 
 const char* kExample = "// depthbench: input=hardware entry=reconstruct uv=top-left view=right-handed";
 
+// The absolute, normal form of a path the user gave.
+std::filesystem::path Absolute(const std::string& given) {
+  std::error_code error;
+  return std::filesystem::absolute(given, error).lexically_normal();
+}
+
 }  // namespace
 
-Expected<Variant> RegisterVariantFile(const std::string& given) {
-  std::error_code error;
-  const std::filesystem::path path = std::filesystem::absolute(given, error).lexically_normal();
-  for (const Registered& r : Store()) {
-    if (r.shader.path == path) return ParseVariant(r.name);
-  }
+Expected<UserVariant> ReadVariantFile(const std::string& given) {
+  const std::filesystem::path path = Absolute(given);
   UserShader shader;
   shader.path = path;
   const std::string extension = path.extension().string();
@@ -137,33 +125,40 @@ Expected<Variant> RegisterVariantFile(const std::string& given) {
                     "rename the file or declare name=... on the '// depthbench:' line",
                     given, name));
   }
-  for (const VariantInfo& v : AllVariants()) {
-    if (v.name == name) {
+  UserVariant variant;
+  variant.shader = shader;
+  variant.name = name;
+  variant.input = *input;
+  variant.source = "user shader " + path.filename().string();
+  variant.idea = fmt::format("{} function {}() from {}", shader.language == ShaderLanguage::kHlsl ? "HLSL" : "GLSL",
+                             shader.entry, path.string());
+  return variant;
+}
+
+Expected<std::unique_ptr<const Catalogue>> MakeCatalogue(const std::vector<std::string>& paths) {
+  std::vector<UserVariant> variants;
+  for (const std::string& given : paths) {
+    const std::filesystem::path path = Absolute(given);
+    const bool again =
+        std::any_of(variants.begin(), variants.end(), [&](const UserVariant& v) { return v.shader.path == path; });
+    if (again) continue;
+    DB_ASSIGN_OR_RETURN(UserVariant variant, ReadVariantFile(given));
+    const bool built_in = std::any_of(AllVariants().begin(), AllVariants().end(),
+                                      [&](const VariantInfo& v) { return v.name == variant.name; });
+    const bool taken =
+        std::any_of(variants.begin(), variants.end(), [&](const UserVariant& v) { return v.name == variant.name; });
+    if (built_in || taken) {
       return InvalidArgument(
           fmt::format("{}: the variant name '{}' is taken{}; declare another with name=... on "
                       "the '// depthbench:' line",
-                      given, name, v.user != nullptr ? " by another --variant-file" : ""));
+                      given, variant.name, taken ? " by another --variant-file" : ""));
     }
+    if (variants.size() >= static_cast<std::size_t>(kMostUserVariants)) {
+      return InvalidArgument(fmt::format("--variant-file: at most {} files", kMostUserVariants));
+    }
+    variants.push_back(std::move(variant));
   }
-  if (Store().size() >= kMostUserVariants) {
-    return InvalidArgument(fmt::format("--variant-file: at most {} files", kMostUserVariants));
-  }
-  Registered& r = Store().emplace_back();
-  r.shader = shader;
-  r.name = name;
-  r.source = "user shader " + path.filename().string();
-  r.idea = fmt::format("{} function {}() from {}", shader.language == ShaderLanguage::kHlsl ? "HLSL" : "GLSL",
-                       shader.entry, path.string());
-  return AddVariant({Variant{}, r.name, r.source, *input, r.idea, &r.shader});
+  return std::make_unique<const Catalogue>(std::move(variants));
 }
-
-Status RegisterVariantFiles(const std::vector<std::string>& paths) {
-  RemoveAddedVariants();
-  Store().clear();
-  for (const std::string& path : paths) DB_RETURN_IF_ERROR(RegisterVariantFile(path).status());
-  return Status::Ok();
-}
-
-bool AnyUserVariant() { return !Store().empty(); }
 
 }  // namespace depthbench

@@ -1,6 +1,6 @@
 // Variants from the user's own shader files (--variant-file): a
 // reconstruction function written in GLSL or HLSL under the contract of
-// docs/variant-files.md, registered in the catalog after the built-in
+// docs/variant-files.md, added to a command's Catalogue after the built-in
 // variants, so that every subcommand runs it as it runs those. The file
 // declares its contract in one comment line:
 //
@@ -20,6 +20,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,18 +40,24 @@ struct UserShader {
   bool view_left_handed = false;
 };
 
-// Reads the declaration line of the shader file at `path` (.glsl or .hlsl)
-// and adds the variant to the catalog; the same file twice is one variant.
+// A variant a user's shader file declares: what a Catalogue holds for it.
+struct UserVariant {
+  UserShader shader;
+  std::string name;
+  DepthInput input = DepthInput::kHardware;
+  std::string source;  // "user shader NAME.glsl"
+  std::string idea;    // the language, function and path
+};
+
+// Reads the declaration line of the shader file at `path` (.glsl or .hlsl).
 // InvalidArgument, naming the file (and line) and what is allowed, when the
-// file cannot be read, declares nothing or something unknown, or its name
-// is taken.
-Expected<Variant> RegisterVariantFile(const std::string& path);
+// file cannot be read or declares nothing or something unknown.
+Expected<UserVariant> ReadVariantFile(const std::string& path);
 
-// Registers every file, in order, after dropping those registered before
-// (each command of a process starts from the built-in catalog).
-Status RegisterVariantFiles(const std::vector<std::string>& paths);
-
-// Whether any variant of the catalog comes from a user's file.
-bool AnyUserVariant();
+// The catalogue of one command: the built-in variants, then the variant of
+// each file of `paths`, in order (the same file twice is one variant).
+// ReadVariantFile's errors, and InvalidArgument when a variant's name is
+// taken or there are more than kMostUserVariants files.
+Expected<std::unique_ptr<const Catalogue>> MakeCatalogue(const std::vector<std::string>& paths);
 
 }  // namespace depthbench

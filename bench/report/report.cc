@@ -356,7 +356,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
       std::vector<FrontEntry> entries;
       for (const TradeFront& front : BuildTrade(speed, at, backend, speed.run.trade_resolution, left_out)) {
         for (const TradePoint& p : front.points) {
-          const Cell cell{p.variant, front.convention, front.format};
+          const Cell cell{p.variant, front.convention, front.format, speed.catalogue};
           const std::optional<CellAccuracy> cell_accuracy = accuracy_of(cell);
           if (!cell_accuracy) continue;
           const double us_per_frame = kFramePixels * 1e-3;
@@ -519,13 +519,14 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
 
   // The speed files first: a bad one is refused before the sweeps.
   begin("speed files");
+  const Catalogue& catalogue = plan.catalogue != nullptr ? *plan.catalogue : Catalogue::BuiltIn();
   for (const std::filesystem::path& path : plan.speed_files) {
-    DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path));
+    DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path, catalogue));
     m.speed.emplace_back(path, std::move(speed));
   }
   // A shader copy that does not compile leaves the front without its
   // instruction counts, not the report without its other parts.
-  m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string()), m.static_costs);
+  m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string(), catalogue), m.static_costs);
   end("speed files", fmt::format("{} read", m.speed.size()));
 
   FitPlan fit_plan = plan.fit;

@@ -41,7 +41,10 @@ struct ReportPlan {
   std::uint64_t main_seed = 1;  // the default-domain sweep
   std::uint64_t main_samples = 0;
   Domain main_domain;
-  std::vector<Cell> cells;  // empty: all
+  std::vector<Cell> cells;  // empty: all the built-in ones
+  // The catalogue of `cells` and of the speed files' variants (it outlives
+  // the report); null: the built-in one.
+  const Catalogue* catalogue = nullptr;
   std::vector<std::filesystem::path> speed_files;
   std::filesystem::path shader_dir;  // for the instruction mix
   int trend_runs = 60;               // runs of the history the trend shows

@@ -209,7 +209,7 @@ json ToJson(const Results& results) {
       coverage.push_back(entry);
     }
     cells.push_back({{"cell", c.cell.Name()},
-                     {"variant", Info(c.cell.variant).name},
+                     {"variant", c.cell.variant_info().name},
                      {"convention", Info(c.cell.convention).name},
                      {"format", Info(c.cell.format).name},
                      {"backend", c.backend},
@@ -369,7 +369,7 @@ Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
   return d;
 }
 
-Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
+Expected<Results> ResultsFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
   JsonReader top(j, source);
   DB_RETURN_IF_ERROR(top.CheckSchema(kResultsSchema));
   Results results;
@@ -412,7 +412,7 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   DB_ASSIGN_OR_RETURN(run.samples_judged, r.Unsigned("samples_judged"));
   DB_RETURN_IF_ERROR(r.ForEach("cells", [&](const JsonReader& c) -> Status {
     DB_ASSIGN_OR_RETURN(std::string name, c.String());
-    Expected<Cell> cell = ParseCell(name);
+    Expected<Cell> cell = catalogue.ParseCell(name);
     if (!cell.ok()) return c.Error(cell.status().message());
     run.cells.push_back(*cell);
     return Status::Ok();
@@ -439,7 +439,7 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   DB_RETURN_IF_ERROR(top.ForEach("cells", [&](const JsonReader& c) -> Status {
     CellResult result;
     DB_ASSIGN_OR_RETURN(std::string name, c.String("cell"));
-    Expected<Cell> cell = ParseCell(name);
+    Expected<Cell> cell = catalogue.ParseCell(name);
     if (!cell.ok()) return c.Error(cell.status().message());
     result.cell = *cell;
     DB_ASSIGN_OR_RETURN(result.backend, c.String("backend"));
@@ -469,9 +469,9 @@ Expected<Results> ResultsFromJson(const json& j, const std::string& source) {
   return results;
 }
 
-Expected<Results> ReadResults(const std::filesystem::path& path) {
+Expected<Results> ReadResults(const std::filesystem::path& path, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(const json j, ReadJsonFile(path));
-  return ResultsFromJson(j, path.string());
+  return ResultsFromJson(j, path.string(), catalogue);
 }
 
 // ---------------------------------------------------------------- merging

@@ -113,10 +113,12 @@ struct Results {
 };
 
 nlohmann::json ToJson(const Results& results);
-// `source` names the input in error messages (a file path).
-Expected<Results> ResultsFromJson(const nlohmann::json& json, const std::string& source);
+// `source` names the input in error messages (a file path). Cell names are
+// looked up in `catalogue`, which the cells read then point to.
+Expected<Results> ResultsFromJson(const nlohmann::json& json, const std::string& source,
+                                  const Catalogue& catalogue = Catalogue::BuiltIn());
 Status WriteResults(const std::filesystem::path& path, const Results& results);
-Expected<Results> ReadResults(const std::filesystem::path& path);
+Expected<Results> ReadResults(const std::filesystem::path& path, const Catalogue& catalogue = Catalogue::BuiltIn());
 
 // Adds up the results of shards of one sweep. They must share what defines
 // the sweep (version, seed, sample count, plan, domain, cells, backends with

@@ -98,13 +98,13 @@ Status GpuPassTimer::CheckFormat(Format format) const {
   return CheckFormatFeatures(format, properties.optimalTilingFeatures, device().name);
 }
 
-Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention convention, std::uint32_t taps) {
-  const auto key = std::make_tuple(variant, convention, taps);
+Expected<VkPipeline> GpuPassTimer::Pipeline(const VariantInfo& variant, Convention convention, std::uint32_t taps) {
+  const auto key = std::make_tuple(variant.id, convention, taps);
   if (auto found = pipelines_.find(key); found != pipelines_.end()) return found->second.get();
-  auto compiled = spirv_.find(variant);
+  auto compiled = spirv_.find(variant.id);
   if (compiled == spirv_.end()) {
     DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> words, CompileVariant(variant, VariantPass::kSpeed, shader_dir_));
-    compiled = spirv_.emplace(variant, std::move(words)).first;
+    compiled = spirv_.emplace(variant.id, std::move(words)).first;
   }
   const std::vector<std::uint32_t>& spirv = compiled->second;
   const std::array<std::uint32_t, 2> values = {taps, Info(convention).bits};
@@ -114,9 +114,8 @@ Expected<VkPipeline> GpuPassTimer::Pipeline(Variant variant, Convention conventi
   }};
   const VkSpecializationInfo specialization{static_cast<std::uint32_t>(entries.size()), entries.data(), sizeof(values),
                                             values.data()};
-  DB_ASSIGN_OR_RETURN(
-      DeviceObject<VkPipeline> pipeline,
-      pass_->CreatePipeline(spirv, specialization, fmt::format("the {} speed pass", Info(variant).name)));
+  DB_ASSIGN_OR_RETURN(DeviceObject<VkPipeline> pipeline,
+                      pass_->CreatePipeline(spirv, specialization, fmt::format("the {} speed pass", variant.name)));
   auto& stored = pipelines_[key];
   stored = std::move(pipeline);
   return stored.get();
@@ -273,23 +272,23 @@ Expected<std::vector<double>> GpuPassTimer::TimeGroups(ComputePass& pass, std::s
   return ns_per_pass;
 }
 
-Expected<PassTiming> GpuPassTimer::TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup,
+Expected<PassTiming> GpuPassTimer::TimePass(const VariantInfo& variant, std::uint32_t taps, std::uint32_t warmup,
                                             std::uint32_t repetitions) {
-  const Variant variants[] = {variant};
+  const VariantInfo variants[] = {variant};
   DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimePasses(variants, taps, warmup, repetitions));
   return std::move(timings.front());
 }
 
-Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Variant> variants, std::uint32_t taps,
+Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const VariantInfo> variants, std::uint32_t taps,
                                                            std::uint32_t warmup, std::uint32_t repetitions) {
   if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
   if (variants.empty()) return InvalidArgument("no variant to time");
-  for (const Variant variant : variants) {
-    if (!Reads(variant, encoding_.convention, encoding_.format)) {
+  for (const VariantInfo& variant : variants) {
+    if (!Reads(variant.input, encoding_.convention, encoding_.format)) {
       return InvalidArgument(
           fmt::format("{} does not read {} under the {} convention (see 'depthbench list'); "
                       "such a pass is not timed",
-                      Info(variant).name, Info(encoding_.format).name, Info(encoding_.convention).name));
+                      variant.name, Info(encoding_.format).name, Info(encoding_.convention).name));
     }
   }
   if (taps == 0 || taps > kMaxTaps) {
@@ -300,7 +299,7 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   }
   const ValidationScope validation(*context_);
   std::vector<VkPipeline> pipelines;
-  for (const Variant variant : variants) {
+  for (const VariantInfo& variant : variants) {
     // Compiling a pipeline takes seconds on a CPU implementation: a signal
     // stops the timing between two (a submitted pass cannot be stopped).
     if (Interrupted()) return InterruptedError("");

@@ -95,11 +95,13 @@ class GpuPassTimer {
   // One PassTiming per variant, in order. InvalidArgument when a variant
   // does not read the loaded image's encoding (the pairing rule), when
   // there is none, when taps is 0 or above kMaxTaps, or when warmup or
-  // repetitions is 0.
-  Expected<std::vector<PassTiming>> TimePasses(std::span<const Variant> variants, std::uint32_t taps,
+  // repetitions is 0. A timer compiles each variant once, by its id: the
+  // variants it times are of one catalogue.
+  Expected<std::vector<PassTiming>> TimePasses(std::span<const VariantInfo> variants, std::uint32_t taps,
                                                std::uint32_t warmup, std::uint32_t repetitions);
   // The same for one variant.
-  Expected<PassTiming> TimePass(Variant variant, std::uint32_t taps, std::uint32_t warmup, std::uint32_t repetitions);
+  Expected<PassTiming> TimePass(const VariantInfo& variant, std::uint32_t taps, std::uint32_t warmup,
+                                std::uint32_t repetitions);
   // The values the last pass wrote, one per pixel (for tests).
   Expected<std::vector<float>> ReadResults();
 
@@ -114,7 +116,7 @@ class GpuPassTimer {
   explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);
   VkDevice vk_device() const { return context_->device(); }
 
-  Expected<VkPipeline> Pipeline(Variant variant, Convention convention, std::uint32_t taps);
+  Expected<VkPipeline> Pipeline(const VariantInfo& variant, Convention convention, std::uint32_t taps);
   // A buffer of `bytes` in device-local memory, bound to it; the buffer is
   // declared after its memory, so that it is destroyed first.
   struct BoundBuffer {

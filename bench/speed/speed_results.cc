@@ -123,6 +123,10 @@ const CpuCost* SpeedResults::FindCpu(const Cell& cell) const {
   return nullptr;
 }
 
+const VariantInfo& SpeedResults::variant_info(Variant v) const {
+  return (catalogue != nullptr ? *catalogue : Catalogue::BuiltIn()).Info(v);
+}
+
 // ---------------------------------------------------------------- writing
 
 namespace {
@@ -151,9 +155,9 @@ json MixToJson(const InstructionMix& mix) {
           {"total_instructions", mix.total_instructions}};
 }
 
-json VariantNames(const std::vector<Variant>& variants) {
+json VariantNames(const SpeedResults& results, const std::vector<Variant>& variants) {
   json names = json::array();
-  for (Variant v : variants) names.push_back(Info(v).name);
+  for (Variant v : variants) names.push_back(results.variant_info(v).name);
   return names;
 }
 
@@ -209,7 +213,7 @@ json ToJson(const SpeedResults& results) {
                    {"passes_per_repetition", t.passes_per_repetition},
                    {"warmup_passes", t.warmup_passes},
                    {"rank", t.rank},
-                   {"indistinguishable_from", VariantNames(t.indistinguishable_from)}};
+                   {"indistinguishable_from", VariantNames(results, t.indistinguishable_from)}};
     // Memory-bound timings against their floor (derived; not read back).
     if (const std::optional<double> times = results.TimesFloor(t)) {
       timing["times_floor"] = *times;
@@ -227,7 +231,8 @@ json ToJson(const SpeedResults& results) {
   }
   json static_costs = json::array();
   for (const StaticCost& s : results.static_costs) {
-    static_costs.push_back({{"variant", Info(s.variant).name}, {"function", s.function}, {"mix", MixToJson(s.mix)}});
+    static_costs.push_back(
+        {{"variant", results.variant_info(s.variant).name}, {"function", s.function}, {"mix", MixToJson(s.mix)}});
   }
   json cpu = json::array();
   for (const CpuCost& c : results.cpu) {
@@ -240,7 +245,7 @@ json ToJson(const SpeedResults& results) {
   for (const TradeFront& front : results.trade) {
     json points = json::array();
     for (const TradePoint& p : front.points) {
-      points.push_back({{"variant", Info(p.variant).name},
+      points.push_back({{"variant", results.variant_info(p.variant).name},
                         {"gpu_ns_per_reconstruction", p.gpu_ns_per_reconstruction},
                         {"gpu_spread_ns", p.gpu_spread_ns},
                         {"gpu_memory_ns_per_pixel", p.gpu_memory_ns_per_pixel},
@@ -283,18 +288,18 @@ Expected<std::uint32_t> ReadU32(const JsonReader& r, const std::string& key) {
   return static_cast<std::uint32_t>(value);
 }
 
-Expected<Cell> ReadCell(const JsonReader& r, const std::string& key) {
+Expected<Cell> ReadCell(const JsonReader& r, const std::string& key, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(JsonReader field, r.Field(key));
   DB_ASSIGN_OR_RETURN(const std::string name, field.String());
-  Expected<Cell> cell = ParseCell(name);
+  Expected<Cell> cell = catalogue.ParseCell(name);
   if (!cell.ok()) return field.Error(cell.status().message());
   return cell;
 }
 
-Expected<Variant> ReadVariant(const JsonReader& r, const std::string& key) {
+Expected<Variant> ReadVariant(const JsonReader& r, const std::string& key, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(JsonReader field, r.Field(key));
   DB_ASSIGN_OR_RETURN(const std::string name, field.String());
-  Expected<Variant> variant = ParseVariant(name);
+  Expected<Variant> variant = catalogue.ParseVariant(name);
   if (!variant.ok()) return field.Error(variant.status().message());
   return variant;
 }
@@ -379,9 +384,9 @@ Expected<SpeedRunInfo> ReadRun(const JsonReader& r) {
   return run;
 }
 
-Expected<GpuTiming> ReadGpuTiming(const JsonReader& r) {
+Expected<GpuTiming> ReadGpuTiming(const JsonReader& r, const Catalogue& catalogue) {
   GpuTiming t;
-  DB_ASSIGN_OR_RETURN(t.cell, ReadCell(r, "cell"));
+  DB_ASSIGN_OR_RETURN(t.cell, ReadCell(r, "cell", catalogue));
   DB_ASSIGN_OR_RETURN(JsonReader resolution, r.Field("resolution"));
   DB_ASSIGN_OR_RETURN(t.resolution, ReadResolution(resolution));
   DB_ASSIGN_OR_RETURN(JsonReader regime_field, r.Field("regime"));
@@ -403,7 +408,7 @@ Expected<GpuTiming> ReadGpuTiming(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(t.rank, ReadU32(r, "rank"));
   DB_RETURN_IF_ERROR(r.ForEach("indistinguishable_from", [&](const JsonReader& element) -> Status {
     DB_ASSIGN_OR_RETURN(const std::string name, element.String());
-    Expected<Variant> variant = ParseVariant(name);
+    Expected<Variant> variant = catalogue.ParseVariant(name);
     if (!variant.ok()) return element.Error(variant.status().message());
     t.indistinguishable_from.push_back(*variant);
     return Status::Ok();
@@ -446,7 +451,7 @@ Expected<MemoryFloor> ReadFloor(const JsonReader& r) {
   return f;
 }
 
-Expected<TradeFront> ReadFront(const JsonReader& r) {
+Expected<TradeFront> ReadFront(const JsonReader& r, const Catalogue& catalogue) {
   TradeFront front;
   DB_ASSIGN_OR_RETURN(JsonReader convention_field, r.Field("convention"));
   DB_ASSIGN_OR_RETURN(const std::string convention, convention_field.String());
@@ -460,9 +465,9 @@ Expected<TradeFront> ReadFront(const JsonReader& r) {
   front.format = *f;
   DB_RETURN_IF_ERROR(r.ForEach("points", [&](const JsonReader& p) -> Status {
     TradePoint point;
-    DB_ASSIGN_OR_RETURN(point.variant, ReadVariant(p, "variant"));
-    if (!Reads(point.variant, front.convention, front.format)) {
-      return p.Error(fmt::format("{} does not read {} under the {} convention", Info(point.variant).name,
+    DB_ASSIGN_OR_RETURN(point.variant, ReadVariant(p, "variant", catalogue));
+    if (!catalogue.Reads(point.variant, front.convention, front.format)) {
+      return p.Error(fmt::format("{} does not read {} under the {} convention", catalogue.Info(point.variant).name,
                                  Info(front.format).name, Info(front.convention).name));
     }
     DB_ASSIGN_OR_RETURN(point.gpu_ns_per_reconstruction, p.Number("gpu_ns_per_reconstruction"));
@@ -482,10 +487,11 @@ Expected<TradeFront> ReadFront(const JsonReader& r) {
 
 }  // namespace
 
-Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& source) {
+Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
   const JsonReader top(j, source);
   DB_RETURN_IF_ERROR(top.CheckSchema(kSpeedSchema));
   SpeedResults results;
+  results.catalogue = &catalogue;
   DB_ASSIGN_OR_RETURN(JsonReader run, top.Field("run"));
   DB_ASSIGN_OR_RETURN(results.run, ReadRun(run));
   // Files made before the bandwidth probe have neither part.
@@ -499,13 +505,13 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
     }));
   }
   DB_RETURN_IF_ERROR(top.ForEach("gpu", [&](const JsonReader& r) -> Status {
-    DB_ASSIGN_OR_RETURN(GpuTiming timing, ReadGpuTiming(r));
+    DB_ASSIGN_OR_RETURN(GpuTiming timing, ReadGpuTiming(r, catalogue));
     results.gpu.push_back(std::move(timing));
     return Status::Ok();
   }));
   DB_RETURN_IF_ERROR(top.ForEach("static", [&](const JsonReader& r) -> Status {
     StaticCost cost;
-    DB_ASSIGN_OR_RETURN(cost.variant, ReadVariant(r, "variant"));
+    DB_ASSIGN_OR_RETURN(cost.variant, ReadVariant(r, "variant", catalogue));
     DB_ASSIGN_OR_RETURN(cost.function, r.String("function"));
     DB_ASSIGN_OR_RETURN(JsonReader mix, r.Field("mix"));
     DB_ASSIGN_OR_RETURN(cost.mix, ReadMix(mix));
@@ -514,7 +520,7 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
   }));
   DB_RETURN_IF_ERROR(top.ForEach("cpu", [&](const JsonReader& r) -> Status {
     CpuCost cost;
-    DB_ASSIGN_OR_RETURN(cost.cell, ReadCell(r, "cell"));
+    DB_ASSIGN_OR_RETURN(cost.cell, ReadCell(r, "cell", catalogue));
     DB_ASSIGN_OR_RETURN(JsonReader summary, r.Field("ns_per_reconstruction"));
     DB_ASSIGN_OR_RETURN(cost.ns_per_reconstruction, ReadSummary(summary));
     DB_ASSIGN_OR_RETURN(cost.runs_per_repetition, ReadU32(r, "runs_per_repetition"));
@@ -523,7 +529,7 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
     return Status::Ok();
   }));
   DB_RETURN_IF_ERROR(top.ForEach("trade", [&](const JsonReader& r) -> Status {
-    DB_ASSIGN_OR_RETURN(TradeFront front, ReadFront(r));
+    DB_ASSIGN_OR_RETURN(TradeFront front, ReadFront(r, catalogue));
     results.trade.push_back(std::move(front));
     return Status::Ok();
   }));
@@ -535,9 +541,9 @@ Expected<SpeedResults> SpeedResultsFromJson(const json& j, const std::string& so
   return results;
 }
 
-Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path) {
+Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(const json j, ReadJsonFile(path));
-  return SpeedResultsFromJson(j, path.string());
+  return SpeedResultsFromJson(j, path.string(), catalogue);
 }
 
 // ---------------------------------------------------------------- comparing
@@ -574,8 +580,8 @@ Expected<RankingComparison> CompareRankings(const SpeedResults& first, const Spe
             "{} {} {}: {} is {} than {} in the first run ({:.4g} vs {:.4g} ns per pass) but {} in the second "
             "({:.4g} vs {:.4g})",
             Info(a1.cell.convention).name, Info(a1.cell.format).name,
-            fmt::format("{} {}", ResolutionName(a1.resolution), RegimeName(a1.regime)), Info(a1.cell.variant).name,
-            OrderingName(in_first), Info(b1.cell.variant).name, a1.ns_per_pass.median, b1.ns_per_pass.median,
+            fmt::format("{} {}", ResolutionName(a1.resolution), RegimeName(a1.regime)), a1.cell.variant_info().name,
+            OrderingName(in_first), b1.cell.variant_info().name, a1.ns_per_pass.median, b1.ns_per_pass.median,
             OrderingName(in_second), a2->ns_per_pass.median, b2->ns_per_pass.median));
       }
     }

@@ -150,6 +150,9 @@ struct SpeedRunInfo {
 };
 
 struct SpeedResults {
+  // The catalogue the variants below are of (it outlives the results);
+  // null: the built-in one.
+  const Catalogue* catalogue = nullptr;
   SpeedRunInfo run;
   std::optional<BandwidthProbe> bandwidth;  // none in files made before the probe, or when it failed
   std::vector<MemoryFloor> floors;          // per format and resolution timed; empty without a probe
@@ -165,15 +168,20 @@ struct SpeedResults {
   // timing or where no floor is known.
   std::optional<double> TimesFloor(const GpuTiming& timing) const;
   const CpuCost* FindCpu(const Cell& cell) const;
+  // A variant of these results: its name, and what it reads.
+  const VariantInfo& variant_info(Variant v) const;
 };
 
 nlohmann::json ToJson(const SpeedResults& results);
 // `source` names the input in error messages (a file path). Records of
 // cells that do not exist (a variant paired with a format or convention it
-// does not read) are refused with the field that holds them.
-Expected<SpeedResults> SpeedResultsFromJson(const nlohmann::json& json, const std::string& source);
+// does not read) are refused with the field that holds them. Variant names
+// are looked up in `catalogue`, which the results then refer to.
+Expected<SpeedResults> SpeedResultsFromJson(const nlohmann::json& json, const std::string& source,
+                                            const Catalogue& catalogue = Catalogue::BuiltIn());
 Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results);
-Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path);
+Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path,
+                                        const Catalogue& catalogue = Catalogue::BuiltIn());
 
 // "1920x1080" and back.
 std::string ResolutionName(Resolution resolution);

@@ -35,9 +35,9 @@ Status ValidateSpeedOptions(const SpeedOptions& o) {
   }
   if (o.cpu.repetitions < 3) return InvalidArgument("Violated constraint: CpuCostOptions::repetitions >= 3");
   for (const Cell& cell : o.cells) {
-    if (!Reads(cell.variant, cell.convention, cell.format)) {
+    if (!Reads(cell.variant_info().input, cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention: no such pass to time",
-                                         Info(cell.variant).name, Info(cell.format).name, Info(cell.convention).name));
+                                         cell.variant_info().name, Info(cell.format).name, Info(cell.convention).name));
     }
   }
   return Status::Ok();
@@ -83,11 +83,11 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
     for (const Encoding& encoding : layout.encodings) {
       // The variants reading this image compete: they are timed together.
       std::vector<Cell> group;
-      std::vector<Variant> variants;
+      std::vector<VariantInfo> variants;
       for (const CellPlan& plan : layout.cells) {
         if (plan.cell.encoding() != encoding) continue;
         group.push_back(plan.cell);
-        variants.push_back(plan.cell.variant);
+        variants.push_back(plan.cell.variant_info());
       }
       const double per_measurement = done > 0 ? elapsed() / static_cast<double>(done) : 0.0;
       // The first depth image is always measured: the rate comes from it.
@@ -142,16 +142,21 @@ Expected<std::vector<GpuTiming>> TimeGpuPasses(GpuPassTimer& timer, const SpeedO
 
 Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path& shader_dir,
                                                      std::span<const Cell> cells) {
+  // The cells' variants, in catalog order.
+  std::vector<VariantInfo> variants;
+  for (const Cell& cell : cells) {
+    const bool seen =
+        std::any_of(variants.begin(), variants.end(), [&](const VariantInfo& v) { return v.id == cell.variant; });
+    if (!seen) variants.push_back(cell.variant_info());
+  }
+  std::sort(variants.begin(), variants.end(), [](const VariantInfo& a, const VariantInfo& b) { return a.id < b.id; });
   std::vector<StaticCost> costs;
-  for (const VariantInfo& variant : AllVariants()) {
-    const bool selected =
-        std::any_of(cells.begin(), cells.end(), [&](const Cell& c) { return c.variant == variant.id; });
-    if (!selected) continue;
+  for (const VariantInfo& variant : variants) {
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv,
-                        CompileVariant(variant.id, VariantPass::kSpeed, shader_dir));
-    const std::string function = VariantFunctionName(variant.id);
+                        CompileVariant(variant, VariantPass::kSpeed, shader_dir));
+    const std::string function = VariantFunctionName(variant);
     Expected<InstructionMix> mix = CountInstructionMix(spirv, function);
-    if (!mix.ok()) return mix.status().WithContext(VariantProgramName(variant.id, VariantPass::kSpeed, shader_dir));
+    if (!mix.ok()) return mix.status().WithContext(VariantProgramName(variant, VariantPass::kSpeed, shader_dir));
     costs.push_back({variant.id, function, *mix});
   }
   return costs;
@@ -178,6 +183,7 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
                                 const SpeedOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SpeedResults results;
+  results.catalogue = options.catalogue;
   SpeedRunInfo& run = results.run;
   run.version = BuildVersion();
   run.commit = BuildCommit();
@@ -220,12 +226,12 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
   std::vector<Cell> cpu_cells;
   std::vector<Variant> not_timed;
   for (const Cell& cell : options.cells) {
-    if (Info(cell.variant).user == nullptr) {
+    if (cell.variant_info().user == nullptr) {
       cpu_cells.push_back(cell);
     } else if (std::find(not_timed.begin(), not_timed.end(), cell.variant) == not_timed.end()) {
       not_timed.push_back(cell.variant);
       results.skipped.push_back(
-          fmt::format("cpu: {} not timed: a shader file runs on Vulkan only", Info(cell.variant).name));
+          fmt::format("cpu: {} not timed: a shader file runs on Vulkan only", cell.variant_info().name));
     }
   }
   if (!cpu_cells.empty()) {

@@ -22,6 +22,8 @@ namespace depthbench {
 
 struct SpeedOptions {
   std::vector<Cell> cells;
+  // The catalogue of `cells` (it outlives the results); null: the built-in one.
+  const Catalogue* catalogue = nullptr;
   std::vector<Resolution> resolutions{{1920, 1080}, {3840, 2160}};
   std::uint32_t alu_taps = 16;  // reconstructions per pixel in the ALU-bound regime
   std::uint32_t warmup = 2;     // warm-up passes per measurement (at least; see gpu_pass_timer.h)

@@ -84,7 +84,7 @@ void PrintGpuTable(const SpeedResults& results, const TextOutput& out) {
       if (!first && cell.encoding() != previous) table.AddSeparator();
       first = false;
       previous = cell.encoding();
-      std::vector<std::string> row = {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
+      std::vector<std::string> row = {std::string(cell.variant_info().name), std::string(Info(cell.convention).name),
                                       std::string(Info(cell.format).short_name)};
       for (const Resolution& r : results.run.resolutions) {
         const GpuTiming* t = results.FindGpu(cell, r, regime);
@@ -150,9 +150,10 @@ void PrintStaticTable(const SpeedResults& results, const TextOutput& out) {
     for (const auto& [name, count] : s.mix.extended_by_name) {
       extended += fmt::format("{}{} {}", extended.empty() ? "" : ", ", name, Count(count));
     }
-    table.AddRow({std::string(Info(s.variant).name), Count(s.mix.fdiv), Count(s.mix.fmul), Count(s.mix.fadd),
-                  Count(s.mix.fma), Count(s.mix.dot), Count(s.mix.matrix_vector), extended.empty() ? "-" : extended,
-                  fmt::format("{}", s.mix.function_calls), fmt::format("{}", s.mix.total_instructions)});
+    table.AddRow({std::string(results.variant_info(s.variant).name), Count(s.mix.fdiv), Count(s.mix.fmul),
+                  Count(s.mix.fadd), Count(s.mix.fma), Count(s.mix.dot), Count(s.mix.matrix_vector),
+                  extended.empty() ? "-" : extended, fmt::format("{}", s.mix.function_calls),
+                  fmt::format("{}", s.mix.total_instructions)});
   }
   out.text << "Static cost: SPIR-V instructions of one reconstruction (lanes in parentheses where vector), counted "
               "in the compiled module\n";
@@ -190,7 +191,7 @@ void PrintTradeTable(const SpeedResults& results, const TextOutput& out) {
     first = false;
     for (const TradePoint& p : front.points) {
       table.AddRow({std::string(Info(front.convention).name), std::string(Info(front.format).short_name),
-                    std::string(Info(p.variant).name), fmt::format("{:.1f}", p.p999_bits_lost),
+                    std::string(results.variant_info(p.variant).name), fmt::format("{:.1f}", p.p999_bits_lost),
                     WithSpread(p.gpu_ns_per_reconstruction * pixels * 1e-3, p.gpu_spread_ns * pixels * 1e-3),
                     p.on_gpu_front ? "*" : "",
                     p.has_cpu_cost() ? WithSpread(p.cpu_ns_per_reconstruction, p.cpu_spread_ns) : "-",

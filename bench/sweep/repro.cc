@@ -165,10 +165,10 @@ nlohmann::json ReproToJson(const Repro& repro) {
 
 std::string ReproCommand(std::uint64_t seed, std::uint64_t index, const Domain& domain, const Cell& cell,
                          const std::string& backend) {
-  const UserShader* user = Info(cell.variant).user;
+  const UserShader* user = cell.variant_info().user;
   return fmt::format("depthbench run --seed {} --index {} --backend {} {}--variant {} --convention {} --format {} {}",
                      seed, index, backend, user != nullptr ? "--variant-file " + user->path.string() + " " : "",
-                     Info(cell.variant).name, Info(cell.convention).name, Info(cell.format).name, domain.ToFlags());
+                     cell.variant_info().name, Info(cell.convention).name, Info(cell.format).name, domain.ToFlags());
 }
 
 }  // namespace depthbench

@@ -154,7 +154,7 @@ class CpuBackend final : public Backend {
 
   Status Prepare(std::span<const CellPlan> cells, PassKind) override {
     for (const CellPlan& plan : cells) {
-      const VariantInfo& variant = Info(plan.cell.variant);
+      const VariantInfo& variant = plan.cell.variant_info();
       if (variant.user != nullptr) {
         return Unavailable(fmt::format(
             "the cpu backend cannot run '{}': its formula is a shader file ({}), which runs on Vulkan only; "

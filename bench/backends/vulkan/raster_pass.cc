@@ -339,14 +339,15 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   }
 
   reconstruction_.clear();
-  reconstruction_.resize(AllVariants().size());
+  reconstruction_.resize(kMostVariants);
   for (const CellPlan& plan : cells) {
     const Variant variant = plan.cell.variant;
     DeviceObject<VkPipeline>& pipeline = reconstruction_[static_cast<std::size_t>(variant)];
     if (pipeline.get() != VK_NULL_HANDLE) continue;
-    const std::string name = VariantProgramName(variant, VariantPass::kRaster, shader_dir);
-    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> fragment,
-                        module(CompileVariant(variant, VariantPass::kRaster, shader_dir, &sources), name));
+    const std::string name = VariantProgramName(plan.cell.variant_info(), VariantPass::kRaster, shader_dir);
+    DB_ASSIGN_OR_RETURN(
+        const DeviceObject<VkShaderModule> fragment,
+        module(CompileVariant(plan.cell.variant_info(), VariantPass::kRaster, shader_dir, &sources), name));
     DrawState state;
     state.light_volume = variant == Variant::kVolumeRay;
     state.vertex = state.light_volume ? light_volume.get() : full_screen.get();

@@ -8,8 +8,9 @@
 namespace depthbench {
 namespace {
 
-std::filesystem::path BuiltInProgram(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir) {
-  const std::string file = std::string(Info(variant).name) + ".comp";
+std::filesystem::path BuiltInProgram(const VariantInfo& variant, VariantPass pass,
+                                     const std::filesystem::path& shader_dir) {
+  const std::string file = std::string(variant.name) + ".comp";
   return pass == VariantPass::kSpeed ? shader_dir / "speed" / file : shader_dir / file;
 }
 
@@ -24,22 +25,22 @@ const char* PassName(VariantPass pass) {
 
 // Whether the program is generated around the variant's function rather
 // than read from a file of the shader directory.
-bool Generated(Variant variant, VariantPass pass) {
-  return Info(variant).user != nullptr || pass == VariantPass::kRaster;
+bool Generated(const VariantInfo& variant, VariantPass pass) {
+  return variant.user != nullptr || pass == VariantPass::kRaster;
 }
 
 // The program around a variant's function: for a user's, the contract's
 // settings, the shared headers, the contract, the user's file; for a
 // built-in one, the shared headers and its shared/variants/ header; then
 // the pass.
-std::string GeneratedProgram(Variant variant, VariantPass pass, const std::filesystem::path& dir) {
-  const UserShader* user = Info(variant).user;
+std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& dir) {
+  const UserShader* user = variant.user;
   const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
   auto include = [](const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); };
   std::string text = hlsl ? "" : "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
   if (user == nullptr) {
     text += include(dir / "common.glsl");
-    text += include(dir.parent_path() / "shared" / "variants" / (std::string(Info(variant).name) + ".h"));
+    text += include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
     text += fmt::format("#define RECONSTRUCT {}\n", VariantFunctionName(variant));
   } else {
     text += fmt::format(
@@ -64,20 +65,19 @@ std::string GeneratedProgram(Variant variant, VariantPass pass, const std::files
 
 }  // namespace
 
-std::string VariantFunctionName(Variant variant) {
-  const VariantInfo& info = Info(variant);
-  return info.user != nullptr ? info.user->entry : std::string(info.name) + "_world_position";
+std::string VariantFunctionName(const VariantInfo& variant) {
+  return variant.user != nullptr ? variant.user->entry : std::string(variant.name) + "_world_position";
 }
 
-std::string VariantProgramName(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir) {
+std::string VariantProgramName(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& shader_dir) {
   if (!Generated(variant, pass)) return BuiltInProgram(variant, pass, shader_dir).string();
-  return fmt::format("<{}'s {} program>", Info(variant).name, PassName(pass));
+  return fmt::format("<{}'s {} program>", variant.name, PassName(pass));
 }
 
-Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass pass,
+Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources) {
-  const UserShader* user = Info(variant).user;
+  const UserShader* user = variant.user;
   if (!Generated(variant, pass)) return CompileShader(BuiltInProgram(variant, pass, shader_dir), ShaderStage::kCompute, sources);
   const bool raster = pass == VariantPass::kRaster;
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();

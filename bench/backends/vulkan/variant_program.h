@@ -28,16 +28,16 @@ enum class VariantPass : std::uint8_t {
 
 // SPIR-V of `variant`'s pass, from the programs in `shader_dir`. The text
 // of every source compiled is appended to `sources` when it is not null.
-Expected<std::vector<std::uint32_t>> CompileVariant(Variant variant, VariantPass pass,
+Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources = nullptr);
 
 // The function of the program that holds the variant's arithmetic (what a
 // static cost model counts): <name>_world_position, or the user's entry.
-std::string VariantFunctionName(Variant variant);
+std::string VariantFunctionName(const VariantInfo& variant);
 
 // What compile messages call the program: its path, or for a generated
 // one "<NAME's accuracy program>" (speed, raster).
-std::string VariantProgramName(Variant variant, VariantPass pass, const std::filesystem::path& shader_dir);
+std::string VariantProgramName(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& shader_dir);
 
 }  // namespace depthbench

@@ -157,7 +157,7 @@ struct DispatchPlan {
 DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std::uint32_t> which,
                             const SliceLayout& slices) {
   DispatchPlan plan;
-  for (std::size_t v = 0; v < AllVariants().size(); ++v) {
+  for (std::size_t v = 0; v < kMostVariants; ++v) {
     const auto first = static_cast<std::uint32_t>(plan.cell_slices.size());
     for (std::size_t k = 0; k < which.size(); ++k) {
       const CellPlan& cell = cells[which[k]];
@@ -230,7 +230,7 @@ class VulkanBackend final : public Backend {
 
   Status PrepareOnDevice(std::span<const CellPlan> cells, PassKind pass);
   // `sources` collects the text of every source file compiled.
-  Expected<DeviceObject<VkPipeline>> BuildPipeline(Variant variant, const PassShape& shape,
+  Expected<DeviceObject<VkPipeline>> BuildPipeline(const VariantInfo& variant, const PassShape& shape,
                                                    std::vector<std::string>& sources) const;
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
@@ -321,7 +321,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
   DB_RETURN_IF_ERROR(CheckDirectory(shader_dir_, "shader directory"));
   // Built aside so that a failure leaves the previous preparation intact.
   DB_ASSIGN_OR_RETURN(const PassShape shape, PassShapeFor(context_->properties().type, options_));
-  std::vector<DeviceObject<VkPipeline>> pipelines(AllVariants().size());
+  std::vector<DeviceObject<VkPipeline>> pipelines(kMostVariants);
   std::vector<std::string> sources;
   std::unique_ptr<RasterPass> raster;
   if (pass == PassKind::kRaster) {
@@ -330,7 +330,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
     for (const CellPlan& plan : cells) {
       DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
       if (pipeline.get() != VK_NULL_HANDLE) continue;
-      DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant, shape, sources));
+      DB_ASSIGN_OR_RETURN(pipeline, BuildPipeline(plan.cell.variant_info(), shape, sources));
     }
   }
   pipelines_ = std::move(pipelines);
@@ -367,7 +367,7 @@ std::uint64_t VulkanBackend::MaxBatchSamples() const {
   return most;
 }
 
-Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(Variant variant, const PassShape& shape,
+Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(const VariantInfo& variant, const PassShape& shape,
                                                                 std::vector<std::string>& sources) const {
   DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compiled,
                       CompileVariant(variant, VariantPass::kAccuracy, shader_dir_, &sources));
@@ -495,7 +495,7 @@ Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const Shad
     return InvalidArgument(fmt::format(
         "the {} shader did not write its output for {} of {} samples (cell {}): it returns before writing, or "
         "writes another element; nothing it did not write is judged",
-        Info(cell.variant).name, unwritten, batch.count, cell.Name()));
+        cell.variant_info().name, unwritten, batch.count, cell.Name()));
   }
   return Status::Ok();
 }
