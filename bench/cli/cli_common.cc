@@ -68,19 +68,19 @@ void DomainFlags::Add(CLI::App& app) {
       ->group("Domain");
 }
 
-Expected<Domain> DomainByName(const std::string& name_or_file) {
+Expected<Domain> DomainByName(const std::string& name_or_file, const Catalogue& catalogue) {
   const bool file = name_or_file.find('/') != std::string::npos || name_or_file.ends_with(".toml");
   if (!file) {
     Expected<Domain> named = NamedDomain(name_or_file);
     if (!named.ok()) return named.status().WithContext("--domain");
     return named;
   }
-  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(name_or_file));
+  DB_ASSIGN_OR_RETURN(const Scene scene, LoadScene(name_or_file, catalogue));
   return scene.domain;
 }
 
-Expected<Domain> DomainFlags::Apply(Domain d) const {
-  if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain), d));
+Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const {
+  if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain, catalogue), d));
   const bool narrowed =
       !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() && camera_distance.empty() &&
         eye_depth.empty() && resolution.empty() && production.empty() && constants.empty() && pipeline.empty());

@@ -21,8 +21,9 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFinding = 1;
 inline constexpr int kExitCannotRun = 2;
 
-// A named domain (typical, wide, extremes) or the domain of a scene file.
-Expected<Domain> DomainByName(const std::string& name_or_file);
+// A named domain (typical, wide, extremes) or the domain of a scene file
+// (whose variant names are looked up in `catalogue`).
+Expected<Domain> DomainByName(const std::string& name_or_file, const Catalogue& catalogue);
 // What --domain says, for the commands that take it.
 inline constexpr const char* kDomainHelp =
     "the scenes to sample: typical (the default: what games and viewers render, camera-relative: fov 30-100 deg, "
@@ -40,7 +41,7 @@ struct DomainFlags {
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;
   void Add(CLI::App& app);
   // The domain --domain names (or `base`), narrowed by the range flags.
-  Expected<Domain> Apply(Domain base) const;
+  Expected<Domain> Apply(Domain base, const Catalogue& catalogue) const;
 };
 
 struct CellFlags {

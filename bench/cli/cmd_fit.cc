@@ -32,7 +32,7 @@ Expected<int> Fit(const FitFlags& f, const CommandContext& context) {
     return InvalidArgument(
         "--ratio and --far do not apply to fit: it sweeps far/near from 1e1 to 1e8 and infinity itself");
   }
-  DB_ASSIGN_OR_RETURN(plan.domain, f.domain.Apply(plan.domain));
+  DB_ASSIGN_OR_RETURN(plan.domain, f.domain.Apply(plan.domain, context.catalogue));
   DB_ASSIGN_OR_RETURN(plan.cells, f.cells.Select(context.catalogue));
   DB_ASSIGN_OR_RETURN(const Level level, ParseLevel(f.level));
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));

@@ -87,7 +87,8 @@ void PrintFindings(const std::vector<FindingGroup>& groups, const TextOutput& ou
 }
 
 Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends,
-                       const TextOutput& out) {
+                       const CommandContext& context) {
+  const TextOutput& out = context.output;
   DB_ASSIGN_OR_RETURN(const std::vector<KnownFinding> known, KnownFindings(f));
   CampaignOptions options;
   options.seconds = f.seconds;
@@ -103,7 +104,7 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
     options.corpus.push_back(std::move(seeds));
   }
   options.out = f.out;
-  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(FuzzDomain()));
+  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(FuzzDomain(), context.catalogue));
   // The campaign's cases (and the reproducers it writes) carry no pipeline
   // model: they are produced as a GPU does, with exactly rounded constants.
   const Domain defaults;
@@ -178,8 +179,9 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
 }
 
 Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::span<Backend* const> backends,
-                     const TextOutput& out) {
-  DB_ASSIGN_OR_RETURN(const Domain domain, f.domain.Apply(Domain{}));
+                     const CommandContext& context) {
+  const TextOutput& out = context.output;
+  DB_ASSIGN_OR_RETURN(const Domain domain, f.domain.Apply(Domain{}, context.catalogue));
   std::uint64_t random_samples = 0;
   if (!f.against_random.empty()) {
     DB_ASSIGN_OR_RETURN(random_samples, ParseCount(f.against_random, "--against-random"));
@@ -236,7 +238,6 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
 }
 
 Expected<int> Fuzz(const FuzzFlags& f, const CommandContext& context) {
-  const TextOutput& out = context.output;
   if (!(f.seconds > 0)) return InvalidArgument(fmt::format("--seconds: must be positive (got {})", f.seconds));
   DB_ASSIGN_OR_RETURN(const std::vector<Cell> cells, f.cells.Select(context.catalogue));
   if (!f.search && !f.out.empty()) {
@@ -248,7 +249,7 @@ Expected<int> Fuzz(const FuzzFlags& f, const CommandContext& context) {
   BackendFlags backend_flags = f.backends;
   if (f.search && backend_flags.backends.size() > 1) backend_flags.backends = {"cpu"};
   DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make(context.catalogue));
-  return f.search ? Search(f, cells, made.view(), out) : Campaign(f, cells, made.view(), out);
+  return f.search ? Search(f, cells, made.view(), context) : Campaign(f, cells, made.view(), context);
 }
 
 }  // namespace

@@ -67,7 +67,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   plan.fit.seed = f.seed;
   // The default-domain sweep's domain; the fit sweeps take its lens,
   // planes and targets, with the camera at the origin and their own ratios.
-  DB_ASSIGN_OR_RETURN(plan.main_domain, f.domain.Apply(plan.main_domain));
+  DB_ASSIGN_OR_RETURN(plan.main_domain, f.domain.Apply(plan.main_domain, context.catalogue));
   plan.fit.domain = plan.main_domain;
   plan.fit.domain.camera_distance = {0.0, 0.0};
   plan.shader_dir = f.backends.shaders;

@@ -103,7 +103,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
   if (!f.shard.empty()) {
     DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
-  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}));
+  DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}, context.catalogue));
   DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
   std::vector<BandFamily> splits;
   for (const std::string& s : f.split) {

@@ -42,17 +42,17 @@ struct SpeedFlags {
 
 // Accuracy results for the trade: the file given, or a run of the selected
 // cells on the same device's Vulkan backend.
-Expected<Results> AccuracyFor(const SpeedFlags& f, const std::vector<Cell>& cells,
+Expected<Results> AccuracyFor(const SpeedFlags& f, const Catalogue& catalogue, const std::vector<Cell>& cells,
                               std::shared_ptr<VulkanContext> context, std::uint64_t samples, std::string& source) {
   if (!f.results.empty()) {
     source = f.results;
-    return ReadResults(f.results);
+    return ReadResults(f.results, catalogue);
   }
   BackendOptions backend_options{f.device, f.shaders, f.validate};
   DB_ASSIGN_OR_RETURN(std::unique_ptr<Backend> backend, MakeVulkanBackend(std::move(context), backend_options));
   SweepOptions sweep;
   sweep.samples = samples;
-  if (!f.domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(f.domain), sweep.domain));
+  if (!f.domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(f.domain, catalogue), sweep.domain));
   sweep.cells = CellsForDomain(cells, sweep.domain);
   Backend* backends[] = {backend.get()};
   source = fmt::format("internal run of {} samples, seed {}, {}", samples, sweep.seed, sweep.domain.Describe());
@@ -132,8 +132,9 @@ Expected<int> Speed(const SpeedFlags& f, const CommandContext& context) {
   if (!f.quiet) progress.Finish(fmt::format("{} GPU timings in {:.1f} s", results.gpu.size(), results.run.seconds));
 
   std::string source;
-  Expected<Results> accuracy = given_accuracy ? Expected<Results>(*given_accuracy)
-                                              : AccuracyFor(f, options.cells, shared_context, accuracy_samples, source);
+  Expected<Results> accuracy =
+      given_accuracy ? Expected<Results>(*given_accuracy)
+                     : AccuracyFor(f, context.catalogue, options.cells, shared_context, accuracy_samples, source);
   if (given_accuracy) source = f.results;
   if (!accuracy.ok()) return accuracy.status().WithContext("accuracy results for the trade");
   DB_RETURN_IF_ERROR(AddTrade(results, *accuracy, source).WithContext("accuracy results for the trade"));

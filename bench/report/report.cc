@@ -41,7 +41,7 @@ std::string RatioLabel(double ratio) {
 Figure Log10Ratio(double ratio) { return std::isinf(ratio) ? Figure() : Shown(std::log10(ratio)); }
 
 CellColumns Columns(const Cell& cell, const std::string& backend = "") {
-  return {std::string(Info(cell.variant).name), std::string(Info(cell.convention).name),
+  return {std::string(cell.variant_info().name), std::string(Info(cell.convention).name),
           std::string(Info(cell.format).name), backend};
 }
 
