@@ -74,7 +74,8 @@ TEST(SweepErrorTest, AFailedRunIsTheSweepsError) {
 TEST(SweepErrorTest, TooFewPositionsReadBackAreRefusedNotJudged) {
   for (bool concurrent : {true, false}) {
     StubBackend stub({.fault = Fault::kReadBack, .fail_at_run = 3, .concurrent = concurrent});
-    ExpectError(RunWith(stub), StatusCode::kInternal, {"running the stub backend", "the stub backend returned", "needed"});
+    ExpectError(RunWith(stub), StatusCode::kInternal,
+                {"running the stub backend", "the stub backend returned", "needed"});
   }
 }
 

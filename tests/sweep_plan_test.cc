@@ -86,8 +86,11 @@ TEST(SweepPlanTest, OptionsNameTheViolatedConstraint) {
     return options.Validate().message();
   };
   EXPECT_EQ(message([](SweepOptions&) {}), "");
-  EXPECT_EQ(message([](SweepOptions& o) { o.samples = 0; }), "Violated constraint: SweepOptions::samples >= 1 (it is 0)");
-  EXPECT_EQ(message([](SweepOptions& o) { o.shard = {3, 2}; }),
+  EXPECT_EQ(message([](SweepOptions& o) { o.samples = 0; }),
+            "Violated constraint: SweepOptions::samples >= 1 (it is 0)");
+  EXPECT_EQ(message([](SweepOptions& o) {
+              o.shard = {3, 2};
+            }),
             "Violated constraint: 1 <= SweepOptions::shard.index <= shard.count (it is 3/2)");
   EXPECT_EQ(message([](SweepOptions& o) { o.batch_size = 63; }),
             "Violated constraint: SweepOptions::batch_size == 0 or in [64, 4194304] (it is 63)");

@@ -111,8 +111,6 @@ FarEndPrediction PredictAtFarEnd(const Scene& scene, const CellResult& in_scene,
   const double near = scene.domain.near.min, far_end = DepthLimit(scene.domain);
   const double lowest = scene.domain.eye_depth ? scene.domain.eye_depth->min : near;
   std::vector<FitPoint> points;
-  // Differences within the histograms' quarter-octave bins are not resolved.
-  constexpr double kResolvedBits = 0.25;
   double camera_term = 0.0, most_above = kResolvedBits;
   for (int d = 0; d < kDepthBands; ++d) {
     const double lo = std::max(lowest, near * DepthBandLow(d)), hi = std::min(far_end, near * DepthBandLow(d) * 10.0);

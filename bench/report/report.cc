@@ -28,7 +28,7 @@ const Level kChartLevels[] = {Level::kP999, Level::kMax};
 const double kFrontRatios[] = {1e2, 1e4, 1e6};
 // Backend differences smaller than this are the statistics' resolution
 // (quarter-octave bins: a p99.9 is known to a quarter of a bit).
-constexpr double kNotableDifferenceBits = kBitsResolution;
+constexpr double kNotableDifferenceBits = kResolvedBits;
 constexpr std::size_t kMostWorstSamples = 40;
 constexpr std::size_t kMostDifferences = 40;
 
@@ -380,10 +380,6 @@ SpeedSection Speed(const ReportMeasurements& m) {
   return section;
 }
 
-// Two variants whose far-plane predictions are closer than this are tied:
-// the gate's tolerance at p99.9, below what the fits resolve.
-constexpr double kTieBits = 0.25;
-
 // The first screen, from the headline (fits: each prediction with its
 // interval) and the speed section (costs): on the GPU backend where the
 // report ran one, at far/near 1e4 for finite conventions.
@@ -435,7 +431,7 @@ std::vector<RecommendationRow> Recommendations(const Report& report) {
     for (const HeadlineRow* h : groups[key]) best = std::min(best, bits_of(h));
     std::vector<const HeadlineRow*> tied;
     for (const HeadlineRow* h : groups[key])
-      if (bits_of(h) <= best + kTieBits) tied.push_back(h);
+      if (bits_of(h) <= best + kResolvedBits) tied.push_back(h);
     // The cheapest of the tied first (unknown costs last), then the more precise.
     std::stable_sort(tied.begin(), tied.end(), [&](const HeadlineRow* a, const HeadlineRow* b) {
       const double ca = cost(a).value_or(INFINITY), cb = cost(b).value_or(INFINITY);

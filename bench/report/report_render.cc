@@ -10,6 +10,7 @@
 #include "bench/base/files.h"
 #include "bench/base/text_table.h"
 #include "bench/pipeline/cells.h"
+#include "bench/pipeline/stats.h"
 #include "bench/report/report_json.h"
 
 namespace depthbench {
@@ -166,10 +167,11 @@ void WhatToUse(const Report& report, std::string& out) {
                        f ? f->ratio : "-", bits(f), f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
                        f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite));
   }
-  out +=
-      "\nUse: the cheapest variant within 0.25 bit of the most precise (= tied ones); bits lost at p99.9 at the far "
+  out += fmt::format(
+      "\nUse: the cheapest variant within {} bit of the most precise (= tied ones); bits lost at p99.9 at the far "
       "plane, the model's 95% interval; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that "
-      "relative error; infinite far: the convention's -inf form, at its far end.\n\n";
+      "relative error; infinite far: the convention's -inf form, at its far end.\n\n",
+      kResolvedBits);
 }
 
 // The worst cells over the default domain and the NaN/Inf findings by

@@ -123,7 +123,9 @@ void PrintResultsTable(const Results& results, std::ostream& out) {
          Count(all.stored_nonfinite)});
   }
   out << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
-         "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
+      << fmt::format("(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below {} samples / max) and, at p99.9, of its\n",
+                     MinimumSamples(Level::kP999))
+      << 
          "three causes: prod (the depth the pipeline produced), stor (the format's rounding and fetch), shader (the\n"
          "variant's float32 arithmetic); the absolute error in world units ('<=': below the histogram's range of\n"
          "2^-48, so only bounded); NaN and Inf outputs where exact arithmetic on the shader's inputs is finite\n"
@@ -165,8 +167,8 @@ void PrintBandTable(const Results& results, BandFamily family, std::ostream& out
     }
     table.AddRow(std::move(row));
   }
-  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under 4000)\n",
-                     title);
+  out << fmt::format("\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under {})\n",
+                     title, MinimumSamples(Level::kP999));
   table.Print(out);
 }
 

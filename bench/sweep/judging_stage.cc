@@ -86,8 +86,8 @@ class HostJudgingStage final : public JudgingStage {
   // cells on the thread that judges them; another runs every cell first.
   Status Judge(const Batch& batch, std::span<CellAccumulator> encodings, ThreadPool& pool) override {
     if (scratch_.size() < pool.size()) scratch_.resize(pool.size());
-    const Status judged = backend().concurrent() ? RunAndJudgeBySlot(batch, encodings, pool)
-                                                 : RunThenJudge(batch, encodings, pool);
+    const Status judged =
+        backend().concurrent() ? RunAndJudgeBySlot(batch, encodings, pool) : RunThenJudge(batch, encodings, pool);
     return judged.WithContext("running the " + backend().name() + " backend");
   }
 
@@ -104,7 +104,8 @@ class HostJudgingStage final : public JudgingStage {
           error.Set(read);
           return;
         }
-        JudgeCellsOfSlot(batch, slot, encodings, [&](std::size_t k, std::uint32_t) { return Positions(*out, batch, k); });
+        JudgeCellsOfSlot(batch, slot, encodings,
+                         [&](std::size_t k, std::uint32_t) { return Positions(*out, batch, k); });
       }
     });
     return error.Get();
@@ -117,7 +118,7 @@ class HostJudgingStage final : public JudgingStage {
     pool.ParallelFor(slot_order_.size(), [&](std::size_t lo, std::size_t hi, unsigned) {
       for (std::size_t next = lo; next < hi; ++next) {
         JudgeCellsOfSlot(batch, slot_order_[next], encodings,
-                  [&](std::size_t, std::uint32_t c) { return Positions(*out, batch, c); });
+                         [&](std::size_t, std::uint32_t c) { return Positions(*out, batch, c); });
       }
     });
     return Status::Ok();

@@ -84,7 +84,8 @@ class SweepLoop {
     std::size_t turn = 0;
     for (std::uint64_t first = plan_.first_sample; first < plan_.end_sample && !Interrupted();
          first += plan_.batch_size, turn = plan_.overlap ? turn ^ 1 : 0) {
-      const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(plan_.batch_size, plan_.end_sample - first));
+      const auto count =
+          static_cast<std::uint32_t>(std::min<std::uint64_t>(plan_.batch_size, plan_.end_sample - first));
       Batch& batch = batches_[turn];
       DB_RETURN_IF_ERROR(Build(first, count, batch));
       if (!plan_.overlap) {

@@ -25,8 +25,8 @@ Status SweepOptions::Validate() const {
         fmt::format("1 <= SweepOptions::shard.index <= shard.count (it is {})", shard.ToString()));
   }
   if (batch_size != 0 && (batch_size < kMinBatch || batch_size > kMaxBatch)) {
-    return ViolatedConstraint(fmt::format("SweepOptions::batch_size == 0 or in [{}, {}] (it is {})", kMinBatch,
-                                          kMaxBatch, batch_size));
+    return ViolatedConstraint(
+        fmt::format("SweepOptions::batch_size == 0 or in [{}, {}] (it is {})", kMinBatch, kMaxBatch, batch_size));
   }
   if (flush_every < 1 || flush_every > kMaxFlushEvery) {
     return ViolatedConstraint(fmt::format("SweepOptions::flush_every in [1, 2^31] (it is {})", flush_every));

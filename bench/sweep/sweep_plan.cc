@@ -16,7 +16,9 @@ Status SweepPlan::Validate() const {
   if (overlap != (built_for != BatchFor::kHostJudge)) {
     return ViolatedConstraint("SweepPlan::overlap == (built_for != kHostJudge): a host judge needs the build's cores");
   }
-  if (overlap != (stage_threads > 0)) return ViolatedConstraint("SweepPlan::stage_threads > 0 exactly where it overlaps");
+  if (overlap != (stage_threads > 0)) {
+    return ViolatedConstraint("SweepPlan::stage_threads > 0 exactly where it overlaps");
+  }
   return Status::Ok();
 }
 
@@ -27,18 +29,14 @@ std::optional<int> LoneDistanceBand(const SweepOptions& options) {
 
 bool WantsDeviceJudge(JudgeSite site, bool gpu, PassKind pass) {
   switch (site) {
-    case JudgeSite::kHost:
-      return false;
-    case JudgeSite::kDevice:
-      return true;
-    case JudgeSite::kAuto:
-      return gpu && pass == PassKind::kCompute;
+    case JudgeSite::kHost: return false;
+    case JudgeSite::kDevice: return true;
+    case JudgeSite::kAuto: return gpu && pass == PassKind::kCompute;
   }
   return false;
 }
 
-Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const StageTraits> stages,
-                              bool devices_can_draw) {
+Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const StageTraits> stages, bool devices_can_draw) {
   if (stages.empty()) return InvalidArgument("no backend to run");
   SweepPlan plan;
   plan.first_sample = options.shard.Begin(options.samples);
@@ -47,9 +45,8 @@ Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const Stage
   plan.only_distance_band = LoneDistanceBand(options);
 
   // A batch no stage can take whole is cut to what the smallest takes.
-  const bool gpu_judges = std::any_of(stages.begin(), stages.end(), [](const StageTraits& s) {
-    return s.site == JudgeSite::kDevice && s.gpu;
-  });
+  const bool gpu_judges = std::any_of(stages.begin(), stages.end(),
+                                      [](const StageTraits& s) { return s.site == JudgeSite::kDevice && s.gpu; });
   std::uint64_t batch = options.batch_size != 0 ? options.batch_size : gpu_judges ? kDeviceJudgeBatch : kHostBatch;
   for (const StageTraits& stage : stages) batch = std::min(batch, stage.max_batch_samples);
   plan.batch_size = static_cast<std::uint32_t>(batch);
@@ -57,11 +54,11 @@ Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const Stage
   // The host stores the texels and computes the reference only where it
   // judges. Where every stage judges on its device, the devices also draw
   // the samples when they can.
-  const bool host_judges = std::any_of(stages.begin(), stages.end(),
-                                       [](const StageTraits& s) { return s.site == JudgeSite::kHost; });
-  plan.built_for = host_judges                                   ? BatchFor::kHostJudge
+  const bool host_judges =
+      std::any_of(stages.begin(), stages.end(), [](const StageTraits& s) { return s.site == JudgeSite::kHost; });
+  plan.built_for = host_judges                                ? BatchFor::kHostJudge
                    : options.device_draws && devices_can_draw ? BatchFor::kDeviceDraws
-                                                                 : BatchFor::kDeviceJudge;
+                                                              : BatchFor::kDeviceJudge;
 
   // Where every stage judges on its device, the host builds the next batch
   // while the devices take the last one, and the threads are shared out: a

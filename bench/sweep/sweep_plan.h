@@ -17,8 +17,8 @@ namespace depthbench {
 
 // What the plan needs to know of one backend's judging stage.
 struct StageTraits {
-  JudgeSite site = JudgeSite::kHost;  // where it judges: kHost or kDevice, never kAuto
-  bool gpu = false;                   // its device is a GPU (DeviceKind::kGpu)
+  JudgeSite site = JudgeSite::kHost;             // where it judges: kHost or kDevice, never kAuto
+  bool gpu = false;                              // its device is a GPU (DeviceKind::kGpu)
   std::uint64_t max_batch_samples = UINT64_MAX;  // its backend's and its judge's limit
 };
 
@@ -33,8 +33,8 @@ struct SweepPlan {
   // (two batches in turn). Only where no stage needs the host's cores to
   // judge, that is where built_for is not kHostJudge.
   bool overlap = false;
-  unsigned build_threads = 1;  // the sweep's pool: builds, host judging, final flush
-  unsigned stage_threads = 0;  // the judging stage's own pool where it overlaps (its uploads); else 0
+  unsigned build_threads = 1;     // the sweep's pool: builds, host judging, final flush
+  unsigned stage_threads = 0;     // the judging stage's own pool where it overlaps (its uploads); else 0
   std::uint64_t flush_every = 0;  // samples after which the 32-bit counters move into the statistics
   // The camera-distance band every sample lies in, made from the joint
   // bands at the end instead of being recorded per sample; none where the
@@ -58,7 +58,6 @@ bool WantsDeviceJudge(JudgeSite site, bool gpu, PassKind pass);
 // The plan for validated `options` and the stages (one per backend, in
 // order). `devices_can_draw`: whether the samples can be drawn on a device
 // (BatchBuilder::DevicesCanDraw).
-Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const StageTraits> stages,
-                              bool devices_can_draw);
+Expected<SweepPlan> PlanSweep(const SweepOptions& options, std::span<const StageTraits> stages, bool devices_can_draw);
 
 }  // namespace depthbench
