@@ -292,12 +292,8 @@ void AddFronts(const std::string& source, double ratio, const std::vector<FrontE
   }
 }
 
-// Pixels of the frame a GPU cost is given for.
-constexpr double kFramePixels = 1920.0 * 1080.0;
-constexpr const char* kFrameName = "1920x1080";
-
 // The speed/accuracy front at the far/near ratios a scene typically has:
-// the cost from each speed file (GPU time per 1920x1080 frame, from the
+// the cost from each speed file (GPU time per kCostFrame frame, from the
 // ALU-bound time per reconstruction) and from the instruction mix (which
 // always exists), the accuracy from this report's sweep at that ratio on
 // the GPU backend, with its interval. Sources best first (CostKind).
@@ -326,9 +322,10 @@ SpeedSection Speed(const ReportMeasurements& m) {
     source.kind = speed.run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
     source.device = speed.run.device.name;
     source.cost_unit =
-        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})", kFrameName,
+        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})",
+                    ResolutionName(kCostFrame),
                     ResolutionName(speed.run.trade_resolution), speed.run.started_at);
-    source.cost_title = fmt::format("GPU time per {} frame (µs) on {}", kFrameName, speed.run.device.name);
+    source.cost_title = fmt::format("GPU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
     source.accuracy = accuracy;
     section.sources.push_back(std::move(source));
   }
@@ -359,7 +356,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
           const Cell cell{p.variant, front.convention, front.format};
           const std::optional<CellAccuracy> cell_accuracy = accuracy_of(cell);
           if (!cell_accuracy) continue;
-          const double us_per_frame = kFramePixels * 1e-3;
+          const double us_per_frame = static_cast<double>(kCostFrame.width) * kCostFrame.height * 1e-3;
           entries.push_back({cell,
                              {p.gpu_ns_per_reconstruction * us_per_frame, p.gpu_spread_ns * us_per_frame,
                               FrontBits(p.p999_bits_lost)},
@@ -380,79 +377,99 @@ SpeedSection Speed(const ReportMeasurements& m) {
   return section;
 }
 
-// The first screen, from the headline (fits: each prediction with its
-// interval) and the speed section (costs): on the GPU backend where the
-// report ran one, at far/near 1e4 for finite conventions.
-std::vector<RecommendationRow> Recommendations(const Report& report) {
-  std::string backend;
-  for (const HeadlineRow& h : report.headline)
-    if (backend.empty() || h.cell.backend == "vulkan") backend = h.cell.backend;
-  // Costs: the best source with a front (sources are best first: a GPU's
-  // time over a software rasteriser's over the static model).
-  const FrontSource* source = nullptr;
-  for (const FrontSource& s : report.speed.sources) {
-    const bool has_rows = std::any_of(report.speed.rows.begin(), report.speed.rows.end(),
-                                      [&](const FrontRow& r) { return r.source == s.source; });
-    if (has_rows && source == nullptr) source = &s;
+// The costs the first screen ranks by: the best speed file's (a GPU's
+// time over a software rasteriser's) where it covers every candidate,
+// else the static model for all (ChooseCosts), with its unit and kind.
+struct ScreenCosts {
+  CostLookup lookup;
+  CostKind kind = CostKind::kStaticModel;
+  std::string unit = kStaticCostUnit;
+};
+ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> candidates) {
+  const SpeedResults* best = nullptr;
+  std::string best_name;
+  for (const auto& [path, speed] : m.speed) {
+    if (speed.gpu.empty()) continue;
+    if (best == nullptr || (speed.run.device.kind == "gpu" && best->run.device.kind != "gpu")) {
+      best = &speed;
+      best_name = path.filename().string();
+    }
   }
-  std::map<std::string, double> cost_of;  // variant/convention/format -> cost
-  for (const FrontRow& r : report.speed.rows)
-    if (source != nullptr && r.source == source->source && r.cost) cost_of.emplace(r.cell.Name(), *r.cost);
-  const CostKind kind = source != nullptr ? source->kind : CostKind::kStaticModel;
-  const std::string unit = kind == CostKind::kStaticModel
-                               ? std::string(kStaticCostUnit)
-                               : fmt::format("µs per {} frame on {}", kFrameName, source->device);
+  CostSources sources{{}, best_name, m.static_costs};
+  if (best != nullptr) sources.measured = SpeedCostLookup(*best, best_name);
+  const CostChoice choice = ChooseCosts(sources, candidates);
+  ScreenCosts costs;
+  costs.lookup = choice.lookup;
+  if (choice.measured) {
+    costs.kind = best->run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    costs.unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), best->run.device.name);
+  }
+  return costs;
+}
 
-  std::map<std::pair<std::string, std::string>, std::vector<const HeadlineRow*>> groups;
-  std::vector<std::pair<std::string, std::string>> order;
-  for (const HeadlineRow& h : report.headline) {
-    if (h.cell.backend != backend) continue;
-    const auto key = std::make_pair(h.cell.convention, h.cell.format);
+// The first screen: per convention and format, on the GPU backend where
+// the report ran one, at far/near 1e4 for finite conventions. The fits'
+// predictions at the far plane (unrounded) within the statistics'
+// resolution of the most precise meet the bar, and the ranking that
+// `choose` uses (choose/ranking.h) puts them in order, cheapest first.
+std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
+  std::string backend;
+  for (const PrecisionFit& f : m.fits) {
+    if (backend.empty() || f.backend == "vulkan") backend = f.backend;
+  }
+  std::vector<const PrecisionFit*> screen;
+  std::vector<Cell> candidates;
+  for (const PrecisionFit& f : m.fits) {
+    if (f.metric != Metric::kTotal || f.level != Level::kP999 || f.backend != backend) continue;
+    screen.push_back(&f);
+    candidates.push_back(f.cell);
+  }
+  const ScreenCosts costs = CostsForScreen(m, candidates);
+  std::map<std::pair<Convention, Format>, std::vector<const PrecisionFit*>> groups;
+  std::vector<std::pair<Convention, Format>> order;
+  for (const PrecisionFit* f : screen) {
+    const auto key = std::make_pair(f->cell.convention, f->cell.format);
     if (groups[key].empty()) order.push_back(key);
-    groups[key].push_back(&h);
+    groups[key].push_back(f);
   }
   std::vector<RecommendationRow> rows;
   for (const auto& key : order) {
+    const std::vector<const PrecisionFit*>& group = groups[key];
     RecommendationRow row;
-    row.convention = key.first;
-    row.format = key.second;
+    row.convention = Info(key.first).name;
+    row.format = Info(key.second).name;
     row.backend = backend;
-    row.ratio = groups[key].front()->infinite_far ? "inf" : "1e4";
-    const auto bits_of = [&](const HeadlineRow* h) {
-      auto it = h->predicted_bits.find(row.ratio);
-      return it == h->predicted_bits.end() || !it->second ? kAllBitsLost : *it->second;
-    };
-    const auto cost = [&](const HeadlineRow* h) -> std::optional<double> {
-      auto it = cost_of.find(h->cell.Name());
-      if (it == cost_of.end()) return std::nullopt;
-      return it->second;
+    row.ratio = group.front()->infinite_far ? "inf" : "1e4";
+    const auto bits_of = [&](const PrecisionFit* f) {
+      auto it = f->predicted.find(row.ratio);
+      return it == f->predicted.end() || !std::isfinite(it->second) ? kAllBitsLost : it->second;
     };
     double best = kAllBitsLost;
-    for (const HeadlineRow* h : groups[key]) best = std::min(best, bits_of(h));
-    std::vector<const HeadlineRow*> tied;
-    for (const HeadlineRow* h : groups[key])
-      if (bits_of(h) <= best + kResolvedBits) tied.push_back(h);
-    // The cheapest of the tied first (unknown costs last), then the more precise.
-    std::stable_sort(tied.begin(), tied.end(), [&](const HeadlineRow* a, const HeadlineRow* b) {
-      const double ca = cost(a).value_or(INFINITY), cb = cost(b).value_or(INFINITY);
-      if (ca != cb) return ca < cb;
-      return bits_of(a) < bits_of(b);
-    });
-    const HeadlineRow& chosen = *tied.front();
-    for (const HeadlineRow* h : tied) row.variants.push_back(h->cell.variant);
+    for (const PrecisionFit* f : group) best = std::min(best, bits_of(f));
+    std::vector<RankInput> inputs;
+    for (const PrecisionFit* f : group) {
+      inputs.push_back({.meets = bits_of(f) <= best + kResolvedBits,
+                        .error = bits_of(f),
+                        .cost = costs.lookup ? costs.lookup(f->cell) : std::nullopt});
+    }
+    const std::vector<RankPlace> ranked = Rank(inputs);
+    for (const RankPlace& place : ranked) {
+      if (inputs[place.candidate].meets) row.variants.emplace_back(Info(group[place.candidate]->cell.variant).name);
+    }
+    const PrecisionFit& chosen = *group[ranked.front().candidate];
     row.bits = Shown(bits_of(&chosen));
     // The interval of that very prediction (the fit's model at the far
     // plane of the ratio), not of a band's point: a band can sit elsewhere
     // (the infinite sweep's deepest band ends short of the span predicted).
     if (auto it = chosen.predicted_interval.find(row.ratio); it != chosen.predicted_interval.end() && row.bits) {
-      row.bits_low = it->second.first;
-      row.bits_high = it->second.second;
+      row.bits_low = Shown(it->second.first);
+      row.bits_high = Shown(it->second.second);
     }
-    if (const std::optional<double> c = cost(&chosen)) row.cost = Shown(*c);
-    row.cost_kind = kind;
-    row.cost_unit = unit;
-    row.ratio_for_1e3 = chosen.ratio_for_1e3;
-    row.ratio_for_1e6 = chosen.ratio_for_1e6;
+    if (const std::optional<CandidateCost>& c = inputs[ranked.front().candidate].cost) row.cost = Shown(c->value);
+    row.cost_kind = costs.kind;
+    row.cost_unit = costs.unit;
+    row.ratio_for_1e3 = Budget(chosen, "1e-3");
+    row.ratio_for_1e6 = Budget(chosen, "1e-6");
     rows.push_back(std::move(row));
   }
   return rows;
@@ -571,7 +588,7 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   report.backend_differences = Differences(m.sweeps, backends);
   Findings(m, report);
   report.speed = Speed(m);
-  report.recommendations = Recommendations(report);
+  report.recommendations = Recommendations(m);
   return report;
 }
 

@@ -13,6 +13,10 @@
 
 namespace depthbench {
 
+// The frame a GPU cost is given for (a time per reconstruction times its
+// pixels): what a frame budget is usually counted in.
+inline constexpr Resolution kCostFrame{1920, 1080};
+
 // A cell whose NaN and Inf outputs exceed this share of its judged samples
 // has a non-finite p99.9: it counts as losing every bit.
 inline constexpr double kNonfiniteShareAtP999 = 0.001;
