@@ -323,9 +323,9 @@ SpeedSection Speed(const ReportMeasurements& m) {
     source.device = speed.run.device.name;
     source.cost_unit =
         fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})",
-                    ResolutionName(kCostFrame),
-                    ResolutionName(speed.run.trade_resolution), speed.run.started_at);
-    source.cost_title = fmt::format("GPU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
+                    ResolutionName(kCostFrame), ResolutionName(speed.run.trade_resolution), speed.run.started_at);
+    source.cost_title =
+        fmt::format("GPU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
     source.accuracy = accuracy;
     section.sources.push_back(std::move(source));
   }
@@ -501,6 +501,57 @@ ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& 
 
 }  // namespace
 
+// Groups the history's changes by cell (HistorySection::worse_cells) and
+// counts the cells better and unchanged of the `cells` compared.
+void CountChangedCells(std::size_t cells, HistorySection& h) {
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> worse;
+  std::set<std::pair<std::string, std::string>> better;
+  for (const HistorySection::Change& c : h.changes) {
+    if (c.direction == HistorySection::Direction::kWorse) {
+      worse[{c.cell, c.backend}].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
+    }
+  }
+  for (const HistorySection::Change& c : h.changes) {
+    if (c.direction == HistorySection::Direction::kBetter && !worse.count({c.cell, c.backend})) {
+      better.insert({c.cell, c.backend});
+    }
+  }
+  for (auto& [key, bands] : worse) h.worse_cells.push_back({key.first, key.second, std::move(bands)});
+  h.better_cells = better.size();
+  h.unchanged_cells = cells - std::min(cells, h.worse_cells.size() + h.better_cells);
+}
+
+// The headline's measured cells, worst first; a cell with the same figures
+// on several backends once.
+std::vector<Report::WorstCell> WorstCells(const std::vector<HeadlineRow>& headline) {
+  std::vector<std::size_t> rows;
+  for (std::size_t k = 0; k < headline.size(); ++k) {
+    if (headline[k].measured) rows.push_back(k);
+  }
+  std::stable_sort(rows.begin(), rows.end(), [&](std::size_t i, std::size_t j) {
+    const HeadlineRow* a = &headline[i];
+    const HeadlineRow* b = &headline[j];
+    const double a_p999 = a->measured->p999_bits.value_or(INFINITY), b_p999 = b->measured->p999_bits.value_or(INFINITY);
+    if (a_p999 != b_p999) return a_p999 > b_p999;
+    return a->measured->max_bits.value_or(INFINITY) > b->measured->max_bits.value_or(INFINITY);
+  });
+  std::vector<Report::WorstCell> worst;
+  for (std::size_t k : rows) {
+    const HeadlineRow& row = headline[k];
+    auto same = std::find_if(worst.begin(), worst.end(), [&](const Report::WorstCell& w) {
+      const HeadlineRow& other = headline[w.row];
+      return other.cell.Name() == row.cell.Name() && other.measured->p999_bits == row.measured->p999_bits &&
+             other.measured->max_bits == row.measured->max_bits;
+    });
+    if (same != worst.end()) {
+      same->backends.push_back(row.cell.backend);
+    } else {
+      worst.push_back({k, {row.cell.backend}});
+    }
+  }
+  return worst;
+}
+
 ReportPlan ReportPlan::Nightly() {
   ReportPlan plan;
   plan.fit.samples_per_ratio = 300000;
@@ -589,6 +640,7 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   Findings(m, report);
   report.speed = Speed(m);
   report.recommendations = Recommendations(m);
+  report.worst_cells = WorstCells(report.headline);
   return report;
 }
 
@@ -622,16 +674,19 @@ Status AddHistory(Report& report, History& history, const HistoryRun& run, std::
     DB_ASSIGN_OR_RETURN(GateComparison comparison, CompareWithBaseline(before_figures, now, tolerance));
     for (const std::string& note : comparison.notes) section.notes.push_back(now.backend + ": " + note);
     for (const CellVerdict& v : comparison.cells) {
-      auto add = [&](const char* direction, const std::string& band, const std::vector<std::string>& reasons,
-                     double before_bits, double after_bits) {
+      auto add = [&](HistorySection::Direction direction, const std::string& band,
+                     const std::vector<std::string>& reasons, double before_bits, double after_bits) {
         section.changes.push_back(
             {direction, now.backend, v.cell, band, reasons, Shown(before_bits), Shown(after_bits)});
       };
-      if (v.disappeared) add("worse", "all", {"the cell is missing from this run"}, NAN, NAN);
-      for (const BandChange& c : v.worse) add("worse", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
-      for (const BandChange& c : v.better) add("better", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
+      constexpr auto kWorse = HistorySection::Direction::kWorse;
+      if (v.disappeared) add(kWorse, "all", {"the cell is missing from this run"}, NAN, NAN);
+      for (const BandChange& c : v.worse) add(kWorse, c.band, c.reasons, c.before.total_p999, c.after.total_p999);
+      for (const BandChange& c : v.better)
+        add(HistorySection::Direction::kBetter, c.band, c.reasons, c.before.total_p999, c.after.total_p999);
     }
   }
+  CountChangedCells(report.headline.size(), section);
   report.history = std::move(section);
   return Status::Ok();
 }

@@ -153,7 +153,7 @@ json History(const std::optional<HistorySection>& h) {
           {"notes", h->notes},
           {"changes", Rows(h->changes,
                            [](const HistorySection::Change& c) {
-                             return json{{"direction", c.direction},
+                             return json{{"direction", DirectionName(c.direction)},
                                          {"backend", c.backend},
                                          {"cell", c.cell},
                                          {"band", c.band},

@@ -35,7 +35,11 @@ const char* CostKindName(CostKind kind) {
 
 std::size_t HistorySection::worse() const {
   return static_cast<std::size_t>(
-      std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == "worse"; }));
+      std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == Direction::kWorse; }));
+}
+
+const char* DirectionName(HistorySection::Direction direction) {
+  return direction == HistorySection::Direction::kWorse ? "worse" : "better";
 }
 
 }  // namespace depthbench
