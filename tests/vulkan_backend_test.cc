@@ -158,7 +158,7 @@ TEST_F(VulkanBackendTest, DescribesLavapipe) {
   EXPECT_EQ(vulkan_->name(), "vulkan");
   EXPECT_FALSE(vulkan_->concurrent());
   EXPECT_NE(device.name.find("llvmpipe"), std::string::npos) << device.name;
-  EXPECT_EQ(device.kind, "cpu");
+  EXPECT_EQ(device.kind, DeviceKind::kCpu);
   EXPECT_EQ(device.api.rfind("Vulkan 1.", 0), 0u) << device.api;
   EXPECT_EQ(device.compiler.rfind("glslang ", 0), 0u) << device.compiler;
   EXPECT_NE(device.driver.find("Mesa"), std::string::npos) << device.driver;

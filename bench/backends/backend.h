@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/shader_inputs.h"
 

@@ -319,7 +319,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
     if (speed.gpu.empty()) continue;
     FrontSource source;
     source.source = source_name(path, speed);
-    source.kind = speed.run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    source.kind = speed.run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
     source.device = speed.run.device.name;
     source.cost_unit =
         fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})",
@@ -390,7 +390,7 @@ ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> ca
   std::string best_name;
   for (const auto& [path, speed] : m.speed) {
     if (speed.gpu.empty()) continue;
-    if (best == nullptr || (speed.run.device.kind == "gpu" && best->run.device.kind != "gpu")) {
+    if (best == nullptr || (speed.run.device.kind == DeviceKind::kGpu && best->run.device.kind != DeviceKind::kGpu)) {
       best = &speed;
       best_name = path.filename().string();
     }
@@ -401,7 +401,7 @@ ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> ca
   ScreenCosts costs;
   costs.lookup = choice.lookup;
   if (choice.measured) {
-    costs.kind = best->run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    costs.kind = best->run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
     costs.unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), best->run.device.name);
   }
   return costs;

@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
 
 namespace depthbench {

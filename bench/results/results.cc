@@ -131,7 +131,7 @@ json SummaryToJson(const BandStats& all) {
 }  // namespace
 
 json DeviceToJson(const DeviceInfo& d) {
-  return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", d.kind}, {"compiler", d.compiler}};
+  return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", DeviceKindName(d.kind)}, {"compiler", d.compiler}};
 }
 
 Expected<DeviceInfo> DeviceFromJson(const JsonReader& r) {
@@ -139,7 +139,11 @@ Expected<DeviceInfo> DeviceFromJson(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(d.name, r.String("name"));
   DB_ASSIGN_OR_RETURN(d.driver, r.String("driver"));
   DB_ASSIGN_OR_RETURN(d.api, r.String("api"));
-  DB_ASSIGN_OR_RETURN(d.kind, r.String("kind"));
+  DB_ASSIGN_OR_RETURN(const JsonReader kind_field, r.Field("kind"));
+  DB_ASSIGN_OR_RETURN(const std::string kind, kind_field.String());
+  const std::optional<DeviceKind> parsed = ParseDeviceKind(kind);
+  if (!parsed) return kind_field.Error(fmt::format("'{}' is not a device kind; allowed: cpu, gpu", kind));
+  d.kind = *parsed;
   DB_ASSIGN_OR_RETURN(d.compiler, r.String("compiler"));
   return d;
 }

@@ -55,7 +55,7 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   for (const auto& b : run.backends) {
     out << fmt::format("backend {}: {} [{}; {}; {}]", b.name, b.device.name, b.device.driver, b.device.api,
                        b.device.compiler);
-    if (b.name == "vulkan" && b.device.kind == "cpu") out << " (software rasterizer on the CPU)";
+    if (b.name == "vulkan" && b.device.kind == DeviceKind::kCpu) out << " (software rasterizer on the CPU)";
     if (b.name == "vulkan") out << fmt::format(", shaders {} ({})", b.program.shaders, b.program.hash);
     out << "\n";
   }

@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"

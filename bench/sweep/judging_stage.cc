@@ -79,7 +79,7 @@ class HostJudgingStage final : public JudgingStage {
   }
 
   StageTraits traits() const override {
-    return {JudgeSite::kHost, backend().device().kind == "gpu", backend().MaxBatchSamples()};
+    return {JudgeSite::kHost, backend().device().kind == DeviceKind::kGpu, backend().MaxBatchSamples()};
   }
 
   // A backend that runs on several threads at once runs a depth slot's
@@ -168,7 +168,7 @@ class DeviceJudgingStage final : public JudgingStage {
       : JudgingStage(backend, cell_count, record_distances), judge_(std::move(judge)) {}
 
   StageTraits traits() const override {
-    return {JudgeSite::kDevice, backend().device().kind == "gpu",
+    return {JudgeSite::kDevice, backend().device().kind == DeviceKind::kGpu,
             std::min(backend().MaxBatchSamples(), judge_->MaxBatchSamples())};
   }
 
@@ -195,7 +195,7 @@ class DeviceJudgingStage final : public JudgingStage {
 Expected<std::unique_ptr<JudgingStage>> MakeJudgingStage(const SweepOptions& options, Backend& backend,
                                                          const RunLayout& layout, bool record_distances) {
   const ProductionModel production = options.domain.production;
-  const bool gpu = backend.device().kind == "gpu";
+  const bool gpu = backend.device().kind == DeviceKind::kGpu;
   if (WantsDeviceJudge(options.judge, gpu, PassKindOf(production))) {
     Expected<std::unique_ptr<DeviceJudge>> judge =
         DeviceJudge::Create(backend, layout, production, record_distances, options.device_tuning);

@@ -148,14 +148,15 @@ class SweepLoop {
     return judged;
   }
 
-  // The last flush: the stages' counts kept on devices (which finishes
-  // their last batch, so it counts as judging), then every accumulator.
+  // The last flush, which counts as judging: the stages' counts kept on
+  // devices (which finishes their last batch), then every accumulator's
+  // into the statistics.
   Status FlushAll() {
     const auto last_flush = std::chrono::steady_clock::now();
     for (std::size_t s = 0; s < stages_.size(); ++s) DB_RETURN_IF_ERROR(stages_[s]->Flush(EncodingsFor(s)));
-    run_.stages.judging += SecondsSince(last_flush);
     encodings_.FlushAll(pool_);
     for (const auto& stage : stages_) stage->cells().FlushAll(pool_);
+    run_.stages.judging += SecondsSince(last_flush);
     return Status::Ok();
   }
 
