@@ -89,7 +89,9 @@ std::vector<ModelPointRow> ModelAlongPoints(const PrecisionFit& fit, const FitSw
     row.log10_ratio = Log10Ratio(band.ratio);
     row.depth = Shown(std::exp2(p.y));
     row.measured = band.modelled ? value(p.b) : Figure();
-    row.state = band.modelled ? "measured" : std::isinf(p.b) ? "not finite" : "below resolution";
+    row.state = band.modelled     ? ModelPointRow::State::kMeasured
+                : std::isinf(p.b) ? ModelPointRow::State::kNotFinite
+                                  : ModelPointRow::State::kBelowResolution;
     row.model = value(model.value);
     row.low = value(model.low);
     row.high = value(model.high);

@@ -95,7 +95,7 @@ json ModelPoint(const ModelPointRow& r) {
                           {"log10_ratio", Value(r.log10_ratio)},
                           {"depth", Value(r.depth)},
                           {"measured", Value(r.measured)},
-                          {"state", r.state},
+                          {"state", PointStateName(r.state)},
                           {"model", Value(r.model)},
                           {"low", Value(r.low)},
                           {"high", Value(r.high)},

@@ -38,6 +38,15 @@ std::size_t HistorySection::worse() const {
       std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == Direction::kWorse; }));
 }
 
+const char* PointStateName(ModelPointRow::State state) {
+  switch (state) {
+    case ModelPointRow::State::kMeasured: return "measured";
+    case ModelPointRow::State::kNotFinite: return "not finite";
+    case ModelPointRow::State::kBelowResolution: return "below resolution";
+  }
+  return "?";
+}
+
 const char* DirectionName(HistorySection::Direction direction) {
   return direction == HistorySection::Direction::kWorse ? "worse" : "better";
 }

@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
+#include "bench/pipeline/device_info.h"
 
 namespace depthbench {
 
@@ -89,8 +89,12 @@ struct ModelPointRow {
   std::string ratio;  // "1e4", "inf"
   Figure log10_ratio;
   Figure depth;
-  Figure measured;    // none: see state
-  std::string state;  // "measured", "not finite", "below resolution"
+  // What a band's measured figure is: a figure, none because the outputs
+  // were not finite, or none because the error is below what the
+  // histograms resolve.
+  enum class State : std::uint8_t { kMeasured, kNotFinite, kBelowResolution };
+  Figure measured;  // none: see state
+  State state = State::kMeasured;
   Figure model, low, high;
   bool held_out = false;
 };
@@ -214,6 +218,7 @@ struct HistorySection {
 
   std::size_t worse() const;  // changes for the worse
 };
+const char* PointStateName(ModelPointRow::State state);          // "measured", "not finite", "below resolution"
 const char* DirectionName(HistorySection::Direction direction);  // "worse", "better"
 
 // The first screen: per convention and format, the variant to use (with
