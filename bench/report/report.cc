@@ -294,6 +294,13 @@ void AddFronts(const std::string& source, double ratio, const std::vector<FrontE
   }
 }
 
+// The backend the first screen and the speed section speak for: the
+// Vulkan backend where the report ran it (TradeBackend), else the CPU.
+std::string FirstScreenBackend(const ReportMeasurements& m) {
+  const Expected<std::string> backend = TradeBackend(m.main);
+  return backend.ok() ? *backend : "cpu";
+}
+
 // The speed/accuracy front at the far/near ratios a scene typically has:
 // the cost from each speed file (GPU time per kCostFrame frame, from the
 // ALU-bound time per reconstruction) and from the instruction mix (which
@@ -306,8 +313,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
     return section;
   }
   std::vector<FrontRow>& rows = section.rows;
-  const Expected<std::string> trade_backend = TradeBackend(m.main);
-  const std::string backend = trade_backend.ok() ? *trade_backend : "cpu";
+  const std::string backend = FirstScreenBackend(m);
   std::string device;
   for (const BackendRecord& b : m.main.run.backends) {
     if (b.name == backend) device = b.device.name;
@@ -415,10 +421,7 @@ ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> ca
 // resolution of the most precise meet the bar, and the ranking that
 // `choose` uses (choose/ranking.h) puts them in order, cheapest first.
 std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
-  std::string backend;
-  for (const PrecisionFit& f : m.fits) {
-    if (backend.empty() || f.backend == "vulkan") backend = f.backend;
-  }
+  const std::string backend = FirstScreenBackend(m);
   std::vector<const PrecisionFit*> screen;
   std::vector<Cell> candidates;
   for (const PrecisionFit& f : m.fits) {
