@@ -16,7 +16,7 @@
 #include "bench/base/json_reader.h"
 #include "bench/choose/ranking.h"
 #include "bench/choose/scene.h"
-#include "bench/fit/error_model.h"
+#include "bench/models/error_model.h"
 #include "bench/speed/speed_results.h"
 
 namespace depthbench {
