@@ -84,7 +84,8 @@ class HostJudgingStage final : public JudgingStage {
 
   // A backend that runs on several threads at once runs a depth slot's
   // cells on the thread that judges them; another runs every cell first.
-  Status Judge(const Batch& batch, std::span<CellAccumulator> encodings, ThreadPool& pool) override {
+  Status Judge(const Batch& batch, const DeviceJudgeInputs& /*device*/, std::span<CellAccumulator> encodings,
+               ThreadPool& pool) override {
     if (scratch_.size() < pool.size()) scratch_.resize(pool.size());
     const Status judged =
         backend().concurrent() ? RunAndJudgeBySlot(batch, encodings, pool) : RunThenJudge(batch, encodings, pool);
@@ -172,8 +173,9 @@ class DeviceJudgingStage final : public JudgingStage {
             std::min(backend().MaxBatchSamples(), judge_->MaxBatchSamples())};
   }
 
-  Status Judge(const Batch& batch, std::span<CellAccumulator> encodings, ThreadPool& pool) override {
-    return judge_->Judge(batch, cells().accumulators(), encodings, pool)
+  Status Judge(const Batch& batch, const DeviceJudgeInputs& device, std::span<CellAccumulator> encodings,
+               ThreadPool& pool) override {
+    return judge_->Judge(batch, device, cells().accumulators(), encodings, pool)
         .WithContext("running and judging on the " + backend().name() + " backend");
   }
 

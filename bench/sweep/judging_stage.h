@@ -57,11 +57,13 @@ class JudgingStage {
   virtual StageTraits traits() const = 0;
 
   // Runs the backend on every cell of the layout for `batch` and records
-  // the errors. `encodings` is empty, or one accumulator per depth slot
-  // into which this stage also records the storage and production errors
-  // (a property of the batch, recorded by one stage only). A stage may
-  // return before its device has finished; Flush finishes it.
-  virtual Status Judge(const Batch& batch, std::span<CellAccumulator> encodings, ThreadPool& pool) = 0;
+  // the errors. `device`: what a judge on the device reads beside the
+  // batch. `encodings` is empty, or one accumulator per depth slot into
+  // which this stage also records the storage and production errors (a
+  // property of the batch, recorded by one stage only). A stage may return
+  // before its device has finished; Flush finishes it.
+  virtual Status Judge(const Batch& batch, const DeviceJudgeInputs& device, std::span<CellAccumulator> encodings,
+                       ThreadPool& pool) = 0;
   // Brings every count the stage keeps outside its accumulators (a
   // device's) into them; `encodings` as Judge got them.
   virtual Status Flush(std::span<CellAccumulator> /*encodings*/) { return Status::Ok(); }

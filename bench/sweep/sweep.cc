@@ -87,13 +87,15 @@ class SweepLoop {
       const auto count =
           static_cast<std::uint32_t>(std::min<std::uint64_t>(plan_.batch_size, plan_.end_sample - first));
       Batch& batch = batches_[turn];
-      DB_RETURN_IF_ERROR(Build(first, count, batch));
+      DeviceJudgeInputs& device = device_inputs_[turn];
+      DB_RETURN_IF_ERROR(Build(first, count, batch, device));
       if (!plan_.overlap) {
-        DB_RETURN_IF_ERROR(JudgeBatch(batch, pool_));
+        DB_RETURN_IF_ERROR(JudgeBatch(batch, device, pool_));
         continue;
       }
       DB_RETURN_IF_ERROR(FinishJudging());
-      judging_ = std::async(std::launch::async, [this, &batch] { return JudgeBatch(batch, *stage_pool_); });
+      judging_ =
+          std::async(std::launch::async, [this, &batch, &device] { return JudgeBatch(batch, device, *stage_pool_); });
     }
     DB_RETURN_IF_ERROR(FinishJudging());
     DB_RETURN_IF_ERROR(FlushAll());
@@ -101,9 +103,9 @@ class SweepLoop {
   }
 
  private:
-  Status Build(std::uint64_t first, std::uint32_t count, Batch& batch) {
+  Status Build(std::uint64_t first, std::uint32_t count, Batch& batch, DeviceJudgeInputs& device) {
     const auto building = std::chrono::steady_clock::now();
-    builder_.Build(first, count, batch, pool_, plan_.built_for);
+    builder_.Build(first, count, batch, pool_, plan_.built_for, &device);
     if (renderer_ != nullptr) DB_RETURN_IF_ERROR(AdoptRenderedDepths(*renderer_, builder_, batch, pool_));
     run_.stages.build += SecondsSince(building);
     return Status::Ok();
@@ -117,10 +119,10 @@ class SweepLoop {
   // Every stage judges the batch; the counts flush where due; progress is
   // reported. `pool`: the sweep's, or where it overlaps the build, the
   // stages' own.
-  Status JudgeBatch(const Batch& batch, ThreadPool& pool) {
+  Status JudgeBatch(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool) {
     const auto judging_started = std::chrono::steady_clock::now();
     for (std::size_t s = 0; s < stages_.size(); ++s) {
-      DB_RETURN_IF_ERROR(stages_[s]->Judge(batch, EncodingsFor(s), pool));
+      DB_RETURN_IF_ERROR(stages_[s]->Judge(batch, device, EncodingsFor(s), pool));
     }
     // Counts kept on a device join the stage's accumulators when those
     // are due, and then flush with them.
@@ -171,6 +173,8 @@ class SweepLoop {
   std::unique_ptr<ThreadPool> stage_pool_;
   std::array<Batch, 2> batches_;  // (the second only where the stages overlap)
   std::future<Status> judging_;   // the stages' work on the batch before, while it runs
+  // What a judge on the device reads beside each batch.
+  std::array<DeviceJudgeInputs, 2> device_inputs_;
   SweepProgress progress_;
   std::size_t reconstructions_per_sample_ = 0;
   std::chrono::steady_clock::time_point started_;
