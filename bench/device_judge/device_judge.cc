@@ -139,15 +139,14 @@ struct JudgeGroups {
 // With the table: as large as the device allows, up to 1024 invocations,
 // 16384 samples (below 2^15, the count an entry holds) and 4096 entries
 // (16 KiB, the shared memory every Vulkan device has). Larger groups merge
-// more of their bins before the device's counters see them: on the
-// typical domain, groups of 2048 samples added one bin to the counters for
-// each 4.7 the shader recorded, groups of 16384 one for each 23. Fewer,
-// wider groups hold less shared memory on each of a GPU's multiprocessors
-// at once, and what they do not hold serves as cache: on an H200 phase 0
-// took 0.590 s per 1e8 samples in groups of 128 invocations, 0.331 in 256,
-// 0.228 in 512, 0.214 in 1024; a table of 8192 entries (32 KiB) was slower
-// at every width (reports/device-judge/h200.txt, section 23). Without the
-// table: a sample per invocation, in groups of 64.
+// more of their bins before the device's counters see them
+// (reports/device-judge/lavapipe.txt, section 2). Fewer, wider groups hold
+// less shared memory on each of a GPU's multiprocessors at once, and what
+// they do not hold serves as cache: the widest groups are the fastest, and
+// a larger table is slower at every width (reports/device-judge/h200.txt,
+// section 23). Without the table (a CPU device by default, where the
+// table is slower: lavapipe.txt, section 2): a sample per invocation, in
+// groups of 64.
 JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeTuning tuning) {
   JudgeBinMerge bins = tuning.bins;
   if (bins == JudgeBinMerge::kAuto) {

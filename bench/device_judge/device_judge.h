@@ -21,8 +21,8 @@
 //   - shaders/judge/store.comp, queued before the reconstruction pass
 //     (between the backend's Stage and QueueStaged),
 //     stores every pipeline float in each depth slot's format and writes
-//     what a fetch returns into the buffer that pass reads its texels from
-//     (the host used to upload a texel per slot and sample);
+//     what a fetch returns into the buffer that pass reads its texels from,
+//     so that no texel per slot and sample crosses the bus;
 //   - shaders/judge/reference.comp decodes, in double-double, the depth
 //     each stored value and each pipeline float denotes, and computes the
 //     reference of every (depth slot, sample): true and denoted depth,
@@ -63,8 +63,8 @@ namespace depthbench {
 // the device's counters (far fewer global atomic additions on bins that
 // neighbouring samples share); kDeviceCounters: straight into the
 // device's counters. kAuto: the table on a GPU, the counters on a CPU
-// device (lavapipe, where the table made a run slower). Either gives the
-// same counts.
+// device, where the table is slower (reports/device-judge/lavapipe.txt,
+// section 2). Either gives the same counts.
 enum class JudgeBinMerge : std::uint8_t { kAuto, kWorkgroupTable, kDeviceCounters };
 
 // How the judge works on its device; any choice records the same figures

@@ -20,7 +20,7 @@
 namespace depthbench {
 namespace {
 
-constexpr std::uint32_t kBatch = 131072;  // the size the figures in docs/ were measured at
+constexpr std::uint32_t kBatch = 131072;  // as in reports/device-judge/h200.txt, sections 7 to 9
 
 void BM_BuildBatch(benchmark::State& state, BatchFor judge) {
   const Domain domain = TypicalDomain();

@@ -97,7 +97,7 @@ struct RunInfo {
   // figures are of the first samples_judged samples of its shards only.
   bool partial = false;
   std::uint64_t samples_judged = 0;  // of the shards held, summed over merged parts
-  StageSeconds stages;               // (absent from results written before 2026-12)
+  StageSeconds stages;               // all zero where a file has no stage_seconds
 };
 
 struct CellResult {
