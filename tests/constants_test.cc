@@ -301,8 +301,9 @@ TEST(ConstantsTest, BatchConstantsAreEachFramesOwn) {
   for (const Domain& domain : {WideDomain(), infinite}) {
     const Sampler sampler(29, domain);
     Batch batch;
+    DeviceJudgeInputs frames_only;  // (the device draws the samples: the batch holds its frames)
     BatchBuilder(sampler, {{Convention::kStandard, Format::kD32Sfloat}})
-        .Build(37, 101 * kSamplesPerFrame + 5, batch, pool, BatchFor::kDeviceDraws);
+        .Build(37, 101 * kSamplesPerFrame + 5, batch, pool, BatchFor::kDeviceDraws, &frames_only);
     ASSERT_NE(batch.frames.size() % kShaderConstantsLanes, 0u);
     const Constants expected = OneByOne(batch.frames, ConstantsModel::kExact);
     const Constants actual{batch.frame_params, batch.depth_params};

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -200,11 +201,17 @@ void ComputeBothReferences(const Domain& domain, TwoReferences& out) {
   const Sampler sampler(3, domain);
   const BatchBuilder builder(sampler, out.layout.encodings);
   ThreadPool pool(2);
-  builder.Build(1000000037, 6000, out.batch, pool);  // a batch that starts inside a frame
+  DeviceJudgeInputs inputs;
+  builder.Build(1000000037, 6000, out.batch, pool, BatchFor::kHostJudge, &inputs);  // starts inside a frame
   Batch frames_only;
-  if (builder.DevicesCanDraw()) builder.Build(1000000037, 6000, frames_only, pool, BatchFor::kDeviceDraws);
+  DeviceJudgeInputs draw_inputs;
+  if (builder.DevicesCanDraw()) {
+    builder.Build(1000000037, 6000, frames_only, pool, BatchFor::kDeviceDraws, &draw_inputs);
+  }
   std::vector<CellAccumulator> accumulators(out.layout.cells.size());
-  const Status judged = (*judge)->Judge(frames_only.drawn_on_device ? frames_only : out.batch, accumulators, {}, pool);
+  const bool drawn_on_device = draw_inputs.draw_seed.has_value();
+  const Status judged = (*judge)->Judge(drawn_on_device ? frames_only : out.batch,
+                                        drawn_on_device ? draw_inputs : inputs, accumulators, {}, pool);
   ASSERT_TRUE(judged.ok()) << judged.message();
   auto device = (*judge)->LastReference();
   ASSERT_TRUE(device.ok()) << device.status().message();
@@ -330,19 +337,22 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   const Sampler sampler(5, domain);
   ThreadPool pool(2);
   Batch batch;
+  DeviceJudgeInputs inputs;
   const BatchBuilder builder(sampler, layout.encodings);
-  builder.Build(7, count, batch, pool, BatchFor::kDeviceJudge);
+  builder.Build(7, count, batch, pool, BatchFor::kDeviceJudge, &inputs);
+  EXPECT_FALSE(inputs.draw_seed.has_value());
   // The stored-value picks' texels, per frame and slot, are those a batch
   // for the host judge stores for each pick.
   const std::size_t slots = layout.encodings.size();
-  ASSERT_EQ(batch.edge_texels.size(), batch.frames.size() * slots * 4);
+  ASSERT_EQ(inputs.edge_texels.size(), batch.frames.size() * slots * 4);
   const auto edge_texel = [&](std::size_t slot, std::uint32_t i) {
     const auto pick = static_cast<std::size_t>(batch.samples.pick[i]);
-    return batch.edge_texels[(batch.FrameOf(i) * slots + slot) * 4 + pick - 1];
+    return inputs.edge_texels[(batch.FrameOf(i) * slots + slot) * 4 + pick - 1];
   };
   Batch for_host;
-  builder.Build(7, count, for_host, pool, BatchFor::kHostJudge);
-  ASSERT_EQ(for_host.edge_texels, batch.edge_texels);
+  DeviceJudgeInputs for_host_inputs;
+  builder.Build(7, count, for_host, pool, BatchFor::kHostJudge, &for_host_inputs);
+  ASSERT_EQ(for_host_inputs.edge_texels, inputs.edge_texels);
   std::size_t picks = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
     if (batch.samples.pick[i] == DepthPick::kEyeDepth) continue;
@@ -365,7 +375,8 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
     const Sampler float32_sampler(5, TypicalDomain());
     const BatchBuilder float32_builder(float32_sampler, layout.encodings);
     Batch lean, full;
-    float32_builder.Build(7, count, lean, pool, BatchFor::kDeviceJudge);
+    DeviceJudgeInputs lean_inputs;
+    float32_builder.Build(7, count, lean, pool, BatchFor::kDeviceJudge, &lean_inputs);
     float32_builder.Build(7, count, full, pool, BatchFor::kHostJudge);
     EXPECT_TRUE(lean.samples.near.empty());
     EXPECT_TRUE(lean.samples.inverse_distance_sq.empty());
@@ -374,17 +385,22 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
     EXPECT_EQ(lean.samples.coverage, full.samples.coverage);
     EXPECT_EQ(lean.ray_x, full.ray_x);
     EXPECT_EQ(lean.ray_z, full.ray_z);
-    // Where the device draws the samples, the batch holds none of them.
+    // Where the device draws the samples, the batch holds none of them,
+    // and its inputs hold the sampler's seed to draw them from.
     Batch frames_only;
+    DeviceJudgeInputs draw_inputs;
     ASSERT_TRUE(float32_builder.DevicesCanDraw());
-    float32_builder.Build(7, count, frames_only, pool, BatchFor::kDeviceDraws);
-    EXPECT_TRUE(frames_only.drawn_on_device);
-    EXPECT_EQ(frames_only.seed, 5u);
+    float32_builder.Build(7, count, frames_only, pool, BatchFor::kDeviceDraws, &draw_inputs);
+    EXPECT_EQ(draw_inputs.draw_seed, std::optional<std::uint64_t>(5));
     EXPECT_TRUE(frames_only.samples.pick.empty());
     EXPECT_TRUE(frames_only.pixels.empty());
     EXPECT_TRUE(frames_only.ray_x.empty());
     EXPECT_EQ(frames_only.frames.size(), lean.frames.size());
-    EXPECT_EQ(frames_only.edge_texels, lean.edge_texels);
+    EXPECT_EQ(draw_inputs.edge_texels, lean_inputs.edge_texels);
+    // Without inputs to carry the seed, nothing is drawn on the device.
+    Batch not_drawn;
+    float32_builder.Build(7, count, not_drawn, pool, BatchFor::kDeviceDraws);
+    EXPECT_EQ(not_drawn.samples.pick.size(), count);
     // Exact production needs the host's floats: no device draws there.
     EXPECT_FALSE(builder.DevicesCanDraw());
   }
@@ -404,7 +420,7 @@ TEST_F(DeviceJudgeTest, StoresEveryFormatAsTheHostDoes) {
   EXPECT_NE(past.status().message().find("reads depth slot"), std::string::npos) << past.status().message();
   for (std::size_t at = 0; at < batch.pipeline_floats.size(); ++at) batch.pipeline_floats[at] = values[at % count];
   std::vector<CellAccumulator> accumulators(layout.cells.size());
-  const Status judged = (*judge)->Judge(batch, accumulators, {}, pool);
+  const Status judged = (*judge)->Judge(batch, inputs, accumulators, {}, pool);
   ASSERT_TRUE(judged.ok()) << judged.message();
   auto texels = (*judge)->LastTexels();
   ASSERT_TRUE(texels.ok()) << texels.status().message();

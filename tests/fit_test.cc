@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/fit/error_model.h"
+#include "bench/models/error_model.h"
 
 namespace depthbench {
 namespace {

@@ -147,7 +147,7 @@ TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
   // also runs on the neighbours of that value, up to kDecodeUlps away; a
   // raster position is compared with the nearest of them.
   constexpr int kDecodeUlps = 2;
-  const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+  const std::vector<std::uint32_t> texels = raster_->raster_texels();
   ASSERT_EQ(texels.size(), batch.codes.size());
   std::vector<std::vector<float>> computed;
   for (int shift = -kDecodeUlps; shift <= kDecodeUlps; ++shift) {
@@ -243,7 +243,7 @@ TEST_F(RasterPassTest, CountsAgreementPerDepthSlot) {
     std::vector<float> scratch;
     auto drawn = raster_->Run(batch, which, scratch);
     ASSERT_TRUE(drawn.ok()) << drawn.status().message();
-    const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+    const std::vector<std::uint32_t> texels = raster_->raster_texels();
     for (std::size_t slot = 0; slot < expected.size(); ++slot) {
       for (std::uint32_t i = 0; i < count; ++i) {
         if (!HasGeometry(batch.raster[i])) continue;
@@ -353,7 +353,7 @@ TEST_F(RasterPassTest, UserVariantsInBothLanguagesRunAsInTheComputeForm) {
     auto drawn = raster_->Run(batch, which, scratch);
     ASSERT_TRUE(drawn.ok()) << drawn.status().message();
     const std::vector<float> raster(drawn->begin(), drawn->end());
-    const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+    const std::vector<std::uint32_t> texels = raster_->raster_texels();
     for (std::uint32_t i = 0; i < batch.count; ++i) batch.depths[i] = FetchTexel(Format::kD32Sfloat, texels[i]);
     auto computed = compute_->Run(batch, which, scratch);
     ASSERT_TRUE(computed.ok()) << computed.status().message();
@@ -413,7 +413,7 @@ TEST_F(RasterPassTest, RenderDepthsThenRunReadsTheRenderedAtlases) {
   auto alone = raster_->Run(batch, which, scratch);
   ASSERT_TRUE(alone.ok()) << alone.status().message();
   const std::vector<float> both_passes(alone->begin(), alone->end());
-  const std::vector<std::uint32_t> texels = RasterTexels(*raster_);
+  const std::vector<std::uint32_t> texels = raster_->raster_texels();
 
   // Another batch in between, so that the atlases hold something else.
   ASSERT_TRUE(raster_->Run(BuildBatch(layout, 0, 300), which, scratch).ok());

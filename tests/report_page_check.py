@@ -53,10 +53,14 @@ def check_schema(report_dir, schema_path):
     if errors:
         fail("%d schema errors in results.json" % len(errors))
     # The schema must be able to say no: a bits figure as text, a missing
-    # section, an unknown level.
+    # section, an unknown level, a device field it does not name (the
+    # device is written from the results' field list: the schema must keep
+    # up with it).
     for name, broken in [("bits as text", lambda d: d["split"][0].__setitem__("total", "12")),
                          ("no headline", lambda d: d.pop("headline")),
-                         ("unknown level", lambda d: d["precision_points"][0].__setitem__("level", "p42"))]:
+                         ("unknown level", lambda d: d["precision_points"][0].__setitem__("level", "p42")),
+                         ("an unnamed device field",
+                          lambda d: d["environment"]["backends"][0]["device"].__setitem__("memory", "80 GB"))]:
         d = copy.deepcopy(document)
         broken(d)
         if validator.is_valid(d):

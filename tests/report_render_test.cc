@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "bench/pipeline/cells.h"
+#include "bench/report/report.h"
 #include "bench/report/report_render.h"
 
 namespace depthbench {
@@ -68,11 +69,15 @@ Report LargestReport() {
   const std::vector<Cell> cells = AllCells();
   for (std::size_t i = 0; i < 12; ++i) {
     for (const char* band : {"all", "ratio 1e2-1e3", "ratio 1e3-1e4", "depth 1e1-1e2", "depth 1e2-1e3"}) {
-      history.changes.push_back({"worse", "vulkan", cells[i].Name(), band, {"p99.9 +1.2 bits"}, 20.0, 21.2});
+      history.changes.push_back(
+          {HistorySection::Direction::kWorse, "vulkan", cells[i].Name(), band, {"p99.9 +1.2 bits"}, 20.0, 21.2});
     }
   }
-  history.changes.push_back({"better", "cpu", cells[20].Name(), "all", {"p99.9 -0.5 bits"}, 20.0, 19.5});
+  history.changes.push_back(
+      {HistorySection::Direction::kBetter, "cpu", cells[20].Name(), "all", {"p99.9 -0.5 bits"}, 20.0, 19.5});
+  CountChangedCells(report.headline.size(), history);
   report.history = history;
+  report.worst_cells = WorstCells(report.headline);
   return report;
 }
 

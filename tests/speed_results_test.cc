@@ -41,7 +41,7 @@ SpeedResults Example() {
   r.run.commit = "abc";
   r.run.started_at = "2026-01-01T00:00:00Z";
   r.run.host = "test";
-  r.run.device = {"llvmpipe (LLVM 15.0.6, 256 bits)", "llvmpipe Mesa 22.3.6", "Vulkan 1.3.230", "cpu", "glslang 12"};
+  r.run.device = {"llvmpipe (LLVM 15.0.6, 256 bits)", "llvmpipe Mesa 22.3.6", "Vulkan 1.3.230", DeviceKind::kCpu, "glslang 12"};
   r.run.device_type = "cpu";
   r.run.timestamp_period_ns = 1.0;
   r.run.timestamp_valid_bits = 64;

@@ -140,7 +140,7 @@ class NonFinitePatternBackend final : public Backend {
   }
 
  private:
-  DeviceInfo device_{"pattern", "test", "none", "cpu", "none"};
+  DeviceInfo device_{"pattern", "test", "none", DeviceKind::kCpu, "none"};
 };
 
 TEST(SweepTest, NonFiniteOutputsAreCountedByTheirComponents) {
@@ -312,8 +312,10 @@ TEST(SweepTest, ResultsSurviveTheJsonRoundTrip) {
 
 // Where the host judges, the build and the judging take turns on the
 // main thread: their times are disjoint spans of the run's wall clock,
-// and with the set-up before the first batch, most of it (the rest is
-// the host accumulators' last flush). Merged shards add them up.
+// and with the set-up before the first batch and the last flush (judging),
+// nearly all of it: 80%, since the results are assembled outside them
+// (moves of a few hundred statistics, milliseconds even on a busy
+// machine). Merged shards add them up.
 TEST(SweepTest, StageTimesShareOutTheWallClock) {
   const Results whole = RunCpu(7, 200000, {});
   const StageSeconds& t = whole.run.stages;
@@ -321,7 +323,7 @@ TEST(SweepTest, StageTimesShareOutTheWallClock) {
   EXPECT_GT(t.judging, 0.0);
   EXPECT_GT(t.setup, 0.0);
   EXPECT_LE(t.setup + t.build + t.judging, whole.run.seconds);
-  EXPECT_GE(t.setup + t.build + t.judging, 0.5 * whole.run.seconds);
+  EXPECT_GE(t.setup + t.build + t.judging, 0.8 * whole.run.seconds);
   EXPECT_EQ(t.build_waited, 0.0);   // nothing overlaps
   EXPECT_EQ(t.device_waited, 0.0);  // no device judges
   const Results a = RunCpu(7, 2000, {1, 2}), b = RunCpu(7, 2000, {2, 2});

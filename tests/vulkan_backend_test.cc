@@ -158,7 +158,7 @@ TEST_F(VulkanBackendTest, DescribesLavapipe) {
   EXPECT_EQ(vulkan_->name(), "vulkan");
   EXPECT_FALSE(vulkan_->concurrent());
   EXPECT_NE(device.name.find("llvmpipe"), std::string::npos) << device.name;
-  EXPECT_EQ(device.kind, "cpu");
+  EXPECT_EQ(device.kind, DeviceKind::kCpu);
   EXPECT_EQ(device.api.rfind("Vulkan 1.", 0), 0u) << device.api;
   EXPECT_EQ(device.compiler.rfind("glslang ", 0), 0u) << device.compiler;
   EXPECT_NE(device.driver.find("Mesa"), std::string::npos) << device.driver;
@@ -268,6 +268,44 @@ TEST_F(VulkanBackendTest, EmptyRunsReturnNothing) {
   auto no_cells = vulkan_->Run(BuildBatch(layout, 0, 10), {}, scratch);
   ASSERT_TRUE(no_cells.ok()) << no_cells.status().message();
   EXPECT_TRUE(no_cells->empty());
+}
+
+// Runs that leave their positions on the device are the Vulkan backend's
+// capability, and come in steps a judge on the device sequences:
+// QueueStaged queues what Stage staged, once; a Run in between discards
+// it; the raster form stages nothing.
+TEST_F(VulkanBackendTest, DeviceResidentRunsAreStagedThenQueuedOnce) {
+  EXPECT_EQ(cpu_->device_resident(), nullptr);
+  DeviceResidentRuns* runs = vulkan_->device_resident();
+  ASSERT_NE(runs, nullptr);
+  EXPECT_EQ(runs->context(), context_);
+  const RunLayout layout =
+      MakeRunLayout(std::vector<Cell>{{Variant::kInverseVp, Convention::kStandard, Format::kD32Sfloat},
+                                      {Variant::kPq, Convention::kReversed, Format::kD16Unorm}});
+  ASSERT_TRUE(vulkan_->Prepare(layout.cells, PassKind::kCompute).ok());
+  const std::vector<std::uint32_t> which = AllIndices(layout);
+  const Batch batch = BuildBatch(layout, 4101, 1000);
+  EXPECT_EQ(runs->QueueStaged().code(), StatusCode::kInternal);  // nothing staged yet
+
+  auto staged = runs->Stage(batch, which, nullptr);
+  ASSERT_TRUE(staged.ok()) << staged.status().message();
+  EXPECT_NE(staged->positions, VK_NULL_HANDLE);
+  EXPECT_NE(staged->texels, VK_NULL_HANDLE);
+  EXPECT_GE(staged->slice_length, staged->lead + batch.count);
+  EXPECT_EQ(staged->position_bytes, 3 * which.size() * staged->slice_length * sizeof(float));
+  EXPECT_EQ(staged->texel_bytes, layout.encodings.size() * staged->slice_length * sizeof(float));
+  const Status queued = runs->QueueStaged();
+  ASSERT_TRUE(queued.ok()) << queued.message();
+  EXPECT_EQ(runs->QueueStaged().code(), StatusCode::kInternal);  // queued already
+
+  ASSERT_TRUE(runs->Stage(batch, which, nullptr).ok());
+  std::vector<float> scratch;
+  ASSERT_TRUE(vulkan_->Run(batch, which, scratch).ok());
+  EXPECT_EQ(runs->QueueStaged().code(), StatusCode::kInternal);
+
+  ASSERT_TRUE(vulkan_->Prepare(layout.cells, PassKind::kRaster).ok());
+  EXPECT_EQ(runs->Stage(batch, which, nullptr).status().code(), StatusCode::kUnavailable);
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
 }
 
 TEST_F(VulkanBackendTest, CellIndexOutOfRangeIsInvalidArgument) {

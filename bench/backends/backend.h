@@ -21,11 +21,15 @@
 #include <string>
 #include <vector>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/shader_inputs.h"
 
 namespace depthbench {
+
+// A backend's runs that leave their outputs on its device for a judge
+// there (the Vulkan backend's: vulkan_backend.h).
+class DeviceResidentRuns;
 
 enum class PassKind { kCompute, kRaster };
 // The raster production model is produced by the raster form.
@@ -74,6 +78,11 @@ class Backend {
   // How the rendered depths agreed with the batch's (the host's model of
   // a rasterizer, before adoption), per depth slot, since Prepare.
   virtual std::vector<RasterAgreement> raster_agreement() const { return {}; }
+  // The texel bits a raster backend's last Run or RenderDepths rendered,
+  // laid out as ShaderInputs::codes (the batch's own code where it drew
+  // nothing); empty for any other backend or form. What the device
+  // stored, for tests and diagnosis that compare forms on the same texels.
+  virtual std::vector<std::uint32_t> raster_texels() const { return {}; }
 
   // World positions of the prepared cells listed in `which` (indices into
   // Prepare's list) for every sample of `batch`, component by component:
@@ -90,6 +99,11 @@ class Backend {
   // Whether Run may be called from several threads at once (with disjoint
   // scratch). The sweep then spreads cells over threads.
   virtual bool concurrent() const = 0;
+
+  // Runs whose outputs stay in device memory, for a judge on the same
+  // device (bench/device_judge/); null where outputs come back to the host
+  // alone. The same object as this backend, valid as long as it is.
+  virtual DeviceResidentRuns* device_resident() { return nullptr; }
 };
 
 // Options that select and configure a backend.

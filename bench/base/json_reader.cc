@@ -99,9 +99,21 @@ Status JsonReader::Error(const std::string& message) const {
   return InvalidArgument(fmt::format("{}: {}: {}", source_, path_.empty() ? "(top level)" : path_, message));
 }
 
+Status JsonReader::ExpectObject() const {
+  if (!json_.is_object()) return Error(fmt::format("expected an object, found {}", KindOf(json_)));
+  return Status::Ok();
+}
+
+Expected<std::vector<std::string>> JsonReader::Keys() const {
+  DB_RETURN_IF_ERROR(ExpectObject());
+  std::vector<std::string> keys;
+  for (const auto& item : json_.items()) keys.push_back(item.key());
+  return keys;
+}
+
 Expected<JsonReader> JsonReader::Field(const std::string& key) const {
   std::string path = path_.empty() ? key : path_ + "." + key;
-  if (!json_.is_object()) return Error(fmt::format("expected an object, found {}", KindOf(json_)));
+  DB_RETURN_IF_ERROR(ExpectObject());
   auto it = json_.find(key);
   if (it == json_.end()) {
     return InvalidArgument(fmt::format("{}: {}: missing field", source_, path));

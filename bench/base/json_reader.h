@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -36,6 +37,8 @@ class JsonReader {
   Expected<JsonReader> Field(const std::string& key) const;  // must exist
   Expected<JsonReader> Element(std::size_t index) const;     // of an array
   Expected<std::size_t> ArraySize() const;                   // must be an array
+  Status ExpectObject() const;                               // Ok when this is an object
+  Expected<std::vector<std::string>> Keys() const;           // of an object, in order
 
   Expected<std::string> String() const;
   Expected<double> Number() const;           // also "inf", "-inf", "nan" strings

@@ -47,6 +47,11 @@ inline Status Unavailable(std::string message) { return Status(StatusCode::kUnav
 inline Status CompileError(std::string message) { return Status(StatusCode::kCompileError, std::move(message)); }
 inline Status IoError(std::string message) { return Status(StatusCode::kIoError, std::move(message)); }
 inline Status Internal(std::string message) { return Status(StatusCode::kInternal, std::move(message)); }
+// An options struct's own check failed: "Violated constraint: <constraint>",
+// the constraint named as a reader of the struct would write it.
+inline Status ViolatedConstraint(const std::string& constraint) {
+  return InvalidArgument("Violated constraint: " + constraint);
+}
 
 // A value or the Status that explains why there is none.
 template <class T>

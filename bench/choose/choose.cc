@@ -15,6 +15,7 @@
 #include "bench/base/text_table.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/speed_results.h"
+#include "bench/speed/trade.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
@@ -34,11 +35,6 @@ double WeighedCost(const InstructionMix& m) {
   return weight(0) * (m.fadd.lanes + m.fmul.lanes) + weight(1) * m.fneg.lanes + weight(2) * m.fma.lanes +
          weight(3) * (m.dot.lanes + m.matrix_vector.lanes + m.matrix_matrix.lanes) + weight(4) * m.fdiv.lanes +
          weight(5) * special + weight(6) * other;
-}
-
-// Two costs that the ranking cannot tell apart.
-bool CostsTie(const CandidateCost& a, const CandidateCost& b) {
-  return std::fabs(a.value - b.value) <= std::max(a.spread, b.spread);
 }
 
 // The requirement's unit, from a band's statistics.
@@ -111,8 +107,6 @@ FarEndPrediction PredictAtFarEnd(const Scene& scene, const CellResult& in_scene,
   const double near = scene.domain.near.min, far_end = DepthLimit(scene.domain);
   const double lowest = scene.domain.eye_depth ? scene.domain.eye_depth->min : near;
   std::vector<FitPoint> points;
-  // Differences within the histograms' quarter-octave bins are not resolved.
-  constexpr double kResolvedBits = 0.25;
   double camera_term = 0.0, most_above = kResolvedBits;
   for (int d = 0; d < kDepthBands; ++d) {
     const double lo = std::max(lowest, near * DepthBandLow(d)), hi = std::min(far_end, near * DepthBandLow(d) * 10.0);
@@ -191,15 +185,18 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catal
 
 Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue) {
   DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(speed_file, catalogue));
-  // Per 1080p frame: what a frame budget is counted in.
-  constexpr double kFramePixels = 1920.0 * 1080.0;
-  const std::string unit = "µs per 1920x1080 frame on " + speed.run.device.name;
+  return SpeedCostLookup(speed, speed_file);
+}
+
+CostLookup SpeedCostLookup(const SpeedResults& speed, const std::string& source) {
+  const std::string unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), speed.run.device.name);
+  const double us_per_ns = static_cast<double>(kCostFrame.width) * kCostFrame.height * 1e-3;
   std::map<Cell, CandidateCost> measured;
   for (const TradeFront& front : speed.trade) {
     for (const TradePoint& p : front.points) {
       if (!(p.gpu_ns_per_reconstruction > 0.0)) continue;
-      measured[catalogue.MakeCell(p.variant, front.convention, front.format)] = {
-          p.gpu_ns_per_reconstruction * kFramePixels * 1e-3, p.gpu_spread_ns * kFramePixels * 1e-3, unit, speed_file};
+      measured[speed.variant_catalogue().MakeCell(p.variant, front.convention, front.format)] = {
+          p.gpu_ns_per_reconstruction * us_per_ns, p.gpu_spread_ns * us_per_ns, unit, source};
     }
   }
   return CostLookup([measured](const Cell& cell) -> std::optional<CandidateCost> {
@@ -251,20 +248,9 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   result.device = backend.device().name;
 
   // One cost unit for the whole ranking.
-  CostLookup cost_of = costs.static_model;
-  if (costs.measured) {
-    std::vector<std::string> missing;
-    for (const Cell& cell : cells)
-      if (!costs.measured(cell)) missing.push_back(cell.Name());
-    if (missing.empty()) {
-      cost_of = costs.measured;
-    } else {
-      result.cost_note = fmt::format(
-          "{} has no GPU time for {} of the {} candidates ({}{}): every candidate is ranked by the static cost "
-          "model instead, so that one unit ranks them all",
-          costs.measured_from, missing.size(), cells.size(), missing.front(), missing.size() > 1 ? ", ..." : "");
-    }
-  }
+  const CostChoice chosen_costs = ChooseCosts(costs, cells);
+  const CostLookup& cost_of = chosen_costs.lookup;
+  result.cost_note = chosen_costs.note;
 
   const std::uint64_t needed = MinimumSamples(req.level);
   for (const Cell& cell : cells) {
@@ -326,38 +312,18 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     result.cost_source = result.ranked.front().cost->source;
   }
 
-  // Meeting and affordable, cheapest first; then meeting but too costly;
-  // then failing, closest first. Candidates whose costs tie (within the
-  // spread of a measurement) go in order of accuracy, and share a rank.
-  auto group = [](const CandidateVerdict& v) { return !v.meets ? 2 : v.over_budget ? 1 : 0; };
-  auto value_of = [](const CandidateVerdict& v) { return v.cost ? v.cost->value : INFINITY; };
-  std::stable_sort(result.ranked.begin(), result.ranked.end(),
-                   [&](const CandidateVerdict& a, const CandidateVerdict& b) {
-                     if (group(a) != group(b)) return group(a) < group(b);
-                     if (group(a) < 2 && value_of(a) != value_of(b)) return value_of(a) < value_of(b);
-                     if (a.nonfinite != b.nonfinite) return a.nonfinite < b.nonfinite;
-                     if (a.supported != b.supported) return a.supported;
-                     return a.interval.high < b.interval.high;
-                   });
-  // Cost ties among the meeting candidates: a run of candidates whose costs
-  // all tie with the run's first is reordered by accuracy.
-  for (std::size_t k = 0; k < result.ranked.size();) {
-    std::size_t end = k + 1;
-    const CandidateVerdict& first = result.ranked[k];
-    while (end < result.ranked.size() && group(result.ranked[end]) == group(first) && group(first) < 2 && first.cost &&
-           result.ranked[end].cost && CostsTie(*first.cost, *result.ranked[end].cost)) {
-      ++end;
-    }
-    std::stable_sort(
-        result.ranked.begin() + static_cast<std::ptrdiff_t>(k),
-        result.ranked.begin() + static_cast<std::ptrdiff_t>(end),
-        [](const CandidateVerdict& a, const CandidateVerdict& b) { return a.interval.high < b.interval.high; });
-    for (std::size_t i = k; i < end; ++i) {
-      result.ranked[i].rank = static_cast<int>(k) + 1;
-      result.ranked[i].tied = end - k > 1;
-    }
-    k = end;
+  // The ranking (ranking.h), on the upper end of each interval.
+  std::vector<RankInput> inputs;
+  for (const CandidateVerdict& v : result.ranked) {
+    inputs.push_back({v.meets, v.over_budget, v.nonfinite, v.supported, v.interval.high, v.cost});
   }
+  std::vector<CandidateVerdict> ranked;
+  for (const RankPlace& place : Rank(inputs)) {
+    ranked.push_back(result.ranked[place.candidate]);
+    ranked.back().rank = place.rank;
+    ranked.back().tied = place.tied;
+  }
+  result.ranked = std::move(ranked);
 
   const double limit = req.value;
   const CandidateVerdict* cheapest = result.Met() ? &result.ranked.front() : nullptr;

@@ -15,25 +15,16 @@
 
 #include "bench/base/json_reader.h"
 #include "bench/base/text_table.h"
+#include "bench/choose/ranking.h"
 #include "bench/choose/scene.h"
-#include "bench/fit/error_model.h"
+#include "bench/models/error_model.h"
+#include "bench/speed/speed_results.h"
 
 namespace depthbench {
 
 inline constexpr JsonSchema kChooseSchema{"depthbench.choose", 2, "a choice of depthbench choose --json"};
 
 class Backend;  // bench/backends/backend.h
-
-// The cost of a candidate, in the one unit of its ranking.
-struct CandidateCost {
-  double value = 0.0;
-  double spread = 0.0;  // two costs closer than the larger spread are a tie (0: exact)
-  std::string unit;     // "us per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
-  std::string source;   // where it came from
-};
-
-// Costs per cell; `nullopt` when none is known for a cell.
-using CostLookup = std::function<std::optional<CandidateCost>(const Cell&)>;
 
 // The static cost model: the compiled shader's floating-point instructions,
 // lane by lane, each weighed by what it costs on GPU hardware relative to
@@ -47,18 +38,11 @@ extern const std::vector<OperationCost> kOperationCosts;
 inline constexpr const char* kStaticCostUnit = "FMA-equivalent slots";
 // For every variant of `catalogue`.
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catalogue& catalogue = Catalogue::BuiltIn());
-// Measured GPU time per frame from a `depthbench speed --json` file
-// (ALU-bound regime), for the cells the file has; its variant names are
+// Measured GPU time per frame (kCostFrame) from a `depthbench speed --json`
+// file (ALU-bound regime), for the cells the file has; its variant names are
 // looked up in `catalogue`.
 Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue = Catalogue::BuiltIn());
-
-// Where a ranking's costs come from: measured times when they cover every
-// candidate, else the static model for all (a ranking never mixes units).
-struct CostSources {
-  CostLookup measured;  // empty: none given
-  std::string measured_from;
-  CostLookup static_model;
-};
+CostLookup SpeedCostLookup(const SpeedResults& speed, const std::string& source);
 
 struct CandidateVerdict {
   Cell cell;

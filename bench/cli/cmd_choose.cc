@@ -10,6 +10,7 @@
 #include "bench/choose/choose.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
+#include "bench/speed/trade.h"
 
 namespace depthbench::cli {
 namespace {
@@ -62,7 +63,9 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
       "the 95% interval of its measured level is within the limit, it has enough samples for that level, and it "
       "has no NaN or Inf findings inside the scene's ranges. When nothing does, it says so, shows the closest, and "
       "what would have to change. Example scenes: bench/scenes/*.toml.\n\n"
-      "Costs come in one unit per ranking: GPU time per 1920x1080 frame from a `depthbench speed --json` file "
+      "Costs come in one unit per ranking: GPU time per " +
+      ResolutionName(kCostFrame) +
+      " frame from a `depthbench speed --json` file "
       "(--speed) when it has every candidate, with its spread (costs within it tie, shown '='), otherwise the "
       "static model for every candidate: the compiled shader's floating-point instructions, each lane weighed in "
       "FMA-equivalent issue slots:\n" +

@@ -182,13 +182,13 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
       "and band the run measures is compared unless --allow-uncovered, and then what was not compared is listed, and "
       "skipped in JUnit), 130 when interrupted (nothing is written). A band with no finite output has no bits "
       "figure: it counts as worse when it had one before. Worse: the p99.9 or maximum bits lost of the total "
-      "or arithmetic error grew by more than 0.25 or 0.5 bit (the same seed and device give identical results; "
+      "or arithmetic error grew by more than {} or {} bit (the same seed and device give identical results; "
       "the tolerance absorbs driver and compiler updates), NaN or Inf appeared, or a cell disappeared.\n\n"
       "Examples:\n"
       "  depthbench gate --baseline reports/baselines/cpu.json --baseline reports/baselines/lavapipe.json\n"
       "  depthbench gate --baseline reports/baselines/lavapipe.json --shaders my_edited_copy/shaders --junit gate.xml\n"
       "  depthbench gate --update --baseline reports/baselines/cpu.json",
-      plan.seed, plan.samples));
+      plan.seed, plan.samples, GateTolerance{}.p999_bits, GateTolerance{}.max_bits));
   cmd->add_option("--baseline", flags->baselines, "baseline file, one per backend (repeat for several)")->required();
   cmd->add_option("--backend", flags->new_backends,
                   "with --update, the backend of each baseline file that does not exist yet, in order");

@@ -188,7 +188,7 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   fmt::format("samples per batch (memory is proportional to it; cut to what the Vulkan device can "
                               "bind at once); default {}, or {} when a GPU judges (the fastest measured)",
                               kHostBatch, kDeviceJudgeBatch))
-      ->check(CLI::Range(64u, 1u << 22));
+      ->check(CLI::Range(kMinBatch, kMaxBatch));
   cmd->add_option("--judge", flags->judge,
                   "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
                   "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "

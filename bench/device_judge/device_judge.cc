@@ -139,15 +139,14 @@ struct JudgeGroups {
 // With the table: as large as the device allows, up to 1024 invocations,
 // 16384 samples (below 2^15, the count an entry holds) and 4096 entries
 // (16 KiB, the shared memory every Vulkan device has). Larger groups merge
-// more of their bins before the device's counters see them: on the
-// typical domain, groups of 2048 samples added one bin to the counters for
-// each 4.7 the shader recorded, groups of 16384 one for each 23. Fewer,
-// wider groups hold less shared memory on each of a GPU's multiprocessors
-// at once, and what they do not hold serves as cache: on an H200 phase 0
-// took 0.590 s per 1e8 samples in groups of 128 invocations, 0.331 in 256,
-// 0.228 in 512, 0.214 in 1024; a table of 8192 entries (32 KiB) was slower
-// at every width (reports/device-judge/h200.txt, section 23). Without the
-// table: a sample per invocation, in groups of 64.
+// more of their bins before the device's counters see them
+// (reports/device-judge/lavapipe.txt, section 2). Fewer, wider groups hold
+// less shared memory on each of a GPU's multiprocessors at once, and what
+// they do not hold serves as cache: the widest groups are the fastest, and
+// a larger table is slower at every width (reports/device-judge/h200.txt,
+// section 23). Without the table (a CPU device by default, where the
+// table is slower: lavapipe.txt, section 2): a sample per invocation, in
+// groups of 64.
 JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeTuning tuning) {
   JudgeBinMerge bins = tuning.bins;
   if (bins == JudgeBinMerge::kAuto) {
@@ -188,7 +187,7 @@ constexpr std::array<const char*, kMarks> kPassNames = {"idle",      "sample", "
 }  // namespace
 
 struct DeviceJudge::State {
-  Backend* backend = nullptr;
+  DeviceResidentRuns* runs = nullptr;  // the backend's
   std::shared_ptr<VulkanContext> context;
   std::unique_ptr<ComputePass> pass;
   DeviceObject<VkPipeline> sample_pipeline;
@@ -215,8 +214,8 @@ struct DeviceJudge::State {
   std::vector<Cell> run_cells;
   std::size_t depth_slots = 0;
   std::size_t pipelines = 0;
-  std::uint32_t last_count = 0;    // samples of the last batch judged
-  DevicePositions last_positions;  // the backend's buffers for it
+  std::uint32_t last_count = 0;  // samples of the last batch judged
+  DeviceRunBuffers last_run;     // the backend's buffers for it
   bool exact_production = false;
   bool record_distances = true;
   JudgeGroups judge_groups;
@@ -284,12 +283,14 @@ struct DeviceJudge::State {
     vkCmdFillBuffer(commands, Buffer(kFirstNonFinite).handle(), 0, VK_WHOLE_SIZE, 0xffffffffu);
     vkCmdFillBuffer(commands, Buffer(kUnwritten).handle(), 0, VK_WHOLE_SIZE, 0u);
   }
-  Status UploadForStorage(const Batch& batch, ThreadPool& pool);
-  Status UploadForReference(const Batch& batch, ThreadPool& pool);
-  void Bind(const DevicePositions& positions, const Batch& batch);
-  L::JudgePass PassConstants(const Batch& batch, const DevicePositions& positions) const;
-  void RecordStore(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions) const;
-  void Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions, bool encodings) const;
+  Status UploadForStorage(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool);
+  Status UploadForReference(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool);
+  void Bind(const DeviceRunBuffers& run, const Batch& batch);
+  L::JudgePass PassConstants(const Batch& batch, const DeviceJudgeInputs& device, const DeviceRunBuffers& run) const;
+  // The sample pass where the device draws (`draws`), and the storage pass.
+  void RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws) const;
+  // The reference and judge passes, and the copy of the maxima.
+  void Record(VkCommandBuffer commands, L::JudgePass constants, bool encodings) const;
   Status MergeMaxima(std::uint32_t lane, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
   // Waits for `lane`'s batch, if one is queued, and joins its maxima and
   // samples to the accumulators it was given.
@@ -322,8 +323,9 @@ DeviceJudge::~DeviceJudge() = default;
 Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, const RunLayout& layout,
                                                            ProductionModel production, bool record_distances,
                                                            DeviceJudgeTuning tuning) {
-  std::shared_ptr<VulkanContext> context = ContextOf(backend);
-  if (context == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
+  DeviceResidentRuns* runs = backend.device_resident();
+  if (runs == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
+  const std::shared_ptr<VulkanContext>& context = runs->context();
   if (production == ProductionModel::kRaster) {
     return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
   }
@@ -334,7 +336,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
         context->properties().name));
   }
   auto state = std::make_unique<State>();
-  state->backend = &backend;
+  state->runs = runs;
   state->context = context;
   state->record_distances = record_distances;
   state->exact_production = production == ProductionModel::kExact;
@@ -430,7 +432,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
 // waiting), in two parts: what the storage pass reads, before it is
 // queued, and what only the reference reads, while the reconstruction
 // pass runs.
-Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool) {
+Status DeviceJudge::State::UploadForStorage(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool) {
   const std::size_t count = batch.count, frames = batch.frames.size();
   const std::size_t slot_samples = depth_slots * count, pipeline_samples = pipelines * count;
   if (!device_produces() && batch.pipeline_floats.size() != pipeline_samples) {
@@ -454,13 +456,13 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
 
   // What each frame and slot stores for the stored-value picks.
   const SampleArrays& samples = batch.samples;
-  const std::size_t drawn = batch.drawn_on_device ? 0 : count;
-  if (batch.edge_texels.size() != frames * depth_slots * 4 || samples.pick.size() != drawn) {
+  const std::size_t drawn = device.draw_seed ? 0 : count;
+  if (device.edge_texels.size() != frames * depth_slots * 4 || samples.pick.size() != drawn) {
     return InvalidArgument(
         fmt::format("a batch of {} samples in {} frames with {} drawn samples and {} edge texels, for {} depth slots",
-                    count, frames, samples.pick.size(), batch.edge_texels.size(), depth_slots));
+                    count, frames, samples.pick.size(), device.edge_texels.size(), depth_slots));
   }
-  pool.Copy(Buffer(kEdgeTexels).mapped(), batch.edge_texels.data(), batch.edge_texels.size() * sizeof(float));
+  pool.Copy(Buffer(kEdgeTexels).mapped(), device.edge_texels.data(), device.edge_texels.size() * sizeof(float));
   // Per frame. The frame's planes are those the host's reference reads
   // for each of its samples (PlanesOf); what the sample pass draws from
   // is the host sampler's (DrawFrameOf). On the pool's threads, as the
@@ -533,8 +535,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, ThreadPool& pool
   return Status::Ok();
 }
 
-Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& pool) {
-  if (batch.drawn_on_device) return Status::Ok();  // the sample pass wrote the rays
+Status DeviceJudge::State::UploadForReference(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool) {
+  if (device.draw_seed) return Status::Ok();  // the sample pass wrote the rays
   const std::size_t count = batch.count;
   auto* rays = static_cast<double*>(Buffer(kRays).mapped());
   pool.ParallelFor((count + kUploadChunk - 1) / kUploadChunk, [&](std::size_t begin, std::size_t end, unsigned) {
@@ -550,11 +552,11 @@ Status DeviceJudge::State::UploadForReference(const Batch& batch, ThreadPool& po
 }
 
 // Points every binding at the bytes this batch uses.
-void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& batch) {
+void DeviceJudge::State::Bind(const DeviceRunBuffers& run, const Batch& batch) {
   const std::size_t count = batch.count, frames = batch.frames.size(), slot_samples = depth_slots * count;
   const std::array<VkDeviceSize, kBindingCount> bytes = {
       layout_words() * sizeof(std::uint32_t),
-      positions.bytes,
+      run.position_bytes,
       frames * 4 * sizeof(std::uint32_t),
       3 * count * sizeof(double),
       count * sizeof(std::uint32_t),
@@ -562,7 +564,7 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       frames * L::DB_JUDGE_FRAME_WORDS * sizeof(std::uint32_t),
       count * sizeof(double),
       pipelines * count * sizeof(float),
-      positions.texel_bytes,
+      run.texel_bytes,
       5 * slot_samples * sizeof(double),
       slot_samples * sizeof(std::uint32_t),
       counts_bytes(),
@@ -571,15 +573,15 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
       unwritten_bytes(),
       std::max<VkDeviceSize>(frames * depth_slots * 4 * sizeof(float), 16),
       std::max<VkDeviceSize>(frames * L::DB_JUDGE_FRAME_DRAWS * sizeof(double), 16),
-      positions.pixel_bytes,
+      run.pixel_bytes,
       std::max<VkDeviceSize>(candidates_bytes(), 16),
       candidate_counts_bytes()};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    const VkBuffer backends = b == kPositions ? positions.buffer
-                              : b == kTexels  ? positions.texels
-                              : b == kPixels  ? positions.pixels
+    const VkBuffer backends = b == kPositions ? run.positions
+                              : b == kTexels  ? run.texels
+                              : b == kPixels  ? run.pixels
                                               : VK_NULL_HANDLE;
     infos[b] = {backends != VK_NULL_HANDLE ? backends : Buffer(static_cast<Binding>(b)).handle(), 0, bytes[b]};
     writes[b].dstBinding = b;
@@ -589,10 +591,12 @@ void DeviceJudge::State::Bind(const DevicePositions& positions, const Batch& bat
   pass->WriteDescriptors(writes, lane);
 }
 
-L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DevicePositions& positions) const {
+L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceJudgeInputs& device,
+                                               const DeviceRunBuffers& run) const {
+  const std::uint64_t seed = device.draw_seed.value_or(0);  // (read by the sample pass alone)
   return L::JudgePass{.count = batch.count,
-                      .lead = positions.lead,
-                      .slice_length = positions.slice_length,
+                      .lead = run.lead,
+                      .slice_length = run.slice_length,
                       .first_offset = batch.first_offset,
                       .first_index_lo = static_cast<std::uint32_t>(batch.first_index),
                       .first_index_hi = static_cast<std::uint32_t>(batch.first_index >> 32),
@@ -602,13 +606,12 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceP
                       .depth_slots = static_cast<std::uint32_t>(depth_slots),
                       .accumulators = static_cast<std::uint32_t>(accumulators()),
                       .exact_production = exact_production ? 1u : 0u,
-                      .seed_lo = static_cast<std::uint32_t>(batch.seed),
-                      .seed_hi = static_cast<std::uint32_t>(batch.seed >> 32),
+                      .seed_lo = static_cast<std::uint32_t>(seed),
+                      .seed_hi = static_cast<std::uint32_t>(seed >> 32),
                       .row_order = static_cast<std::uint32_t>(row_order_at())};
 }
 
-void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batch,
-                                     const DevicePositions& positions) const {
+void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws) const {
   if (clock.count() > 0) clock.RecordReset(commands, Query(lane, 0), kMarks);
   RecordMark(commands, kStoreStart);
   // Everything queued before (the last batch's judge reading the
@@ -619,9 +622,8 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
                           VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
-  L::JudgePass constants = PassConstants(batch, positions);
-  const std::uint32_t slice_groups = (positions.slice_length + kWorkgroupSize - 1) / kWorkgroupSize;
-  if (batch.drawn_on_device) {
+  const std::uint32_t slice_groups = (constants.slice_length + kWorkgroupSize - 1) / kWorkgroupSize;
+  if (draws) {
     // The samples first: every later pass reads them.
     pass->Bind(commands, sample_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
     pass->PushConstants(commands, &constants, sizeof(constants));
@@ -634,8 +636,8 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
   const auto slots = static_cast<std::uint32_t>(depth_slots);
   if (device_produces()) {
     pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, (batch.count + kWorkgroupSize - 1) / kWorkgroupSize, static_cast<std::uint32_t>(pipelines),
-                  1);
+    vkCmdDispatch(commands, (constants.count + kWorkgroupSize - 1) / kWorkgroupSize,
+                  static_cast<std::uint32_t>(pipelines), 1);
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
@@ -649,8 +651,7 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, const Batch& batc
   RecordMark(commands, kStored);
 }
 
-void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, const DevicePositions& positions,
-                                bool encodings) const {
+void DeviceJudge::State::Record(VkCommandBuffer commands, L::JudgePass constants, bool encodings) const {
   RecordMark(commands, kJudgeStart);
   // This batch's maxima start at nothing: zero squares, no index, no
   // candidate for one.
@@ -658,8 +659,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
   vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), 0, half, 0u);
   vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), half, half, 0xffffffffu);
   vkCmdFillBuffer(commands, Buffer(kCandidateCounts).handle(), 0, VK_WHOLE_SIZE, 0u);
-  L::JudgePass constants = PassConstants(batch, positions);
-  const std::uint32_t groups = (batch.count + kWorkgroupSize - 1) / kWorkgroupSize;
+  const std::uint32_t groups = (constants.count + kWorkgroupSize - 1) / kWorkgroupSize;
   // The reference of every (depth slot, sample).
   pass->Bind(commands, reference_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   pass->PushConstants(commands, &constants, sizeof(constants));
@@ -672,7 +672,7 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, const Batch& batch, co
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
   pass->Bind(commands, judge_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
-  const std::uint32_t groups_per_row = (batch.count + judge_groups.samples - 1) / judge_groups.samples;
+  const std::uint32_t groups_per_row = (constants.count + judge_groups.samples - 1) / judge_groups.samples;
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
     constants.phase = phase;
     pass->PushConstants(commands, &constants, sizeof(constants));
@@ -751,8 +751,8 @@ std::uint64_t DeviceJudge::MaxBatchSamples() const {
   return std::max<std::uint64_t>(s.context->properties().limits.maxStorageBufferRange / widest, kWorkgroupSize);
 }
 
-Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
-                          ThreadPool& pool) {
+Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, std::span<CellAccumulator> cells,
+                          std::span<CellAccumulator> encodings, ThreadPool& pool) {
   State& s = *state_;
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   if (batch.count == 0) return Status::Ok();
@@ -761,26 +761,29 @@ Status DeviceJudge::Judge(const Batch& batch, std::span<CellAccumulator> cells, 
   // long done; the last batch's may still run on the device meanwhile.
   s.lane = static_cast<std::uint32_t>(s.batches % kLanes);
   DB_RETURN_IF_ERROR(s.Finish(s.lane));
-  // The storage pass's inputs first: queued before the backend's pass, it
-  // makes the texels from them. The reference's go in while both run.
-  DB_RETURN_IF_ERROR(s.UploadForStorage(batch, pool));
-  const auto store = [&](const DevicePositions& on_device) {
-    s.Bind(on_device, batch);
-    return s.pass->SubmitWithoutWaiting([&](VkCommandBuffer commands) { s.RecordStore(commands, batch, on_device); },
-                                        StoreSlot(s.lane));
-  };
-  DB_ASSIGN_OR_RETURN(const DevicePositions positions,
-                      RunLeavingOnDevice(*s.backend, batch, s.every_cell, &pool, store));
-  DB_RETURN_IF_ERROR(s.UploadForReference(batch, pool));
-  // The reference's and the judge's passes, after the storage and
-  // reconstruction passes already queued; this batch joins the
-  // accumulators once the next one is queued (or at Flush).
+  // On the device's queue, in this order: the sample and storage passes,
+  // which write what the backend's reconstruction reads beyond what the
+  // host uploads to it (the texels, and the pixels where the device
+  // draws); the reconstruction; the reference and judge passes, which
+  // read its positions. The storage pass's inputs go up first, the
+  // backend's next, the reference's while the first two passes run.
+  DB_RETURN_IF_ERROR(s.UploadForStorage(batch, device, pool));
+  DB_ASSIGN_OR_RETURN(const DeviceRunBuffers run, s.runs->Stage(batch, s.every_cell, &pool));
+  s.Bind(run, batch);
+  const L::JudgePass constants = s.PassConstants(batch, device, run);
+  const bool draws = device.draw_seed.has_value();
   DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
-      [&](VkCommandBuffer commands) { s.Record(commands, batch, positions, !encodings.empty()); }, JudgeSlot(s.lane)));
+      [&](VkCommandBuffer commands) { s.RecordStore(commands, constants, draws); }, StoreSlot(s.lane)));
+  DB_RETURN_IF_ERROR(s.runs->QueueStaged());
+  DB_RETURN_IF_ERROR(s.UploadForReference(batch, device, pool));
+  // This batch joins the accumulators once the next one is queued (or at
+  // Flush).
+  DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
+      [&](VkCommandBuffer commands) { s.Record(commands, constants, !encodings.empty()); }, JudgeSlot(s.lane)));
   s.pending[s.lane] = {
       .queued = true, .count = batch.count, .cells = cells, .encodings = encodings, .order = s.batches++};
   s.last_count = batch.count;
-  s.last_positions = positions;
+  s.last_run = run;
   DB_RETURN_IF_ERROR(s.Finish(1 - s.lane));
   return validation.Check("judging on the device");
 }
@@ -834,10 +837,10 @@ Expected<std::vector<float>> DeviceJudge::LastTexels() const {
     DB_RETURN_IF_ERROR(s.pass->Submit([&](VkCommandBuffer commands) {
       std::vector<VkBufferCopy> regions;
       for (std::size_t slot = 0; slot < slots; ++slot) {
-        regions.push_back({(slot * s.last_positions.slice_length + s.last_positions.lead) * sizeof(float),
+        regions.push_back({(slot * s.last_run.slice_length + s.last_run.lead) * sizeof(float),
                            slot * count * sizeof(float), count * sizeof(float)});
       }
-      vkCmdCopyBuffer(commands, s.last_positions.texels, readback.handle(), static_cast<std::uint32_t>(regions.size()),
+      vkCmdCopyBuffer(commands, s.last_run.texels, readback.handle(), static_cast<std::uint32_t>(regions.size()),
                       regions.data());
       RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                           VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);

@@ -1,5 +1,8 @@
 // DeviceJudge: the texels' storage, the reference and the judge run where
-// a Vulkan backend's outputs already are.
+// a Vulkan backend's outputs already are, reached through the backend's
+// DeviceResidentRuns (Backend::device_resident, vulkan_backend.h): the
+// judge stages the backend's run and queues its own passes around the
+// backend's reconstruction pass.
 //
 // The host judge (bench/pipeline/judge.h) reads every position back and
 // bins it on the host's cores, against a reference the host computed; on a
@@ -15,10 +18,11 @@
 //     draws every sample from (seed, index) as the host's sampler would
 //     (shared/draw.h) and writes its pixel into the buffer the
 //     reconstruction pass reads, and its eye depth, coverage and ray;
-//   - shaders/judge/store.comp, queued before the reconstruction pass,
+//   - shaders/judge/store.comp, queued before the reconstruction pass
+//     (between the backend's Stage and QueueStaged),
 //     stores every pipeline float in each depth slot's format and writes
-//     what a fetch returns into the buffer that pass reads its texels from
-//     (the host used to upload a texel per slot and sample);
+//     what a fetch returns into the buffer that pass reads its texels from,
+//     so that no texel per slot and sample crosses the bus;
 //   - shaders/judge/reference.comp decodes, in double-double, the depth
 //     each stored value and each pipeline float denotes, and computes the
 //     reference of every (depth slot, sample): true and denoted depth,
@@ -59,8 +63,8 @@ namespace depthbench {
 // the device's counters (far fewer global atomic additions on bins that
 // neighbouring samples share); kDeviceCounters: straight into the
 // device's counters. kAuto: the table on a GPU, the counters on a CPU
-// device (lavapipe, where the table made a run slower). Either gives the
-// same counts.
+// device, where the table is slower (reports/device-judge/lavapipe.txt,
+// section 2). Either gives the same counts.
 enum class JudgeBinMerge : std::uint8_t { kAuto, kWorkgroupTable, kDeviceCounters };
 
 // How the judge works on its device; any choice records the same figures
@@ -75,11 +79,11 @@ struct DeviceJudgeTuning {
 
 class DeviceJudge {
  public:
-  // A judge on the device of `backend`, a Vulkan backend prepared for the
-  // compute form with the cells of `layout`, for depths produced by
-  // `production` (kFloat32 or kExact). Unavailable, saying why, for
-  // another backend, form or production, or a device without float64
-  // arithmetic and 64-bit atomics. `record_distances`: whether natural
+  // A judge on the device of `backend`, a backend with device-resident
+  // runs (a Vulkan backend's) prepared for the compute form with the cells
+  // of `layout`, for depths produced by `production` (kFloat32 or kExact).
+  // Unavailable, saying why, for another backend, form or production, or
+  // a device without float64 arithmetic and 64-bit atomics. `record_distances`: whether natural
   // samples also go to their camera-distance band
   // (CellAccumulator::records_distances).
   static Expected<std::unique_ptr<DeviceJudge>> Create(Backend& backend, const RunLayout& layout,
@@ -89,21 +93,21 @@ class DeviceJudge {
   DeviceJudge(const DeviceJudge&) = delete;
   DeviceJudge& operator=(const DeviceJudge&) = delete;
 
-  // Draws the samples of `batch` where it was built for that
-  // (BatchFor::kDeviceDraws), stores its texels (of the host's, only the
-  // stored-value picks' edge texels are read), runs every cell of the
-  // layout on it and judges the outputs on the device. It returns once the
-  // batch is queued there and the batch before it is finished: the device
-  // runs one batch while the host writes the next one's inputs. A
-  // finished batch's maxima go into `cells` (one accumulator per cell, in
-  // layout order) and, unless it is empty, `encodings` (one per depth
-  // slot: the storage and production errors, which the device then
-  // records too), which also count its samples: the accumulators of the
-  // last call must outlive the next call or Flush, which finishes the
-  // last batch. The counts stay on the device until Flush. `pool` writes
-  // the uploads.
-  Status Judge(const Batch& batch, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings,
-               ThreadPool& pool);
+  // Draws the samples of `batch` where `device` says so (its draw seed:
+  // BatchFor::kDeviceDraws), stores its texels (of the host's, only
+  // `device`'s edge texels for the stored-value picks are read), runs
+  // every cell of the layout on it and judges the outputs on the device.
+  // It returns once the batch is queued there and the batch before it is
+  // finished: the device runs one batch while the host writes the next
+  // one's inputs. A finished batch's maxima go into `cells` (one
+  // accumulator per cell, in layout order) and, unless it is empty,
+  // `encodings` (one per depth slot: the storage and production errors,
+  // which the device then records too), which also count its samples: the
+  // accumulators of the last call must outlive the next call or Flush,
+  // which finishes the last batch. The counts stay on the device until
+  // Flush. `pool` writes the uploads.
+  Status Judge(const Batch& batch, const DeviceJudgeInputs& device, std::span<CellAccumulator> cells,
+               std::span<CellAccumulator> encodings, ThreadPool& pool);
   // The most samples one batch may have: the widest binding (the
   // reference of every depth slot) within the device's limit.
   std::uint64_t MaxBatchSamples() const;

@@ -45,7 +45,7 @@ Estimate ClampedEstimate(const FittedModel& m, double x, double y) {
 
 // Points at or above this carry no slope: the error has reached the
 // distance itself (a quarter bit below 24: the statistics' resolution).
-constexpr double kSaturatedBits = kAllBitsLost - 0.25;
+constexpr double kSaturatedBits = kAllBitsLost - kResolvedBits;
 
 // Slope of the far-plane curve between f/n = 1e2 and 1e8, as a function of
 // the parameters (exact for the linear models).

@@ -22,7 +22,7 @@
 #include "bench/backends/backend.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/text_table.h"
-#include "bench/fit/error_model.h"
+#include "bench/models/error_model.h"
 #include "bench/results/results.h"
 #include "bench/sweep/sweep.h"
 

@@ -1,11 +1,10 @@
 #include "bench/gate/baseline.h"
 
-#include <limits>
-
-#include <fmt/format.h>
+#include <algorithm>
 
 #include "bench/base/environment.h"
 #include "bench/base/files.h"
+#include "bench/base/json_fields.h"
 #include "bench/base/json_reader.h"
 
 namespace depthbench {
@@ -62,93 +61,65 @@ Baseline BaselineFromResults(const Results& results, const std::string& backend)
   return b;
 }
 
-json SamplePlanToJson(const SamplePlan& plan) {
-  return {{"seed", plan.seed},
-          {"samples", plan.samples},
-          {"samples_per_frame", plan.samples_per_frame},
-          {"domain", DomainToJson(plan.domain)}};
+namespace {
+
+const JsonFields<SamplePlan>& SamplePlanFields() {
+  static const JsonFields<SamplePlan> fields{{
+      JsonMember("seed", &SamplePlan::seed),
+      JsonMember("samples", &SamplePlan::samples),
+      JsonMember("samples_per_frame", &SamplePlan::samples_per_frame),
+      JsonMember("domain", &SamplePlan::domain, JsonObject{DomainFields()}),
+  }};
+  return fields;
 }
 
-Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan) {
-  SamplePlan p;
-  DB_ASSIGN_OR_RETURN(p.seed, plan.Unsigned("seed"));
-  DB_ASSIGN_OR_RETURN(p.samples, plan.Unsigned("samples"));
-  DB_ASSIGN_OR_RETURN(std::uint64_t per_frame, plan.Unsigned("samples_per_frame"));
-  p.samples_per_frame = static_cast<std::uint32_t>(per_frame);
-  DB_ASSIGN_OR_RETURN(JsonReader domain, plan.Field("domain"));
-  DB_ASSIGN_OR_RETURN(p.domain, DomainFromJson(domain.json(), plan.source()));
-  return p;
+const JsonFields<BandFigures>& BandFiguresFields() {
+  static const JsonFields<BandFigures> fields{{
+      JsonMember("total_p999_bits", &BandFigures::total_p999),
+      JsonMember("total_max_bits", &BandFigures::total_max),
+      JsonMember("arith_p999_bits", &BandFigures::arith_p999),
+      JsonMember("arith_max_bits", &BandFigures::arith_max),
+      // (absent from baselines made before the interval was kept)
+      JsonMemberOr("p999_interval_bits", &BandFigures::p999_interval_bits, JsonReal(), 0.0),
+      JsonMember("judged", &BandFigures::judged),
+      JsonMember("nan", &BandFigures::nan),
+      JsonMember("inf", &BandFigures::inf),
+      JsonMember("worst_index", &BandFigures::worst_index, JsonIndexOrNull()),
+      JsonMember("first_nonfinite_index", &BandFigures::first_nonfinite_index, JsonIndexOrNull()),
+  }};
+  return fields;
 }
 
-json BaselineToJson(const Baseline& b) {
-  json cells = json::object();
-  for (const auto& [name, figures] : b.cells) {
-    json bands = json::object();
-    for (const auto& [band, f] : figures) {
-      bands[band] = {{"total_p999_bits", f.total_p999},
-                     {"total_max_bits", JsonNumber(f.total_max)},
-                     {"arith_p999_bits", f.arith_p999},
-                     {"arith_max_bits", JsonNumber(f.arith_max)},
-                     {"p999_interval_bits", f.p999_interval_bits},
-                     {"judged", f.judged},
-                     {"nan", f.nan},
-                     {"inf", f.inf},
-                     {"worst_index", JsonIndex(f.worst_index)},
-                     {"first_nonfinite_index", JsonIndex(f.first_nonfinite_index)}};
-    }
-    cells[name] = bands;
-  }
-  return WithSchema(kBaselineSchema, {{"backend", b.backend},
-                                      {"device", DeviceToJson(b.device)},
-                                      {"version", b.version},
-                                      {"commit", b.commit},
-                                      {"made_at", b.made_at},
-                                      {"plan", SamplePlanToJson(b.plan)},
-                                      {"cells", cells}});
+// Built for the catalogue whose cells the names are read as.
+JsonFields<Baseline> BaselineFields(const Catalogue& catalogue) {
+  // Cells by their own spelling, as the gate looks them up; bands by name.
+  const JsonMap<JsonMap<JsonObject<BandFigures>>> cells{
+      JsonMap<JsonObject<BandFigures>>{JsonObject{BandFiguresFields()}},
+      [&catalogue](std::string_view name) -> Expected<std::string> {
+        DB_ASSIGN_OR_RETURN(const Cell cell, catalogue.ParseCell(name));
+        return cell.Name();
+      }};
+  return {{
+      JsonMember("backend", &Baseline::backend),
+      JsonMember("device", &Baseline::device, JsonObject{DeviceFields()}),
+      JsonMember("version", &Baseline::version),
+      JsonMember("commit", &Baseline::commit),
+      JsonMember("made_at", &Baseline::made_at),
+      JsonMember("plan", &Baseline::plan, JsonObject{SamplePlanFields()}),
+      JsonMember("cells", &Baseline::cells, cells),
+  }};
+}
+
+}  // namespace
+
+json SamplePlanToJson(const SamplePlan& plan) { return WriteFields(SamplePlanFields(), plan); }
+
+json BaselineToJson(const Baseline& baseline) {
+  return WriteDocument(kBaselineSchema, BaselineFields(Catalogue::BuiltIn()), baseline);
 }
 
 Expected<Baseline> BaselineFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
-  JsonReader top(j, source);
-  DB_RETURN_IF_ERROR(top.CheckSchema(kBaselineSchema));
-  Baseline b;
-  DB_ASSIGN_OR_RETURN(b.backend, top.String("backend"));
-  DB_ASSIGN_OR_RETURN(JsonReader device, top.Field("device"));
-  DB_ASSIGN_OR_RETURN(b.device, DeviceFromJson(device));
-  DB_ASSIGN_OR_RETURN(b.version, top.String("version"));
-  DB_ASSIGN_OR_RETURN(b.commit, top.String("commit"));
-  DB_ASSIGN_OR_RETURN(b.made_at, top.String("made_at"));
-  DB_ASSIGN_OR_RETURN(JsonReader plan, top.Field("plan"));
-  DB_ASSIGN_OR_RETURN(b.plan, SamplePlanFromJson(plan));
-  DB_ASSIGN_OR_RETURN(JsonReader cells, top.Field("cells"));
-  if (!cells.json().is_object()) return cells.Error("expected an object of cells");
-  for (const auto& [name, bands_json] : cells.json().items()) {
-    Expected<Cell> cell = catalogue.ParseCell(name);
-    if (!cell.ok()) return cells.Error(cell.status().message());
-    DB_ASSIGN_OR_RETURN(JsonReader bands, cells.Field(name));
-    if (!bands.json().is_object()) return bands.Error("expected an object of bands");
-    // Keyed by the cell's own spelling, as the gate looks it up.
-    if (b.cells.contains(cell->Name())) return cells.Error(fmt::format("cell '{}' is given twice", cell->Name()));
-    CellFigures& figures = b.cells[cell->Name()];
-    for (const auto& [band, unused] : bands_json.items()) {
-      (void)unused;
-      DB_ASSIGN_OR_RETURN(JsonReader r, bands.Field(band));
-      BandFigures f;
-      DB_ASSIGN_OR_RETURN(f.total_p999, r.Number("total_p999_bits"));
-      DB_ASSIGN_OR_RETURN(f.total_max, r.Number("total_max_bits"));
-      DB_ASSIGN_OR_RETURN(f.arith_p999, r.Number("arith_p999_bits"));
-      DB_ASSIGN_OR_RETURN(f.arith_max, r.Number("arith_max_bits"));
-      if (r.Has("p999_interval_bits")) {
-        DB_RETURN_IF_ERROR(StoreInto(r.Number("p999_interval_bits"), f.p999_interval_bits));
-      }
-      DB_ASSIGN_OR_RETURN(f.judged, r.Unsigned("judged"));
-      DB_ASSIGN_OR_RETURN(f.nan, r.Unsigned("nan"));
-      DB_ASSIGN_OR_RETURN(f.inf, r.Unsigned("inf"));
-      DB_ASSIGN_OR_RETURN(f.worst_index, r.Unsigned("worst_index"));
-      DB_ASSIGN_OR_RETURN(f.first_nonfinite_index, r.Unsigned("first_nonfinite_index"));
-      figures[band] = f;
-    }
-  }
-  return b;
+  return ReadDocument(kBaselineSchema, BaselineFields(catalogue), j, source);
 }
 
 Status WriteBaseline(const std::filesystem::path& path, const Baseline& baseline) {

@@ -1,6 +1,7 @@
 // Baseline: the headline figures of every cell and band of a gate sweep, as
 // committed under reports/baselines/ (one file per backend), with how they
-// were made. Schema "depthbench.baseline", version 1.
+// were made. Schema "depthbench.baseline", version 1, written and read from
+// one field list per type (baseline.cc, json_fields.h).
 #pragma once
 
 #include <cstdint>
@@ -11,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
@@ -62,8 +63,8 @@ struct Baseline {
 // The figures of one backend's cells in a run.
 Baseline BaselineFromResults(const Results& results, const std::string& backend);
 
+// The plan as JSON, as the baseline spells it (a key of the report's history).
 nlohmann::json SamplePlanToJson(const SamplePlan& plan);
-Expected<SamplePlan> SamplePlanFromJson(const JsonReader& plan);
 
 nlohmann::json BaselineToJson(const Baseline& baseline);
 // Cell names are checked against `catalogue`.

@@ -5,8 +5,8 @@
 // the tolerances absorb what a driver or compiler update may legitimately
 // change (the order of a float sum: a few units in the last place), not
 // noise. In bits lost, a few ulps at the p99.9 (where errors are at least a
-// few ulps) move the figure by under 0.25 bit; the maximum is one sample
-// and may move by up to 0.5 bit. Where a band's p99.9 has a wider sampling
+// few ulps) move the figure by less than the statistics resolve
+// (kResolvedBits); the maximum is one sample and may move by up to 0.5 bit. Where a band's p99.9 has a wider sampling
 // interval (few samples above it), that interval is the tolerance, and a
 // band with too few samples for a p99.9 (MinimumSamples) is compared at
 // its maximum only.
@@ -20,7 +20,7 @@
 namespace depthbench {
 
 struct GateTolerance {
-  double p999_bits = 0.25;
+  double p999_bits = kResolvedBits;
   double max_bits = 0.5;
 };
 

@@ -51,16 +51,15 @@ BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> en
 }
 
 bool BatchBuilder::DevicesCanDraw() const {
-  return dynamic_cast<const Sampler*>(&sampler_) != nullptr && model_ == ProductionModel::kFloat32;
+  return sampler_.device_draw_seed().has_value() && model_ == ProductionModel::kFloat32;
 }
 
-void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
-                         BatchFor judge) const {
+void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool, BatchFor judge,
+                         DeviceJudgeInputs* device) const {
   const std::size_t slots = encodings_.size();
   const bool for_host = judge == BatchFor::kHostJudge;
-  const bool device_draws = judge == BatchFor::kDeviceDraws && DevicesCanDraw();
-  batch.drawn_on_device = device_draws;
-  batch.seed = device_draws ? static_cast<const Sampler&>(sampler_).seed() : 0;
+  const bool device_draws = judge == BatchFor::kDeviceDraws && device != nullptr && DevicesCanDraw();
+  if (device != nullptr) device->draw_seed = device_draws ? sampler_.device_draw_seed() : std::nullopt;
   batch.first_index = first;
   batch.count = count;
   batch.first_offset = static_cast<std::uint32_t>(first % kSamplesPerFrame);
@@ -146,7 +145,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
     }
   }
   edges_.resize(frames * slots * 4);
-  batch.edge_texels.resize(edges_.size());
+  if (device != nullptr) device->edge_texels.resize(edges_.size());
   pool.ParallelFor(frames, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t f = begin; f < end; ++f) {
       for (std::size_t s = 0; s < slots; ++s) {
@@ -155,7 +154,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
           const std::size_t at = (f * slots + s) * 4 + pick - 1;
           edges_[at] = per_frame ? EncodeEdge(encodings_[s], batch.frames[f], static_cast<DepthPick>(pick))
                                  : fixed_edges[s][pick - 1];
-          batch.edge_texels[at] = edges_[at].fetched;
+          if (device != nullptr) device->edge_texels[at] = edges_[at].fetched;
         }
       }
     }

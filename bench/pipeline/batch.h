@@ -2,10 +2,12 @@
 // judge. The builder draws the samples, encodes every depth the run's cells
 // read, packs the shader inputs (the part a backend sees, shader_inputs.h)
 // and computes the reference for every (encoding, sample), which only the
-// judge reads (unless the judge computes it on its device: BatchFor).
+// judge reads (unless the judge computes it on its device: BatchFor). What
+// only a judge on a device reads comes apart, in DeviceJudgeInputs.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -31,17 +33,21 @@ struct Batch : ShaderInputs {
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
   // count + sample].
   std::vector<float> pipeline_floats;
-  // What a fetch returns for each stored-value pick (a DepthPick other
-  // than kEyeDepth) in each frame and depth slot, [(frame * depth slots +
-  // slot) * 4 + pick - 1], for a judge that stores the other texels on its
-  // device.
-  std::vector<float> edge_texels;
-  // BatchFor::kDeviceDraws: the samples are drawn on the device, from this
-  // seed (the sampler's); the batch holds its frames alone.
-  bool drawn_on_device = false;
-  std::uint64_t seed = 0;
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
+};
+
+// What a judge on the device (bench/device_judge/) reads of a batch beyond
+// the Batch itself, whatever the batch was built for.
+struct DeviceJudgeInputs {
+  // What a fetch returns for each stored-value pick (a DepthPick other
+  // than kEyeDepth) in each frame and depth slot, [(frame * depth slots +
+  // slot) * 4 + pick - 1]: the judge stores the other texels itself.
+  std::vector<float> edge_texels;
+  // Where the device draws the samples (BatchFor::kDeviceDraws), the seed
+  // it draws them from (SampleSource::device_draw_seed); the batch then
+  // holds its frames alone. Nullopt where the batch holds its samples.
+  std::optional<std::uint64_t> draw_seed;
 };
 
 // The pipeline whose float each depth slot stores, [depth slot]: the
@@ -53,14 +59,14 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings);
 // and the reference included. kDeviceJudge: where every judge works on its
 // device (bench/device_judge/), which produces the depths (in float32),
 // stores the texels and computes the reference itself: the batch's stored
-// depths (depths, codes) are not filled (edge_texels are), its reference
-// is empty, and so are its pipeline floats unless depths are produced
-// exactly (ProductionModel), when its samples also hold only what was
-// drawn (SampleFields::kDrawn). kDeviceDraws: as kDeviceJudge, and the
-// device draws the samples too (shaders/judge/sample.comp): the batch
-// holds its frames, their shader constants and edge texels, and nothing
-// per sample. It needs the random Sampler and float32 production
-// (BatchBuilder::DevicesCanDraw); elsewhere it builds as kDeviceJudge.
+// depths (depths, codes) are not filled, its reference is empty, and so
+// are its pipeline floats unless depths are produced exactly
+// (ProductionModel), when its samples also hold only what was drawn
+// (SampleFields::kDrawn). kDeviceDraws: as kDeviceJudge, and the device
+// draws the samples too (shaders/judge/sample.comp): the batch holds its
+// frames and their shader constants, and nothing per sample. It needs
+// DevicesCanDraw() and a DeviceJudgeInputs to carry the seed; elsewhere it
+// builds as kDeviceJudge.
 enum class BatchFor : std::uint8_t { kHostJudge, kDeviceJudge, kDeviceDraws };
 
 class BatchBuilder {
@@ -69,13 +75,15 @@ class BatchBuilder {
   // (bench/base/isa.h). Depth is produced as the source says (domain.h).
   BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa = Isa::kWidest);
 
-  // Whether a device can draw this builder's samples: they come from the
-  // random Sampler (not a list) and their depths are produced in float32.
+  // Whether a device can draw this builder's samples: their source says
+  // it can (SampleSource::device_draw_seed: the random Sampler, not a
+  // list) and their depths are produced in float32.
   bool DevicesCanDraw() const;
 
-  // Fills `batch` with samples [first, first + count).
+  // Fills `batch` with samples [first, first + count) and, where given,
+  // `device` with what a judge on the device reads beside it.
   void Build(std::uint64_t first, std::uint32_t count, Batch& batch, ThreadPool& pool,
-             BatchFor judge = BatchFor::kHostJudge) const;
+             BatchFor judge = BatchFor::kHostJudge, DeviceJudgeInputs* device = nullptr) const;
 
   // The raster pipeline on a device: replaces the stored texels of the
   // samples that have geometry by the ones the device rendered (codes and
@@ -110,7 +118,7 @@ class BatchBuilder {
   // pick_counts_[chunk] (for the host judge).
   mutable std::vector<std::uint32_t> pick_samples_, pick_counts_;
   // What each frame and depth slot stores for each stored-value pick, laid
-  // out as Batch::edge_texels.
+  // out as DeviceJudgeInputs::edge_texels.
   mutable std::vector<StoredDepth> edges_;
 };
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -81,6 +82,9 @@ class SampleSource {
   virtual ProductionModel production() const { return ProductionModel::kFloat32; }
   // How the shaders' per-frame constants are computed.
   virtual ConstantsModel constants() const { return ConstantsModel::kExact; }
+  // The seed a device draws this source's samples from, as SampleAt draws
+  // them (shared/draw.h), where it can; nullopt where it cannot (a list).
+  virtual std::optional<std::uint64_t> device_draw_seed() const { return std::nullopt; }
 };
 
 // A point of the domain in unit coordinates: every random choice the
@@ -120,6 +124,7 @@ class Sampler : public SampleSource {
   PixelSample SampleAt(std::uint64_t index, const Frame& frame) const override;
   ProductionModel production() const override { return domain_.production; }
   ConstantsModel constants() const override { return domain_.constants; }
+  std::optional<std::uint64_t> device_draw_seed() const override { return seed_; }
   FrameUnits FrameUnitsAt(std::uint64_t frame_index) const;
   SampleUnits SampleUnitsAt(std::uint64_t index) const;
 

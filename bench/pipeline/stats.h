@@ -43,6 +43,11 @@ inline constexpr int kMetricCount = 5;
 const char* MetricName(Metric m);
 
 inline constexpr int kBinsPerOctave = 4;
+// Bits-lost figures closer than this are the same accuracy: errors are kept
+// in quarter-octave bins, so a quantile is known to a quarter of a bit and
+// finer differences are interpolation. Ties between variants, the gate's
+// p99.9 tolerance and the choice's resolution all use it.
+inline constexpr double kResolvedBits = 1.0 / kBinsPerOctave;
 inline constexpr int kOctavesKept = 64;
 inline constexpr int kBinsKept = kBinsPerOctave * kOctavesKept;
 // Lowest kept octave per metric: relative errors from 2^-56 (32 bits below

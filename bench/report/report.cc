@@ -28,7 +28,7 @@ const Level kChartLevels[] = {Level::kP999, Level::kMax};
 const double kFrontRatios[] = {1e2, 1e4, 1e6};
 // Backend differences smaller than this are the statistics' resolution
 // (quarter-octave bins: a p99.9 is known to a quarter of a bit).
-constexpr double kNotableDifferenceBits = kBitsResolution;
+constexpr double kNotableDifferenceBits = kResolvedBits;
 constexpr std::size_t kMostWorstSamples = 40;
 constexpr std::size_t kMostDifferences = 40;
 
@@ -89,7 +89,9 @@ std::vector<ModelPointRow> ModelAlongPoints(const PrecisionFit& fit, const FitSw
     row.log10_ratio = Log10Ratio(band.ratio);
     row.depth = Shown(std::exp2(p.y));
     row.measured = band.modelled ? value(p.b) : Figure();
-    row.state = band.modelled ? "measured" : std::isinf(p.b) ? "not finite" : "below resolution";
+    row.state = band.modelled     ? ModelPointRow::State::kMeasured
+                : std::isinf(p.b) ? ModelPointRow::State::kNotFinite
+                                  : ModelPointRow::State::kBelowResolution;
     row.model = value(model.value);
     row.low = value(model.low);
     row.high = value(model.high);
@@ -292,12 +294,15 @@ void AddFronts(const std::string& source, double ratio, const std::vector<FrontE
   }
 }
 
-// Pixels of the frame a GPU cost is given for.
-constexpr double kFramePixels = 1920.0 * 1080.0;
-constexpr const char* kFrameName = "1920x1080";
+// The backend the first screen and the speed section speak for: the
+// Vulkan backend where the report ran it (TradeBackend), else the CPU.
+std::string FirstScreenBackend(const ReportMeasurements& m) {
+  const Expected<std::string> backend = TradeBackend(m.main);
+  return backend.ok() ? *backend : "cpu";
+}
 
 // The speed/accuracy front at the far/near ratios a scene typically has:
-// the cost from each speed file (GPU time per 1920x1080 frame, from the
+// the cost from each speed file (GPU time per kCostFrame frame, from the
 // ALU-bound time per reconstruction) and from the instruction mix (which
 // always exists), the accuracy from this report's sweep at that ratio on
 // the GPU backend, with its interval. Sources best first (CostKind).
@@ -308,8 +313,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
     return section;
   }
   std::vector<FrontRow>& rows = section.rows;
-  const Expected<std::string> trade_backend = TradeBackend(m.main);
-  const std::string backend = trade_backend.ok() ? *trade_backend : "cpu";
+  const std::string backend = FirstScreenBackend(m);
   std::string device;
   for (const BackendRecord& b : m.main.run.backends) {
     if (b.name == backend) device = b.device.name;
@@ -323,12 +327,13 @@ SpeedSection Speed(const ReportMeasurements& m) {
     if (speed.gpu.empty()) continue;
     FrontSource source;
     source.source = source_name(path, speed);
-    source.kind = speed.run.device.kind == "gpu" ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    source.kind = speed.run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
     source.device = speed.run.device.name;
     source.cost_unit =
-        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})", kFrameName,
-                    ResolutionName(speed.run.trade_resolution), speed.run.started_at);
-    source.cost_title = fmt::format("GPU time per {} frame (µs) on {}", kFrameName, speed.run.device.name);
+        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})",
+                    ResolutionName(kCostFrame), ResolutionName(speed.run.trade_resolution), speed.run.started_at);
+    source.cost_title =
+        fmt::format("GPU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
     source.accuracy = accuracy;
     section.sources.push_back(std::move(source));
   }
@@ -359,7 +364,7 @@ SpeedSection Speed(const ReportMeasurements& m) {
           const Cell cell{p.variant, front.convention, front.format, speed.catalogue};
           const std::optional<CellAccuracy> cell_accuracy = accuracy_of(cell);
           if (!cell_accuracy) continue;
-          const double us_per_frame = kFramePixels * 1e-3;
+          const double us_per_frame = static_cast<double>(kCostFrame.width) * kCostFrame.height * 1e-3;
           entries.push_back({cell,
                              {p.gpu_ns_per_reconstruction * us_per_frame, p.gpu_spread_ns * us_per_frame,
                               FrontBits(p.p999_bits_lost)},
@@ -380,83 +385,96 @@ SpeedSection Speed(const ReportMeasurements& m) {
   return section;
 }
 
-// Two variants whose far-plane predictions are closer than this are tied:
-// the gate's tolerance at p99.9, below what the fits resolve.
-constexpr double kTieBits = 0.25;
-
-// The first screen, from the headline (fits: each prediction with its
-// interval) and the speed section (costs): on the GPU backend where the
-// report ran one, at far/near 1e4 for finite conventions.
-std::vector<RecommendationRow> Recommendations(const Report& report) {
-  std::string backend;
-  for (const HeadlineRow& h : report.headline)
-    if (backend.empty() || h.cell.backend == "vulkan") backend = h.cell.backend;
-  // Costs: the best source with a front (sources are best first: a GPU's
-  // time over a software rasteriser's over the static model).
-  const FrontSource* source = nullptr;
-  for (const FrontSource& s : report.speed.sources) {
-    const bool has_rows = std::any_of(report.speed.rows.begin(), report.speed.rows.end(),
-                                      [&](const FrontRow& r) { return r.source == s.source; });
-    if (has_rows && source == nullptr) source = &s;
+// The costs the first screen ranks by: the best speed file's (a GPU's
+// time over a software rasteriser's) where it covers every candidate,
+// else the static model for all (ChooseCosts), with its unit and kind.
+struct ScreenCosts {
+  CostLookup lookup;
+  CostKind kind = CostKind::kStaticModel;
+  std::string unit = kStaticCostUnit;
+};
+ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> candidates) {
+  const SpeedResults* best = nullptr;
+  std::string best_name;
+  for (const auto& [path, speed] : m.speed) {
+    if (speed.gpu.empty()) continue;
+    if (best == nullptr || (speed.run.device.kind == DeviceKind::kGpu && best->run.device.kind != DeviceKind::kGpu)) {
+      best = &speed;
+      best_name = path.filename().string();
+    }
   }
-  std::map<std::string, double> cost_of;  // variant/convention/format -> cost
-  for (const FrontRow& r : report.speed.rows)
-    if (source != nullptr && r.source == source->source && r.cost) cost_of.emplace(r.cell.Name(), *r.cost);
-  const CostKind kind = source != nullptr ? source->kind : CostKind::kStaticModel;
-  const std::string unit = kind == CostKind::kStaticModel
-                               ? std::string(kStaticCostUnit)
-                               : fmt::format("µs per {} frame on {}", kFrameName, source->device);
+  CostSources sources{{}, best_name, m.static_costs};
+  if (best != nullptr) sources.measured = SpeedCostLookup(*best, best_name);
+  const CostChoice choice = ChooseCosts(sources, candidates);
+  ScreenCosts costs;
+  costs.lookup = choice.lookup;
+  if (choice.measured) {
+    costs.kind = best->run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
+    costs.unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), best->run.device.name);
+  }
+  return costs;
+}
 
-  std::map<std::pair<std::string, std::string>, std::vector<const HeadlineRow*>> groups;
-  std::vector<std::pair<std::string, std::string>> order;
-  for (const HeadlineRow& h : report.headline) {
-    if (h.cell.backend != backend) continue;
-    const auto key = std::make_pair(h.cell.convention, h.cell.format);
+// The first screen: per convention and format, on the GPU backend where
+// the report ran one, at far/near 1e4 for finite conventions. The fits'
+// predictions at the far plane (unrounded) within the statistics'
+// resolution of the most precise meet the bar, and the ranking that
+// `choose` uses (choose/ranking.h) puts them in order, cheapest first.
+std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
+  const std::string backend = FirstScreenBackend(m);
+  std::vector<const PrecisionFit*> screen;
+  std::vector<Cell> candidates;
+  for (const PrecisionFit& f : m.fits) {
+    if (f.metric != Metric::kTotal || f.level != Level::kP999 || f.backend != backend) continue;
+    screen.push_back(&f);
+    candidates.push_back(f.cell);
+  }
+  const ScreenCosts costs = CostsForScreen(m, candidates);
+  std::map<std::pair<Convention, Format>, std::vector<const PrecisionFit*>> groups;
+  std::vector<std::pair<Convention, Format>> order;
+  for (const PrecisionFit* f : screen) {
+    const auto key = std::make_pair(f->cell.convention, f->cell.format);
     if (groups[key].empty()) order.push_back(key);
-    groups[key].push_back(&h);
+    groups[key].push_back(f);
   }
   std::vector<RecommendationRow> rows;
   for (const auto& key : order) {
+    const std::vector<const PrecisionFit*>& group = groups[key];
     RecommendationRow row;
-    row.convention = key.first;
-    row.format = key.second;
+    row.convention = Info(key.first).name;
+    row.format = Info(key.second).name;
     row.backend = backend;
-    row.ratio = groups[key].front()->infinite_far ? "inf" : "1e4";
-    const auto bits_of = [&](const HeadlineRow* h) {
-      auto it = h->predicted_bits.find(row.ratio);
-      return it == h->predicted_bits.end() || !it->second ? kAllBitsLost : *it->second;
-    };
-    const auto cost = [&](const HeadlineRow* h) -> std::optional<double> {
-      auto it = cost_of.find(h->cell.Name());
-      if (it == cost_of.end()) return std::nullopt;
-      return it->second;
+    row.ratio = group.front()->infinite_far ? "inf" : "1e4";
+    const auto bits_of = [&](const PrecisionFit* f) {
+      auto it = f->predicted.find(row.ratio);
+      return it == f->predicted.end() || !std::isfinite(it->second) ? kAllBitsLost : it->second;
     };
     double best = kAllBitsLost;
-    for (const HeadlineRow* h : groups[key]) best = std::min(best, bits_of(h));
-    std::vector<const HeadlineRow*> tied;
-    for (const HeadlineRow* h : groups[key])
-      if (bits_of(h) <= best + kTieBits) tied.push_back(h);
-    // The cheapest of the tied first (unknown costs last), then the more precise.
-    std::stable_sort(tied.begin(), tied.end(), [&](const HeadlineRow* a, const HeadlineRow* b) {
-      const double ca = cost(a).value_or(INFINITY), cb = cost(b).value_or(INFINITY);
-      if (ca != cb) return ca < cb;
-      return bits_of(a) < bits_of(b);
-    });
-    const HeadlineRow& chosen = *tied.front();
-    for (const HeadlineRow* h : tied) row.variants.push_back(h->cell.variant);
+    for (const PrecisionFit* f : group) best = std::min(best, bits_of(f));
+    std::vector<RankInput> inputs;
+    for (const PrecisionFit* f : group) {
+      inputs.push_back({.meets = bits_of(f) <= best + kResolvedBits,
+                        .error = bits_of(f),
+                        .cost = costs.lookup ? costs.lookup(f->cell) : std::nullopt});
+    }
+    const std::vector<RankPlace> ranked = Rank(inputs);
+    for (const RankPlace& place : ranked) {
+      if (inputs[place.candidate].meets) row.variants.emplace_back(group[place.candidate]->cell.variant_info().name);
+    }
+    const PrecisionFit& chosen = *group[ranked.front().candidate];
     row.bits = Shown(bits_of(&chosen));
     // The interval of that very prediction (the fit's model at the far
     // plane of the ratio), not of a band's point: a band can sit elsewhere
     // (the infinite sweep's deepest band ends short of the span predicted).
     if (auto it = chosen.predicted_interval.find(row.ratio); it != chosen.predicted_interval.end() && row.bits) {
-      row.bits_low = it->second.first;
-      row.bits_high = it->second.second;
+      row.bits_low = Shown(it->second.first);
+      row.bits_high = Shown(it->second.second);
     }
-    if (const std::optional<double> c = cost(&chosen)) row.cost = Shown(*c);
-    row.cost_kind = kind;
-    row.cost_unit = unit;
-    row.ratio_for_1e3 = chosen.ratio_for_1e3;
-    row.ratio_for_1e6 = chosen.ratio_for_1e6;
+    if (const std::optional<CandidateCost>& c = inputs[ranked.front().candidate].cost) row.cost = Shown(c->value);
+    row.cost_kind = costs.kind;
+    row.cost_unit = costs.unit;
+    row.ratio_for_1e3 = Budget(chosen, "1e-3");
+    row.ratio_for_1e6 = Budget(chosen, "1e-6");
     rows.push_back(std::move(row));
   }
   return rows;
@@ -487,6 +505,57 @@ ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& 
 }
 
 }  // namespace
+
+// Groups the history's changes by cell (HistorySection::worse_cells) and
+// counts the cells better and unchanged of the `cells` compared.
+void CountChangedCells(std::size_t cells, HistorySection& h) {
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> worse;
+  std::set<std::pair<std::string, std::string>> better;
+  for (const HistorySection::Change& c : h.changes) {
+    if (c.direction == HistorySection::Direction::kWorse) {
+      worse[{c.cell, c.backend}].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
+    }
+  }
+  for (const HistorySection::Change& c : h.changes) {
+    if (c.direction == HistorySection::Direction::kBetter && !worse.count({c.cell, c.backend})) {
+      better.insert({c.cell, c.backend});
+    }
+  }
+  for (auto& [key, bands] : worse) h.worse_cells.push_back({key.first, key.second, std::move(bands)});
+  h.better_cells = better.size();
+  h.unchanged_cells = cells - std::min(cells, h.worse_cells.size() + h.better_cells);
+}
+
+// The headline's measured cells, worst first; a cell with the same figures
+// on several backends once.
+std::vector<Report::WorstCell> WorstCells(const std::vector<HeadlineRow>& headline) {
+  std::vector<std::size_t> rows;
+  for (std::size_t k = 0; k < headline.size(); ++k) {
+    if (headline[k].measured) rows.push_back(k);
+  }
+  std::stable_sort(rows.begin(), rows.end(), [&](std::size_t i, std::size_t j) {
+    const HeadlineRow* a = &headline[i];
+    const HeadlineRow* b = &headline[j];
+    const double a_p999 = a->measured->p999_bits.value_or(INFINITY), b_p999 = b->measured->p999_bits.value_or(INFINITY);
+    if (a_p999 != b_p999) return a_p999 > b_p999;
+    return a->measured->max_bits.value_or(INFINITY) > b->measured->max_bits.value_or(INFINITY);
+  });
+  std::vector<Report::WorstCell> worst;
+  for (std::size_t k : rows) {
+    const HeadlineRow& row = headline[k];
+    auto same = std::find_if(worst.begin(), worst.end(), [&](const Report::WorstCell& w) {
+      const HeadlineRow& other = headline[w.row];
+      return other.cell.Name() == row.cell.Name() && other.measured->p999_bits == row.measured->p999_bits &&
+             other.measured->max_bits == row.measured->max_bits;
+    });
+    if (same != worst.end()) {
+      same->backends.push_back(row.cell.backend);
+    } else {
+      worst.push_back({k, {row.cell.backend}});
+    }
+  }
+  return worst;
+}
 
 ReportPlan ReportPlan::Nightly() {
   ReportPlan plan;
@@ -576,7 +645,8 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   report.backend_differences = Differences(m.sweeps, backends);
   Findings(m, report);
   report.speed = Speed(m);
-  report.recommendations = Recommendations(report);
+  report.recommendations = Recommendations(m);
+  report.worst_cells = WorstCells(report.headline);
   return report;
 }
 
@@ -610,16 +680,19 @@ Status AddHistory(Report& report, History& history, const HistoryRun& run, std::
     DB_ASSIGN_OR_RETURN(GateComparison comparison, CompareWithBaseline(before_figures, now, tolerance));
     for (const std::string& note : comparison.notes) section.notes.push_back(now.backend + ": " + note);
     for (const CellVerdict& v : comparison.cells) {
-      auto add = [&](const char* direction, const std::string& band, const std::vector<std::string>& reasons,
-                     double before_bits, double after_bits) {
+      auto add = [&](HistorySection::Direction direction, const std::string& band,
+                     const std::vector<std::string>& reasons, double before_bits, double after_bits) {
         section.changes.push_back(
             {direction, now.backend, v.cell, band, reasons, Shown(before_bits), Shown(after_bits)});
       };
-      if (v.disappeared) add("worse", "all", {"the cell is missing from this run"}, NAN, NAN);
-      for (const BandChange& c : v.worse) add("worse", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
-      for (const BandChange& c : v.better) add("better", c.band, c.reasons, c.before.total_p999, c.after.total_p999);
+      constexpr auto kWorse = HistorySection::Direction::kWorse;
+      if (v.disappeared) add(kWorse, "all", {"the cell is missing from this run"}, NAN, NAN);
+      for (const BandChange& c : v.worse) add(kWorse, c.band, c.reasons, c.before.total_p999, c.after.total_p999);
+      for (const BandChange& c : v.better)
+        add(HistorySection::Direction::kBetter, c.band, c.reasons, c.before.total_p999, c.after.total_p999);
     }
   }
+  CountChangedCells(report.headline.size(), section);
   report.history = std::move(section);
   return Status::Ok();
 }

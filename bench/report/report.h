@@ -80,6 +80,13 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
 // The report, without its history part.
 Report BuildReport(const ReportPlan& plan, const ReportMeasurements& measured);
 
+// The parts of the model that group or order other parts: the history's
+// changes by cell (worse_cells, better_cells, unchanged_cells, of `cells`
+// compared) and the headline's worst cells (Report::worst_cells). The
+// writers only loop over them.
+void CountChangedCells(std::size_t cells, HistorySection& history);
+std::vector<Report::WorstCell> WorstCells(const std::vector<HeadlineRow>& headline);
+
 // The headline figures of each backend, as the history keeps them.
 std::vector<Baseline> HistoryFigures(const ReportMeasurements& measured);
 

@@ -95,7 +95,7 @@ json ModelPoint(const ModelPointRow& r) {
                           {"log10_ratio", Value(r.log10_ratio)},
                           {"depth", Value(r.depth)},
                           {"measured", Value(r.measured)},
-                          {"state", r.state},
+                          {"state", PointStateName(r.state)},
                           {"model", Value(r.model)},
                           {"low", Value(r.low)},
                           {"high", Value(r.high)},
@@ -153,7 +153,7 @@ json History(const std::optional<HistorySection>& h) {
           {"notes", h->notes},
           {"changes", Rows(h->changes,
                            [](const HistorySection::Change& c) {
-                             return json{{"direction", c.direction},
+                             return json{{"direction", DirectionName(c.direction)},
                                          {"backend", c.backend},
                                          {"cell", c.cell},
                                          {"band", c.band},

@@ -35,7 +35,20 @@ const char* CostKindName(CostKind kind) {
 
 std::size_t HistorySection::worse() const {
   return static_cast<std::size_t>(
-      std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == "worse"; }));
+      std::count_if(changes.begin(), changes.end(), [](const Change& c) { return c.direction == Direction::kWorse; }));
+}
+
+const char* PointStateName(ModelPointRow::State state) {
+  switch (state) {
+    case ModelPointRow::State::kMeasured: return "measured";
+    case ModelPointRow::State::kNotFinite: return "not finite";
+    case ModelPointRow::State::kBelowResolution: return "below resolution";
+  }
+  return "?";
+}
+
+const char* DirectionName(HistorySection::Direction direction) {
+  return direction == HistorySection::Direction::kWorse ? "worse" : "better";
 }
 
 }  // namespace depthbench

@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "bench/backends/device_info.h"
 #include "bench/base/json_reader.h"
+#include "bench/pipeline/device_info.h"
 
 namespace depthbench {
 
@@ -89,8 +89,12 @@ struct ModelPointRow {
   std::string ratio;  // "1e4", "inf"
   Figure log10_ratio;
   Figure depth;
-  Figure measured;    // none: see state
-  std::string state;  // "measured", "not finite", "below resolution"
+  // What a band's measured figure is: a figure, none because the outputs
+  // were not finite, or none because the error is below what the
+  // histograms resolve.
+  enum class State : std::uint8_t { kMeasured, kNotFinite, kBelowResolution };
+  Figure measured;  // none: see state
+  State state = State::kMeasured;
   Figure model, low, high;
   bool held_out = false;
 };
@@ -186,13 +190,24 @@ struct HistorySection {
   std::vector<Previous> previous;
   double tolerance_p999_bits = 0.0, tolerance_max_bits = 0.0;
   std::vector<std::string> notes;
+  enum class Direction : std::uint8_t { kWorse, kBetter };
   struct Change {
-    std::string direction;  // "worse", "better"
+    Direction direction = Direction::kWorse;
     std::string backend, cell, band;
     std::vector<std::string> reasons;
     Figure before_p999_bits, after_p999_bits;
   };
   std::vector<Change> changes;
+  // The changes by cell: each (cell, backend) that got worse in any band,
+  // with what got worse in each band ("band: reasons"), in order of cell
+  // and backend; a cell worse in one band and better in another is worse.
+  struct WorseCell {
+    std::string cell, backend;
+    std::vector<std::string> bands;
+  };
+  std::vector<WorseCell> worse_cells;
+  std::size_t better_cells = 0;     // better in some band, worse in none
+  std::size_t unchanged_cells = 0;  // of the headline's cells
   struct TrendPoint {
     std::int64_t run = 0;
     std::string made_at, commit, backend, cell;
@@ -203,6 +218,8 @@ struct HistorySection {
 
   std::size_t worse() const;  // changes for the worse
 };
+const char* PointStateName(ModelPointRow::State state);          // "measured", "not finite", "below resolution"
+const char* DirectionName(HistorySection::Direction direction);  // "worse", "better"
 
 // The first screen: per convention and format, the variant to use (with
 // those it ties with), how precise it is at the far plane, what it costs,
@@ -229,6 +246,14 @@ struct Report {
   std::vector<NonFiniteRow> nonfinite;
   std::vector<FindingGroup> finding_groups;  // the non-finite rows by cause, most rows first
   std::vector<WorstSampleRow> worst;
+  // The headline's cells with measured figures, worst first (p99.9 bits
+  // lost, then the maximum), a cell measured the same on several backends
+  // once, with every backend named.
+  struct WorstCell {
+    std::size_t row = 0;  // an index into headline
+    std::vector<std::string> backends;
+  };
+  std::vector<WorstCell> worst_cells;
   SpeedSection speed;
   std::optional<HistorySection> history;  // none with --no-history
 };

@@ -10,6 +10,7 @@
 #include "bench/base/files.h"
 #include "bench/base/text_table.h"
 #include "bench/pipeline/cells.h"
+#include "bench/pipeline/stats.h"
 #include "bench/report/report_json.h"
 
 namespace depthbench {
@@ -74,35 +75,23 @@ void Verdict(const Report& report, std::string& out) {
   for (const HistorySection::Previous& p : h.previous) {
     previous.push_back(fmt::format("{} run {} (commit `{}`)", p.backend, p.run, p.commit.substr(0, 12)));
   }
-  // Worse first, grouped by cell and backend; a cell worse in one band and
-  // better in another counts as worse.
-  std::map<std::pair<std::string, std::string>, std::vector<std::string>> worse;
-  std::set<std::pair<std::string, std::string>> better;
-  for (const HistorySection::Change& c : h.changes) {
-    const std::pair<std::string, std::string> key{c.cell, c.backend};
-    if (c.direction == "worse") worse[key].push_back(fmt::format("{}: {}", c.band, fmt::join(c.reasons, ", ")));
-  }
-  for (const HistorySection::Change& c : h.changes) {
-    const std::pair<std::string, std::string> key{c.cell, c.backend};
-    if (c.direction == "better" && !worse.count(key)) better.insert(key);
-  }
-  const std::size_t cells = report.headline.size();
-  const std::size_t unchanged = cells - std::min(cells, worse.size() + better.size());
+  const std::vector<HistorySection::WorseCell>& worse = h.worse_cells;
   out += fmt::format(
       "**Verdict: {}** since {}: {} cells worse, {} better, {} unchanged of {} (tolerance {} bit at "
       "p99.9, {} bit at the maximum).\n\n",
       worse.empty() ? "nothing got worse" : fmt::format("{} cell(s) got worse", worse.size()),
-      fmt::join(previous, ", "), worse.size(), better.size(), unchanged, cells, h.tolerance_p999_bits,
-      h.tolerance_max_bits);
-  std::size_t shown = 0;
-  for (const auto& [key, bands] : worse) {
-    if (shown++ == kChangesInSummary) {
+      fmt::join(previous, ", "), worse.size(), h.better_cells, h.unchanged_cells, report.headline.size(),
+      h.tolerance_p999_bits, h.tolerance_max_bits);
+  for (std::size_t shown = 0; shown < worse.size(); ++shown) {
+    if (shown == kChangesInSummary) {
       out += fmt::format("- ... and {} more: see report.html\n", worse.size() - kChangesInSummary);
       break;
     }
+    const std::vector<std::string>& bands = worse[shown].bands;
     const std::size_t kBandsShown = 3;
     std::vector<std::string> first(bands.begin(), bands.begin() + std::min(bands.size(), kBandsShown));
-    out += fmt::format("- `{}` on {}: {}{}\n", key.first, key.second, Escape(fmt::format("{}", fmt::join(first, "; "))),
+    out += fmt::format("- `{}` on {}: {}{}\n", worse[shown].cell, worse[shown].backend,
+                       Escape(fmt::format("{}", fmt::join(first, "; "))),
                        bands.size() > kBandsShown ? fmt::format(" (+{} bands)", bands.size() - kBandsShown) : "");
   }
   // The comparison's notes, folded into one item of the same list.
@@ -166,33 +155,23 @@ void WhatToUse(const Report& report, std::string& out) {
                        f ? f->ratio : "-", bits(f), f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
                        f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite));
   }
-  out +=
-      "\nUse: the cheapest variant within 0.25 bit of the most precise (= tied ones); bits lost at p99.9 at the far "
+  out += fmt::format(
+      "\nUse: the cheapest variant within {} bit of the most precise (= tied ones); bits lost at p99.9 at the far "
       "plane, the model's 95% interval; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that "
-      "relative error; infinite far: the convention's -inf form, at its far end.\n\n";
+      "relative error; infinite far: the convention's -inf form, at its far end.\n\n",
+      kResolvedBits);
 }
 
 // The worst cells over the default domain and the NaN/Inf findings by
 // cause, a few lines each: the page lists them all.
 void Problems(const Report& report, std::string& out) {
   out += "## Worst cells and NaN/Inf findings\n\n";
-  // A cell as bad on every backend is one line.
-  std::vector<std::pair<const HeadlineRow*, std::vector<std::string>>> worst;
-  for (const HeadlineRow* row : WorstRows(report, report.headline.size())) {
-    auto same = std::find_if(worst.begin(), worst.end(), [&](const auto& w) {
-      return w.first->cell.Name() == row->cell.Name() && w.first->measured->p999_bits == row->measured->p999_bits &&
-             w.first->measured->max_bits == row->measured->max_bits;
-    });
-    if (same != worst.end()) {
-      same->second.push_back(row->cell.backend);
-    } else if (worst.size() < kWorstInSummary) {
-      worst.push_back({row, {row->cell.backend}});
-    }
-  }
   std::vector<std::string> worst_text;
-  for (const auto& [row, backends] : worst) {
-    worst_text.push_back(fmt::format("`{}` on {} ({}, {})", row->cell.Name(), fmt::join(backends, ", "),
-                                     Bits(row->measured->p999_bits), Bits(row->measured->max_bits)));
+  for (std::size_t k = 0; k < report.worst_cells.size() && k < kWorstInSummary; ++k) {
+    const HeadlineRow& row = report.headline[report.worst_cells[k].row];
+    worst_text.push_back(fmt::format("`{}` on {} ({}, {})", row.cell.Name(),
+                                     fmt::join(report.worst_cells[k].backends, ", "), Bits(row.measured->p999_bits),
+                                     Bits(row.measured->max_bits)));
   }
   if (!worst_text.empty()) {
     out += fmt::format("- worst (bits lost at p99.9 and at the maximum over the default domain): {}\n",
@@ -298,20 +277,6 @@ std::string RenderMarkdown(const Report& report) {
       ShortCount(static_cast<double>(env.default_sweep.samples)), env.quick ? " (quick)" : "",
       env.seconds.value_or(0.0));
   return out;
-}
-
-std::vector<const HeadlineRow*> WorstRows(const Report& report, std::size_t count) {
-  std::vector<const HeadlineRow*> rows;
-  for (const HeadlineRow& row : report.headline) {
-    if (row.measured) rows.push_back(&row);
-  }
-  std::stable_sort(rows.begin(), rows.end(), [](const HeadlineRow* a, const HeadlineRow* b) {
-    const double a_p999 = a->measured->p999_bits.value_or(INFINITY), b_p999 = b->measured->p999_bits.value_or(INFINITY);
-    if (a_p999 != b_p999) return a_p999 > b_p999;
-    return a->measured->max_bits.value_or(INFINITY) > b->measured->max_bits.value_or(INFINITY);
-  });
-  if (rows.size() > count) rows.resize(count);
-  return rows;
 }
 
 }  // namespace depthbench

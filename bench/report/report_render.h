@@ -36,8 +36,4 @@ Expected<std::string> RenderHtml(const Report& report, const std::filesystem::pa
 // headline per convention and format, the worst cells, NaN/Inf findings.
 std::string RenderMarkdown(const Report& report);
 
-// The cells the summary calls worst: the highest p99.9 bits lost over the
-// default domain (then the highest maximum), `count` of them.
-std::vector<const HeadlineRow*> WorstRows(const Report& report, std::size_t count);
-
 }  // namespace depthbench

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/base/json_fields.h"
 #include "bench/base/json_reader.h"
 
 namespace depthbench {
@@ -74,34 +75,150 @@ void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
   }
 }
 
-// ---------------------------------------------------------------- writing
+// ---------------------------------------------------------------- fields
 
 namespace {
 
-json RangeToJson(const Range& r) { return json::array({r.min, r.max}); }
-
-json MetricToJson(const MetricStats& m) {
-  json bins = json::array();
-  for (const auto& [slot, count] : m.bins) bins.push_back(json::array({slot, count}));
-  return {{"max_square", JsonNumber(m.max_square)},
-          {"max", JsonNumber(m.max())},  // for readers; max_square is the exact record
-          {"worst_index", JsonIndex(m.worst_index)},
-          {"bins", bins}};
+// The two elements of an array of exactly two ([min, max], [width, height]).
+Expected<std::pair<JsonReader, JsonReader>> TwoElements(const JsonReader& r, const char* spelled) {
+  DB_ASSIGN_OR_RETURN(const std::size_t n, r.ArraySize());
+  if (n != 2) return r.Error(fmt::format("expected {}", spelled));
+  DB_ASSIGN_OR_RETURN(JsonReader first, r.Element(0));
+  DB_ASSIGN_OR_RETURN(JsonReader second, r.Element(1));
+  return std::pair<JsonReader, JsonReader>(std::move(first), std::move(second));
 }
 
-json BandToJson(const BandStats& b) {
-  json metrics = json::object();
-  for (int m = 0; m < kMetricCount; ++m) metrics[MetricName(static_cast<Metric>(m))] = MetricToJson(b.metrics[m]);
-  return {{"finite", b.finite},
-          {"nan", b.nan},
-          {"inf", b.inf},
-          {"stored_nonfinite", b.stored_nonfinite},
-          {"degenerate", b.degenerate},
-          {"outside", b.outside},
-          {"first_nonfinite_index", JsonIndex(b.first_nonfinite_index)},
-          {"metrics", metrics}};
+// A range as [min, max].
+struct RangeCodec {
+  json Write(const Range& r) const { return json::array({JsonReal().Write(r.min), JsonReal().Write(r.max)}); }
+  Status Read(const JsonReader& r, Range& out) const {
+    DB_ASSIGN_OR_RETURN(const auto elements, TwoElements(r, "[min, max]"));
+    DB_RETURN_IF_ERROR(JsonReal().Read(elements.first, out.min));
+    return JsonReal().Read(elements.second, out.max);
+  }
+};
+
+// A resolution as [width, height].
+struct ResolutionPairCodec {
+  json Write(const Resolution& r) const { return json::array({r.width, r.height}); }
+  Status Read(const JsonReader& r, Resolution& out) const {
+    DB_ASSIGN_OR_RETURN(const auto elements, TwoElements(r, "[width, height]"));
+    DB_RETURN_IF_ERROR(JsonInteger<std::uint32_t>().Read(elements.first, out.width));
+    return JsonInteger<std::uint32_t>().Read(elements.second, out.height);
+  }
+};
+
+// A metric's histogram as [slot, count] pairs, slots within the dense bins.
+struct BinsCodec {
+  json Write(const std::map<int, std::uint64_t>& bins) const {
+    json out = json::array();
+    for (const auto& [slot, count] : bins) out.push_back(json::array({slot, count}));
+    return out;
+  }
+  Status Read(const JsonReader& r, std::map<int, std::uint64_t>& out) const {
+    out.clear();
+    return r.ForEach([&](const JsonReader& pair) -> Status {
+      DB_ASSIGN_OR_RETURN(const auto elements, TwoElements(pair, "[slot, count]"));
+      int slot = 0;
+      DB_RETURN_IF_ERROR((JsonInteger<int>{0, kDenseBins - 1}.Read(elements.first, slot)));
+      if (out.contains(slot)) return elements.first.Error(fmt::format("bin {} is given twice", slot));
+      return JsonInteger<std::uint64_t>().Read(elements.second, out[slot]);
+    });
+  }
+};
+
+const JsonFields<MetricStats>& MetricFields() {
+  static const JsonFields<MetricStats> fields{{
+      JsonMember("max_square", &MetricStats::max_square),
+      JsonDerived<MetricStats>("max", [](const MetricStats& m) { return JsonNumber(m.max()); }),
+      JsonMember("worst_index", &MetricStats::worst_index, JsonIndexOrNull()),
+      JsonMember("bins", &MetricStats::bins, BinsCodec()),
+  }};
+  return fields;
 }
 
+// Every metric, under its name.
+using MetricsArray = std::array<MetricStats, kMetricCount>;
+const JsonFields<MetricsArray>& MetricsFields() {
+  static const JsonFields<MetricsArray> fields = [] {
+    JsonFields<MetricsArray> list;
+    for (int m = 0; m < kMetricCount; ++m) {
+      list.fields.push_back(JsonAccess<MetricsArray>(
+          MetricName(static_cast<Metric>(m)), [m](auto& metrics) -> auto& { return metrics[m]; },
+          JsonObject{MetricFields()}));
+    }
+    return list;
+  }();
+  return fields;
+}
+
+// A band's counts; a cell's "counts" are those of all its natural bands.
+const JsonFields<BandStats>& BandCountFields() {
+  static const JsonFields<BandStats> fields{{
+      JsonMember("finite", &BandStats::finite),
+      JsonMember("nan", &BandStats::nan),
+      JsonMember("inf", &BandStats::inf),
+      JsonMember("stored_nonfinite", &BandStats::stored_nonfinite),
+      JsonMember("degenerate", &BandStats::degenerate),
+      JsonMember("outside", &BandStats::outside),
+      JsonMember("first_nonfinite_index", &BandStats::first_nonfinite_index, JsonIndexOrNull()),
+  }};
+  return fields;
+}
+
+const JsonFields<BandStats>& BandFields() {
+  static const JsonFields<BandStats> fields = [] {
+    JsonFields<BandStats> list = BandCountFields();
+    list.fields.push_back(JsonMember("metrics", &BandStats::metrics, JsonObject{MetricsFields()}));
+    return list;
+  }();
+  return fields;
+}
+
+// A band index in [0, count), as `key`, with its name beside it as `name_key`
+// (for readers; not read back).
+JsonFields<int> BandKeyFields(const char* key, int count, const char* name_key, std::string (*name)(int)) {
+  return {{JsonAccess<int>(
+               key, [](auto& band) -> auto& { return band; }, JsonInteger<int>{0, count - 1}),
+           JsonDerived<int>(name_key, name)}};
+}
+
+// One half of a joint band (ratio or depth), in its own field.
+JsonField<int> JointHalf(const char* key, int count, int (*half)(int joint), int (*with)(int joint, int half)) {
+  const JsonInteger<int> codec{0, count - 1};
+  return {key, [=](const int& joint) { return codec.Write(half(joint)); },
+          [=](const JsonReader& value, int& joint) -> Status {
+            int read = 0;
+            DB_RETURN_IF_ERROR(codec.Read(value, read));
+            joint = with(joint, read);
+            return Status::Ok();
+          }};
+}
+
+const JsonFields<int>& JointKeyFields() {
+  static const JsonFields<int> fields{{
+      JointHalf("ratio_band", kRatioBands, RatioOfJoint,
+                [](int joint, int ratio) { return JointBand(ratio, DepthOfJoint(joint)); }),
+      JointHalf("depth_band", kDepthBands, DepthOfJoint,
+                [](int joint, int depth) { return JointBand(RatioOfJoint(joint), depth); }),
+      JsonDerived<int>("ratio", [](int joint) { return RatioBandName(RatioOfJoint(joint)); }),
+      JsonDerived<int>("depth", [](int joint) { return DepthBandName(DepthOfJoint(joint)); }),
+  }};
+  return fields;
+}
+
+const JsonFields<CellStats>& CellStatsFields() {
+  static const JsonFields<int> distance = BandKeyFields("distance_band", kDistanceBands, "distance", DistanceBandName);
+  static const JsonFields<int> coverage = BandKeyFields("coverage_band", kCoverageBands, "coverage", CoverageBandName);
+  static const JsonFields<CellStats> fields{{
+      JsonMember("joint", &CellStats::joint, JsonEntries{JointKeyFields(), BandFields()}),
+      JsonMember("distance", &CellStats::distance, JsonEntries{distance, BandFields()}),
+      JsonMember("coverage", &CellStats::coverage, JsonEntries{coverage, BandFields()}),
+  }};
+  return fields;
+}
+
+// The quantiles of every metric, for readers: derived from the bins.
 json SummaryToJson(const BandStats& all) {
   json out = json::object();
   for (int m = 0; m < kMetricCount; ++m) {
@@ -128,345 +245,173 @@ json SummaryToJson(const BandStats& all) {
   return out;
 }
 
+// The lists that name cells are built for the catalogue their names are
+// read in; writing needs none (a cell knows its own name).
+JsonFields<CellResult> CellResultFields(const Catalogue& catalogue) {
+  return {{
+      JsonMember("cell", &CellResult::cell, JsonCellName(catalogue)),
+      JsonDerived<CellResult>("variant", [](const CellResult& c) { return std::string(c.cell.variant_info().name); }),
+      JsonDerived<CellResult>("convention",
+                              [](const CellResult& c) { return std::string(Info(c.cell.convention).name); }),
+      JsonDerived<CellResult>("format", [](const CellResult& c) { return std::string(Info(c.cell.format).name); }),
+      JsonMember("backend", &CellResult::backend),
+      JsonDerived<CellResult>("counts",
+                              [](const CellResult& c) { return WriteFields(BandCountFields(), c.stats.All()); }),
+      JsonDerived<CellResult>("summary", [](const CellResult& c) { return SummaryToJson(c.stats.All()); }),
+      JsonMember("bands", &CellResult::stats, JsonObject{CellStatsFields()}),
+  }};
+}
+
+const JsonFields<BackendRecord>& BackendFields() {
+  // Where older files lack it, the backend was judged on the host.
+  static const JsonNamed<std::string> judge{
+      [](const std::string& where) { return where; },
+      [](std::string_view where) -> Expected<std::string> {
+        if (where == "host" || where == "device") return std::string(where);
+        return InvalidArgument(fmt::format("judge must be \"host\" or \"device\", not \"{}\"", where));
+      }};
+  static const JsonFields<BackendRecord> fields{{
+      JsonMember("name", &BackendRecord::name),
+      JsonMember("device", &BackendRecord::device, JsonObject{DeviceFields()}),
+      JsonAccess<BackendRecord>(
+          "shaders", [](auto& b) -> auto& { return b.program.shaders; }, JsonText()),
+      JsonAccess<BackendRecord>(
+          "program_hash", [](auto& b) -> auto& { return b.program.hash; }, JsonText()),
+      JsonMemberOr("judge", &BackendRecord::judge, judge, "host"),
+  }};
+  return fields;
+}
+
+const JsonFields<StageSeconds>& StageFields() {
+  using Pass = std::pair<std::string, double>;
+  static const JsonFields<Pass> pass{{JsonMember("pass", &Pass::first), JsonMember("seconds", &Pass::second)}};
+  static const JsonFields<StageSeconds> fields{{
+      JsonMember("setup", &StageSeconds::setup),
+      JsonMember("build", &StageSeconds::build),
+      JsonMember("judging", &StageSeconds::judging),
+      JsonMember("build_waited", &StageSeconds::build_waited),
+      JsonMember("device_waited", &StageSeconds::device_waited),
+      JsonMemberOr("device_passes", &StageSeconds::device_passes, JsonArray{JsonObject{pass}}, {}),
+  }};
+  return fields;
+}
+
+JsonFields<RunInfo> RunFields(const Catalogue& catalogue) {
+  return {{
+      JsonMember("version", &RunInfo::version),
+      JsonMember("commit", &RunInfo::commit),
+      JsonMember("started_at", &RunInfo::started_at),
+      JsonMember("host", &RunInfo::host),
+      JsonMember("seed", &RunInfo::seed),
+      JsonMember("samples", &RunInfo::samples),
+      JsonMember("samples_per_frame", &RunInfo::samples_per_frame),
+      JsonMember("seconds", &RunInfo::seconds),
+      JsonMember("reconstructions", &RunInfo::reconstructions),
+      JsonMemberOr("stage_seconds", &RunInfo::stages, JsonObject{StageFields()}, {}),
+      JsonMember("shards", &RunInfo::shards,
+                 JsonArray{JsonNamed<Shard>{[](const Shard& s) { return s.ToString(); }, ParseShard}}),
+      JsonMember("partial", &RunInfo::partial),
+      JsonMember("samples_judged", &RunInfo::samples_judged),
+      JsonMember("cells", &RunInfo::cells, JsonArray{JsonCellName(catalogue)}),
+      JsonMember("domain", &RunInfo::domain, JsonObject{DomainFields()}),
+      JsonMember("backends", &RunInfo::backends, JsonArray{JsonObject{BackendFields()}}),
+  }};
+}
+
+JsonFields<Results> ResultsFields(const Catalogue& catalogue) {
+  return {{
+      JsonMember("run", &Results::run, JsonObject{RunFields(catalogue)}),
+      JsonMember("cells", &Results::cells, JsonArray{JsonObject{CellResultFields(catalogue)}}),
+  }};
+}
+
 }  // namespace
 
-json DeviceToJson(const DeviceInfo& d) {
-  return {{"name", d.name}, {"driver", d.driver}, {"api", d.api}, {"kind", d.kind}, {"compiler", d.compiler}};
+JsonNamed<Cell> JsonCellName(const Catalogue& catalogue) {
+  return {[](const Cell& cell) { return cell.Name(); },
+          [&catalogue](std::string_view name) { return catalogue.ParseCell(name); }};
 }
+JsonNamed<Variant> JsonVariantName(const Catalogue& catalogue) {
+  return {[&catalogue](const Variant& v) -> std::string { return std::string(catalogue.Info(v).name); },
+          [&catalogue](std::string_view name) { return catalogue.ParseVariant(name); }};
+}
+JsonNamed<Convention> JsonConventionName() {
+  return {[](const Convention& c) -> std::string { return std::string(Info(c).name); }, ParseConvention};
+}
+JsonNamed<Format> JsonFormatName() {
+  return {[](const Format& f) -> std::string { return std::string(Info(f).name); }, ParseFormat};
+}
+
+const JsonFields<DeviceInfo>& DeviceFields() {
+  static const JsonFields<DeviceInfo> fields{{
+      JsonMember("name", &DeviceInfo::name),
+      JsonMember("driver", &DeviceInfo::driver),
+      JsonMember("api", &DeviceInfo::api),
+      JsonMember("kind", &DeviceInfo::kind,
+                 JsonNamed<DeviceKind>{[](const DeviceKind& kind) -> std::string { return DeviceKindName(kind); },
+                                       [](std::string_view name) -> Expected<DeviceKind> {
+                                         const std::optional<DeviceKind> kind = ParseDeviceKind(name);
+                                         if (!kind) {
+                                           return InvalidArgument(
+                                               fmt::format("'{}' is not a device kind; allowed: cpu, gpu", name));
+                                         }
+                                         return *kind;
+                                       }}),
+      JsonMember("compiler", &DeviceInfo::compiler),
+  }};
+  return fields;
+}
+
+json DeviceToJson(const DeviceInfo& device) { return WriteFields(DeviceFields(), device); }
 
 Expected<DeviceInfo> DeviceFromJson(const JsonReader& r) {
-  DeviceInfo d;
-  DB_ASSIGN_OR_RETURN(d.name, r.String("name"));
-  DB_ASSIGN_OR_RETURN(d.driver, r.String("driver"));
-  DB_ASSIGN_OR_RETURN(d.api, r.String("api"));
-  DB_ASSIGN_OR_RETURN(d.kind, r.String("kind"));
-  DB_ASSIGN_OR_RETURN(d.compiler, r.String("compiler"));
-  return d;
+  DeviceInfo device;
+  DB_RETURN_IF_ERROR(ReadFields(DeviceFields(), r, device));
+  return device;
 }
 
-json DomainToJson(const Domain& d) {
-  json resolutions = json::array();
-  for (const auto& r : d.resolutions) resolutions.push_back(json::array({r.width, r.height}));
-  json out = {{"fov_degrees", RangeToJson(d.fov_degrees)},
-              {"aspect", RangeToJson(d.aspect)},
-              {"near", RangeToJson(d.near)},
-              {"ratio", RangeToJson(d.ratio)},
-              {"finite_far", d.finite_far},
-              {"infinite_far", d.infinite_far},
-              {"far", d.far ? RangeToJson(*d.far) : json(nullptr)},
-              {"camera_distance", RangeToJson(d.camera_distance)},
-              {"eye_depth", d.eye_depth ? RangeToJson(*d.eye_depth) : json(nullptr)},
-              {"resolutions", resolutions},
-              {"name", d.name},
-              {"production", ProductionModelName(d.production)},
-              {"constants", ConstantsModelName(d.constants)}};
-  return out;
+const JsonFields<Domain>& DomainFields() {
+  static const JsonNamed<ProductionModel> production{
+      [](const ProductionModel& m) -> std::string { return ProductionModelName(m); }, ParseProductionModel};
+  static const JsonNamed<ConstantsModel> constants{
+      [](const ConstantsModel& m) -> std::string { return ConstantsModelName(m); }, ParseConstantsModel};
+  // What files written before a field existed meant: a domain without a
+  // name, depth produced exactly, exact constants.
+  static const JsonFields<Domain> fields{
+      {
+          JsonMember("fov_degrees", &Domain::fov_degrees, RangeCodec()),
+          JsonMember("aspect", &Domain::aspect, RangeCodec()),
+          JsonMember("near", &Domain::near, RangeCodec()),
+          JsonMember("ratio", &Domain::ratio, RangeCodec()),
+          JsonMember("finite_far", &Domain::finite_far),
+          JsonMember("infinite_far", &Domain::infinite_far),
+          JsonMember("far", &Domain::far, JsonNullable{RangeCodec()}),
+          JsonMember("camera_distance", &Domain::camera_distance, RangeCodec()),
+          JsonMember("eye_depth", &Domain::eye_depth, JsonNullable{RangeCodec()}),
+          JsonMember("resolutions", &Domain::resolutions, JsonArray{ResolutionPairCodec()}),
+          JsonMemberOr("name", &Domain::name, JsonText(), "custom"),
+          JsonMemberOr("production", &Domain::production, production, ProductionModel::kExact),
+          JsonMemberOr("constants", &Domain::constants, constants, ConstantsModel::kExact),
+      },
+      [](const JsonReader& r, const Domain& d) {
+        const Status valid = d.Validate();
+        return valid.ok() ? valid : r.Error(valid.message());
+      }};
+  return fields;
 }
+
+json DomainToJson(const Domain& domain) { return WriteFields(DomainFields(), domain); }
 
 json ToJson(const Results& results) {
-  const RunInfo& run = results.run;
-  json shards = json::array();
-  for (const Shard& s : run.shards) shards.push_back(s.ToString());
-  json backends = json::array();
-  for (const auto& b : run.backends) {
-    backends.push_back({{"name", b.name},
-                        {"device", DeviceToJson(b.device)},
-                        {"shaders", b.program.shaders},
-                        {"program_hash", b.program.hash},
-                        {"judge", b.judge}});
-  }
-  json run_cells = json::array();
-  for (const Cell& c : run.cells) run_cells.push_back(c.Name());
-  json device_passes = json::array();
-  for (const auto& [name, seconds] : run.stages.device_passes) {
-    device_passes.push_back({{"pass", name}, {"seconds", seconds}});
-  }
+  return WriteDocument(kResultsSchema, ResultsFields(Catalogue::BuiltIn()), results);
+}
 
-  json cells = json::array();
-  for (const CellResult& c : results.cells) {
-    BandStats all = c.stats.All();
-    json joint = json::array();
-    for (const auto& [band, stats] : c.stats.joint) {
-      json entry = BandToJson(stats);
-      entry["ratio_band"] = RatioOfJoint(band);
-      entry["depth_band"] = DepthOfJoint(band);
-      entry["ratio"] = RatioBandName(RatioOfJoint(band));
-      entry["depth"] = DepthBandName(DepthOfJoint(band));
-      joint.push_back(entry);
-    }
-    json distance = json::array();
-    for (const auto& [band, stats] : c.stats.distance) {
-      json entry = BandToJson(stats);
-      entry["distance_band"] = band;
-      entry["distance"] = DistanceBandName(band);
-      distance.push_back(entry);
-    }
-    json coverage = json::array();
-    for (const auto& [band, stats] : c.stats.coverage) {
-      json entry = BandToJson(stats);
-      entry["coverage_band"] = band;
-      entry["coverage"] = CoverageBandName(band);
-      coverage.push_back(entry);
-    }
-    cells.push_back({{"cell", c.cell.Name()},
-                     {"variant", c.cell.variant_info().name},
-                     {"convention", Info(c.cell.convention).name},
-                     {"format", Info(c.cell.format).name},
-                     {"backend", c.backend},
-                     {"counts",
-                      {{"finite", all.finite},
-                       {"nan", all.nan},
-                       {"inf", all.inf},
-                       {"stored_nonfinite", all.stored_nonfinite},
-                       {"degenerate", all.degenerate},
-                       {"outside", all.outside},
-                       {"first_nonfinite_index", JsonIndex(all.first_nonfinite_index)}}},
-                     {"summary", SummaryToJson(all)},
-                     {"bands", {{"joint", joint}, {"distance", distance}, {"coverage", coverage}}}});
-  }
-
-  return WithSchema(kResultsSchema, {{"run",
-                                      {{"version", run.version},
-                                       {"commit", run.commit},
-                                       {"started_at", run.started_at},
-                                       {"host", run.host},
-                                       {"seed", run.seed},
-                                       {"samples", run.samples},
-                                       {"samples_per_frame", run.samples_per_frame},
-                                       {"shards", shards},
-                                       {"partial", run.partial},
-                                       {"samples_judged", run.samples_judged},
-                                       {"cells", run_cells},
-                                       {"domain", DomainToJson(run.domain)},
-                                       {"backends", backends},
-                                       {"seconds", run.seconds},
-                                       {"stage_seconds",
-                                        {{"setup", run.stages.setup},
-                                         {"build", run.stages.build},
-                                         {"judging", run.stages.judging},
-                                         {"build_waited", run.stages.build_waited},
-                                         {"device_waited", run.stages.device_waited},
-                                         {"device_passes", device_passes}}},
-                                       {"reconstructions", run.reconstructions}}},
-                                     {"cells", cells}});
+Expected<Results> ResultsFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
+  return ReadDocument(kResultsSchema, ResultsFields(catalogue), j, source);
 }
 
 Status WriteResults(const std::filesystem::path& path, const Results& results) {
   return WriteFileAtomically(path, ToJson(results).dump(1) + "\n");
-}
-
-// ---------------------------------------------------------------- reading
-
-namespace {
-
-Expected<Range> RangeFrom(const JsonReader& r) {
-  DB_ASSIGN_OR_RETURN(std::size_t n, r.ArraySize());
-  if (n != 2) return r.Error("expected [min, max]");
-  DB_ASSIGN_OR_RETURN(JsonReader lo, r.Element(0));
-  DB_ASSIGN_OR_RETURN(JsonReader hi, r.Element(1));
-  DB_ASSIGN_OR_RETURN(double min, lo.Number());
-  DB_ASSIGN_OR_RETURN(double max, hi.Number());
-  return Range{min, max};
-}
-
-Expected<MetricStats> MetricFrom(const JsonReader& r) {
-  MetricStats m;
-  DB_ASSIGN_OR_RETURN(m.max_square, r.Number("max_square"));
-  DB_ASSIGN_OR_RETURN(m.worst_index, r.Unsigned("worst_index"));
-  DB_RETURN_IF_ERROR(r.ForEach("bins", [&](const JsonReader& pair) -> Status {
-    DB_ASSIGN_OR_RETURN(JsonReader slot, pair.Element(0));
-    DB_ASSIGN_OR_RETURN(JsonReader count, pair.Element(1));
-    DB_ASSIGN_OR_RETURN(std::int64_t s, slot.Integer());
-    DB_ASSIGN_OR_RETURN(std::uint64_t c, count.Unsigned());
-    if (s < 0 || s >= kDenseBins) return slot.Error(fmt::format("bin {} outside [0, {})", s, kDenseBins));
-    m.bins[static_cast<int>(s)] += c;
-    return Status::Ok();
-  }));
-  return m;
-}
-
-Expected<BandStats> BandFrom(const JsonReader& r) {
-  BandStats b;
-  DB_ASSIGN_OR_RETURN(b.finite, r.Unsigned("finite"));
-  DB_ASSIGN_OR_RETURN(b.nan, r.Unsigned("nan"));
-  DB_ASSIGN_OR_RETURN(b.inf, r.Unsigned("inf"));
-  DB_ASSIGN_OR_RETURN(b.stored_nonfinite, r.Unsigned("stored_nonfinite"));
-  DB_ASSIGN_OR_RETURN(b.degenerate, r.Unsigned("degenerate"));
-  DB_ASSIGN_OR_RETURN(b.outside, r.Unsigned("outside"));
-  DB_ASSIGN_OR_RETURN(b.first_nonfinite_index, r.Unsigned("first_nonfinite_index"));
-  DB_ASSIGN_OR_RETURN(JsonReader metrics, r.Field("metrics"));
-  for (int m = 0; m < kMetricCount; ++m) {
-    DB_ASSIGN_OR_RETURN(JsonReader metric, metrics.Field(MetricName(static_cast<Metric>(m))));
-    DB_ASSIGN_OR_RETURN(b.metrics[m], MetricFrom(metric));
-  }
-  return b;
-}
-
-Expected<int> BandIndex(const JsonReader& r, const std::string& key, int count) {
-  DB_ASSIGN_OR_RETURN(std::int64_t v, r.Integer(key));
-  if (v < 0 || v >= count) return r.Error(fmt::format("{} {} outside [0, {})", key, v, count));
-  return static_cast<int>(v);
-}
-
-// An optional field naming a model (ProductionModel, ConstantsModel):
-// `missing` for files written before the field existed.
-template <class Model>
-Status ReadModel(const JsonReader& r, const char* field, Expected<Model> (*parse)(std::string_view), Model missing,
-                 Model& out) {
-  out = missing;
-  if (!r.Has(field)) return Status::Ok();
-  DB_ASSIGN_OR_RETURN(const JsonReader value, r.Field(field));
-  DB_ASSIGN_OR_RETURN(const std::string name, value.String());
-  const Expected<Model> model = parse(name);
-  if (!model.ok()) return value.Error(model.status().message());
-  out = *model;
-  return Status::Ok();
-}
-
-}  // namespace
-
-Expected<Domain> DomainFromJson(const json& j, const std::string& source) {
-  JsonReader r(j, source, "run.domain");
-  Domain d;
-  auto range = [&](const std::string& key) -> Expected<Range> {
-    DB_ASSIGN_OR_RETURN(JsonReader f, r.Field(key));
-    return RangeFrom(f);
-  };
-  auto optional_range = [&](const std::string& key, std::optional<Range>& out) -> Status {
-    DB_ASSIGN_OR_RETURN(JsonReader f, r.Field(key));
-    if (f.json().is_null()) return Status::Ok();
-    DB_ASSIGN_OR_RETURN(Range value, RangeFrom(f));
-    out = value;
-    return Status::Ok();
-  };
-  DB_ASSIGN_OR_RETURN(d.fov_degrees, range("fov_degrees"));
-  DB_ASSIGN_OR_RETURN(d.aspect, range("aspect"));
-  DB_ASSIGN_OR_RETURN(d.near, range("near"));
-  DB_ASSIGN_OR_RETURN(d.ratio, range("ratio"));
-  DB_ASSIGN_OR_RETURN(d.finite_far, r.Bool("finite_far"));
-  DB_ASSIGN_OR_RETURN(d.infinite_far, r.Bool("infinite_far"));
-  DB_RETURN_IF_ERROR(optional_range("far", d.far));
-  DB_ASSIGN_OR_RETURN(d.camera_distance, range("camera_distance"));
-  DB_RETURN_IF_ERROR(optional_range("eye_depth", d.eye_depth));
-  d.resolutions.clear();
-  DB_RETURN_IF_ERROR(r.ForEach("resolutions", [&](const JsonReader& pair) -> Status {
-    DB_ASSIGN_OR_RETURN(JsonReader w, pair.Element(0));
-    DB_ASSIGN_OR_RETURN(JsonReader h, pair.Element(1));
-    DB_ASSIGN_OR_RETURN(std::uint64_t width, w.Unsigned());
-    DB_ASSIGN_OR_RETURN(std::uint64_t height, h.Unsigned());
-    d.resolutions.push_back({static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
-    return Status::Ok();
-  }));
-  // Files written before these fields existed: their depth was produced
-  // exactly, and their domain had no name.
-  d.name = "custom";
-  if (r.Has("name")) DB_RETURN_IF_ERROR(StoreInto(r.String("name"), d.name));
-  DB_RETURN_IF_ERROR(ReadModel(r, "production", ParseProductionModel, ProductionModel::kExact, d.production));
-  // Files written before --constants existed had exact constants.
-  DB_RETURN_IF_ERROR(ReadModel(r, "constants", ParseConstantsModel, ConstantsModel::kExact, d.constants));
-  Status valid = d.Validate();
-  if (!valid.ok()) return r.Error(valid.message());
-  return d;
-}
-
-Expected<Results> ResultsFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
-  JsonReader top(j, source);
-  DB_RETURN_IF_ERROR(top.CheckSchema(kResultsSchema));
-  Results results;
-  RunInfo& run = results.run;
-  DB_ASSIGN_OR_RETURN(JsonReader r, top.Field("run"));
-  DB_ASSIGN_OR_RETURN(run.version, r.String("version"));
-  DB_ASSIGN_OR_RETURN(run.commit, r.String("commit"));
-  DB_ASSIGN_OR_RETURN(run.started_at, r.String("started_at"));
-  DB_ASSIGN_OR_RETURN(run.host, r.String("host"));
-  DB_ASSIGN_OR_RETURN(run.seed, r.Unsigned("seed"));
-  DB_ASSIGN_OR_RETURN(run.samples, r.Unsigned("samples"));
-  DB_ASSIGN_OR_RETURN(std::uint64_t per_frame, r.Unsigned("samples_per_frame"));
-  run.samples_per_frame = static_cast<std::uint32_t>(per_frame);
-  DB_ASSIGN_OR_RETURN(run.seconds, r.Number("seconds"));
-  DB_ASSIGN_OR_RETURN(run.reconstructions, r.Unsigned("reconstructions"));
-  if (r.Has("stage_seconds")) {
-    DB_ASSIGN_OR_RETURN(JsonReader stages, r.Field("stage_seconds"));
-    DB_ASSIGN_OR_RETURN(run.stages.setup, stages.Number("setup"));
-    DB_ASSIGN_OR_RETURN(run.stages.build, stages.Number("build"));
-    DB_ASSIGN_OR_RETURN(run.stages.judging, stages.Number("judging"));
-    DB_ASSIGN_OR_RETURN(run.stages.build_waited, stages.Number("build_waited"));
-    DB_ASSIGN_OR_RETURN(run.stages.device_waited, stages.Number("device_waited"));
-    if (stages.Has("device_passes")) {
-      DB_RETURN_IF_ERROR(stages.ForEach("device_passes", [&](const JsonReader& pass) -> Status {
-        DB_ASSIGN_OR_RETURN(std::string name, pass.String("pass"));
-        DB_ASSIGN_OR_RETURN(double seconds, pass.Number("seconds"));
-        run.stages.AddDevicePass(name, seconds);
-        return Status::Ok();
-      }));
-    }
-  }
-  DB_RETURN_IF_ERROR(r.ForEach("shards", [&](const JsonReader& s) -> Status {
-    DB_ASSIGN_OR_RETURN(std::string text, s.String());
-    Expected<Shard> shard = ParseShard(text);
-    if (!shard.ok()) return s.Error(shard.status().message());
-    run.shards.push_back(*shard);
-    return Status::Ok();
-  }));
-  DB_ASSIGN_OR_RETURN(run.partial, r.Bool("partial"));
-  DB_ASSIGN_OR_RETURN(run.samples_judged, r.Unsigned("samples_judged"));
-  DB_RETURN_IF_ERROR(r.ForEach("cells", [&](const JsonReader& c) -> Status {
-    DB_ASSIGN_OR_RETURN(std::string name, c.String());
-    Expected<Cell> cell = catalogue.ParseCell(name);
-    if (!cell.ok()) return c.Error(cell.status().message());
-    run.cells.push_back(*cell);
-    return Status::Ok();
-  }));
-  DB_ASSIGN_OR_RETURN(JsonReader domain, r.Field("domain"));
-  DB_ASSIGN_OR_RETURN(run.domain, DomainFromJson(domain.json(), source));
-  DB_RETURN_IF_ERROR(r.ForEach("backends", [&](const JsonReader& b) -> Status {
-    BackendRecord record;
-    DB_ASSIGN_OR_RETURN(record.name, b.String("name"));
-    DB_ASSIGN_OR_RETURN(JsonReader device, b.Field("device"));
-    DB_ASSIGN_OR_RETURN(record.device, DeviceFromJson(device));
-    DB_ASSIGN_OR_RETURN(record.program.shaders, b.String("shaders"));
-    DB_ASSIGN_OR_RETURN(record.program.hash, b.String("program_hash"));
-    if (b.Has("judge")) {  // (older files lack it: judged on the host)
-      DB_RETURN_IF_ERROR(StoreInto(b.String("judge"), record.judge));
-      if (record.judge != "host" && record.judge != "device") {
-        return b.Error("judge must be \"host\" or \"device\", not \"" + record.judge + "\"");
-      }
-    }
-    run.backends.push_back(record);
-    return Status::Ok();
-  }));
-
-  DB_RETURN_IF_ERROR(top.ForEach("cells", [&](const JsonReader& c) -> Status {
-    CellResult result;
-    DB_ASSIGN_OR_RETURN(std::string name, c.String("cell"));
-    Expected<Cell> cell = catalogue.ParseCell(name);
-    if (!cell.ok()) return c.Error(cell.status().message());
-    result.cell = *cell;
-    DB_ASSIGN_OR_RETURN(result.backend, c.String("backend"));
-    DB_ASSIGN_OR_RETURN(JsonReader bands, c.Field("bands"));
-    DB_RETURN_IF_ERROR(bands.ForEach("joint", [&](const JsonReader& b) -> Status {
-      DB_ASSIGN_OR_RETURN(int ratio, BandIndex(b, "ratio_band", kRatioBands));
-      DB_ASSIGN_OR_RETURN(int depth, BandIndex(b, "depth_band", kDepthBands));
-      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
-      result.stats.joint[JointBand(ratio, depth)].Merge(stats);
-      return Status::Ok();
-    }));
-    DB_RETURN_IF_ERROR(bands.ForEach("distance", [&](const JsonReader& b) -> Status {
-      DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "distance_band", kDistanceBands));
-      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
-      result.stats.distance[band].Merge(stats);
-      return Status::Ok();
-    }));
-    DB_RETURN_IF_ERROR(bands.ForEach("coverage", [&](const JsonReader& b) -> Status {
-      DB_ASSIGN_OR_RETURN(int band, BandIndex(b, "coverage_band", kCoverageBands));
-      DB_ASSIGN_OR_RETURN(BandStats stats, BandFrom(b));
-      result.stats.coverage[band].Merge(stats);
-      return Status::Ok();
-    }));
-    results.cells.push_back(std::move(result));
-    return Status::Ok();
-  }));
-  return results;
 }
 
 Expected<Results> ReadResults(const std::filesystem::path& path, const Catalogue& catalogue) {

@@ -1,6 +1,6 @@
 // Results: what a run measured, per cell and backend, with how it was made.
-// Saved as versioned JSON (kResultsSchema; ToJson below is its definition,
-// ResultsFromJson checks every field it reads). The JSON keeps the full
+// Saved as versioned JSON (kResultsSchema), written and read from one field
+// list per type (results.cc, json_fields.h). The JSON keeps the full
 // histograms, so results of shards merge exactly into the results of the
 // whole sweep.
 #pragma once
@@ -12,10 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backends/device_info.h"
+#include "bench/base/json_fields.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/pipeline/domain.h"
 #include "bench/pipeline/stats.h"
 
@@ -96,7 +97,7 @@ struct RunInfo {
   // figures are of the first samples_judged samples of its shards only.
   bool partial = false;
   std::uint64_t samples_judged = 0;  // of the shards held, summed over merged parts
-  StageSeconds stages;               // (absent from results written before 2026-12)
+  StageSeconds stages;               // all zero where a file has no stage_seconds
 };
 
 struct CellResult {
@@ -129,8 +130,18 @@ Expected<Results> ReadResults(const std::filesystem::path& path, const Catalogue
 Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vector<std::string>& sources = {},
                                bool allow_partial = false);
 
+// What the other saved files share with results (json_fields.h): the
+// field lists of a device and a domain, and the names of cells and their
+// parts as every file spells them ("divide/reversed/d32_sfloat").
+const JsonFields<DeviceInfo>& DeviceFields();
+const JsonFields<Domain>& DomainFields();
+// Names read in `catalogue`, which outlives the codecs.
+JsonNamed<Cell> JsonCellName(const Catalogue& catalogue);
+JsonNamed<Variant> JsonVariantName(const Catalogue& catalogue);
+JsonNamed<Convention> JsonConventionName();
+JsonNamed<Format> JsonFormatName();
+
 nlohmann::json DomainToJson(const Domain& domain);
-Expected<Domain> DomainFromJson(const nlohmann::json& json, const std::string& source);
 nlohmann::json DeviceToJson(const DeviceInfo& device);
 Expected<DeviceInfo> DeviceFromJson(const JsonReader& json);
 

@@ -55,7 +55,7 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   for (const auto& b : run.backends) {
     out << fmt::format("backend {}: {} [{}; {}; {}]", b.name, b.device.name, b.device.driver, b.device.api,
                        b.device.compiler);
-    if (b.name == "vulkan" && b.device.kind == "cpu") out << " (software rasterizer on the CPU)";
+    if (b.name == "vulkan" && b.device.kind == DeviceKind::kCpu) out << " (software rasterizer on the CPU)";
     if (b.name == "vulkan") out << fmt::format(", shaders {} ({})", b.program.shaders, b.program.hash);
     out << "\n";
   }
@@ -122,9 +122,11 @@ void PrintResultsTable(const Results& results, const TextOutput& out) {
          measured(Metric::kAbsolute, fmt::format("{:.2g}", absolute.max)), Count(all.nan), Count(all.inf),
          Count(all.stored_nonfinite)});
   }
-  out.text
-      << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
-         "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below 4000 samples / max) and, at p99.9, of its\n"
+  out.text << "The domain's natural distribution (log-uniform eye depth, uniform pixels). Bits lost of the total error\n"
+           << fmt::format(
+                  "(p50 / p99 / p99.9 with its 95% sampling interval, 'few' below {} samples / max) and, at p99.9, of its\n",
+                  MinimumSamples(Level::kP999))
+           << 
          "three causes: prod (the depth the pipeline produced), stor (the format's rounding and fetch), shader (the\n"
          "variant's float32 arithmetic); the absolute error in world units ('<=': below the histogram's range of\n"
          "2^-48, so only bounded); NaN and Inf outputs where exact arithmetic on the shader's inputs is finite\n"
@@ -167,7 +169,8 @@ void PrintBandTable(const Results& results, BandFamily family, const TextOutput&
     table.AddRow(std::move(row));
   }
   out.text << fmt::format(
-      "\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under 4000)\n", title);
+      "\np99.9 bits lost by {} band ('!': NaN or Inf in the band; '-': no samples; 'few': under {})\n", title,
+      MinimumSamples(Level::kP999));
   table.Print(out);
 }
 

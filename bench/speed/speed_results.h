@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
@@ -168,7 +168,9 @@ struct SpeedResults {
   // timing or where no floor is known.
   std::optional<double> TimesFloor(const GpuTiming& timing) const;
   const CpuCost* FindCpu(const Cell& cell) const;
-  // A variant of these results: its name, and what it reads.
+  // The catalogue the variants are of, and one of them: its name, and what
+  // it reads.
+  const Catalogue& variant_catalogue() const;
   const VariantInfo& variant_info(Variant v) const;
 };
 

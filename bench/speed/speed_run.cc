@@ -17,23 +17,23 @@
 namespace depthbench {
 
 Status ValidateSpeedOptions(const SpeedOptions& o) {
-  if (o.cells.empty()) return InvalidArgument("Violated constraint: SpeedOptions::cells is not empty");
-  if (o.resolutions.empty()) return InvalidArgument("Violated constraint: SpeedOptions::resolutions is not empty");
+  if (o.cells.empty()) return ViolatedConstraint("SpeedOptions::cells is not empty");
+  if (o.resolutions.empty()) return ViolatedConstraint("SpeedOptions::resolutions is not empty");
   if (o.alu_taps < 2 || o.alu_taps > GpuPassTimer::kMaxTaps) {
-    return InvalidArgument(
-        fmt::format("Violated constraint: 2 <= SpeedOptions::alu_taps <= {} (it is {}; one tap "
+    return ViolatedConstraint(
+        fmt::format("2 <= SpeedOptions::alu_taps <= {} (it is {}; one tap "
                     "is the memory-bound regime)",
                     GpuPassTimer::kMaxTaps, o.alu_taps));
   }
-  if (o.warmup < 1) return InvalidArgument("Violated constraint: SpeedOptions::warmup >= 1");
+  if (o.warmup < 1) return ViolatedConstraint("SpeedOptions::warmup >= 1");
   // Quartiles of fewer than three values are the values themselves.
   if (o.repetitions < 3) {
-    return InvalidArgument(
-        fmt::format("Violated constraint: SpeedOptions::repetitions >= 3 (it is {}); a spread "
+    return ViolatedConstraint(
+        fmt::format("SpeedOptions::repetitions >= 3 (it is {}); a spread "
                     "needs at least three",
                     o.repetitions));
   }
-  if (o.cpu.repetitions < 3) return InvalidArgument("Violated constraint: CpuCostOptions::repetitions >= 3");
+  if (o.cpu.repetitions < 3) return ViolatedConstraint("CpuCostOptions::repetitions >= 3");
   for (const Cell& cell : o.cells) {
     if (!Reads(cell.variant_info().input, cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention: no such pass to time",

@@ -11,8 +11,8 @@ bool Dominates(const FrontCandidate& a, const FrontCandidate& b) {
   const double spread = std::max(a.spread, b.spread);
   const bool cheaper = b.cost - a.cost > spread;
   const bool costlier = a.cost - b.cost > spread;
-  const bool more_accurate = b.bits_lost - a.bits_lost >= kBitsResolution;
-  const bool less_accurate = a.bits_lost - b.bits_lost >= kBitsResolution;
+  const bool more_accurate = b.bits_lost - a.bits_lost >= kResolvedBits;
+  const bool less_accurate = a.bits_lost - b.bits_lost >= kResolvedBits;
   return !costlier && !less_accurate && (cheaper || more_accurate);
 }
 

@@ -13,10 +13,10 @@
 
 namespace depthbench {
 
-// Bits-lost figures closer than this are the same accuracy: the statistics
-// keep errors in quarter-octave bins (stats.h), so a p99.9 is known to a
-// quarter of a bit and finer differences are interpolation.
-inline constexpr double kBitsResolution = 1.0 / 4.0;
+// The frame a GPU cost is given for (a time per reconstruction times its
+// pixels): what a frame budget is usually counted in.
+inline constexpr Resolution kCostFrame{1920, 1080};
+
 // A cell whose NaN and Inf outputs exceed this share of its judged samples
 // has a non-finite p99.9: it counts as losing every bit.
 inline constexpr double kNonfiniteShareAtP999 = 0.001;
@@ -27,7 +27,7 @@ struct FrontCandidate {
   double bits_lost = 0.0;
 };
 // a dominates b: a is no costlier (cheaper by more than the larger spread,
-// or a tie) and loses no more bits (fewer, or the same to kBitsResolution),
+// or a tie) and loses no more bits (fewer, or the same to kResolvedBits),
 // and is strictly better in one of the two.
 bool Dominates(const FrontCandidate& a, const FrontCandidate& b);
 // For each candidate, whether no other dominates it.

@@ -45,12 +45,14 @@ run_case shard-2 --backend cpu --samples 1e5 --shard 2/2
 "$depthbench" merge "$raw/shard-1.json" "$raw/shard-2.json" --json "$raw/merged.json" >/dev/null
 strip_run "$raw/merged.json" "$out/merged.json"
 
-# The gate: its verdict, its table and its JUnit report (times removed).
+# The gate: its verdict, its table, its full comparison and its JUnit
+# report (times removed).
 echo "identity: gate" >&2
 rc=0
 "$depthbench" gate --baseline reports/baselines/cpu.json --baseline reports/baselines/lavapipe.json \
-  --junit "$raw/gate.xml" >"$raw/gate.txt" 2>&1 || rc=$?
+  --junit "$raw/gate.xml" --json "$raw/gate.json" >"$raw/gate.txt" 2>&1 || rc=$?
 echo "exit $rc" >"$out/gate.txt"
-grep -v -E '^time:|seconds|took' "$raw/gate.txt" >>"$out/gate.txt" || true
+sed -E 's/ \([0-9.]+ s\)//' "$raw/gate.txt" >>"$out/gate.txt"
 sed -E 's/ time="[^"]*"//g; s/ timestamp="[^"]*"//g; s/ hostname="[^"]*"//g' "$raw/gate.xml" >"$out/gate.xml"
+strip_run "$raw/gate.json" "$out/gate.json"
 echo "identity: wrote $(ls "$out" | wc -l) files to $out" >&2

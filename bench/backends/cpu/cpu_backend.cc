@@ -138,7 +138,7 @@ class CpuBackend final : public Backend {
     device_.name = "cpu";
     device_.driver = "GLM float32, -ffp-contract=off";
     device_.api = "C++20";
-    device_.kind = "cpu";
+    device_.kind = DeviceKind::kCpu;
 #if defined(__clang__)
     device_.compiler = fmt::format("clang++ {}.{}.{}", __clang_major__, __clang_minor__, __clang_patchlevel__);
 #elif defined(__GNUC__)

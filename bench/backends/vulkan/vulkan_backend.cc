@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -108,15 +109,15 @@ BindingBytes BytesFor(const ShaderInputs& batch, const SliceLayout& slices, std:
           cells * 3 * slices.length * sizeof(float)};
 }
 
-// The push constants of a dispatch whose cells start at CellSlice entry
-// `first_cell`.
-f32::PassConstants PassConstantsFor(const ShaderInputs& batch, const SliceLayout& slices, std::uint32_t first_cell) {
+// The push constants of a run's dispatches, but first_cell: the CellSlice
+// entry each dispatch's cells start at.
+f32::PassConstants PassConstantsFor(const ShaderInputs& batch, const SliceLayout& slices) {
   return {.slice_length = slices.length,
           .samples_per_frame = kSamplesPerFrame,
           .conventions_per_frame = kHardwareConventionCount,
           .first_in_frame = batch.first_offset - slices.lead,
           .frame_count = static_cast<std::uint32_t>(batch.frame_count()),
-          .first_cell = first_cell,
+          .first_cell = 0,
           .reserved0 = 0,
           .reserved1 = 0};
 }
@@ -173,6 +174,15 @@ DispatchPlan PlanDispatches(std::span<const CellPlan> cells, std::span<const std
   return plan;
 }
 
+// A run of the compute form whose inputs are uploaded and bound: what
+// recording its dispatches needs.
+struct StagedRun {
+  SliceLayout slices;
+  DispatchPlan plan;
+  std::uint32_t workgroups = 0;
+  f32::PassConstants constants{};
+};
+
 // FNV-1a (64 bits) of the sources' texts, each after its length, in the order
 // compiled: it changes with any edit to a shader or a file it includes, and
 // not with where the copy lies.
@@ -188,7 +198,7 @@ std::string SourcesHash(const std::vector<std::string>& sources) {
   return fmt::format("fnv1a64:{:016x}", hash);
 }
 
-class VulkanBackend final : public Backend {
+class VulkanBackend final : public Backend, public DeviceResidentRuns {
  public:
   static Expected<std::unique_ptr<Backend>> Create(std::shared_ptr<VulkanContext> context,
                                                    const BackendOptions& options);
@@ -197,7 +207,7 @@ class VulkanBackend final : public Backend {
     return options_.arithmetic_probes == 0 ? "vulkan" : "vulkan:" + ArithmeticProbesName(options_.arithmetic_probes);
   }
   ~VulkanBackend() override {
-    // Work RunLeavingOnDevice left queued reads the buffers destroyed below.
+    // Work QueueStaged left queued reads the buffers destroyed below.
     if (pass_ != nullptr) (void)pass_->Wait();
   }
 
@@ -215,12 +225,15 @@ class VulkanBackend final : public Backend {
   std::vector<RasterAgreement> raster_agreement() const override {
     return raster_ != nullptr ? raster_->agreement() : std::vector<RasterAgreement>{};
   }
-  Expected<DevicePositions> RunLeavingOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                               ThreadPool* pool, const TexelWriter& write_texels);
-  const std::shared_ptr<VulkanContext>& context() const { return context_; }
-  std::vector<std::uint32_t> raster_texels() const {
+  std::vector<std::uint32_t> raster_texels() const override {
     return raster_ != nullptr ? raster_->texels() : std::vector<std::uint32_t>{};
   }
+  DeviceResidentRuns* device_resident() override { return this; }
+
+  const std::shared_ptr<VulkanContext>& context() const override { return context_; }
+  Expected<DeviceRunBuffers> Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                   ThreadPool* pool) override;
+  Status QueueStaged() override;
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -235,19 +248,17 @@ class VulkanBackend final : public Backend {
 
   Expected<std::span<const float>> RunOnDevice(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                std::vector<float>& scratch);
-  // The compute form's upload and dispatches; the positions stay in their
-  // buffer, laid out as the returned slices say. `wait`: return once the
-  // device has finished; otherwise once the work is queued, and the next
-  // run (or the destructor) waits for it. `write_texels`: as
-  // RunLeavingOnDevice's.
-  Expected<SliceLayout> RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                   ThreadPool* pool = nullptr, bool wait = true,
-                                   const TexelWriter& write_texels = nullptr);
-  // The buffers a judge on the device reads, for slices `slices` of `cells` cells.
-  DevicePositions OnDevice(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const;
+  // The compute form's upload, after waiting for the last run: the
+  // positions go where positions_access_ says, laid out as the returned
+  // run's slices say, once Record's commands run. `host_texels`: whether
+  // the batch's texels (depths) go up too.
+  Expected<StagedRun> StageCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which, ThreadPool* pool,
+                                   bool host_texels);
+  // The buffers of a staged run of `cells` cells, for a judge on the device.
+  DeviceRunBuffers BuffersOf(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const;
   // What either form would read out of bounds.
-  // `host_texels`: whether the run reads the batch's texels (depths), or a
-  // TexelWriter stores them on the device.
+  // `host_texels`: whether the run reads the batch's texels (depths), or
+  // the caller of Stage writes them on the device.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which, bool host_texels = true) const;
   // What the compute form's device cannot address or dispatch.
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
@@ -258,8 +269,7 @@ class VulkanBackend final : public Backend {
   Status Upload(const ShaderInputs& batch, const SliceLayout& slices, const BindingBytes& bytes,
                 std::span<const f32::CellSlice> cell_slices, ThreadPool* pool, bool texels);
   void BindBuffers(const BindingBytes& bytes);
-  void Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
-              const DispatchPlan& plan) const;
+  void Record(VkCommandBuffer commands, const StagedRun& run) const;
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::filesystem::path shader_dir_;
@@ -274,9 +284,11 @@ class VulkanBackend final : public Backend {
   std::vector<DeviceObject<VkPipeline>> pipelines_;
   std::array<VulkanBuffer, kBindingCount> buffers_;
   std::unique_ptr<RasterPass> raster_;  // the raster form, when prepared for it
+  // What Stage uploaded, for QueueStaged to queue.
+  std::optional<StagedRun> staged_;
   // Where the compute form's positions go: memory the host reads them from
   // (Run), or device memory alone, where a judge on the device reads them
-  // (RunLeavingOnDevice); and the kind the buffer now is.
+  // (Stage); and the kind the buffer now is.
   HostAccess positions_access_ = HostAccess::kReadback;
   HostAccess positions_held_in_ = HostAccess::kReadback;
 };
@@ -335,6 +347,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
   }
   pipelines_ = std::move(pipelines);
   raster_ = std::move(raster);
+  staged_.reset();  // its dispatches would bind the replaced pipelines
   // The probes change the program as much as an edit would.
   const std::string probes = ArithmeticProbesName(options_.arithmetic_probes);
   program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir,
@@ -426,8 +439,11 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
     return std::span<const float>(positions, output_floats);
   }
   const ValidationScope validation(*context_);
+  staged_.reset();
   positions_access_ = HostAccess::kReadback;
-  DB_ASSIGN_OR_RETURN(const SliceLayout slices, RunCompute(batch, which));
+  DB_ASSIGN_OR_RETURN(const StagedRun run, StageCompute(batch, which, nullptr, /*host_texels=*/true));
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, run); }));
+  const SliceLayout& slices = run.slices;
   DB_RETURN_IF_ERROR(buffers_[kPositions].InvalidateForHostReads());
   DB_RETURN_IF_ERROR(validation.Check("Run"));
   const auto* device_positions = static_cast<const float*>(buffers_[kPositions].mapped());
@@ -442,46 +458,65 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
   return std::span<const float>(scratch);
 }
 
-Expected<SliceLayout> VulkanBackend::RunCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                                ThreadPool* pool, bool wait, const TexelWriter& write_texels) {
+Expected<StagedRun> VulkanBackend::StageCompute(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                                ThreadPool* pool, bool host_texels) {
   // The last run's work, if it was left queued, reads what this one rewrites.
   DB_RETURN_IF_ERROR(pass_->Wait());
-  const SliceLayout slices = SliceLayoutFor(batch, shape_);
-  const BindingBytes bytes = BytesFor(batch, slices, which.size());
+  StagedRun run;
+  run.slices = SliceLayoutFor(batch, shape_);
+  const BindingBytes bytes = BytesFor(batch, run.slices, which.size());
   DB_RETURN_IF_ERROR(CheckRun(batch, which, bytes));
-  const DispatchPlan plan = PlanDispatches(cells_, which, slices);
-  DB_RETURN_IF_ERROR(Upload(batch, slices, bytes, plan.cell_slices, pool, write_texels == nullptr));
-  if (write_texels != nullptr) DB_RETURN_IF_ERROR(write_texels(OnDevice(batch, slices, which.size())));
-  const auto record = [&](VkCommandBuffer commands) { Record(commands, batch, slices, plan); };
-  DB_RETURN_IF_ERROR(wait ? pass_->Submit(record) : pass_->SubmitWithoutWaiting(record));
-  return slices;
+  run.plan = PlanDispatches(cells_, which, run.slices);
+  run.workgroups = WorkgroupsFor(batch, shape_);
+  run.constants = PassConstantsFor(batch, run.slices);
+  DB_RETURN_IF_ERROR(Upload(batch, run.slices, bytes, run.plan.cell_slices, pool, host_texels));
+  return run;
 }
 
-DevicePositions VulkanBackend::OnDevice(const ShaderInputs& batch, const SliceLayout& slices, std::size_t cells) const {
-  return DevicePositions{buffers_[kPositions].handle(),
-                         std::size_t{3} * cells * slices.length * sizeof(float),
-                         slices.lead,
-                         slices.length,
-                         buffers_[kStoredDepths].handle(),
-                         DepthSlotsOf(batch) * slices.length * sizeof(float),
-                         buffers_[kPixels].handle(),
-                         std::size_t{slices.length} * sizeof(std::uint32_t)};
+DeviceRunBuffers VulkanBackend::BuffersOf(const ShaderInputs& batch, const SliceLayout& slices,
+                                          std::size_t cells) const {
+  return DeviceRunBuffers{buffers_[kPositions].handle(),
+                          std::size_t{3} * cells * slices.length * sizeof(float),
+                          slices.lead,
+                          slices.length,
+                          buffers_[kStoredDepths].handle(),
+                          DepthSlotsOf(batch) * slices.length * sizeof(float),
+                          buffers_[kPixels].handle(),
+                          std::size_t{slices.length} * sizeof(std::uint32_t)};
 }
 
-Expected<DevicePositions> VulkanBackend::RunLeavingOnDevice(const ShaderInputs& batch,
-                                                            std::span<const std::uint32_t> which, ThreadPool* pool,
-                                                            const TexelWriter& write_texels) {
+Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                                ThreadPool* pool) {
+  staged_.reset();
   if (raster_ != nullptr) {
     return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
   }
-  if (batch.count == 0 || which.empty()) return DevicePositions{};
-  DB_RETURN_IF_ERROR(CheckBatch(batch, which, write_texels == nullptr).WithContext(DeviceContext()));
+  if (batch.count == 0 || which.empty()) {
+    staged_ = StagedRun{};  // no dispatch to queue
+    return DeviceRunBuffers{};
+  }
+  DB_RETURN_IF_ERROR(CheckBatch(batch, which, /*host_texels=*/false).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
   positions_access_ = HostAccess::kNone;
-  Expected<SliceLayout> slices = RunCompute(batch, which, pool, /*wait=*/false, write_texels);
-  if (!slices.ok()) return slices.status().WithContext(DeviceContext());
-  DB_RETURN_IF_ERROR(validation.Check("Run").WithContext(DeviceContext()));
-  return OnDevice(batch, *slices, which.size());
+  Expected<StagedRun> run = StageCompute(batch, which, pool, /*host_texels=*/false);
+  if (!run.ok()) return run.status().WithContext(DeviceContext());
+  DB_RETURN_IF_ERROR(validation.Check("Stage").WithContext(DeviceContext()));
+  const DeviceRunBuffers buffers = BuffersOf(batch, run->slices, which.size());
+  staged_ = std::move(run).value();
+  return buffers;
+}
+
+Status VulkanBackend::QueueStaged() {
+  if (!staged_) {
+    return Internal("no staged run to queue: Stage comes first, and a Run after it discards what it staged");
+  }
+  const StagedRun run = std::move(*staged_);
+  staged_.reset();
+  if (run.plan.dispatches.empty()) return Status::Ok();
+  const ValidationScope validation(*context_);
+  Status status = pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) { Record(commands, run); });
+  if (status.ok()) status = validation.Check("QueueStaged");
+  return status.WithContext(DeviceContext());
 }
 
 // Outputs a shader never wrote would be judged as if it had: refused, with
@@ -635,19 +670,18 @@ void VulkanBackend::BindBuffers(const BindingBytes& bytes) {
   pass_->WriteDescriptors(writes);
 }
 
-void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, const SliceLayout& slices,
-                           const DispatchPlan& plan) const {
-  const std::uint32_t groups = WorkgroupsFor(batch, shape_);
+void VulkanBackend::Record(VkCommandBuffer commands, const StagedRun& run) const {
   // Every output starts as kUnwrittenBits; the shaders' writes come after.
   vkCmdFillBuffer(commands, buffers_[kPositions].handle(), 0, VK_WHOLE_SIZE, kUnwrittenBits);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   // Cells write disjoint slices and only read the inputs: no barriers between dispatches.
-  for (const DispatchPlan::Dispatch& dispatch : plan.dispatches) {
+  for (const DispatchPlan::Dispatch& dispatch : run.plan.dispatches) {
     pass_->Bind(commands, pipelines_[VariantIndex(dispatch.variant)].get());
-    const f32::PassConstants constants = PassConstantsFor(batch, slices, dispatch.first_cell);
+    f32::PassConstants constants = run.constants;
+    constants.first_cell = dispatch.first_cell;
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, groups, dispatch.cells, 1);
+    vkCmdDispatch(commands, run.workgroups, dispatch.cells, 1);
   }
   // The host reads the positions once the fence signals.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -655,24 +689,6 @@ void VulkanBackend::Record(VkCommandBuffer commands, const ShaderInputs& batch, 
 }
 
 }  // namespace
-
-std::vector<std::uint32_t> RasterTexels(const Backend& backend) {
-  const auto* vulkan = dynamic_cast<const VulkanBackend*>(&backend);
-  return vulkan != nullptr ? vulkan->raster_texels() : std::vector<std::uint32_t>{};
-}
-
-Expected<DevicePositions> RunLeavingOnDevice(Backend& backend, const ShaderInputs& batch,
-                                             std::span<const std::uint32_t> which, ThreadPool* pool,
-                                             const TexelWriter& write_texels) {
-  auto* vulkan = dynamic_cast<VulkanBackend*>(&backend);
-  if (vulkan == nullptr) return Unavailable("the " + backend.name() + " backend keeps no outputs on a device");
-  return vulkan->RunLeavingOnDevice(batch, which, pool, write_texels);
-}
-
-std::shared_ptr<VulkanContext> ContextOf(const Backend& backend) {
-  const auto* vulkan = dynamic_cast<const VulkanBackend*>(&backend);
-  return vulkan != nullptr ? vulkan->context() : nullptr;
-}
 
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {
   VulkanContextOptions context_options;

@@ -644,7 +644,7 @@ DeviceInfo DeviceInfoOf(const VulkanDeviceProperties& properties) {
   return {.name = properties.name,
           .driver = properties.DriverString(),
           .api = "Vulkan " + VulkanVersionString(properties.api_version),
-          .kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "cpu" : "gpu",
+          .kind = properties.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? DeviceKind::kCpu : DeviceKind::kGpu,
           .compiler = GlslangVersion()};
 }
 

@@ -18,7 +18,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "bench/backends/device_info.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/base/status.h"
 
 namespace depthbench {

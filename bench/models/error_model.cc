@@ -1,4 +1,4 @@
-#include "bench/fit/error_model.h"
+#include "bench/models/error_model.h"
 
 #include <algorithm>
 #include <cmath>

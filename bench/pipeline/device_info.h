@@ -2,15 +2,28 @@
 // plain record, so that readers of results need nothing of the backends.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace depthbench {
 
+// What kind of processor runs a device's work: a CPU (the CPU backend, and
+// software Vulkan such as lavapipe) or a GPU.
+enum class DeviceKind : std::uint8_t { kCpu, kGpu };
+inline const char* DeviceKindName(DeviceKind kind) { return kind == DeviceKind::kGpu ? "gpu" : "cpu"; }
+inline std::optional<DeviceKind> ParseDeviceKind(std::string_view name) {
+  if (name == "cpu") return DeviceKind::kCpu;
+  if (name == "gpu") return DeviceKind::kGpu;
+  return std::nullopt;
+}
+
 struct DeviceInfo {
-  std::string name;      // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
-  std::string driver;    // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
-  std::string api;       // "Vulkan 1.3.230"
-  std::string kind;      // "cpu" for software (lavapipe, the CPU backend), "gpu" otherwise
+  std::string name;    // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
+  std::string driver;  // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"
+  std::string api;     // "Vulkan 1.3.230"
+  DeviceKind kind = DeviceKind::kCpu;
   std::string compiler;  // how the formulas were compiled ("glslang 12.0.0", "g++ 12.2.0")
 };
 
