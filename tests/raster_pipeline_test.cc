@@ -112,6 +112,43 @@ TEST_F(RasterPipelineTest, EveryCellRunsAndIsJudged) {
   EXPECT_GE(cells, 8 * 3);  // every variant, with at least three encodings each
 }
 
+// The agreement of the rendered depths with the host's model is part of
+// the results: one record per encoding for the backend that rendered them,
+// none for the others or the compute form; --json keeps it and merge adds
+// the shards' counts.
+TEST_F(RasterPipelineTest, TheRasterAgreementIsKeptInTheResults) {
+  ASSERT_EQ(raster_->run.backends.size(), 2u);
+  const std::vector<RasterAgreement>& agreement = raster_->run.backends[0].raster_agreement;
+  const RunLayout layout = MakeRunLayout(raster_->run.cells);
+  ASSERT_EQ(agreement.size(), layout.encodings.size());
+  for (std::size_t slot = 0; slot < agreement.size(); ++slot) {
+    EXPECT_EQ(agreement[slot].encoding, layout.encodings[slot]) << slot;
+    // At the origin every sample of the natural population has geometry
+    // (EveryCellRunsAndIsJudged), and more than half of all are natural.
+    EXPECT_GT(agreement[slot].texels, kSamples / 2) << slot;
+    EXPECT_LE(agreement[slot].differing, agreement[slot].texels) << slot;
+  }
+  EXPECT_TRUE(raster_->run.backends[1].raster_agreement.empty());  // the CPU backend renders nothing
+  for (const BackendRecord& b : compute_->run.backends) EXPECT_TRUE(b.raster_agreement.empty()) << b.name;
+
+  const Expected<Results> read = ResultsFromJson(ToJson(*raster_), "raster.json");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->run.backends[0].raster_agreement, agreement);
+
+  Results first = *raster_, second = *raster_;
+  first.run.shards = {Shard{1, 2}};
+  second.run.shards = {Shard{2, 2}};
+  const Expected<Results> merged = MergeResults({first, second}, {"first", "second"}, false);
+  ASSERT_TRUE(merged.ok()) << merged.status().message();
+  const std::vector<RasterAgreement>& sum = merged->run.backends[0].raster_agreement;
+  ASSERT_EQ(sum.size(), agreement.size());
+  for (std::size_t slot = 0; slot < sum.size(); ++slot) {
+    EXPECT_EQ(sum[slot].texels, 2 * agreement[slot].texels) << slot;
+    EXPECT_EQ(sum[slot].differing, 2 * agreement[slot].differing) << slot;
+    EXPECT_EQ(sum[slot].max_code_distance, agreement[slot].max_code_distance) << slot;
+  }
+}
+
 TEST_F(RasterPipelineTest, FarPlaneFiguresFollowTheComputeFormAndTheHostModel) {
   int compared = 0;
   for (const CellResult& c : compute_->cells) {

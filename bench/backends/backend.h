@@ -21,8 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "bench/pipeline/device_info.h"
 #include "bench/base/status.h"
+#include "bench/pipeline/device_info.h"
+#include "bench/pipeline/raster_model.h"
 #include "bench/pipeline/shader_inputs.h"
 
 namespace depthbench {
@@ -41,16 +42,6 @@ inline PassKind PassKindOf(ProductionModel production) {
 struct RenderedDepths {
   std::span<const std::uint32_t> codes;
   std::span<const float> fetched;
-};
-
-// How the depths a raster backend produced compare with the batch's (the
-// host's model of a rasterizer, bench/pipeline/raster_model.h), over the
-// samples that have geometry, since Prepare: one per depth slot.
-struct RasterAgreement {
-  std::uint64_t texels = 0;     // samples with geometry
-  std::uint64_t differing = 0;  // whose texel bits differ from the batch's code
-  std::uint64_t uncovered = 0;  // that the device left uncovered (nothing written)
-  std::uint32_t max_code_distance = 0;  // the largest |device code - batch code| (ulps for float formats)
 };
 
 class Backend {
@@ -76,7 +67,8 @@ class Backend {
     return Unavailable(name() + " does not render depths");
   }
   // How the rendered depths agreed with the batch's (the host's model of
-  // a rasterizer, before adoption), per depth slot, since Prepare.
+  // a rasterizer, before adoption), one per depth slot of the prepared
+  // cells (RunLayout::encodings), since Prepare.
   virtual std::vector<RasterAgreement> raster_agreement() const { return {}; }
   // The texel bits a raster backend's last Run or RenderDepths rendered,
   // laid out as ShaderInputs::codes (the batch's own code where it drew

@@ -69,28 +69,6 @@ Expected<int> ReplayReproFile(const RunFlags& f, std::span<Backend* const> backe
   return failures > 0 ? kExitFinding : kExitOk;
 }
 
-// How the depths each raster backend rendered compare with the host's
-// model of a rasterizer (bench/pipeline/raster_model.h), per encoding.
-void PrintRasterAgreement(const Results& results, std::span<Backend* const> backends, std::ostream& out) {
-  const RunLayout layout = MakeRunLayout(results.run.cells);
-  for (const Backend* backend : backends) {
-    const std::vector<RasterAgreement> agreement = backend->raster_agreement();
-    if (agreement.empty()) continue;
-    out << fmt::format(
-        "\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
-        "the largest difference in codes, ulps for float formats):\n",
-        backend->name());
-    for (std::size_t slot = 0; slot < agreement.size() && slot < layout.encodings.size(); ++slot) {
-      const RasterAgreement& a = agreement[slot];
-      const Encoding e = layout.encodings[slot];
-      out << fmt::format("  {}/{}: {} of {} differ ({:.3g}%), at most {}{}\n", Info(e.convention).name,
-                         Info(e.format).name, a.differing, a.texels,
-                         a.texels == 0 ? 0.0 : 100.0 * static_cast<double>(a.differing) / static_cast<double>(a.texels),
-                         a.max_code_distance, a.uncovered == 0 ? "" : fmt::format("; {} left uncovered", a.uncovered));
-    }
-  }
-}
-
 Expected<int> Run(const RunFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
   SweepOptions options;
@@ -144,7 +122,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
 
   PrintRunHeader(results, out.text);
   PrintResultsTable(results, out);
-  PrintRasterAgreement(results, backends, out.text);
+  PrintRasterAgreement(results, out.text);
   for (BandFamily family : splits) PrintBandTable(results, family, out);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteResults(f.json, results));
   return kExitOk;

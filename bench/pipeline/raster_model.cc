@@ -1,5 +1,6 @@
 #include "bench/pipeline/raster_model.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -270,6 +271,13 @@ f32::FrameParams RasterFrameParams(const f32::FrameParams& frame_params,
     }
   }
   return out;
+}
+
+void RasterAgreement::Merge(const RasterAgreement& other) {
+  texels += other.texels;
+  differing += other.differing;
+  uncovered += other.uncovered;
+  max_code_distance = std::max(max_code_distance, other.max_code_distance);
 }
 
 }  // namespace depthbench

@@ -61,6 +61,22 @@ struct RasterGeometry {
 };
 RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample);
 
+// How the depths a real rasterizer produced for one encoding compare with
+// this model's (the texel codes the batch would hold), over the samples
+// that have geometry. A raster backend counts them (Backend::raster_agreement)
+// and the sweep keeps them in its results.
+struct RasterAgreement {
+  Encoding encoding{};
+  std::uint64_t texels = 0;             // samples with geometry
+  std::uint64_t differing = 0;          // whose texel bits differ from the model's code
+  std::uint64_t uncovered = 0;          // that the device left uncovered (nothing written)
+  std::uint32_t max_code_distance = 0;  // the largest |device code - model code| (ulps for float formats)
+
+  // Adds the counts of another part of the same sweep (a shard).
+  void Merge(const RasterAgreement& other);
+  friend bool operator==(const RasterAgreement&, const RasterAgreement&) = default;
+};
+
 // The value the raster pipeline's first pass stores for a sample, before
 // the format's rounding: window depth for hardware formats, eye depth / far
 // for linear ones, view z for view-z ones. `frame` and `depth` are the

@@ -262,6 +262,20 @@ JsonFields<CellResult> CellResultFields(const Catalogue& catalogue) {
   }};
 }
 
+const JsonFields<RasterAgreement>& RasterAgreementFields() {
+  static const JsonFields<RasterAgreement> fields{{
+      JsonAccess<RasterAgreement>(
+          "convention", [](auto& a) -> auto& { return a.encoding.convention; }, JsonConventionName()),
+      JsonAccess<RasterAgreement>(
+          "format", [](auto& a) -> auto& { return a.encoding.format; }, JsonFormatName()),
+      JsonMember("texels", &RasterAgreement::texels),
+      JsonMember("differing", &RasterAgreement::differing),
+      JsonMember("uncovered", &RasterAgreement::uncovered),
+      JsonMember("max_code_distance", &RasterAgreement::max_code_distance),
+  }};
+  return fields;
+}
+
 const JsonFields<BackendRecord>& BackendFields() {
   // Where older files lack it, the backend was judged on the host.
   static const JsonNamed<std::string> judge{
@@ -278,6 +292,11 @@ const JsonFields<BackendRecord>& BackendFields() {
       JsonAccess<BackendRecord>(
           "program_hash", [](auto& b) -> auto& { return b.program.hash; }, JsonText()),
       JsonMemberOr("judge", &BackendRecord::judge, judge, "host"),
+      // Only a raster run's rendering backend has one (and files written
+      // before it was kept lack it).
+      JsonOnlyIf(JsonMemberOr("raster_agreement", &BackendRecord::raster_agreement,
+                              JsonArray{JsonObject{RasterAgreementFields()}}, {}),
+                 [](const BackendRecord& b) { return !b.raster_agreement.empty(); }),
   }};
   return fields;
 }
@@ -463,6 +482,19 @@ std::vector<std::pair<std::string, std::string>> SweepIdentity(const RunInfo& ru
   };
 }
 
+// Adds `part`'s counts into `into`'s, encoding by encoding.
+void MergeAgreement(const std::vector<RasterAgreement>& part, std::vector<RasterAgreement>& into) {
+  for (const RasterAgreement& a : part) {
+    const auto same = std::find_if(into.begin(), into.end(),
+                                   [&](const RasterAgreement& held) { return held.encoding == a.encoding; });
+    if (same == into.end()) {
+      into.push_back(a);
+    } else {
+      same->Merge(a);
+    }
+  }
+}
+
 // A value in a message: long ones (the domain, every cell) cut short.
 std::string Quoted(const std::string& value) {
   constexpr std::size_t kShown = 160;
@@ -521,6 +553,9 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
     merged.run.reconstructions += part.run.reconstructions;
     merged.run.samples_judged += part.run.samples_judged;
     merged.run.partial = merged.run.partial || part.run.partial;
+    for (std::size_t b = 0; b < part.run.backends.size(); ++b) {
+      MergeAgreement(part.run.backends[b].raster_agreement, merged.run.backends[b].raster_agreement);
+    }
     for (const CellResult& c : part.cells) {
       auto it = std::find_if(merged.cells.begin(), merged.cells.end(),
                              [&](const CellResult& m) { return m.cell == c.cell && m.backend == c.backend; });

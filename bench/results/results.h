@@ -18,6 +18,7 @@
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/device_info.h"
 #include "bench/pipeline/domain.h"
+#include "bench/pipeline/raster_model.h"
 #include "bench/pipeline/stats.h"
 
 namespace depthbench {
@@ -56,6 +57,10 @@ struct BackendRecord {
   // Not part of a sweep's identity: both give the same figures, so shards
   // judged either way merge.
   std::string judge = "host";
+  // For a backend that rasterized its own depths, how they agreed with
+  // the host's model of a rasterizer, per encoding the run stored; empty
+  // for every other backend and form.
+  std::vector<RasterAgreement> raster_agreement;
 };
 
 // Where a sweep's wall time went, in seconds (summed over merged shards).

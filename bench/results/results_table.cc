@@ -174,4 +174,20 @@ void PrintBandTable(const Results& results, BandFamily family, const TextOutput&
   table.Print(out);
 }
 
+void PrintRasterAgreement(const Results& results, std::ostream& out) {
+  for (const BackendRecord& backend : results.run.backends) {
+    if (backend.raster_agreement.empty()) continue;
+    out << fmt::format(
+        "\n{}'s rasterized depths against the host's model of a rasterizer (texels that differ; "
+        "the largest difference in codes, ulps for float formats):\n",
+        backend.name);
+    for (const RasterAgreement& a : backend.raster_agreement) {
+      out << fmt::format("  {}/{}: {} of {} differ ({:.3g}%), at most {}{}\n", Info(a.encoding.convention).name,
+                         Info(a.encoding.format).name, a.differing, a.texels,
+                         a.texels == 0 ? 0.0 : 100.0 * static_cast<double>(a.differing) / static_cast<double>(a.texels),
+                         a.max_code_distance, a.uncovered == 0 ? "" : fmt::format("; {} left uncovered", a.uncovered));
+    }
+  }
+}
+
 }  // namespace depthbench

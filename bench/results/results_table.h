@@ -18,5 +18,9 @@ void PrintResultsTable(const Results& results, const TextOutput& out);
 void PrintBandTable(const Results& results, BandFamily family, const TextOutput& out);
 // The one-paragraph header: seed, samples, domain, devices, throughput.
 void PrintRunHeader(const Results& results, std::ostream& out);
+// How the depths each raster backend rendered compare with the host's model
+// of a rasterizer (bench/pipeline/raster_model.h), per encoding; nothing
+// where no backend rendered its own.
+void PrintRasterAgreement(const Results& results, std::ostream& out);
 
 }  // namespace depthbench

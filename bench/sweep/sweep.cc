@@ -259,6 +259,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
       results.cells.push_back({layout.cells[c].cell, backends[b]->name(), std::move(stats[c])});
     }
     stages[b]->AddTimes(results.run.stages);
+    results.run.backends[b].raster_agreement = backends[b]->raster_agreement();
   }
   RunInfo& run = results.run;
   run.seconds = SecondsSince(started);

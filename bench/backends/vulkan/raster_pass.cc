@@ -274,6 +274,7 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
                                  device_name));
   pass->atlases_.resize(atlases);
   pass->agreement_.assign(slot_count, RasterAgreement{});
+  for (std::uint32_t s = 0; s < slot_count; ++s) pass->agreement_[s].encoding = pass->slots_[s].encoding;
 
   std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
   for (std::uint32_t i = 0; i < kBindingCount; ++i) {

@@ -82,7 +82,7 @@ class RasterPass {
   Expected<const float*> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                              std::uint32_t unwritten_bits);
 
-  // Per depth slot, since Create: RasterAgreement (backend.h).
+  // Per depth slot, since Create: RasterAgreement (raster_model.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
   // The texel bits pass 1 produced last, laid out as ShaderInputs::codes:
   // the batch's own where it drew nothing (a sample without geometry, a
