@@ -233,11 +233,19 @@ TEST(SpeedResultsTest, ComparesRankingsOfOneDevice) {
 }
 
 TEST(SpeedResultsTest, ParsesResolutions) {
+  auto list = ParseResolutions("1920x1080,800x600", "--resolution");
+  ASSERT_TRUE(list.ok());
+  EXPECT_EQ(list->size(), 2u);
+  EXPECT_FALSE(ParseResolutions("1920x1080,", "--resolution").ok());
+
   auto r = ParseResolution("3840x2160", "--resolution");
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(r->width, 3840u);
   EXPECT_EQ(r->height, 2160u);
-  for (const char* bad : {"1920", "0x10", "10x", "x10", "10x10x10", "-5x10"}) {
+  EXPECT_TRUE(ParseResolution("65535x1", "--resolution").ok());
+  // Digits only, each side 1 to kMaxResolutionSide, nothing wrapped.
+  for (const char* bad : {"1920", "0x10", "10x", "x10", "10x10x10", "-5x10", "+5x10", " 5x10", "65536x10",
+                          "4294967297x10", "1e3x10"}) {
     EXPECT_FALSE(ParseResolution(bad, "--resolution").ok()) << bad;
   }
 }

@@ -184,8 +184,9 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     // undefined behaviour (found by fuzz_scene).
     auto w = a && a->size() == 2 ? a->get(0)->value_exact<std::int64_t>() : std::nullopt;
     auto h = a && a->size() == 2 ? a->get(1)->value_exact<std::int64_t>() : std::nullopt;
-    if (!w || !h || *w < 1 || *h < 1 || *w > 65535 || *h > 65535) {
-      return r.Error(res, "projection.resolution", "expected [width, height] in pixels, 1 to 65535 each");
+    if (!w || !h || *w < 1 || *h < 1 || *w > kMaxResolutionSide || *h > kMaxResolutionSide) {
+      return r.Error(res, "projection.resolution",
+                     fmt::format("expected [width, height] in pixels, 1 to {} each", kMaxResolutionSide));
     }
     d.resolutions = {{static_cast<std::uint32_t>(*w), static_cast<std::uint32_t>(*h)}};
   }

@@ -121,30 +121,7 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
     d.eye_depth = z;
   }
   if (!resolution.empty()) {
-    d.resolutions.clear();
-    std::size_t start = 0;
-    while (start <= resolution.size()) {
-      const std::size_t comma = std::min(resolution.find(',', start), resolution.size());
-      const std::string one = resolution.substr(start, comma - start);
-      // Digits only, each side 1..kMaxSide: sscanf's %u would wrap
-      // 4294967297 to 1.
-      constexpr unsigned long kMaxSide = 65536;
-      const std::size_t x = one.find_first_of("xX");
-      auto side = [&](std::size_t from, std::size_t to) -> unsigned long {
-        const std::string digits = one.substr(from, to - from);
-        if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
-          return 0;
-        return std::stoul(digits);
-      };
-      const unsigned long w = x == std::string::npos ? 0 : side(0, x);
-      const unsigned long h = x == std::string::npos ? 0 : side(x + 1, one.size());
-      if (w < 1 || h < 1 || w > kMaxSide || h > kMaxSide) {
-        return InvalidArgument(fmt::format(
-            "--resolution: '{}' is not WIDTHxHEIGHT with each side 1 to {} (e.g. 1920x1080)", one, kMaxSide));
-      }
-      d.resolutions.push_back({static_cast<std::uint32_t>(w), static_cast<std::uint32_t>(h)});
-      start = comma + 1;
-    }
+    DB_ASSIGN_OR_RETURN(d.resolutions, ParseResolutions(resolution, "--resolution"));
   }
   Status valid = d.Validate();
   if (!valid.ok()) return valid;

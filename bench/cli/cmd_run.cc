@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/files.h"
+#include "bench/base/parse_number.h"
 #include "bench/base/progress.h"
 #include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
@@ -100,12 +101,11 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
 
   if (!f.repro.empty()) return ReplayReproFile(f, backends, out.text);
   if (!f.index.empty()) {  // one sample, in full
-    char* end = nullptr;
-    const unsigned long long index = std::strtoull(f.index.c_str(), &end, 10);
-    if (f.index.empty() || *end != '\0' || f.index[0] == '-') {
-      return InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ...)", f.index));
+    const std::optional<std::uint64_t> index = ParseDigits<std::uint64_t>(f.index);
+    if (!index) {
+      return InvalidArgument(fmt::format("--index: '{}' is not a sample index (0, 1, 2, ... below 2^64)", f.index));
     }
-    DB_ASSIGN_OR_RETURN(const Repro repro, Reproduce(options.seed, index, options.domain,
+    DB_ASSIGN_OR_RETURN(const Repro repro, Reproduce(options.seed, *index, options.domain,
                                                      CellsForDomain(options.cells, options.domain), backends));
     PrintRepro(repro, out.text);
     if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ReproToJson(repro).dump(1) + "\n"));

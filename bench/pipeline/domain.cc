@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/parse_number.h"
 #include "bench/base/suggest.h"
 
 namespace depthbench {
@@ -195,9 +196,9 @@ Status Domain::Validate() const {
   }
   if (resolutions.empty()) return InvalidArgument("the domain has no resolution");
   for (const auto& r : resolutions) {
-    if (r.width == 0 || r.height == 0 || r.width > 65535 || r.height > 65535) {
-      return InvalidArgument(
-          fmt::format("resolution {}x{} is out of range; allowed 1 to 65535 pixels a side", r.width, r.height));
+    if (r.width == 0 || r.height == 0 || r.width > kMaxResolutionSide || r.height > kMaxResolutionSide) {
+      return InvalidArgument(fmt::format("resolution {} is out of range; allowed 1 to {} pixels a side",
+                                         ResolutionName(r), kMaxResolutionSide));
     }
   }
   return Status::Ok();
@@ -217,8 +218,7 @@ std::string Domain::ToFlags() const {
   if (eye_depth) flags += " --depth " + range(*eye_depth);
   if (resolutions != Domain{}.resolutions) {
     std::string sizes;
-    for (const Resolution& r : resolutions)
-      sizes += fmt::format("{}{}x{}", sizes.empty() ? "" : ",", r.width, r.height);
+    for (const Resolution& r : resolutions) sizes += (sizes.empty() ? "" : ",") + ResolutionName(r);
     flags += " --resolution " + sizes;
   }
   if (production == ProductionModel::kRaster) {
@@ -244,6 +244,34 @@ std::string Domain::Describe() const {
   if (production != ProductionModel::kFloat32) text += fmt::format(", {} production", ProductionModelName(production));
   if (constants != ConstantsModel::kExact) text += fmt::format(", {} constants", ConstantsModelName(constants));
   return fmt::format("{}: {}", name, text);
+}
+
+std::string ResolutionName(Resolution resolution) { return fmt::format("{}x{}", resolution.width, resolution.height); }
+
+Expected<Resolution> ParseResolution(std::string_view text, std::string_view what) {
+  const std::size_t x = text.find_first_of("xX");
+  const auto side = [&](std::string_view digits) -> std::uint32_t {
+    const std::optional<std::uint32_t> n = ParseDigits<std::uint32_t>(digits);
+    return n && *n <= kMaxResolutionSide ? *n : 0;
+  };
+  const Resolution r = x == std::string_view::npos ? Resolution{0, 0}
+                                                    : Resolution{side(text.substr(0, x)), side(text.substr(x + 1))};
+  if (r.width == 0 || r.height == 0) {
+    return InvalidArgument(fmt::format("{}: '{}' is not WIDTHxHEIGHT with each side 1 to {} (e.g. 1920x1080)", what,
+                                       text, kMaxResolutionSide));
+  }
+  return r;
+}
+
+Expected<std::vector<Resolution>> ParseResolutions(std::string_view text, std::string_view what) {
+  std::vector<Resolution> out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    DB_ASSIGN_OR_RETURN(const Resolution r, ParseResolution(text.substr(start, comma - start), what));
+    out.push_back(r);
+    start = comma + 1;
+  }
+  return out;
 }
 
 }  // namespace depthbench

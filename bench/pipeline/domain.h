@@ -42,6 +42,15 @@ struct Resolution {
   std::uint32_t height;
   friend bool operator==(const Resolution&, const Resolution&) = default;
 };
+// The widest and tallest render target a domain may name, in pixels: what
+// fits a 16-bit side, far above any device's image limit.
+inline constexpr std::uint32_t kMaxResolutionSide = 65535;
+std::string ResolutionName(Resolution resolution);  // "1920x1080"
+// "WIDTHxHEIGHT", each side 1 to kMaxResolutionSide; `what` names the input
+// in the error ("--resolution").
+Expected<Resolution> ParseResolution(std::string_view text, std::string_view what);
+// A comma-separated list of them ("1920x1080,3840x2160").
+Expected<std::vector<Resolution>> ParseResolutions(std::string_view text, std::string_view what);
 
 // How the pipeline produces the depth it stores from a scene point's eye
 // depth z (encode.h):

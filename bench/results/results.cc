@@ -1,7 +1,6 @@
 #include "bench/results/results.h"
 
 #include <algorithm>
-#include <charconv>
 #include <map>
 
 #include <fmt/format.h>
@@ -9,6 +8,7 @@
 #include "bench/base/files.h"
 #include "bench/base/json_fields.h"
 #include "bench/base/json_reader.h"
+#include "bench/base/parse_number.h"
 
 namespace depthbench {
 
@@ -23,15 +23,12 @@ std::uint64_t Shard::End(std::uint64_t total) const {
 std::string Shard::ToString() const { return fmt::format("{}/{}", index, count); }
 
 Expected<Shard> ParseShard(std::string_view text) {
-  auto slash = text.find('/');
-  Shard shard;
-  auto parse = [](std::string_view s, std::uint32_t& out) {
-    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && end == s.data() + s.size();
-  };
-  if (slash == std::string_view::npos || !parse(text.substr(0, slash), shard.index) ||
-      !parse(text.substr(slash + 1), shard.count) || shard.count == 0 || shard.index == 0 ||
-      shard.index > shard.count) {
+  const std::size_t slash = text.find('/');
+  const auto number = [](std::string_view digits) { return ParseDigits<std::uint32_t>(digits).value_or(0); };
+  const Shard shard = slash == std::string_view::npos
+                          ? Shard{0, 0}
+                          : Shard{number(text.substr(0, slash)), number(text.substr(slash + 1))};
+  if (shard.count == 0 || shard.index == 0 || shard.index > shard.count) {
     return InvalidArgument(fmt::format("--shard: '{}' is not K/N with 1 <= K <= N (shard K of N, e.g. 2/4)", text));
   }
   return shard;

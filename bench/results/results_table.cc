@@ -21,13 +21,6 @@ std::string P999(const Summary& s) {
 constexpr const char* kNoFigure = "-";
 std::string Count(std::uint64_t n) { return n == 0 ? "0" : fmt::format("{}", n); }
 
-std::string SiCount(double x) {
-  if (x >= 1e9) return fmt::format("{:.2f}G", x / 1e9);
-  if (x >= 1e6) return fmt::format("{:.2f}M", x / 1e6);
-  if (x >= 1e3) return fmt::format("{:.1f}k", x / 1e3);
-  return fmt::format("{:.0f}", x);
-}
-
 }  // namespace
 
 void PrintRunHeader(const Results& results, std::ostream& out) {
@@ -60,8 +53,8 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     out << "\n";
   }
   if (run.seconds > 0) {
-    out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", SiCount(run.reconstructions), run.seconds,
-                       SiCount(run.reconstructions / run.seconds));
+    out << fmt::format("{} reconstructions verified in {:.2f} s: {}/s\n", ShortCount(run.reconstructions), run.seconds,
+                       ShortCount(run.reconstructions / run.seconds));
   }
   if (!run.stages.empty()) {
     const StageSeconds& t = run.stages;

@@ -1,7 +1,6 @@
 #include "bench/speed/speed_results.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -24,23 +23,6 @@ Expected<Regime> ParseRegime(std::string_view name) {
   if (name == "memory") return Regime::kMemory;
   if (name == "alu") return Regime::kAlu;
   return InvalidArgument(fmt::format("unknown regime '{}'; allowed: memory, alu", name));
-}
-
-std::string ResolutionName(Resolution resolution) { return fmt::format("{}x{}", resolution.width, resolution.height); }
-
-Expected<Resolution> ParseResolution(std::string_view text, std::string_view what) {
-  const auto x = text.find_first_of("xX");
-  Resolution r{0, 0};
-  auto parse = [](std::string_view s, std::uint32_t& out) {
-    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return !s.empty() && ec == std::errc() && end == s.data() + s.size();
-  };
-  if (x == std::string_view::npos || !parse(text.substr(0, x), r.width) || !parse(text.substr(x + 1), r.height) ||
-      r.width == 0 || r.height == 0) {
-    return InvalidArgument(
-        fmt::format("{}: '{}' is not WIDTHxHEIGHT with both at least 1 (e.g. 1920x1080)", what, text));
-  }
-  return r;
 }
 
 bool SameGroup(const GpuTiming& a, const GpuTiming& b) {

@@ -186,8 +186,6 @@ Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path,
                                         const Catalogue& catalogue = Catalogue::BuiltIn());
 
 // "1920x1080" and back.
-std::string ResolutionName(Resolution resolution);
-Expected<Resolution> ParseResolution(std::string_view text, std::string_view what);
 
 // How two runs on one device rank the variants, pair by pair within each
 // group present in both.
