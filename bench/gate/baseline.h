@@ -12,10 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bench/pipeline/device_info.h"
 #include "bench/base/json_reader.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
+#include "bench/pipeline/device_info.h"
 #include "bench/pipeline/domain.h"
 #include "bench/results/results.h"
 

@@ -18,8 +18,8 @@
 
 #include <vulkan/vulkan.h>
 
-#include "bench/pipeline/device_info.h"
 #include "bench/base/status.h"
+#include "bench/pipeline/device_info.h"
 
 namespace depthbench {
 
