@@ -48,7 +48,12 @@ RunInfo DescribeRun(const SweepOptions& options, const std::vector<Cell>& cells,
   run.shards = {options.shard};
   run.domain = options.domain;
   run.cells = cells;
-  for (Backend* backend : backends) run.backends.push_back({backend->name(), backend->device(), backend->program()});
+  for (Backend* backend : backends) {
+    BackendRecord& record = run.backends.emplace_back();
+    record.name = backend->name();
+    record.device = backend->device();
+    record.program = backend->program();
+  }
   return run;
 }
 
