@@ -1,6 +1,8 @@
 // depthbench gate: a fixed-seed sweep of every cell against committed
 // baselines; exit 1 when something got worse, for CI.
+#include <algorithm>
 #include <filesystem>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -29,13 +31,9 @@ struct BaselineSlot {
   Baseline baseline;
 };
 
-Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
-  const TextOutput& out = context.output;
-  for (const auto& [path, what] : {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}}) {
-    if (path.empty()) continue;
-    DB_RETURN_IF_ERROR(CheckWritable(path, what));
-  }
-  // The baselines, and the backends they name.
+// The baselines named, read where they exist; a new one (--update) takes
+// its backend from the next --backend.
+Expected<std::vector<BaselineSlot>> ReadBaselines(const GateFlags& f, const Catalogue& catalogue) {
   std::vector<BaselineSlot> slots;
   std::size_t next_new = 0;
   for (const std::string& path : f.baselines) {
@@ -49,7 +47,7 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
     slot.exists = std::filesystem::exists(std::filesystem::symlink_status(path, ec));
     if (slot.exists) {
       DB_RETURN_IF_ERROR(
-          StoreInto(ReadBaseline(path, context.catalogue), slot.baseline).WithContext("the baseline does not parse"));
+          StoreInto(ReadBaseline(path, catalogue), slot.baseline).WithContext("the baseline does not parse"));
     } else if (!f.update) {
       return NotFound(fmt::format(
           "baseline '{}' does not exist; make one with: depthbench gate --update --baseline {} --backend cpu|vulkan",
@@ -66,6 +64,12 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
     }
     slots.push_back(std::move(slot));
   }
+  return slots;
+}
+
+// The backends the baselines are for, each once, as the flags make them.
+Expected<BackendSet> MakeGateBackends(const GateFlags& f, std::span<const BaselineSlot> slots,
+                                      const Catalogue& catalogue) {
   BackendFlags backend_flags;
   backend_flags.backends.clear();
   for (const BaselineSlot& s : slots) {
@@ -84,20 +88,22 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   backend_flags.device = f.device;
   backend_flags.shaders = f.shaders;
   backend_flags.validate = f.validate;
-  DB_ASSIGN_OR_RETURN(const BackendSet made, backend_flags.Make(context.catalogue));
-  const std::span<Backend* const> backends = made.view();
+  return backend_flags.Make(catalogue);
+}
 
-  // The gate's own sweep.
+// The gate's own sweep (GatePlan) of every cell of the catalogue; a sweep
+// cut short gives no results.
+Expected<Results> RunGateSweep(const GateFlags& f, std::span<Backend* const> backends, const Catalogue& catalogue) {
   const SamplePlan plan = GatePlan();
   SweepOptions options;
   options.seed = plan.seed;
   options.samples = plan.samples;
   options.domain = plan.domain;
   options.threads = f.threads;
-  options.cells = context.catalogue.Cells();
+  options.cells = catalogue.Cells();
   Progress progress("gate", StderrIsTerminal());
   options.progress = [&](const SweepProgress& p) { progress.Update(p.fraction(), p.Describe()); };
-  DB_ASSIGN_OR_RETURN(const Results results, RunSweep(options, backends));
+  DB_ASSIGN_OR_RETURN(Results results, RunSweep(options, backends));
   if (results.run.partial) {
     // Figures of part of the plan compare with nothing: no verdict, report or baseline.
     return InterruptedError(
@@ -105,8 +111,14 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
                     results.run.samples_judged, results.run.samples));
   }
   progress.Finish(fmt::format("{} cells on {} backend(s)", results.cells.size(), backends.size()));
+  return results;
+}
 
-  const GateTolerance tolerance;
+// Each baseline against this run's figures of its backend. Under --update
+// a baseline of another plan or device is not comparable, and is replaced.
+Expected<std::vector<GateRun>> CompareRuns(const GateFlags& f, std::span<const BaselineSlot> slots,
+                                           const Results& results, const GateTolerance& tolerance,
+                                           const CommandContext& context) {
   std::vector<GateRun> runs;
   for (const BaselineSlot& s : slots) {
     GateRun run;
@@ -114,42 +126,57 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
     run.current = BaselineFromResults(results, s.baseline.backend);
     run.shader_dir = f.shaders;
     run.baseline_path = s.path;
+    run.comparison.backend = s.baseline.backend;
     if (s.exists) {
       Expected<GateComparison> comparison = CompareWithBaseline(s.baseline, run.current, tolerance, context.catalogue);
       if (comparison.ok()) {
         run.comparison = std::move(comparison).value();
         run.baseline = s.baseline;
       } else if (f.update) {
-        // A baseline of another plan or device is what --update replaces.
-        out.text << fmt::format("note: '{}' is not comparable ({}); --update replaces it\n", s.path,
-                                comparison.status().message());
-        run.comparison.backend = s.baseline.backend;
+        context.output.text << fmt::format("note: '{}' is not comparable ({}); --update replaces it\n", s.path,
+                                           comparison.status().message());
       } else {
         return comparison.status().WithContext(fmt::format("cannot judge against '{}'", s.path));
       }
-    } else {
-      run.comparison.backend = s.baseline.backend;
     }
     runs.push_back(std::move(run));
   }
-  if (!f.update) {
-    // Everything the run measured is compared, or the gate says what it did not compare.
-    for (const GateRun& r : runs) {
-      const std::string uncovered = r.comparison.Uncovered();
-      if (r.comparison.compared() == 0) {
-        return InvalidArgument(fmt::format(
-            "baseline '{}' covers none of the {} cells this gate ran ({}): nothing would be compared; make it again "
-            "with: depthbench gate --update --baseline {}",
-            r.baseline_path, r.current.cells.size(), uncovered, r.baseline_path));
-      }
-      if (!uncovered.empty() && !f.allow_uncovered) {
-        return InvalidArgument(fmt::format(
-            "baseline '{}' does not cover this run: {}; make it again with --update, or pass --allow-uncovered to "
-            "compare only what it covers",
-            r.baseline_path, uncovered));
-      }
+  return runs;
+}
+
+// Everything the run measured is compared, or the gate says what it did
+// not compare (--allow-uncovered accepts a baseline that covers part).
+Status CheckCoverage(std::span<const GateRun> runs, bool allow_uncovered) {
+  for (const GateRun& r : runs) {
+    const std::string uncovered = r.comparison.Uncovered();
+    if (r.comparison.compared() == 0) {
+      return InvalidArgument(fmt::format(
+          "baseline '{}' covers none of the {} cells this gate ran ({}): nothing would be compared; make it again "
+          "with: depthbench gate --update --baseline {}",
+          r.baseline_path, r.current.cells.size(), uncovered, r.baseline_path));
+    }
+    if (!uncovered.empty() && !allow_uncovered) {
+      return InvalidArgument(fmt::format(
+          "baseline '{}' does not cover this run: {}; make it again with --update, or pass --allow-uncovered to "
+          "compare only what it covers",
+          r.baseline_path, uncovered));
     }
   }
+  return Status::Ok();
+}
+
+Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
+  const TextOutput& out = context.output;
+  for (const auto& [path, what] : {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}}) {
+    if (path.empty()) continue;
+    DB_RETURN_IF_ERROR(CheckWritable(path, what));
+  }
+  DB_ASSIGN_OR_RETURN(const std::vector<BaselineSlot> slots, ReadBaselines(f, context.catalogue));
+  DB_ASSIGN_OR_RETURN(const BackendSet made, MakeGateBackends(f, slots, context.catalogue));
+  DB_ASSIGN_OR_RETURN(const Results results, RunGateSweep(f, made.view(), context.catalogue));
+  const GateTolerance tolerance;
+  DB_ASSIGN_OR_RETURN(const std::vector<GateRun> runs, CompareRuns(f, slots, results, tolerance, context));
+  if (!f.update) DB_RETURN_IF_ERROR(CheckCoverage(runs, f.allow_uncovered));
 
   PrintGateVerdict(runs, tolerance, out.text);
   if (!f.junit.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.junit, GateJUnit(runs)));
