@@ -46,6 +46,63 @@ DB_CONST_UINT(DB_JUDGE_STATUS_JUDGED, 0u)
 DB_CONST_UINT(DB_JUDGE_STATUS_DEGENERATE, 1u)
 DB_CONST_UINT(DB_JUDGE_STATUS_OUTSIDE, 2u)
 
+// The 32-bit words the host and the passes exchange. Each is built and
+// read here alone, so that C++ and GLSL cannot disagree about a field's
+// place: a word is packed by db_*_word and its fields read back by the
+// functions that follow it. Packing keeps each field to its own bits, so
+// that no field can spill into the next; the values given must fit them
+// (each word states its fields' ranges; device_judge.cc checks at compile
+// time those the host's types bound).
+
+// A depth slot's encoding (bindings.glsl's Layout, written by the host):
+//   bits 0-3    what the format stores (DB_JUDGE_STORES_*);
+//   bits 4-7    the convention's DB_CONVENTION_* bits;
+//   bits 8-11   the hardware convention's index, below
+//               DB_JUDGE_HARDWARE_CONVENTIONS (0 for a non-hardware one),
+//               which picks the frame's A and B;
+//   bit 12      1 for a hardware convention whose far plane is at infinity;
+//   bits 16-31  the pipeline that produces the slot's floats.
+DB_FN uint db_encoding_word(uint stores, uint convention, uint hardware, bool infinite_far, uint pipeline) {
+  return (stores & 0xfu) | ((convention & 0xfu) << 4u) | ((hardware & 0xfu) << 8u) | ((infinite_far ? 1u : 0u) << 12u) |
+         (pipeline << 16u);
+}
+DB_FN uint db_encoding_stores(uint word) { return word & 0xfu; }
+DB_FN uint db_encoding_convention(uint word) { return (word >> 4u) & 0xfu; }
+DB_FN uint db_encoding_hardware(uint word) { return (word >> 8u) & 0xfu; }
+DB_FN bool db_encoding_infinite_far(uint word) { return ((word >> 12u) & 1u) != 0u; }
+DB_FN uint db_encoding_pipeline(uint word) { return word >> 16u; }
+
+// A depth slot's texel (bindings.glsl's Layout, written by the host):
+//   bits 0-7    how the format keeps a value (DB_JUDGE_TEXEL_*);
+//   bits 8-31   a unorm format's bits (16 or 24), 0 for the others.
+DB_FN uint db_texel_word(uint kind, uint unorm_bits) { return (kind & 0xffu) | (unorm_bits << 8u); }
+DB_FN uint db_texel_kind(uint word) { return word & 0xffu; }
+DB_FN uint db_texel_unorm_bits(uint word) { return word >> 8u; }
+
+// A sample's coverage word (bindings.glsl's Coverage: uploaded by the host,
+// or written by the sample pass):
+//   bits 0-7    the coverage kind (bands.h's Coverage, 0 for a natural
+//               sample; a targeted pick's kind picks its coverage band);
+//   bits 8-31   the depth pick (sampler.h's DepthPick): 0 for an eye depth,
+//               else which stored value (1-4) the sample takes.
+DB_FN uint db_coverage_word(uint kind, uint pick) { return (kind & 0xffu) | (pick << 8u); }
+DB_FN uint db_coverage_kind(uint word) { return word & 0xffu; }
+DB_FN uint db_coverage_pick(uint word) { return word >> 8u; }
+
+// A (depth slot, sample)'s reference info (bindings.glsl's ReferenceInfo:
+// written by the reference pass, read by the judge and by the host):
+//   bits 0-7    the joint (ratio x depth) band, below DB_JUDGE_JOINT_SLOTS;
+//   bits 8-15   the reference status (DB_JUDGE_STATUS_*);
+//   bit 16      1 when the depth the stored value denotes is holdable (its
+//               squared extent is a finite float), so that the arithmetic
+//               error is recorded.
+DB_FN uint db_reference_info_word(uint joint_band, uint status, bool stored_holdable) {
+  return (joint_band & 0xffu) | ((status & 0xffu) << 8u) | ((stored_holdable ? 1u : 0u) << 16u);
+}
+DB_FN uint db_reference_info_joint_band(uint word) { return word & 0xffu; }
+DB_FN uint db_reference_info_status(uint word) { return (word >> 8u) & 0xffu; }
+DB_FN bool db_reference_info_stored_holdable(uint word) { return ((word >> 16u) & 1u) != 0u; }
+
 // Accumulators: one per cell of the run, then (where the dispatch records
 // them) one per depth slot; workgroup row y judges accumulator y.
 // Push constants of one dispatch of either pass. Sample i of the batch (index

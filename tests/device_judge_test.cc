@@ -7,6 +7,7 @@
 // recorded sample by sample, batches that start and end inside frames,
 // and flushes in the middle of the run.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -25,8 +26,15 @@
 #include "bench/device_judge/device_judge.h"
 #include "bench/numerics/formulas_mpfr.h"
 #include "bench/sweep/sweep.h"
+#include "shared/compat.h"
 
 namespace depthbench {
+// The words the host and the passes exchange, as C++ instantiates them.
+namespace judge_words {
+using uint = std::uint32_t;
+#include "shared/judge.h"
+}  // namespace judge_words
+
 namespace {
 
 class DeviceJudgeTest : public ::testing::Test {
@@ -524,6 +532,89 @@ TEST_F(DeviceJudgeTest, TheRasterFormIsJudgedOnTheHost) {
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.status().message().find("raster form is judged on the host"), std::string::npos)
       << refused.status().message();
+}
+
+// shared/judge.h's packed words, field by field. A word's fields, as
+// numbers (a flag as 0 or 1), and the largest each holds.
+template <std::size_t N>
+struct PackedWord {
+  std::uint32_t (*pack)(const std::array<std::uint32_t, N>&);
+  std::array<std::uint32_t, N> (*fields)(std::uint32_t);
+  std::array<std::uint32_t, N> largest;
+};
+
+// Every field comes back as it went in, alone or with the others, at 0, at
+// 1 and at its largest value; a field at its largest sets no bit that
+// another field's does; and a field given all 32 bits keeps to its own
+// (reading as its largest value) and leaves the others at 0.
+template <std::size_t N>
+void ExpectFieldsRoundTrip(const PackedWord<N>& word) {
+  const std::array<std::uint32_t, N> zeros{};
+  EXPECT_EQ(word.pack(zeros), 0u);
+  EXPECT_EQ(word.fields(word.pack(zeros)), zeros);
+  EXPECT_EQ(word.fields(word.pack(word.largest)), word.largest);
+  std::uint32_t union_of_fields = 0;
+  for (std::size_t f = 0; f < N; ++f) {
+    SCOPED_TRACE(fmt::format("field {}", f));
+    for (const std::uint32_t value : {1u, word.largest[f]}) {
+      std::array<std::uint32_t, N> alone{};
+      alone[f] = value;
+      EXPECT_EQ(word.fields(word.pack(alone)), alone);
+      std::array<std::uint32_t, N> with_others = word.largest;
+      with_others[f] = value;
+      EXPECT_EQ(word.fields(word.pack(with_others)), with_others);
+    }
+    std::array<std::uint32_t, N> alone{};
+    alone[f] = word.largest[f];
+    const std::uint32_t bits = word.pack(alone);
+    EXPECT_EQ(bits & union_of_fields, 0u) << fmt::format("{:#010x} overlaps {:#010x}", bits, union_of_fields);
+    union_of_fields |= bits;
+    std::array<std::uint32_t, N> all_ones{};
+    all_ones[f] = 0xffffffffu;
+    EXPECT_EQ(word.fields(word.pack(all_ones)), alone);
+  }
+  EXPECT_EQ(union_of_fields, word.pack(word.largest));
+}
+
+namespace W = judge_words;
+
+TEST(DeviceJudgeWords, TheEncodingWordKeepsEachField) {
+  ExpectFieldsRoundTrip(PackedWord<5>{
+      [](const std::array<std::uint32_t, 5>& f) { return W::db_encoding_word(f[0], f[1], f[2], f[3] != 0, f[4]); },
+      [](std::uint32_t w) {
+        return std::array<std::uint32_t, 5>{W::db_encoding_stores(w), W::db_encoding_convention(w),
+                                            W::db_encoding_hardware(w), W::db_encoding_infinite_far(w) ? 1u : 0u,
+                                            W::db_encoding_pipeline(w)};
+      },
+      {0xfu, 0xfu, 0xfu, 1u, 0xffffu}});
+}
+
+TEST(DeviceJudgeWords, TheTexelWordKeepsEachField) {
+  ExpectFieldsRoundTrip(
+      PackedWord<2>{[](const std::array<std::uint32_t, 2>& f) { return W::db_texel_word(f[0], f[1]); },
+                    [](std::uint32_t w) {
+                      return std::array<std::uint32_t, 2>{W::db_texel_kind(w), W::db_texel_unorm_bits(w)};
+                    },
+                    {0xffu, 0xffffffu}});
+}
+
+TEST(DeviceJudgeWords, TheCoverageWordKeepsEachField) {
+  ExpectFieldsRoundTrip(
+      PackedWord<2>{[](const std::array<std::uint32_t, 2>& f) { return W::db_coverage_word(f[0], f[1]); },
+                    [](std::uint32_t w) {
+                      return std::array<std::uint32_t, 2>{W::db_coverage_kind(w), W::db_coverage_pick(w)};
+                    },
+                    {0xffu, 0xffffffu}});
+}
+
+TEST(DeviceJudgeWords, TheReferenceInfoWordKeepsEachField) {
+  ExpectFieldsRoundTrip(PackedWord<3>{
+      [](const std::array<std::uint32_t, 3>& f) { return W::db_reference_info_word(f[0], f[1], f[2] != 0); },
+      [](std::uint32_t w) {
+        return std::array<std::uint32_t, 3>{W::db_reference_info_joint_band(w), W::db_reference_info_status(w),
+                                            W::db_reference_info_stored_holdable(w) ? 1u : 0u};
+      },
+      {0xffu, 0xffu, 1u}});
 }
 
 }  // namespace

@@ -51,6 +51,12 @@ static_assert(kSamplesPerFrame == 64);  // bindings.glsl's frame_of
 static_assert(L::DB_JUDGE_STORES_WINDOW_DEPTH == static_cast<unsigned>(DepthInput::kHardware) &&
               L::DB_JUDGE_STORES_LINEAR == static_cast<unsigned>(DepthInput::kLinear) &&
               L::DB_JUDGE_STORES_VIEW_Z == static_cast<unsigned>(DepthInput::kViewZ));
+// The host's values fit their fields of judge.h's words: a depth slot's
+// convention bits and hardware index in four bits each, a joint band in a
+// byte; coverage kinds, depth picks and statuses are bytes already.
+static_assert((f32::DB_CONVENTION_REVERSED | f32::DB_CONVENTION_INFINITE | f32::DB_CONVENTION_CLIP_MINUS_ONE) <= 0xfu &&
+              L::DB_JUDGE_HARDWARE_CONVENTIONS <= 16 && L::DB_JUDGE_JOINT_SLOTS <= 256);
+static_assert(sizeof(Coverage) == 1 && sizeof(DepthPick) == 1 && sizeof(ReferenceStatus) == 1);
 
 // The metrics the device records, in its order, as the host numbers them:
 // a cell's, and a depth slot's (its third is unused).
@@ -102,24 +108,24 @@ constexpr std::uint32_t kLanes = 2;
 constexpr std::uint32_t StoreSlot(std::uint32_t lane) { return 2 * lane; }
 constexpr std::uint32_t JudgeSlot(std::uint32_t lane) { return 2 * lane + 1; }
 
-// What the reference pass needs of a depth slot's encoding
-// (bindings.glsl's Layout): what the format stores, the convention's bits
-// and hardware index, whether its far plane is at infinity, and the slot's
-// pipeline.
+// What the reference and storage passes need of a depth slot's encoding
+// (judge.h's db_encoding_word): what the format stores, the convention's
+// bits and hardware index, whether its far plane is at infinity, and the
+// slot's pipeline.
 std::uint32_t EncodingWord(Encoding encoding, std::uint32_t pipeline) {
   const ConventionInfo& convention = Info(encoding.convention);
   const auto hardware = convention.hardware ? static_cast<std::uint32_t>(encoding.convention) : 0u;
   // As reference.cc's ReferencesBody reads a far plane at infinity.
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
-  return static_cast<std::uint32_t>(Info(encoding.format).stores) | (convention.bits & 0xfu) << 4 | hardware << 8 |
-         (infinite_far ? 1u : 0u) << 12 | pipeline << 16;
+  return L::db_encoding_word(static_cast<std::uint32_t>(Info(encoding.format).stores), convention.bits, hardware,
+                             infinite_far, pipeline);
 }
-// What the storage pass needs of a depth slot's format: how it keeps a
-// value, and a unorm's bits.
+// What the storage pass needs of a depth slot's format (judge.h's
+// db_texel_word): how it keeps a value, and a unorm's bits.
 std::uint32_t TexelWord(Format format) {
   const FormatInfo& info = Info(format);
-  return static_cast<std::uint32_t>(info.texel) |
-         (info.texel == TexelKind::kUnorm ? static_cast<std::uint32_t>(info.bits) : 0u) << 8;
+  return L::db_texel_word(static_cast<std::uint32_t>(info.texel),
+                          info.texel == TexelKind::kUnorm ? static_cast<std::uint32_t>(info.bits) : 0u);
 }
 
 }  // namespace
@@ -518,8 +524,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, const DeviceJudg
         const std::size_t lo = job * kUploadChunk, n = std::min(kUploadChunk, count - lo);
         std::memcpy(eye_depths + lo, samples.eye_depth.data() + lo, n * sizeof(double));
         for (std::size_t i = lo; i < lo + n; ++i) {
-          coverage[i] = static_cast<std::uint32_t>(samples.coverage[i]) | static_cast<std::uint32_t>(samples.pick[i])
-                                                                              << 8;
+          coverage[i] = L::db_coverage_word(static_cast<std::uint32_t>(samples.coverage[i]),
+                                            static_cast<std::uint32_t>(samples.pick[i]));
         }
       } else {
         const std::size_t lo = (job - sample_chunks) * kUploadChunk;
@@ -819,9 +825,9 @@ Expected<ReferenceArrays> DeviceJudge::LastReference() const {
                                     &out.production_square};
   for (std::size_t c = 0; c < 5; ++c) std::copy_n(values + c * slot_samples, slot_samples, columns[c]->begin());
   for (std::size_t r = 0; r < slot_samples; ++r) {
-    out.joint_band[r] = static_cast<std::uint8_t>(info[r] & 0xffu);
-    out.status[r] = static_cast<ReferenceStatus>((info[r] >> 8) & 0xffu);
-    out.stored_holdable[r] = static_cast<std::uint8_t>((info[r] >> 16) & 1u);
+    out.joint_band[r] = static_cast<std::uint8_t>(L::db_reference_info_joint_band(info[r]));
+    out.status[r] = static_cast<ReferenceStatus>(L::db_reference_info_status(info[r]));
+    out.stored_holdable[r] = L::db_reference_info_stored_holdable(info[r]) ? 1 : 0;
   }
   return out;
 }

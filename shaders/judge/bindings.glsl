@@ -5,12 +5,12 @@
 // batch lies in frame (i + pass.first_offset) / 64.
 
 // The run's layout: per cell, the depth slot it reads; then per depth slot
-// its encoding: what the format stores (DB_JUDGE_STORES_*) |
-// DB_CONVENTION_* bits << 4 | hardware convention index << 8 | 1 << 12
-// for a far plane at infinity | pipeline << 16; then per depth slot its
-// texel: DB_JUDGE_TEXEL_* | unorm bits << 8; then per pipeline its first
-// depth slot; then, from pass.row_order, the accumulator each workgroup
-// row of the judge takes.
+// its encoding word (what the format stores, the convention, the hardware
+// convention, a far plane at infinity, the pipeline: shared/judge.h's
+// db_encoding_*); then per depth slot its texel word (how the format keeps
+// a value, a unorm's bits: db_texel_*); then per pipeline its first depth
+// slot; then, from pass.row_order, the accumulator each workgroup row of
+// the judge takes.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and
@@ -21,8 +21,9 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { uint position_b
 layout(std430, set = 0, binding = 2) readonly buffer Frames { uvec4 frames[]; };
 // What was drawn of each sample: uploaded, or written by the sample pass
 // (sample.comp). The world-space ray at unit eye depth, x then y then z
-// slices of `count` values; the coverage kind | the depth pick << 8 (0 for
-// an eye depth, else the stored value: sampler.h's DepthPick).
+// slices of `count` values; per sample its coverage kind and depth pick (0
+// for an eye depth, else the stored value: sampler.h's DepthPick), packed
+// by shared/judge.h's db_coverage_word.
 #ifdef DB_SAMPLE_PASS
 #define DB_DRAWN_ACCESS writeonly
 #else
@@ -58,7 +59,9 @@ layout(std430, set = 0, binding = 9) readonly buffer Texels { uint texel_bits[];
 // Written by the reference pass, read by the judge. Per (depth slot,
 // sample): true depth, denoted depth, inverse squared distance, squared
 // relative storage and production errors, each a slice of slots * count
-// values; and the packed joint band | status << 8 | stored_holdable << 16.
+// values; and per (depth slot, sample) its joint band, status and whether
+// the stored value's depth is holdable, packed by shared/judge.h's
+// db_reference_info_word.
 layout(std430, set = 0, binding = 10) buffer Reference { double reference[]; };
 layout(std430, set = 0, binding = 11) buffer ReferenceInfo { uint reference_info[]; };
 

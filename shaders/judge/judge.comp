@@ -172,7 +172,7 @@ void count(uint k, uint slot, uint status, bool holdable, bool is_nan, uint64_t 
 // The slot of a sample's figures: its joint band, or its coverage band if
 // it is a targeted pick (kind > 0).
 uint band_slot(uint info, uint kind) {
-  return kind == 0u ? DB_JUDGE_DISTANCE_SLOTS + (info & 0xffu)
+  return kind == 0u ? DB_JUDGE_DISTANCE_SLOTS + db_reference_info_joint_band(info)
                     : DB_JUDGE_DISTANCE_SLOTS + DB_JUDGE_JOINT_SLOTS + kind - 1u;
 }
 
@@ -181,11 +181,11 @@ uint band_slot(uint info, uint kind) {
 void record_encoding(uint k, uint s, uint i) {
   uint r = s * pass.count + i;
   uint info = reference_info[r];
-  if (((info >> 8u) & 0xffu) != DB_JUDGE_STATUS_JUDGED) {
+  if (db_reference_info_status(info) != DB_JUDGE_STATUS_JUDGED) {
     return;
   }
   uint slot_samples = pass.depth_slots * pass.count;
-  uint band = band_slot(info, coverage[i] & 0xffu);
+  uint band = band_slot(info, db_coverage_kind(coverage[i]));
   record(k, band, 0u, reference[3u * slot_samples + r], i);
   record(k, band, 1u, reference[4u * slot_samples + r], i);
 }
@@ -217,7 +217,7 @@ Loaded load_sample(uint k, uint i) {
   l.denoted_depth = reference[slots_count + r];
   l.inverse_distance_sq = reference[2u * slots_count + r];
   l.info = reference_info[r];
-  l.kind = coverage[i] & 0xffu;
+  l.kind = db_coverage_kind(coverage[i]);
   return l;
 }
 
@@ -246,8 +246,8 @@ void judge_loaded(uint k, uint i, Loaded l) {
   bool natural = kind == 0u;
   uint band = band_slot(info, kind);
   uint distance = natural && pass.record_distances != 0u ? l.frame.w : kNoSlot;
-  uint status = (info >> 8u) & 0xffu;
-  bool holdable = ((info >> 16u) & 1u) != 0u;
+  uint status = db_reference_info_status(info);
+  bool holdable = db_reference_info_stored_holdable(info);
   bool finite = absolute_sq < 1.0lf / 0.0lf;  // false for NaN
   if (status == DB_JUDGE_STATUS_JUDGED && finite) {
     record(k, band, 0u, total_sq, i);

@@ -73,11 +73,11 @@ void main() {
     return;
   }
   uint encoding = run_layout[pass.cells + slot];
-  uint stores = encoding & 0xfu;
-  uint convention = (encoding >> 4u) & 0xfu;
-  uint hardware = (encoding >> 8u) & 0xfu;
-  bool infinite_far = ((encoding >> 12u) & 1u) != 0u;
-  uint pipeline = encoding >> 16u;
+  uint stores = db_encoding_stores(encoding);
+  uint convention = db_encoding_convention(encoding);
+  uint hardware = db_encoding_hardware(encoding);
+  bool infinite_far = db_encoding_infinite_far(encoding);
+  uint pipeline = db_encoding_pipeline(encoding);
 
   uint frame = frame_of(i);
   uint fd = frame * DB_JUDGE_FRAME_DEPTHS;
@@ -98,7 +98,7 @@ void main() {
   }
 
   // The sample (reference.cc's SampleArrays::Set).
-  bool eye = (coverage[i] >> 8u) == 0u;
+  bool eye = db_coverage_pick(coverage[i]) == 0u;
   double eye_depth = eye_depths[i];
   dvec3 ray = dvec3(rays[i], rays[pass.count + i], rays[2u * pass.count + i]);
   precise double ray_length_sq = ray.x * ray.x + ray.y * ray.y + ray.z * ray.z;
@@ -142,5 +142,5 @@ void main() {
   reference[2u * slot_samples + r] = inverse_out;
   reference[3u * slot_samples + r] = storage_square;
   reference[4u * slot_samples + r] = production_square;
-  reference_info[r] = joint | (status << 8u) | ((stored_holdable ? 1u : 0u) << 16u);
+  reference_info[r] = db_reference_info_word(joint, status, stored_holdable);
 }

@@ -59,7 +59,7 @@ void main() {
   // A stored-value pick's eye depth is its frame's near plane (as the
   // host's SampleArrays hold it).
   eye_depths[i] = s.pick == 0u ? s.eye_depth : frame_depths[frame * DB_JUDGE_FRAME_DEPTHS];
-  coverage[i] = s.coverage | (s.pick << 8u);
+  coverage[i] = db_coverage_word(s.coverage, s.pick);
   dvec3 ray = draw_pixel_ray(s.x, s.y, f);
   rays[i] = ray.x;
   rays[pass.count + i] = ray.y;

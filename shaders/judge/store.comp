@@ -97,9 +97,9 @@ double f32_div(double a, double b) {
 // Float32PipelineFloats for pipeline `pipeline`'s encoding and sample i.
 uint pipeline_float(uint pipeline, uint i) {
   uint encoding = run_layout[pass.cells + run_layout[pass.cells + 2u * pass.depth_slots + pipeline]];
-  uint stores = encoding & 0xfu;
-  uint convention = (encoding >> 4u) & 0xfu;
-  uint hardware = (encoding >> 8u) & 0xfu;
+  uint stores = db_encoding_stores(encoding);
+  uint convention = db_encoding_convention(encoding);
+  uint hardware = db_encoding_hardware(encoding);
   double z = f32(eye_depths[i]);
   uint fc = frame_of(i) * DB_JUDGE_FRAME_WORDS;
   if (stores == DB_JUDGE_STORES_WINDOW_DEPTH) {
@@ -185,8 +185,8 @@ uint half_fetch_bits(uint code) {
 // What a fetch of depth slot `slot`'s texel returns for a pipeline float,
 // as bits.
 uint fetched_bits(uint slot, uint value_bits) {
-  uint texel = run_layout[pass.cells + pass.depth_slots + slot];  // DB_JUDGE_TEXEL_*
-  uint kind = texel & 0xffu;
+  uint texel = run_layout[pass.cells + pass.depth_slots + slot];
+  uint kind = db_texel_kind(texel);
   if (kind == DB_JUDGE_TEXEL_FLOAT32) {
     return value_bits;
   }
@@ -195,7 +195,7 @@ uint fetched_bits(uint slot, uint value_bits) {
   }
   // 1 / (2^16 - 1) and 1 / (2^24 - 1), rounded to float64 (encode.cc's
   // `inverse`), from their bits.
-  bool wide = (texel >> 8u) == 24u;
+  bool wide = db_texel_unorm_bits(texel) == 24u;
   double scale = wide ? 16777215.0lf : 65535.0lf;
   double inverse = wide ? packDouble2x32(uvec2(0x10000010u, 0x3e700000u))
                         : packDouble2x32(uvec2(0x00100010u, 0x3ef00010u));
@@ -222,11 +222,11 @@ void main() {
     return;
   }
   uint i = element - pass.lead;
-  uint pick = coverage[i] >> 8u;
+  uint pick = db_coverage_pick(coverage[i]);
   if (pick != 0u) {
     texel_bits[at] = edge_texel_bits[(frame_of(i) * pass.depth_slots + slot) * 4u + pick - 1u];
     return;
   }
-  uint pipeline = run_layout[pass.cells + slot] >> 16u;
+  uint pipeline = db_encoding_pipeline(run_layout[pass.cells + slot]);
   texel_bits[at] = fetched_bits(slot, pipeline_float_bits[pipeline * pass.count + i]);
 }
