@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/base/status.h"
+#include "bench/pipeline/cells.h"
 
 namespace depthbench::fuzzing {
 
@@ -25,9 +26,9 @@ bool Accepted(const Expected<T>& read) {
 // with another value, or not at all; aborts then.
 template <class T>
 void CheckRoundTrip(const T& value, nlohmann::json (*write)(const T&),
-                    Expected<T> (*read)(const nlohmann::json&, const std::string&)) {
+                    Expected<T> (*read)(const nlohmann::json&, const std::string&, const Catalogue&)) {
   const nlohmann::json written = write(value);
-  const Expected<T> again = read(written, "written");
+  const Expected<T> again = read(written, "written", Catalogue::BuiltIn());
   if (!again.ok() || write(*again).dump() != written.dump()) std::abort();
 }
 
