@@ -111,8 +111,8 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
   ASSERT_TRUE(device.ok()) << device.status().message();
   ASSERT_EQ(host->cells.size(), device->cells.size());
   // The results say where each was judged.
-  EXPECT_EQ(host->run.backends.at(0).judge, "host");
-  EXPECT_EQ(device->run.backends.at(0).judge, "device");
+  EXPECT_EQ(host->run.backends.at(0).judge, JudgedOn::kHost);
+  EXPECT_EQ(device->run.backends.at(0).judge, JudgedOn::kDevice);
   // And where the time went. Here the build of a batch overlaps the
   // judging of the one before: the main thread's spans (set-up, building, waiting
   // for the judging) are disjoint within the wall clock, and so are the

@@ -100,7 +100,7 @@ TEST(SweepErrorTest, AJudgeOnADeviceTheBackendLacksIsRefused) {
   options.judge = JudgeSite::kAuto;
   auto results = RunSweep(options, backends);
   ASSERT_TRUE(results.ok()) << results.status().message();
-  EXPECT_EQ(results->run.backends[0].judge, "host");
+  EXPECT_EQ(results->run.backends[0].judge, JudgedOn::kHost);
 }
 
 TEST(SweepErrorTest, InvalidOptionsFailBeforeAnyBackendIsPrepared) {

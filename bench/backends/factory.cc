@@ -7,8 +7,8 @@
 namespace depthbench {
 
 Expected<std::unique_ptr<Backend>> MakeBackend(const std::string& name, const BackendOptions& options) {
-  if (name == "cpu") return MakeCpuBackend();
-  if (name == "vulkan") return MakeVulkanBackend(options);
+  if (name == BackendKindName(BackendKind::kCpu)) return MakeCpuBackend();
+  if (name == BackendKindName(BackendKind::kVulkan)) return MakeVulkanBackend(options);
   // "vulkan:no-contraction", "vulkan:exact-division+no-contraction": the
   // Vulkan backend with arithmetic probes (backends/vulkan/arithmetic_probe.h).
   if (name.starts_with("vulkan:")) {

@@ -58,7 +58,9 @@ Expected<std::vector<BaselineSlot>> ReadBaselines(const GateFlags& f, const Cata
       return InvalidArgument(fmt::format(
           "baseline '{}' does not exist yet: say which backend it is for with --backend (one per new baseline)", path));
     }
-    if (slot.baseline.backend != "cpu" && slot.baseline.backend != "vulkan") {
+    // A gate compares what a plain backend does; a probed one measures another rule.
+    if (slot.baseline.backend != BackendKindName(BackendKind::kCpu) &&
+        slot.baseline.backend != BackendKindName(BackendKind::kVulkan)) {
       return InvalidArgument(
           fmt::format("baseline '{}' is for backend '{}'; allowed: cpu, vulkan", path, slot.baseline.backend));
     }

@@ -19,6 +19,20 @@ inline std::optional<DeviceKind> ParseDeviceKind(std::string_view name) {
   return std::nullopt;
 }
 
+// What runs a cell's formulas: depthbench's own float32 build of them on
+// the CPU (GLM), or a Vulkan device's shaders. A backend's name is its
+// kind's ("cpu", "vulkan"), or, for the Vulkan backend with arithmetic
+// probes, "vulkan:" and the probes ("vulkan:no-contraction"); results keep
+// the whole name, and ask for the kind through BackendKindOf.
+enum class BackendKind : std::uint8_t { kCpu, kVulkan };
+inline const char* BackendKindName(BackendKind kind) { return kind == BackendKind::kVulkan ? "vulkan" : "cpu"; }
+// The kind of the backend named `name`; nullopt for a name of neither.
+inline std::optional<BackendKind> BackendKindOf(std::string_view name) {
+  if (name == "cpu") return BackendKind::kCpu;
+  if (name == "vulkan" || name.starts_with("vulkan:")) return BackendKind::kVulkan;
+  return std::nullopt;
+}
+
 struct DeviceInfo {
   std::string name;    // "llvmpipe (LLVM 15.0.6, 256 bits)", "cpu"
   std::string driver;  // "Mesa 22.3.6", "GLM float32, -ffp-contract=off"

@@ -275,10 +275,11 @@ const JsonFields<RasterAgreement>& RasterAgreementFields() {
 
 const JsonFields<BackendRecord>& BackendFields() {
   // Where older files lack it, the backend was judged on the host.
-  static const JsonNamed<std::string> judge{
-      [](const std::string& where) { return where; },
-      [](std::string_view where) -> Expected<std::string> {
-        if (where == "host" || where == "device") return std::string(where);
+  static const JsonNamed<JudgedOn> judge{
+      [](const JudgedOn& where) -> std::string { return where == JudgedOn::kDevice ? "device" : "host"; },
+      [](std::string_view where) -> Expected<JudgedOn> {
+        if (where == "host") return JudgedOn::kHost;
+        if (where == "device") return JudgedOn::kDevice;
         return InvalidArgument(fmt::format("judge must be \"host\" or \"device\", not \"{}\"", where));
       }};
   static const JsonFields<BackendRecord> fields{{
@@ -288,7 +289,7 @@ const JsonFields<BackendRecord>& BackendFields() {
           "shaders", [](auto& b) -> auto& { return b.program.shaders; }, JsonText()),
       JsonAccess<BackendRecord>(
           "program_hash", [](auto& b) -> auto& { return b.program.hash; }, JsonText()),
-      JsonMemberOr("judge", &BackendRecord::judge, judge, "host"),
+      JsonMemberOr("judge", &BackendRecord::judge, judge, JudgedOn::kHost),
       // Only a raster run's rendering backend has one (and files written
       // before it was kept lack it).
       JsonOnlyIf(JsonMemberOr("raster_agreement", &BackendRecord::raster_agreement,

@@ -49,14 +49,18 @@ std::vector<Shard> MissingShards(const std::vector<Shard>& held);
 // "2/4, 3/4"; past ten shards, the first ten and "and N more".
 std::string ShardList(const std::vector<Shard>& shards);
 
+// Where a backend's outputs were judged: read back and judged on the host,
+// or judged where they were made (bench/device_judge/).
+enum class JudgedOn : std::uint8_t { kHost, kDevice };
+
 struct BackendRecord {
   std::string name;  // "cpu", "vulkan"
   DeviceInfo device;
   ProgramInfo program;  // what its formulas were built from
-  // Where its outputs were judged: "host", or "device" (bench/device_judge/).
+  // Where its outputs were judged (bench/device_judge/ for the device).
   // Not part of a sweep's identity: both give the same figures, so shards
   // judged either way merge.
-  std::string judge = "host";
+  JudgedOn judge = JudgedOn::kHost;
   // For a backend that rasterized its own depths, how they agreed with
   // the host's model of a rasterizer, per encoding the run stored; empty
   // for every other backend and form.

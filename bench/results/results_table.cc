@@ -48,8 +48,10 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
   for (const auto& b : run.backends) {
     out << fmt::format("backend {}: {} [{}; {}; {}]", b.name, b.device.name, b.device.driver, b.device.api,
                        b.device.compiler);
-    if (b.name == "vulkan" && b.device.kind == DeviceKind::kCpu) out << " (software rasterizer on the CPU)";
-    if (b.name == "vulkan") out << fmt::format(", shaders {} ({})", b.program.shaders, b.program.hash);
+    if (BackendKindOf(b.name) == BackendKind::kVulkan) {
+      if (b.device.kind == DeviceKind::kCpu) out << " (software rasterizer on the CPU)";
+      out << fmt::format(", shaders {} ({})", b.program.shaders, b.program.hash);
+    }
     out << "\n";
   }
   if (run.seconds > 0) {

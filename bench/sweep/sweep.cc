@@ -241,7 +241,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   for (std::size_t b = 0; b < backends.size(); ++b) {
     DB_RETURN_IF_ERROR(StoreInto(MakeJudgingStage(options, *backends[b], layout, record_distances), stages[b]));
     traits.push_back(stages[b]->traits());
-    if (traits.back().site == JudgeSite::kDevice) results.run.backends[b].judge = "device";
+    if (traits.back().site == JudgeSite::kDevice) results.run.backends[b].judge = JudgedOn::kDevice;
   }
   const Sampler sampler(options.seed, options.domain);
   const BatchBuilder builder(sampler, layout.encodings, options.isa);

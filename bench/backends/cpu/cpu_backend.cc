@@ -146,7 +146,7 @@ class CpuBackend final : public Backend {
 #endif
   }
 
-  std::string name() const override { return "cpu"; }
+  std::string name() const override { return BackendKindName(BackendKind::kCpu); }
   const DeviceInfo& device() const override { return device_; }
   // The formulas are compiled into the program: its version names them.
   ProgramInfo program() const override { return {"built-in", std::string("depthbench ") + BuildVersion()}; }

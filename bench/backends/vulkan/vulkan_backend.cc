@@ -204,7 +204,8 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
                                                    const BackendOptions& options);
 
   std::string name() const override {
-    return options_.arithmetic_probes == 0 ? "vulkan" : "vulkan:" + ArithmeticProbesName(options_.arithmetic_probes);
+    const std::string kind = BackendKindName(BackendKind::kVulkan);
+    return options_.arithmetic_probes == 0 ? kind : kind + ":" + ArithmeticProbesName(options_.arithmetic_probes);
   }
   ~VulkanBackend() override {
     // Work QueueStaged left queued reads the buffers destroyed below.
