@@ -1,8 +1,11 @@
 // The real gate, on edited copies of shaders/ and shared/ made in a
 // temporary directory, against the committed lavapipe baseline.
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -30,8 +33,10 @@ class GateTest : public ::testing::Test {
     ASSERT_TRUE(testing::ReplaceInFile(root_ + "/" + relative, from, to)) << "'" << from << "' not in " << relative;
   }
 
-  testing::CommandResult Gate() {
-    return RunDepthbench({"gate", "--baseline", kBaseline, "--shaders", root_ + "/shaders"});
+  testing::CommandResult Gate(const std::vector<std::string>& more = {}) {
+    std::vector<std::string> args = {"gate", "--baseline", kBaseline, "--shaders", root_ + "/shaders"};
+    args.insert(args.end(), more.begin(), more.end());
+    return RunDepthbench(args);
   }
 
   // Runs the first reproducer the gate printed ("  reproduce: depthbench
@@ -53,9 +58,12 @@ class GateTest : public ::testing::Test {
 };
 
 TEST_F(GateTest, UnchangedCopyPasses) {
-  const auto r = Gate();
+  const auto r = Gate({"--summary", root_ + "/summary.md"});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_EQ(r.out.rfind("PASS", 0), 0u) << r.out;  // the verdict comes first
+  const std::string markdown = testing::ReadText(root_ + "/summary.md");
+  EXPECT_EQ(markdown.rfind("### depthbench gate: PASS\n\nno cell got worse (", 0), 0u) << markdown;
+  EXPECT_EQ(markdown.find("| worse cell"), std::string::npos) << markdown;
 }
 
 TEST_F(GateTest, RenamingAndReformattingWithoutNewArithmeticPasses) {
@@ -81,11 +89,30 @@ TEST_F(GateTest, RenamingAndReformattingWithoutNewArithmeticPasses) {
 TEST_F(GateTest, ReciprocalRewrittenAsMultiplyAddFailsOnStandardZ) {
   Edit("shared/variants/reciprocal.h", "real inverse_w = depth.coefficients.y / (ndc_z - depth.coefficients.x);",
        "real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);");
-  const auto r = Gate();
+  // The Markdown summary goes to --summary, and is added to a GitHub
+  // Actions job's summary file after what earlier steps wrote there.
+  const std::string summary = root_ + "/summary.md", job = root_ + "/job-summary.md";
+  { std::ofstream(job) << "earlier step\n"; }
+  const char* before = std::getenv("GITHUB_STEP_SUMMARY");
+  const std::string kept = before != nullptr ? before : "";
+  ::setenv("GITHUB_STEP_SUMMARY", job.c_str(), 1);
+  const auto r = Gate({"--summary", summary});
+  if (before != nullptr) {
+    ::setenv("GITHUB_STEP_SUMMARY", kept.c_str(), 1);
+  } else {
+    ::unsetenv("GITHUB_STEP_SUMMARY");
+  }
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_EQ(r.out.rfind("FAIL", 0), 0u) << r.out;
   EXPECT_NE(r.out.find("worse: reciprocal/standard/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("worse: divide/"), std::string::npos) << "only the edited variant may change";
+
+  const std::string markdown = testing::ReadText(summary);
+  EXPECT_EQ(markdown.rfind("### depthbench gate: FAIL\n", 0), 0u) << markdown;
+  EXPECT_NE(markdown.find("| reciprocal/standard/"), std::string::npos) << markdown;
+  EXPECT_EQ(markdown.find("| divide/"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("`depthbench run --seed"), std::string::npos) << "a row replays its sample: " << markdown;
+  EXPECT_EQ(testing::ReadText(job), "earlier step\n" + markdown + "\n");
 }
 
 TEST_F(GateTest, SixteenBitIntermediateFails) {

@@ -65,6 +65,18 @@ def check_schema(report_dir, schema_path):
         broken(d)
         if validator.is_valid(d):
             fail("the schema accepts a document with " + name)
+    # A report run without --speed costs nothing from a device it did not
+    # run on: every speed file it used was measured on one of its backends'
+    # devices, and so was every measured cost the front shows.
+    devices = {b["device"]["name"] for b in document["environment"]["backends"]}
+    for path in document["environment"]["speed_files"]:
+        with open(path) as f:
+            made_on = json.load(f)["run"]["device"]["name"]
+        if made_on not in devices:
+            fail("the report used %s, measured on %r, a device it did not run on (%s)" % (path, made_on, sorted(devices)))
+    for source in document["speed"]["sources"]:
+        if source["device"] and source["device"] not in devices:
+            fail("the front shows costs measured on %r, a device the report did not run on" % source["device"])
     print("results.json: valid (%d headline rows, %d precision points)" %
           (len(document["headline"]), len(document["precision_points"])))
 

@@ -109,5 +109,25 @@ TEST(ReportRenderTest, FirstRunSummaryIsShorter) {
   EXPECT_LE(Lines(summary), 34u) << summary;
 }
 
+// A committed speed file measured on another device does not cost this
+// report's candidates; one the user names does, whatever made it.
+TEST(ReportSpeedFilesTest, OnlyThoseOfThisReportsDevicesUnlessNamed) {
+  SpeedResults h100;
+  h100.run.device.name = "NVIDIA H100 80GB HBM3";
+  SpeedResults llvmpipe;
+  llvmpipe.run.device.name = "llvmpipe (LLVM 15.0.6, 256 bits)";
+  std::vector<DeviceInfo> devices(2);
+  devices[0].name = "cpu";
+  devices[1].name = "llvmpipe (LLVM 15.0.6, 256 bits)";
+  EXPECT_FALSE(SpeedFileApplies(h100, /*named=*/false, devices));
+  EXPECT_TRUE(SpeedFileApplies(llvmpipe, /*named=*/false, devices));
+  EXPECT_TRUE(SpeedFileApplies(h100, /*named=*/true, devices));
+  // Another build of the same driver (another LLVM, another vector width)
+  // is another device.
+  SpeedResults narrower = llvmpipe;
+  narrower.run.device.name = "llvmpipe (LLVM 15.0.6, 128 bits)";
+  EXPECT_FALSE(SpeedFileApplies(narrower, /*named=*/false, devices));
+}
+
 }  // namespace
 }  // namespace depthbench

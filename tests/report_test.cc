@@ -43,6 +43,8 @@ class ReportTest : public ::testing::Test {
         "  real ndc_z = unpackHalf2x16(packHalf2x16(vec2(ndc_depth_from_window_depth(depth, stored), 0.0f))).x;"));
     std::vector<std::string> args = SmallReport(*root_, *root_ + "/night2");
     args.push_back("--fail-on-regression");
+    args.push_back("--summary");
+    args.push_back(*root_ + "/night2-summary.md");
     second_ = new testing::CommandResult(RunDepthbench(args));
   }
   static void TearDownTestSuite() {
@@ -81,6 +83,13 @@ TEST_F(ReportTest, WritesThePageTheSummaryAndTheDocument) {
   EXPECT_NE(page.find("vegaEmbed"), std::string::npos);
   EXPECT_EQ(page.find("<script src="), std::string::npos) << "the page must not load scripts from anywhere";
   EXPECT_EQ(page.find("DEPTHBENCH:DATA"), std::string::npos);
+}
+
+// --summary gets report.md's text, for a CI job's page.
+TEST_F(ReportTest, TheSummaryFileIsTheMarkdownSummary) {
+  const std::string summary = ReadText(*root_ + "/night2-summary.md");
+  EXPECT_FALSE(summary.empty());
+  EXPECT_EQ(summary, ReadText(*root_ + "/night2/report.md"));
 }
 
 TEST_F(ReportTest, TwoRunsGiveTwoTrendPointsPerCell) {

@@ -4,7 +4,9 @@
 
 #include <array>
 #include <chrono>
+#include <cstdlib>
 #include <ctime>
+#include <string_view>
 
 namespace depthbench {
 
@@ -21,6 +23,16 @@ std::string HostName() {
   std::array<char, 256> name{};
   if (::gethostname(name.data(), name.size() - 1) != 0) return "unknown";
   return name.data();
+}
+
+bool InCi() {
+  const char* ci = std::getenv("CI");
+  return ci != nullptr && std::string_view(ci) != "" && std::string_view(ci) != "false";
+}
+
+std::string StepSummaryFile() {
+  const char* file = std::getenv("GITHUB_STEP_SUMMARY");
+  return file != nullptr ? file : "";
 }
 
 }  // namespace depthbench

@@ -196,4 +196,15 @@ Status WriteFileAtomically(const fs::path& path, std::string_view content) {
   return Status::Ok();
 }
 
+Status AppendToFile(const fs::path& path, std::string_view content) {
+  DB_ASSIGN_OR_RETURN(const fs::path target, OutputTarget(path));
+  const int fd = ::open(target.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0666);
+  if (fd < 0) return IoError(fmt::format("cannot add to '{}': {}", path.string(), std::strerror(errno)));
+  const int error = WriteAll(fd, content) ? 0 : errno;
+  if (::close(fd) != 0 || error != 0) {
+    return IoError(fmt::format("cannot add to '{}': {}", path.string(), std::strerror(error != 0 ? error : errno)));
+  }
+  return Status::Ok();
+}
+
 }  // namespace depthbench

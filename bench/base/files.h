@@ -60,4 +60,8 @@ Expected<std::filesystem::path> OutputTarget(const std::filesystem::path& path);
 // when `path` is "-"; a write that fails (a full disk) is an error.
 Status WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
 
+// Adds `content` at the end of `path`, creating it if needed (a file that
+// several writers add to in turn, such as a CI job's summary).
+Status AppendToFile(const std::filesystem::path& path, std::string_view content);
+
 }  // namespace depthbench

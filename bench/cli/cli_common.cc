@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/factory.h"
+#include "bench/base/environment.h"
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
@@ -214,6 +215,15 @@ Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& w
     return InvalidArgument(fmt::format("{}: '{}' is not a whole number from 1 to 1e15", what, text));
   }
   return static_cast<std::uint64_t>(value);
+}
+
+Status WriteSummary(const std::string& path, const std::string& markdown) {
+  if (!path.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(path, markdown).WithContext("--summary"));
+  const std::string job_summary = StepSummaryFile();
+  if (!job_summary.empty()) {
+    DB_RETURN_IF_ERROR(AppendToFile(job_summary, markdown + "\n").WithContext("GITHUB_STEP_SUMMARY"));
+  }
+  return Status::Ok();
 }
 
 Status CheckWritable(const std::string& path, const std::string& what) {

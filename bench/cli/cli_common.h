@@ -87,6 +87,14 @@ Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& w
 // a user pipes, "-" (standard output) is accepted.
 Status CheckWritable(const std::string& path, const std::string& what);
 
+// A command's Markdown summary for CI: written to `path` (--summary; none
+// when empty), and added to the job's summary page when the job has one
+// (StepSummaryFile: GitHub Actions' $GITHUB_STEP_SUMMARY).
+inline constexpr const char* kSummaryHelp =
+    "write a short Markdown summary here (a CI job's page); inside GitHub Actions it is also added to "
+    "$GITHUB_STEP_SUMMARY";
+Status WriteSummary(const std::string& path, const std::string& markdown);
+
 // True when stderr is a terminal (progress lines are shown only then).
 bool StderrIsTerminal();
 

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/environment.h"
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/base/progress.h"
@@ -20,7 +21,7 @@ namespace {
 struct GateFlags {
   std::vector<std::string> baselines;
   std::vector<std::string> new_backends;  // for --update of baselines that do not exist yet
-  std::string device, shaders, junit, json;
+  std::string device, shaders, junit, json, summary;
   bool update = false, validate = false, allow_uncovered = false;
   unsigned threads = 0;
 };
@@ -31,8 +32,25 @@ struct BaselineSlot {
   Baseline baseline;
 };
 
+// The baselines beside `path` (in its folder), for a message about a name
+// that is not there: "cpu.json, lavapipe.json", or "none".
+std::string BaselinesBeside(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  std::vector<std::string> found;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    if (entry.path().extension() == ".json") found.push_back((folder / entry.path().filename()).string());
+  }
+  std::sort(found.begin(), found.end());
+  std::string list;
+  for (const std::string& name : found) list += (list.empty() ? "" : ", ") + name;
+  return list.empty() ? fmt::format("none in '{}'", folder.string()) : list;
+}
+
 // The baselines named, read where they exist; a new one (--update) takes
-// its backend from the next --backend.
+// its backend from the next --backend. In CI none is made: a misspelt
+// name would make a new baseline that every later run passes.
 Expected<std::vector<BaselineSlot>> ReadBaselines(const GateFlags& f, const Catalogue& catalogue) {
   std::vector<BaselineSlot> slots;
   std::size_t next_new = 0;
@@ -49,9 +67,15 @@ Expected<std::vector<BaselineSlot>> ReadBaselines(const GateFlags& f, const Cata
       DB_RETURN_IF_ERROR(
           StoreInto(ReadBaseline(path, catalogue), slot.baseline).WithContext("the baseline does not parse"));
     } else if (!f.update) {
+      return NotFound(
+          fmt::format("baseline '{}' does not exist (baselines found: {}); make one with: depthbench gate --update "
+                      "--baseline {} --backend cpu|vulkan",
+                      path, BaselinesBeside(path), path));
+    } else if (InCi()) {
       return NotFound(fmt::format(
-          "baseline '{}' does not exist; make one with: depthbench gate --update --baseline {} --backend cpu|vulkan",
-          path, path));
+          "baseline '{}' does not exist (baselines found: {}), and CI is set: a gate in CI makes no new baseline, "
+          "which a misspelt name would make and every later run pass; make it outside CI",
+          path, BaselinesBeside(path)));
     } else if (next_new < f.new_backends.size()) {
       slot.baseline.backend = f.new_backends[next_new++];
     } else {
@@ -169,7 +193,8 @@ Status CheckCoverage(std::span<const GateRun> runs, bool allow_uncovered) {
 
 Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
-  for (const auto& [path, what] : {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}}) {
+  for (const auto& [path, what] :
+       {std::pair{f.junit, "--junit"}, std::pair{f.json, "--json"}, std::pair{f.summary, "--summary"}}) {
     if (path.empty()) continue;
     DB_RETURN_IF_ERROR(CheckWritable(path, what));
   }
@@ -183,6 +208,7 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   PrintGateVerdict(runs, tolerance, out.text);
   if (!f.junit.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.junit, GateJUnit(runs)));
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, GateJson(runs, tolerance).dump(1) + "\n"));
+  DB_RETURN_IF_ERROR(WriteSummary(f.summary, GateSummaryMarkdown(runs, tolerance)));
   if (f.update) {
     for (std::size_t k = 0; k < slots.size(); ++k) {
       DB_RETURN_IF_ERROR(WriteBaseline(slots[k].path, runs[k].current));
@@ -228,6 +254,7 @@ void AddGateCommand(CLI::App& app, CommandAction& action) {
                 "judge even when a baseline lacks cells or bands this run measures; they are listed as not compared");
   cmd->add_option("--junit", flags->junit, "write JUnit XML, one test case per cell");
   cmd->add_option("--json", flags->json, "write the full comparison as JSON");
+  cmd->add_option("--summary", flags->summary, kSummaryHelp);
   cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer");
   cmd->add_option("--threads", flags->threads, kThreadsHelp);
   cmd->callback(

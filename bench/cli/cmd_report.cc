@@ -28,6 +28,7 @@ struct ReportFlags {
   std::string samples, default_samples;
   std::uint64_t seed = 7;
   std::vector<std::string> speed;
+  std::string summary;
   bool no_speed = false;
   std::string plot_library;   // default: the data folder's
   std::string page_template;  // default: the data folder's
@@ -74,6 +75,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(plan.cells, f.cells.Select(context.catalogue));
   plan.catalogue = &context.catalogue;
   DB_ASSIGN_OR_RETURN(plan.speed_files, SpeedFiles(f));
+  plan.speed_files_named = !f.speed.empty();
   for (const fs::path& file : plan.speed_files) {
     DB_RETURN_IF_ERROR(CheckReadableFile(file, kMaxJsonFileBytes).WithContext("--speed"));
   }
@@ -97,6 +99,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   for (const char* name : {"results.json", "report.md", "report.html"}) {
     DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / name).string(), "--out"));
   }
+  if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
   PlotLibrary library{f.plot_library};
   if (library.node_modules.empty())
     DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));
@@ -159,6 +162,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
         {"report.html", page}}) {
     DB_RETURN_IF_ERROR(WriteFileAtomically(out / name, text));
   }
+  DB_RETURN_IF_ERROR(WriteSummary(f.summary, markdown));
   // The run is kept in the history only now that its report is written.
   if (history) DB_RETURN_IF_ERROR(history->Commit().WithContext("--history"));
   progress.end(fmt::format("{} (report.html, report.md, results.json)", out.string()));
@@ -194,6 +198,8 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
       "  depthbench report --out out --backend vulkan --device nvidia --speed reports/speed/nvidia-h100.json");
   cmd->add_option("--out", flags->out, "folder to write report.html, report.md and results.json into (created)")
       ->required();
+  cmd->add_option("--summary", flags->summary,
+                  std::string(kSummaryHelp) + " (the same text as report.md)");
   cmd->add_flag("--quick", flags->quick,
                 "fewer samples (4e4 per far/near ratio, 1e5 default-domain), same page: seconds, not minutes");
   cmd->add_option("--history", flags->history,
@@ -205,8 +211,9 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
                   "samples of the default-domain sweep (default 1e6; quick 1e5)");
   cmd->add_option("--seed", flags->seed, "seed of the far/near sweeps (default 7)");
   cmd->add_option("--speed", flags->speed,
-                  "speed files (depthbench speed --json) for the speed/accuracy front (default: every "
-                  "reports/speed/*.json of the data folder: those committed with depthbench)");
+                  "speed files (depthbench speed --json) for the speed/accuracy front and the first screen's costs, "
+                  "each labelled with the device it was measured on (default: the reports/speed/*.json committed "
+                  "with depthbench that were measured on a device this report runs on)");
   cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses the static cost model only");
   cmd->add_option("--plot-library", flags->plot_library,
                   "node_modules folder holding vega, vega-lite and vega-embed (default: the data folder's "

@@ -51,32 +51,74 @@ std::string DescribeWorse(const CellVerdict& v) {
   return Join(parts, "; ");
 }
 
+// The counts every verdict states.
+struct GateCounts {
+  int failures = 0, improvements = 0, cells = 0, compared = 0, not_compared = 0;
+  std::vector<std::string> uncovered;  // per backend, what was not compared
+  std::vector<std::string> backends;   // "vulkan on llvmpipe (...)"
+};
+GateCounts CountGate(const std::vector<GateRun>& runs) {
+  GateCounts n;
+  for (const GateRun& r : runs) {
+    n.failures += r.comparison.failures();
+    n.improvements += r.comparison.improvements();
+    n.cells += static_cast<int>(r.comparison.cells.size());
+    n.compared += r.comparison.compared();
+    for (const CellVerdict& v : r.comparison.cells) n.not_compared += v.appeared;
+    const std::string what = r.comparison.Uncovered();
+    if (!what.empty()) n.uncovered.push_back(fmt::format("{} ({})", what, r.current.backend));
+    n.backends.push_back(fmt::format("{} on {}", r.current.backend, r.current.device.name));
+  }
+  return n;
+}
+
+const char* VerdictWord(const GateCounts& n) { return n.failures == 0 ? "PASS" : "FAIL"; }
+// "no cell got worse (...)" or "3 of 212 cells got worse (...)".
+std::string VerdictDetail(const GateCounts& n) {
+  return n.failures == 0
+             ? fmt::format("no cell got worse ({} cells compared; {})", n.compared, Join(n.backends, ", "))
+             : fmt::format("{} of {} cells got worse ({})", n.failures, n.cells, Join(n.backends, ", "));
+}
+
+std::string ToleranceLine(const GateTolerance& tolerance) {
+  return fmt::format(
+      "tolerance: {} bit at p99.9, or its sampling interval where wider, {} bit at the maximum; NaN or Inf appearing "
+      "always counts",
+      tolerance.p999_bits, tolerance.max_bits);
+}
+
+// A worse cell's bands, the one that changed most first.
+std::vector<BandChange> WorstBandsFirst(const CellVerdict& v) {
+  std::vector<BandChange> bands = v.worse;
+  std::stable_sort(bands.begin(), bands.end(), [](const BandChange& a, const BandChange& b) {
+    auto growth = [](const BandChange& c) {
+      // No finite output is the largest loss there is.
+      if (c.after.judged == 0 && c.before.judged > 0) return std::numeric_limits<double>::infinity();
+      return std::max(c.after.total_p999 - c.before.total_p999, c.after.arith_p999 - c.before.arith_p999);
+    };
+    return growth(a) > growth(b);
+  });
+  return bands;
+}
+
+// Text in a Markdown table cell: '|' would end the cell.
+std::string MarkdownCell(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
 }  // namespace
 
 void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out) {
-  int failures = 0, improvements = 0, cells = 0, compared = 0, not_compared = 0;
-  std::vector<std::string> uncovered;
-  for (const GateRun& r : runs) {
-    failures += r.comparison.failures();
-    improvements += r.comparison.improvements();
-    cells += static_cast<int>(r.comparison.cells.size());
-    compared += r.comparison.compared();
-    for (const CellVerdict& v : r.comparison.cells) not_compared += v.appeared;
-    const std::string what = r.comparison.Uncovered();
-    if (!what.empty()) uncovered.push_back(fmt::format("{} ({})", what, r.current.backend));
-  }
-  std::vector<std::string> backends;
-  for (const GateRun& r : runs) backends.push_back(fmt::format("{} on {}", r.current.backend, r.current.device.name));
-  out << (failures == 0 ? fmt::format("PASS: no cell got worse ({} cells compared; {})", compared, Join(backends, ", "))
-                        : fmt::format("FAIL: {} of {} cells got worse ({})", failures, cells, Join(backends, ", ")))
-      << "\n";
+  const GateCounts counts = CountGate(runs);
+  const int failures = counts.failures, improvements = counts.improvements, cells = counts.cells,
+            not_compared = counts.not_compared;
+  out << VerdictWord(counts) << ": " << VerdictDetail(counts) << "\n";
   // Only with --allow-uncovered: without it, a gate that does not cover its run gives no verdict.
-  for (const std::string& what : uncovered) out << "NOT COMPARED: " << what << "\n";
+  for (const std::string& what : counts.uncovered) out << "NOT COMPARED: " << what << "\n";
   if (improvements > 0) out << fmt::format("{} cells improved\n", improvements);
-  out << fmt::format(
-      "(tolerance: {} bit at p99.9, or its sampling interval where wider, {} bit at the maximum; NaN or Inf appearing "
-      "always counts)\n",
-      tolerance.p999_bits, tolerance.max_bits);
+  out << "(" << ToleranceLine(tolerance) << ")\n";
   for (const GateRun& r : runs) {
     for (const std::string& note : r.comparison.notes) out << "note (" << r.current.backend << "): " << note << "\n";
   }
@@ -89,15 +131,7 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
         continue;
       }
       // The bands that changed most first; a handful tells the story.
-      std::vector<BandChange> bands = v.worse;
-      std::stable_sort(bands.begin(), bands.end(), [](const BandChange& a, const BandChange& b) {
-        auto growth = [](const BandChange& c) {
-          // No finite output is the largest loss there is.
-          if (c.after.judged == 0 && c.before.judged > 0) return std::numeric_limits<double>::infinity();
-          return std::max(c.after.total_p999 - c.before.total_p999, c.after.arith_p999 - c.before.arith_p999);
-        };
-        return growth(a) > growth(b);
-      });
+      const std::vector<BandChange> bands = WorstBandsFirst(v);
       constexpr std::size_t kShown = 4;
       for (std::size_t k = 0; k < bands.size() && k < kShown; ++k) {
         out << fmt::format("  {}: {}\n", bands[k].band, Join(bands[k].reasons, ", "));
@@ -140,6 +174,45 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
     out << fmt::format("to keep the improvements: depthbench gate --update {}{}\n", Join(improved_baselines, " "),
                        runs.front().shader_dir.empty() ? "" : " --shaders " + runs.front().shader_dir);
   }
+}
+
+std::string GateSummaryMarkdown(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
+  const GateCounts counts = CountGate(runs);
+  std::string out =
+      fmt::format("### depthbench gate: {}\n\n{}.\n\n", VerdictWord(counts), MarkdownCell(VerdictDetail(counts)));
+  for (const std::string& what : counts.uncovered) out += fmt::format("Not compared: {}.\n\n", MarkdownCell(what));
+  // The worse cells, each by the band that changed most, with the command
+  // that replays its sample; a page of them tells the story.
+  constexpr int kRows = 20;
+  int rows = 0, more = 0;
+  for (const GateRun& r : runs) {
+    for (const CellVerdict& v : r.comparison.cells) {
+      if (!v.failed()) continue;
+      if (rows == 0) {
+        out += "| worse cell | backend | band that changed most | change | replay |\n|---|---|---|---|---|\n";
+      }
+      if (rows == kRows) {
+        ++more;
+        continue;
+      }
+      ++rows;
+      if (v.disappeared) {
+        out += fmt::format("| {} | {} | - | in the baseline, did not run | - |\n", MarkdownCell(v.cell),
+                           MarkdownCell(r.current.backend));
+        continue;
+      }
+      const BandChange worst = WorstBandsFirst(v).front();
+      const std::string repro = ReproFor(r, v.cell, worst);
+      out += fmt::format("| {} | {} | {} | {} | {} |\n", MarkdownCell(v.cell), MarkdownCell(r.current.backend),
+                         MarkdownCell(worst.band), MarkdownCell(Join(worst.reasons, ", ")),
+                         repro.empty() ? "-" : "`" + MarkdownCell(repro) + "`");
+    }
+  }
+  if (more > 0) out += fmt::format("\n... and {} more worse cells (the gate's --json has them all).\n", more);
+  if (rows > 0) out += "\n";
+  if (counts.improvements > 0) out += fmt::format("{} cells improved.\n\n", counts.improvements);
+  out += fmt::format("<sub>{}.</sub>\n", ToleranceLine(tolerance));
+  return out;
 }
 
 std::string GateJUnit(const std::vector<GateRun>& runs) {

@@ -28,6 +28,10 @@ struct GateRun {
 
 void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out);
 std::string GateJUnit(const std::vector<GateRun>& runs);
+// A short Markdown summary for a CI job's page: the verdict, then each
+// worse cell by the band that changed most with the command that replays
+// it (at most 20 rows), then the tolerance.
+std::string GateSummaryMarkdown(const std::vector<GateRun>& runs, const GateTolerance& tolerance);
 nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance);
 
 }  // namespace depthbench

@@ -573,6 +573,11 @@ ReportPlan ReportPlan::Quick() {
   return plan;
 }
 
+bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices) {
+  return named || std::any_of(devices.begin(), devices.end(),
+                              [&](const DeviceInfo& d) { return d.name == speed.run.device.name; });
+}
+
 Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,
                                            const ReportProgress& progress) {
   ReportMeasurements m;
@@ -589,14 +594,25 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   // The speed files first: a bad one is refused before the sweeps.
   begin("speed files");
   const Catalogue& catalogue = plan.catalogue != nullptr ? *plan.catalogue : Catalogue::BuiltIn();
+  std::vector<DeviceInfo> devices;
+  for (const Backend* backend : backends) devices.push_back(backend->device());
   for (const std::filesystem::path& path : plan.speed_files) {
     DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(path, catalogue));
-    m.speed.emplace_back(path, std::move(speed));
+    if (SpeedFileApplies(speed, plan.speed_files_named, devices)) {
+      m.speed.emplace_back(path, std::move(speed));
+    } else {
+      m.speed_of_other_devices.push_back(path);
+    }
   }
   // A shader copy that does not compile leaves the front without its
   // instruction counts, not the report without its other parts.
   m.static_costs_status = StoreInto(StaticCostLookup(plan.shader_dir.string(), catalogue), m.static_costs);
-  end("speed files", fmt::format("{} read", m.speed.size()));
+  end("speed files",
+      m.speed_of_other_devices.empty()
+          ? fmt::format("{} read", m.speed.size())
+          : fmt::format("{} of this report's devices read; {} measured on another device left out (name a file with "
+                        "--speed to use its costs)",
+                        m.speed.size(), m.speed_of_other_devices.size()));
 
   FitPlan fit_plan = plan.fit;
   fit_plan.cells = plan.cells;

@@ -46,6 +46,11 @@ struct ReportPlan {
   // the report); null: the built-in one.
   const Catalogue* catalogue = nullptr;
   std::vector<std::filesystem::path> speed_files;
+  // Whether the user named `speed_files` (--speed): then each is used,
+  // labelled with the device it was measured on. Otherwise they are the
+  // committed ones, and only those measured on a device this report runs
+  // on are used: a cost measured on another GPU is not this one's.
+  bool speed_files_named = false;
   std::filesystem::path shader_dir;  // for the instruction mix
   int trend_runs = 60;               // runs of the history the trend shows
 
@@ -67,12 +72,19 @@ struct ReportMeasurements {
   std::vector<PrecisionFit> fits;
   Results main;
   std::vector<std::pair<std::filesystem::path, SpeedResults>> speed;
+  // The committed speed files left out: measured on none of this report's
+  // devices (ReportPlan::speed_files_named).
+  std::vector<std::filesystem::path> speed_of_other_devices;
   // The instruction-mix cost of every variant (compiled from the plan's
   // shaders), or why there is none.
   CostLookup static_costs;
   Status static_costs_status;
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
+
+// Whether a speed file's costs apply to a report that runs on `devices`:
+// always when the user named it, else when it was measured on one of them.
+bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices);
 
 Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,
                                            const ReportProgress& progress = {});
