@@ -110,6 +110,15 @@ TEST(ChooseTest, SceneThatEveryCandidateMeetsGetsTheCheapest) {
   }
   EXPECT_EQ(r.ranked.front().cost->value, cheapest);
   EXPECT_NE(r.ranked.front().reason.find("the cheapest that meets it"), std::string::npos) << r.ranked.front().reason;
+  // The CI summary names the choice and shows the first ten candidates.
+  const std::string summary = ChoiceSummaryMarkdown(r);
+  EXPECT_EQ(summary.rfind("### depthbench choose: scene 'easy'", 0), 0u) << summary;
+  EXPECT_NE(summary.find("Choice: **" + r.ranked.front().cell.Name() + "**"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("| " + r.ranked.front().cell.Name() + " |"), std::string::npos) << summary;
+  if (r.ranked.size() > 10) {
+    EXPECT_EQ(summary.find("| " + r.ranked[10].cell.Name() + " |"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("more candidates"), std::string::npos) << summary;
+  }
   std::filesystem::remove_all(dir);
 }
 
@@ -192,9 +201,11 @@ TEST(ChooseTest, NothingMeetsExitsWithOne) {
   const std::string impossible =
       WriteScene(dir, "impossible", "0.1", "100000", "[requirement]\nrelative_error = 1e-9\n");
   const auto r = testing::RunDepthbench(
-      {"choose", "--scene", impossible, "--backend", "cpu", "--samples", "2e4", "--json", dir + "/choice.json"});
+      {"choose", "--scene", impossible, "--backend", "cpu", "--samples", "2e4", "--json", dir + "/choice.json",
+       "--summary", dir + "/summary.md"});
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("nothing meets"), std::string::npos) << r.out;
+  EXPECT_NE(testing::ReadText(dir + "/summary.md").find("\n\nNo candidate meets it.\n"), std::string::npos);
   auto json = ReadJsonFile(dir + "/choice.json");
   ASSERT_TRUE(json.ok()) << json.status().message();
   EXPECT_EQ((*json)["met"], false);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -410,10 +411,51 @@ std::string Limit(const CandidateVerdict& v) {
   }
 }
 
+// The ranked candidates, best first; at most `rows` of them.
+TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
+  using Align = TextTable::Align;
+  TextTable table({{"rank"},
+                   {"candidate", Align::kLeft},
+                   {"measured (upper)"},
+                   {"far end (model)"},
+                   {"NaN/Inf"},
+                   {"meets", Align::kLeft},
+                   {"held back by", Align::kLeft, true},
+                   {"cost"}});
+  for (std::size_t k = 0; k < r.ranked.size() && k < rows; ++k) {
+    const CandidateVerdict& v = r.ranked[k];
+    table.AddRow(
+        {fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
+         v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
+                                      : fmt::format("{:.3g}", v.measured),
+         std::isfinite(v.predicted) ? fmt::format("{:.3g} ({})", v.predicted, v.model) : fmt::format("- ({})", v.model),
+         std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+         v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
+  }
+  return table;
+}
+
 }  // namespace
 
+std::string ChoiceSummaryMarkdown(const ChooseResult& r) {
+  std::ostringstream out;
+  out << fmt::format("### depthbench choose: scene '{}'\n\n{}.\n\n", r.scene, r.requirement);
+  if (r.Met()) {
+    out << fmt::format("Choice: **{}** ({}).\n\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+  } else {
+    out << "No candidate meets it.\n\n";
+  }
+  constexpr std::size_t kRows = 10;
+  CandidateTable(r, kRows).Print(TextOutput(out, TableStyle{TableFormat::kMarkdown, 0}));
+  if (r.ranked.size() > kRows) {
+    out << fmt::format("\n... and {} more candidates (choose --json has them all).\n", r.ranked.size() - kRows);
+  }
+  out << fmt::format("\n<sub>Cost: {} ({}). Backend {} on {}.</sub>\n", r.cost_unit, r.cost_source, r.backend,
+                     r.device);
+  return out.str();
+}
+
 void PrintChoice(const ChooseResult& r, const TextOutput& out) {
-  using Align = TextTable::Align;
   out.text << fmt::format("scene '{}': {}\nbackend {} on {}; {:.1f} s\n", r.scene, r.requirement, r.backend, r.device,
                           r.seconds);
   out.text << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
@@ -429,24 +471,7 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
   }
   for (const std::string& s : r.suggestions) out.text << s << "\n";
   if (!r.suggestions.empty()) out.text << "\n";
-  TextTable table({{"rank"},
-                   {"candidate", Align::kLeft},
-                   {"measured (upper)"},
-                   {"far end (model)"},
-                   {"NaN/Inf"},
-                   {"meets", Align::kLeft},
-                   {"held back by", Align::kLeft, true},
-                   {"cost"}});
-  for (const CandidateVerdict& v : r.ranked) {
-    table.AddRow(
-        {fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
-         v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
-                                      : fmt::format("{:.3g}", v.measured),
-         std::isfinite(v.predicted) ? fmt::format("{:.3g} ({})", v.predicted, v.model) : fmt::format("- ({})", v.model),
-         std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
-         v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
-  }
-  table.Print(out);
+  CandidateTable(r, r.ranked.size()).Print(out);
   out.text << fmt::format(
       "measured: at the requirement's level and depth, with the upper end of its 95% interval where it differs "
       "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end (constant or depth: "

@@ -94,6 +94,9 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
                               const ChooseOptions& options);
 
 void PrintChoice(const ChooseResult& result, const TextOutput& out);
+// A short Markdown summary for a CI job's page: the requirement, the
+// choice (or that none meets it), the first ten candidates.
+std::string ChoiceSummaryMarkdown(const ChooseResult& result);
 nlohmann::json ChoiceToJson(const ChooseResult& result);
 
 }  // namespace depthbench

@@ -20,7 +20,7 @@ struct ChooseFlags {
   std::string samples = "1e5";
   std::uint64_t seed = 11;
   std::string speed;
-  std::string json;
+  std::string json, summary;
   std::string backend = "vulkan";
   std::string device, shaders;
 };
@@ -32,6 +32,7 @@ Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(options.samples, ParseCount(f.samples, "--samples"));
   options.seed = f.seed;
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
+  if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
   CostSources costs;
   DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders, context.catalogue));
   if (!f.speed.empty()) {
@@ -44,6 +45,7 @@ Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
   progress.Finish(fmt::format("{} candidates", choice.ranked.size()));
   PrintChoice(choice, out);
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, ChoiceToJson(choice).dump(1) + "\n"));
+  DB_RETURN_IF_ERROR(WriteSummary(f.summary, ChoiceSummaryMarkdown(choice)));
   return choice.Met() ? kExitOk : kExitFinding;
 }
 
@@ -79,6 +81,7 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--samples", flags->samples, "samples in the scene (default 1e5)");
   cmd->add_option("--seed", flags->seed, "random seed (default 11)");
   cmd->add_option("--speed", flags->speed, "rank by the GPU times of a `depthbench speed --json` file");
+  cmd->add_option("--summary", flags->summary, kSummaryHelp);
   cmd->add_option("--json", flags->json, "write the whole decision (schema depthbench.choose v2) to FILE");
   cmd->add_option("--backend", flags->backend, "the backend the scene's engine runs: vulkan (default) or cpu");
   cmd->add_option("--device", flags->device, "Vulkan device (part of its name); default lavapipe");
