@@ -34,9 +34,6 @@ class RasterPipelineTest : public ::testing::Test {
     auto context = VulkanContext::Create(context_options);
     ASSERT_TRUE(context.ok()) << context.status().message();
     context_ = new std::shared_ptr<VulkanContext>(std::move(context).value());
-    compute_ = new Results(Sweep(ProductionModel::kFloat32, /*with_vulkan=*/true));
-    raster_ = new Results(Sweep(ProductionModel::kRaster, /*with_vulkan=*/true));
-    host_model_ = new Results(Sweep(ProductionModel::kRaster, /*with_vulkan=*/false));
   }
   static void TearDownTestSuite() {
     delete compute_;
@@ -84,6 +81,17 @@ class RasterPipelineTest : public ::testing::Test {
     return BitsLost(Summarize(band, metric).p999);
   }
 
+  // Each sweep is run when a test first asks for it: CTest runs every test
+  // in a process of its own, so a sweep no test of the process reads is
+  // time lost (a minute under ASan).
+  static const Results& Lazy(Results*& results, ProductionModel production, bool with_vulkan) {
+    if (results == nullptr) results = new Results(Sweep(production, with_vulkan));
+    return *results;
+  }
+  static const Results& Compute() { return Lazy(compute_, ProductionModel::kFloat32, /*with_vulkan=*/true); }
+  static const Results& Raster() { return Lazy(raster_, ProductionModel::kRaster, /*with_vulkan=*/true); }
+  static const Results& HostModel() { return Lazy(host_model_, ProductionModel::kRaster, /*with_vulkan=*/false); }
+
   static std::shared_ptr<VulkanContext>* context_;
   static Results* compute_;
   static Results* raster_;
@@ -95,11 +103,11 @@ Results* RasterPipelineTest::raster_ = nullptr;
 Results* RasterPipelineTest::host_model_ = nullptr;
 
 TEST_F(RasterPipelineTest, EveryCellRunsAndIsJudged) {
-  ASSERT_FALSE(compute_->cells.empty());
+  ASSERT_FALSE(Compute().cells.empty());
   int cells = 0;
-  for (const CellResult& c : compute_->cells) {
+  for (const CellResult& c : Compute().cells) {
     if (c.backend != "vulkan") continue;
-    const CellResult* r = Find(*raster_, c.cell, "vulkan");
+    const CellResult* r = Find(Raster(), c.cell, "vulkan");
     ASSERT_NE(r, nullptr) << c.cell.Name() << " did not run in raster mode";
     ++cells;
     // At the origin every sample of the natural population has geometry:
@@ -110,16 +118,18 @@ TEST_F(RasterPipelineTest, EveryCellRunsAndIsJudged) {
     EXPECT_EQ(raster.nan + raster.inf, 0u) << c.cell.Name() << ": non-finite findings";
   }
   EXPECT_GE(cells, 8 * 3);  // every variant, with at least three encodings each
+  // The compute form renders nothing: no raster agreement is recorded.
+  for (const BackendRecord& b : Compute().run.backends) EXPECT_TRUE(b.raster_agreement.empty()) << b.name;
 }
 
 // The agreement of the rendered depths with the host's model is part of
 // the results: one record per encoding for the backend that rendered them,
-// none for the others or the compute form; --json keeps it and merge adds
-// the shards' counts.
+// none for the others (nor in the compute form: EveryCellRunsAndIsJudged);
+// --json keeps it and merge adds the shards' counts.
 TEST_F(RasterPipelineTest, TheRasterAgreementIsKeptInTheResults) {
-  ASSERT_EQ(raster_->run.backends.size(), 2u);
-  const std::vector<RasterAgreement>& agreement = raster_->run.backends[0].raster_agreement;
-  const RunLayout layout = MakeRunLayout(raster_->run.cells);
+  ASSERT_EQ(Raster().run.backends.size(), 2u);
+  const std::vector<RasterAgreement>& agreement = Raster().run.backends[0].raster_agreement;
+  const RunLayout layout = MakeRunLayout(Raster().run.cells);
   ASSERT_EQ(agreement.size(), layout.encodings.size());
   for (std::size_t slot = 0; slot < agreement.size(); ++slot) {
     EXPECT_EQ(agreement[slot].encoding, layout.encodings[slot]) << slot;
@@ -128,14 +138,13 @@ TEST_F(RasterPipelineTest, TheRasterAgreementIsKeptInTheResults) {
     EXPECT_GT(agreement[slot].texels, kSamples / 2) << slot;
     EXPECT_LE(agreement[slot].differing, agreement[slot].texels) << slot;
   }
-  EXPECT_TRUE(raster_->run.backends[1].raster_agreement.empty());  // the CPU backend renders nothing
-  for (const BackendRecord& b : compute_->run.backends) EXPECT_TRUE(b.raster_agreement.empty()) << b.name;
+  EXPECT_TRUE(Raster().run.backends[1].raster_agreement.empty());  // the CPU backend renders nothing
 
-  const Expected<Results> read = ResultsFromJson(ToJson(*raster_), "raster.json");
+  const Expected<Results> read = ResultsFromJson(ToJson(Raster()), "raster.json");
   ASSERT_TRUE(read.ok()) << read.status().message();
   EXPECT_EQ(read->run.backends[0].raster_agreement, agreement);
 
-  Results first = *raster_, second = *raster_;
+  Results first = Raster(), second = Raster();
   first.run.shards = {Shard{1, 2}};
   second.run.shards = {Shard{2, 2}};
   const Expected<Results> merged = MergeResults({first, second}, {"first", "second"}, false);
@@ -151,13 +160,13 @@ TEST_F(RasterPipelineTest, TheRasterAgreementIsKeptInTheResults) {
 
 TEST_F(RasterPipelineTest, FarPlaneFiguresFollowTheComputeFormAndTheHostModel) {
   int compared = 0;
-  for (const CellResult& c : compute_->cells) {
+  for (const CellResult& c : Compute().cells) {
     if (c.backend != "vulkan") continue;
     const bool standard_d24 = c.cell.convention == Convention::kStandard && c.cell.format == Format::kX8D24Unorm;
     const bool reversed_d32 = c.cell.convention == Convention::kReversed && c.cell.format == Format::kD32Sfloat;
     if (!standard_d24 && !reversed_d32) continue;
-    const CellResult* device = Find(*raster_, c.cell, "vulkan");
-    const CellResult* model = Find(*host_model_, c.cell, "cpu");
+    const CellResult* device = Find(Raster(), c.cell, "vulkan");
+    const CellResult* model = Find(HostModel(), c.cell, "cpu");
     ASSERT_NE(device, nullptr);
     ASSERT_NE(model, nullptr);
     const double compute_bits = DeepestP999(c), model_bits = DeepestP999(*model), device_bits = DeepestP999(*device);
@@ -193,10 +202,10 @@ TEST_F(RasterPipelineTest, TheShaderPartIsTheComputeFormsOnTheDevicesTexels) {
   // bit). Before the fetch was adopted, lavapipe's unorm conversion (up to
   // 2 ulps off) read as 13 bits of "shader" error here.
   int compared = 0;
-  for (const CellResult& c : compute_->cells) {
+  for (const CellResult& c : Compute().cells) {
     if (c.backend != "vulkan" || Info(c.cell.variant).input != DepthInput::kHardware) continue;
     if ((Info(c.cell.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u) continue;
-    const CellResult* device = Find(*raster_, c.cell, "vulkan");
+    const CellResult* device = Find(Raster(), c.cell, "vulkan");
     ASSERT_NE(device, nullptr);
     EXPECT_NEAR(DeepestP999(*device, Metric::kArith), DeepestP999(c, Metric::kArith), 0.5) << c.cell.Name();
     ++compared;
@@ -214,9 +223,9 @@ TEST_F(RasterPipelineTest, RasterizedFloatDepthShowsTheCostOfTheGlRemap) {
   // of the shader's (10.7 measured for reciprocal against 1.5). The host's
   // model shows the same, so it is the pipeline, not lavapipe.
   const Cell cell{Variant::kReciprocal, Convention::kReversedGl, Format::kD32Sfloat};
-  const CellResult* compute = Find(*compute_, cell, "vulkan");
-  const CellResult* device = Find(*raster_, cell, "vulkan");
-  const CellResult* model = Find(*host_model_, cell, "cpu");
+  const CellResult* compute = Find(Compute(), cell, "vulkan");
+  const CellResult* device = Find(Raster(), cell, "vulkan");
+  const CellResult* model = Find(HostModel(), cell, "cpu");
   ASSERT_TRUE(compute != nullptr && device != nullptr && model != nullptr);
   EXPECT_GT(DeepestP999(*device, Metric::kArith), DeepestP999(*compute, Metric::kArith) + 4.0);
   EXPECT_GT(DeepestP999(*model, Metric::kArith), DeepestP999(*compute, Metric::kArith) + 4.0);
