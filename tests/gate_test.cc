@@ -188,7 +188,9 @@ TEST(GateInputTest, ForeignOrBrokenBaselinesCannotBeJudged) {
   EXPECT_NE(r.err.find("the baseline does not parse: " + dir + "/broken.json:1:"), std::string::npos) << r.err;
   r = RunDepthbench({"gate", "--baseline", dir + "/none.json"});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("does not exist; make one with"), std::string::npos) << r.err;
+  // Named with the baselines beside it (a typo shows at once).
+  EXPECT_NE(r.err.find("does not exist (baselines found: " + dir + "/broken.json); make one with"), std::string::npos)
+      << r.err;
   // A baseline made with another sample plan.
   std::ifstream in(kBaseline);
   std::stringstream text;

@@ -55,6 +55,7 @@ void NameOptionTypes(CLI::App& app) {
                                                          {"--split", "BAND[,BAND]"},
                                                          {"--json", "FILE|-"},
                                                          {"--junit", "FILE"},
+                                                         {"--summary", "FILE"},
                                                          {"--scene", "FILE"},
                                                          {"--baseline", "FILE"},
                                                          {"--results", "FILE"},
