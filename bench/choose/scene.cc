@@ -133,23 +133,16 @@ std::vector<Cell> Scene::Candidates() const {
   return CellsForDomain(cells, domain);
 }
 
-Expected<Scene> ParseScene(std::string_view text, const std::string& source, const Catalogue& catalogue) {
-  SceneReader r(source);
-  toml::table root;
-  try {
-    root = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    return InvalidArgument(fmt::format("{}:{}:{}: not valid TOML: {}", source, e.source().begin.line,
-                                       e.source().begin.column, e.description()));
-  }
-  DB_RETURN_IF_ERROR(r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "engine", "requirement", "cost"}));
-  Scene scene;
-  scene.catalogue = &catalogue;
-  scene.source = source;
-  scene.name = root["name"].value_or(std::string(std::filesystem::path(source).stem()));
-  Domain& d = scene.domain;
-  d.name = "scene " + scene.name;
+namespace {
 
+// The deepest eye depth a scene's domain holds: its far plane, or the span
+// an infinite far plane is sampled over.
+double DeepestEyeDepth(const Domain& d) {
+  return d.finite_far ? d.far->max : d.near.min * Domain::kInfiniteDepthSpan;
+}
+
+// [projection]: the planes, the lens and the render target.
+Status ReadProjection(SceneReader& r, const toml::table& root, Domain& d) {
   DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
   DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));
   const toml::node* near_node = projection->get("near");
@@ -191,6 +184,11 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     d.resolutions = {{static_cast<std::uint32_t>(*w), static_cast<std::uint32_t>(*h)}};
   }
 
+  return Status::Ok();
+}
+
+// [camera] and [depth]: where the camera stands and which eye depths matter.
+Status ReadCameraAndDepth(SceneReader& r, const toml::table& root, Domain& d) {
   DB_ASSIGN_OR_RETURN(const toml::table* camera, r.Table(root, "camera", false));
   d.camera_distance = {0.0, 0.0};
   if (camera != nullptr) {
@@ -206,7 +204,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     DB_RETURN_IF_ERROR(r.OnlyKeys(*depth, "depth", {"range"}));
     if (const toml::node* node = depth->get("range")) {
       DB_ASSIGN_OR_RETURN(Range range, r.NumberOrRange(node, "depth.range"));
-      const double limit = d.finite_far ? far : near * Domain::kInfiniteDepthSpan;
+      const double near = d.near.min, limit = DeepestEyeDepth(d);
       if (range.min < near || range.max > limit || range.min > range.max) {
         return r.Error(
             node, "depth.range",
@@ -216,6 +214,11 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     }
   }
 
+  return Status::Ok();
+}
+
+// [engine]: the variants, conventions and formats the engine allows.
+Status ReadEngine(SceneReader& r, const toml::table& root, const Catalogue& catalogue, Scene& scene) {
   DB_ASSIGN_OR_RETURN(const toml::table* engine, r.Table(root, "engine", false));
   if (engine != nullptr) {
     DB_RETURN_IF_ERROR(r.OnlyKeys(*engine, "engine", {"variants", "conventions", "formats"}));
@@ -227,10 +230,14 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     DB_RETURN_IF_ERROR(r.Names<Format>(*engine, "formats", "engine.formats", ParseFormat, scene.formats));
   }
 
+  return Status::Ok();
+}
+
+// [requirement]: one error bound, the depth it applies at and its level.
+Status ReadRequirement(SceneReader& r, const toml::table& root, const Domain& d, Requirement& req) {
   DB_ASSIGN_OR_RETURN(const toml::table* requirement, r.Table(root, "requirement", true));
   DB_RETURN_IF_ERROR(
       r.OnlyKeys(*requirement, "requirement", {"absolute_error", "relative_error", "bits_lost", "at_depth", "level"}));
-  Requirement& req = scene.requirement;
   int kinds = 0;
   for (const auto& [key, kind] : {std::pair{"absolute_error", Requirement::Kind::kAbsolute},
                                   std::pair{"relative_error", Requirement::Kind::kRelative},
@@ -253,8 +260,8 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
   }
   if (const toml::node* node = requirement->get("at_depth")) {
     DB_ASSIGN_OR_RETURN(double at, r.Number(node, "requirement.at_depth"));
-    const double lo = d.eye_depth ? d.eye_depth->min : near;
-    const double hi = d.eye_depth ? d.eye_depth->max : (d.finite_far ? far : near * Domain::kInfiniteDepthSpan);
+    const double lo = d.eye_depth ? d.eye_depth->min : d.near.min;
+    const double hi = d.eye_depth ? d.eye_depth->max : DeepestEyeDepth(d);
     if (!(at >= lo && at <= hi)) {
       return r.Error(node, "requirement.at_depth",
                      fmt::format("must lie in the scene's eye-depth range [{:g}, {:g}]; got {:g}", lo, hi, at));
@@ -273,6 +280,11 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     req.level = *level;
   }
 
+  return Status::Ok();
+}
+
+// [cost]: the most a candidate may cost.
+Status ReadCost(SceneReader& r, const toml::table& root, Scene& scene) {
   DB_ASSIGN_OR_RETURN(const toml::table* cost, r.Table(root, "cost", false));
   if (cost != nullptr) {
     DB_RETURN_IF_ERROR(r.OnlyKeys(*cost, "cost", {"max_cost"}));
@@ -282,6 +294,33 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
       scene.max_cost = max_cost;
     }
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Expected<Scene> ParseScene(std::string_view text, const std::string& source, const Catalogue& catalogue) {
+  SceneReader r(source);
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    return InvalidArgument(fmt::format("{}:{}:{}: not valid TOML: {}", source, e.source().begin.line,
+                                       e.source().begin.column, e.description()));
+  }
+  DB_RETURN_IF_ERROR(r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "engine", "requirement", "cost"}));
+  Scene scene;
+  scene.catalogue = &catalogue;
+  scene.source = source;
+  scene.name = root["name"].value_or(std::string(std::filesystem::path(source).stem()));
+  Domain& d = scene.domain;
+  d.name = "scene " + scene.name;
+
+  DB_RETURN_IF_ERROR(ReadProjection(r, root, d));
+  DB_RETURN_IF_ERROR(ReadCameraAndDepth(r, root, d));
+  DB_RETURN_IF_ERROR(ReadEngine(r, root, catalogue, scene));
+  DB_RETURN_IF_ERROR(ReadRequirement(r, root, d, scene.requirement));
+  DB_RETURN_IF_ERROR(ReadCost(r, root, scene));
   DB_RETURN_IF_ERROR(d.Validate().WithContext(source));
   if (scene.Candidates().empty()) {
     return InvalidArgument(fmt::format(
