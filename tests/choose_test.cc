@@ -9,6 +9,8 @@
 #include "bench/backends/factory.h"
 #include "bench/base/json_reader.h"
 #include "bench/choose/choose.h"
+#include "bench/choose/frame_cost.h"
+#include "bench/speed/trade.h"
 #include "bench/fit/precision_fit.h"
 #include "tests/command_runner.h"
 
@@ -27,9 +29,13 @@ ChooseResult ChooseFor(const std::string& scene_file, const std::string& speed_f
   EXPECT_TRUE(static_model.ok()) << static_model.status().message();
   costs.static_model = *static_model;
   if (!speed_file.empty()) {
-    auto measured = SpeedCostLookup(speed_file);
-    EXPECT_TRUE(measured.ok()) << measured.status().message();
-    costs.measured = *measured;
+    FrameCostModel model;
+    auto speed = SpeedFileFor((*backend)->device(), speed_file, Catalogue::BuiltIn(), model.source);
+    EXPECT_TRUE(speed.ok()) << speed.status().message();
+    model.speed = *speed;
+    model.frame = scene->resolution.value_or(kCostFrame);
+    model.stencil = scene->stencil;
+    costs.measured = FrameCostLookup(model);
     costs.measured_from = speed_file;
   }
   ChooseOptions options;

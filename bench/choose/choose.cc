@@ -176,35 +176,13 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catal
   for (const VariantInfo& v : catalogue.variants()) {
     DB_ASSIGN_OR_RETURN(std::vector<std::uint32_t> spirv, CompileVariant(v, VariantPass::kAccuracy, dir));
     DB_ASSIGN_OR_RETURN(InstructionMix mix, CountInstructionMix(spirv, VariantFunctionName(v)));
-    by_variant[v.id] = {
-        WeighedCost(mix), 0.0, kStaticCostUnit,
-        "static model: the compiled shader's instructions, weighed per operation as choose --help lists"};
+    CandidateCost& cost = by_variant[v.id];
+    cost.value = WeighedCost(mix);
+    cost.unit = kStaticCostUnit;
+    cost.source = "static model: the compiled shader's instructions, weighed per operation as choose --help lists";
   }
   return CostLookup(
       [by_variant](const Cell& cell) -> std::optional<CandidateCost> { return by_variant.at(cell.variant); });
-}
-
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue) {
-  DB_ASSIGN_OR_RETURN(SpeedResults speed, ReadSpeedResults(speed_file, catalogue));
-  return SpeedCostLookup(speed, speed_file);
-}
-
-CostLookup SpeedCostLookup(const SpeedResults& speed, const std::string& source) {
-  const std::string unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), speed.run.device.name);
-  const double us_per_ns = static_cast<double>(kCostFrame.width) * kCostFrame.height * 1e-3;
-  std::map<Cell, CandidateCost> measured;
-  for (const TradeFront& front : speed.trade) {
-    for (const TradePoint& p : front.points) {
-      if (!(p.gpu_ns_per_reconstruction > 0.0)) continue;
-      measured[speed.variant_catalogue().MakeCell(p.variant, front.convention, front.format)] = {
-          p.gpu_ns_per_reconstruction * us_per_ns, p.gpu_spread_ns * us_per_ns, unit, source};
-    }
-  }
-  return CostLookup([measured](const Cell& cell) -> std::optional<CandidateCost> {
-    auto it = measured.find(cell);
-    if (it != measured.end()) return it->second;
-    return std::nullopt;
-  });
 }
 
 Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
@@ -247,6 +225,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   result.requirement = req.Describe();
   result.backend = backend.name();
   result.device = backend.device().name;
+  result.unusable_formats = scene.UnusableFormats();
 
   // One cost unit for the whole ranking.
   const CostChoice chosen_costs = ChooseCosts(costs, cells);
@@ -421,6 +400,7 @@ TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
                    {"NaN/Inf"},
                    {"meets", Align::kLeft},
                    {"held back by", Align::kLeft, true},
+                   {"B/px"},
                    {"cost"}});
   for (std::size_t k = 0; k < r.ranked.size() && k < rows; ++k) {
     const CandidateVerdict& v = r.ranked[k];
@@ -430,6 +410,7 @@ TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
                                       : fmt::format("{:.3g}", v.measured),
          std::isfinite(v.predicted) ? fmt::format("{:.3g} ({})", v.predicted, v.model) : fmt::format("- ({})", v.model),
          std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+         v.cost && v.cost->bytes_per_pixel > 0 ? std::to_string(v.cost->bytes_per_pixel) : "-",
          v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
   }
   return table;
@@ -445,6 +426,7 @@ std::string ChoiceSummaryMarkdown(const ChooseResult& r) {
   } else {
     out << "No candidate meets it.\n\n";
   }
+  for (const std::string& u : r.unusable_formats) out << "Not a candidate: " << u << ".\n\n";
   constexpr std::size_t kRows = 10;
   CandidateTable(r, kRows).Print(TextOutput(out, TableStyle{TableFormat::kMarkdown, 0}));
   if (r.ranked.size() > kRows) {
@@ -460,6 +442,7 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
                           r.seconds);
   out.text << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
   if (!r.cost_note.empty()) out.text << "note: " << r.cost_note << "\n";
+  for (const std::string& u : r.unusable_formats) out.text << "not a candidate: " << u << "\n";
   out.text << "\n";
   if (r.Met()) {
     out.text << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
@@ -479,7 +462,8 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
       "docs/choosing.md); NaN/Inf: findings inside the scene's ranges;\nheld back by: the part of the error that "
       "dominates (production, storage or shader), or what else "
       "fails it (interval: the measured value meets it, the upper end of its interval does not);\nrank: '=' marks "
-      "costs that tie; exit status 0 when a candidate meets the requirement, 1 when none "
+      "costs that tie; B/px: bytes per pixel the depth makes a frame move (the attachment written and read, or "
+      "the attachment written and the linear target written and read; none under the static model);\nexit status 0 when a candidate meets the requirement, 1 when none "
       "does\n");
 }
 
@@ -506,7 +490,10 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"meets", v.meets},
                       {"too_close", v.too_close},
                       {"over_budget", v.over_budget},
-                      {"cost", v.cost ? nlohmann::json{{"value", v.cost->value}, {"spread", v.cost->spread}}
+                      {"cost", v.cost ? nlohmann::json{{"value", v.cost->value},
+                                                       {"spread", v.cost->spread},
+                                                       {"bytes_per_pixel", v.cost->bytes_per_pixel},
+                                                       {"parts", v.cost->parts}}
                                       : nlohmann::json(nullptr)},
                       {"reason", v.reason}});
   }
@@ -520,6 +507,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                      {"device", r.device},
                      {"seconds", r.seconds},
                      {"met", r.Met()},
+                     {"unusable_formats", r.unusable_formats},
                      {"choice", r.Met() ? nlohmann::json(r.ranked.front().cell.Name()) : nlohmann::json(nullptr)},
                      {"cost",
                       {{"unit", r.cost_unit},

@@ -38,11 +38,6 @@ extern const std::vector<OperationCost> kOperationCosts;
 inline constexpr const char* kStaticCostUnit = "FMA-equivalent slots";
 // For every variant of `catalogue`.
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catalogue& catalogue = Catalogue::BuiltIn());
-// Measured GPU time per frame (kCostFrame) from a `depthbench speed --json`
-// file (ALU-bound regime), for the cells the file has; its variant names are
-// looked up in `catalogue`.
-Expected<CostLookup> SpeedCostLookup(const std::string& speed_file, const Catalogue& catalogue = Catalogue::BuiltIn());
-CostLookup SpeedCostLookup(const SpeedResults& speed, const std::string& source);
 
 struct CandidateVerdict {
   Cell cell;
@@ -86,6 +81,7 @@ struct ChooseResult {
   std::string cost_note;                 // why the static model ranks, when a speed file was given
   std::vector<CandidateVerdict> ranked;  // best first
   std::vector<std::string> suggestions;  // when nothing meets the requirement
+  std::vector<std::string> unusable_formats;  // listed but never a candidate (Scene::UnusableFormats)
   bool Met() const { return !ranked.empty() && ranked.front().meets; }
   double seconds = 0.0;
 };

@@ -13,7 +13,7 @@ bool CostsTie(const CandidateCost& a, const CandidateCost& b) {
 }
 
 CostChoice ChooseCosts(const CostSources& sources, std::span<const Cell> candidates) {
-  if (!sources.measured) return {sources.static_model, false, ""};
+  if (!sources.measured) return {sources.static_model, false, sources.no_measured_note};
   std::vector<std::string> missing;
   for (const Cell& cell : candidates) {
     if (!sources.measured(cell)) missing.push_back(cell.Name());

@@ -21,8 +21,12 @@ namespace depthbench {
 struct CandidateCost {
   double value = 0.0;
   double spread = 0.0;  // two costs closer than the larger spread are a tie (0: exact)
-  std::string unit;     // "us per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
+  std::string unit;     // "µs per 2560x1440 frame on llvmpipe", "FMA-equivalent slots"
   std::string source;   // where it came from
+  // For a frame's cost (frame_cost.h): the bytes per pixel the choice makes
+  // the frame move, and the parts in words; 0 and empty otherwise.
+  std::uint32_t bytes_per_pixel = 0;
+  std::string parts;
 };
 
 // Costs per cell; `nullopt` when none is known for a cell.
@@ -37,6 +41,7 @@ struct CostSources {
   CostLookup measured;  // empty: none given
   std::string measured_from;
   CostLookup static_model;
+  std::string no_measured_note;  // why none was given, when none was
 };
 struct CostChoice {
   CostLookup lookup;      // empty where no source was given

@@ -5,6 +5,7 @@
 #include <initializer_list>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include "bench/base/files.h"
@@ -54,6 +55,11 @@ class SceneReader {
     if (node == nullptr) return Error(nullptr, field, "missing");
     if (auto v = node->value<double>()) return *v;
     return Error(node, field, "expected a number");
+  }
+
+  Expected<bool> Boolean(const toml::node* node, const std::string& field) {
+    if (auto v = node->value<bool>()) return *v;
+    return Error(node, field, "expected true or false");
   }
 
   // A number, or [min, max].
@@ -131,6 +137,33 @@ std::vector<Cell> Scene::Candidates() const {
   for (const Cell& c : (catalogue != nullptr ? *catalogue : Catalogue::BuiltIn()).Cells())
     if (filter.Keeps(c)) cells.push_back(c);
   return CellsForDomain(cells, domain);
+}
+
+std::vector<std::string> Scene::UnusableFormats() const {
+  const Catalogue& cat = catalogue != nullptr ? *catalogue : Catalogue::BuiltIn();
+  const std::vector<Cell> candidates = Candidates();
+  std::vector<std::string> unusable;
+  for (const Format format : formats) {
+    if (std::any_of(candidates.begin(), candidates.end(), [&](const Cell& c) { return c.format == format; })) continue;
+    // The conventions that would read it, with the engine's variants, in this domain.
+    const CellFilter any_convention{variants, {}, {format}};
+    std::vector<Cell> readers;
+    for (const Cell& c : cat.Cells())
+      if (any_convention.Keeps(c)) readers.push_back(c);
+    std::vector<std::string> needed;
+    for (const Cell& c : CellsForDomain(readers, domain)) {
+      const std::string name(Info(c.convention).name);
+      if (std::find(needed.begin(), needed.end(), name) == needed.end()) needed.push_back(name);
+    }
+    unusable.push_back(
+        needed.empty()
+            ? fmt::format("{}: no convention can read it in this scene's ranges (a linear or view-z format needs a "
+                          "finite far plane)",
+                          Info(format).name)
+            : fmt::format("{}: read only under {}, which engine.conventions does not list", Info(format).name,
+                          fmt::join(needed, ", ")));
+  }
+  return unusable;
 }
 
 namespace {
@@ -221,7 +254,10 @@ Status ReadCameraAndDepth(SceneReader& r, const toml::table& root, Domain& d) {
 Status ReadEngine(SceneReader& r, const toml::table& root, const Catalogue& catalogue, Scene& scene) {
   DB_ASSIGN_OR_RETURN(const toml::table* engine, r.Table(root, "engine", false));
   if (engine != nullptr) {
-    DB_RETURN_IF_ERROR(r.OnlyKeys(*engine, "engine", {"variants", "conventions", "formats"}));
+    DB_RETURN_IF_ERROR(r.OnlyKeys(*engine, "engine", {"variants", "conventions", "formats", "stencil"}));
+    if (const toml::node* stencil = engine->get("stencil")) {
+      DB_ASSIGN_OR_RETURN(scene.stencil, r.Boolean(stencil, "engine.stencil"));
+    }
     DB_RETURN_IF_ERROR(r.Names<Variant>(
         *engine, "variants", "engine.variants", [&](std::string_view name) { return catalogue.ParseVariant(name); },
         scene.variants));
@@ -317,6 +353,8 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
   d.name = "scene " + scene.name;
 
   DB_RETURN_IF_ERROR(ReadProjection(r, root, d));
+  // projection.resolution leaves the one it names; the default domain has several.
+  if (d.resolutions.size() == 1) scene.resolution = d.resolutions.front();
   DB_RETURN_IF_ERROR(ReadCameraAndDepth(r, root, d));
   DB_RETURN_IF_ERROR(ReadEngine(r, root, catalogue, scene));
   DB_RETURN_IF_ERROR(ReadRequirement(r, root, d, scene.requirement));

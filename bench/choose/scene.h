@@ -17,6 +17,7 @@
 //   conventions = "any"       # or a list: ["standard", "reversed"]
 //   formats = ["x8_d24_unorm", "d32_sfloat"]
 //   variants = "any"
+//   stencil = true            # the depth attachment holds stencil (default false)
 //   [requirement]             # exactly one of absolute_error, relative_error, bits_lost
 //   absolute_error = 0.01     # world units ...
 //   at_depth = 50000          # ... at this eye depth ("1 cm at 50 km")
@@ -61,11 +62,17 @@ struct Scene {
   std::vector<Variant> variants;        // empty: any
   std::vector<Convention> conventions;  // empty: any
   std::vector<Format> formats;          // empty: any
+  bool stencil = false;                 // the depth attachment holds stencil (frame_cost.h)
+  std::optional<Resolution> resolution;  // projection.resolution, the frame a cost is for
   Requirement requirement;
   std::optional<double> max_cost;
 
   // The catalogue's cells this scene's engine can use and its domain allows.
   std::vector<Cell> Candidates() const;
+  // Each listed format that no candidate has, in words: which conventions
+  // would read it ("r16_sfloat: read only under linear, which
+  // engine.conventions does not list"), or why the domain rules it out.
+  std::vector<std::string> UnusableFormats() const;
 };
 
 // Errors name the file, line and column, the field, and what is allowed.

@@ -44,17 +44,7 @@ Expected<std::vector<fs::path>> SpeedFiles(const ReportFlags& f) {
   std::vector<fs::path> files;
   if (f.no_speed) return files;
   if (!f.speed.empty()) return std::vector<fs::path>(f.speed.begin(), f.speed.end());
-  DB_ASSIGN_OR_RETURN(const fs::path folder, DataPath("reports/speed"));
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    const std::string name = entry.path().filename().string();
-    // "x.repeat.json" files repeat "x.json" (a repeatability check): one is enough.
-    if (entry.path().extension() == ".json" && name.find(".repeat.") == std::string::npos) {
-      files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  return files;
+  return CommittedSpeedFiles();
 }
 
 Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {

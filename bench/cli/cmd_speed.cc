@@ -37,7 +37,7 @@ struct SpeedFlags {
   bool quiet = false;
   double budget = 0.0;  // seconds of GPU timings; 0: no limit
   // Which flags were given (quick must not override them).
-  bool repetitions_given = false, warmup_given = false, accuracy_samples_given = false;
+  bool repetitions_given = false, warmup_given = false, accuracy_samples_given = false, resolutions_given = false;
 };
 
 // Accuracy results for the trade: the file given, or a run of the selected
@@ -65,7 +65,9 @@ Expected<int> Speed(const SpeedFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
   options.catalogue = &context.catalogue;
   options.resolutions.clear();
-  for (const std::string& text : f.resolutions) {
+  const std::vector<std::string> resolutions =
+      f.quick && !f.resolutions_given ? std::vector<std::string>{"1280x720"} : f.resolutions;
+  for (const std::string& text : resolutions) {
     DB_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(text, "--resolution"));
     options.resolutions.push_back(resolution);
   }
@@ -180,8 +182,10 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
   cmd->add_flag("--validate", flags->validate, "enable the Vulkan validation layer and fail on its messages");
   flags->cells.Add(*cmd);
   cmd->add_option("--resolution", flags->resolutions,
-                  "full-screen pass sizes WIDTHxHEIGHT (several, or comma-separated; default 1920x1080,3840x2160)")
-      ->delimiter(',');
+                  "full-screen pass sizes WIDTHxHEIGHT (several, or comma-separated; default 1920x1080,3840x2160, "
+                  "with --quick 1280x720)")
+      ->delimiter(',')
+      ->each([flags](const std::string&) { flags->resolutions_given = true; });
   cmd->add_option("--taps", flags->taps, "reconstructions per pixel in the ALU-bound regime, 2 to 64 (default 16)");
   cmd->add_option("--repetitions", flags->repetitions, "timed repetitions per measurement, at least 3 (default 10)")
       ->each([flags](const std::string&) { flags->repetitions_given = true; });
@@ -202,7 +206,8 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
                   "an earlier speed JSON of the same device: report whether the variants rank the same way "
                   "wherever their medians differ by more than the spread (exit 1 where they do not)");
   cmd->add_flag("--quick", flags->quick,
-                "fewer repetitions (1 warm-up, 5 repetitions) and a 1e4-sample accuracy run, for tests");
+                "a usable speed file in about a minute on lavapipe, seconds on a GPU: one resolution (1280x720), 1 "
+                "warm-up, 5 repetitions, a 1e4-sample accuracy run; choose and report cost frames from it");
   cmd->add_flag("--quiet", flags->quiet, "no progress line");
   cmd->add_option("--budget", flags->budget,
                   "seconds the GPU timings may take: depth images whose timings would end past it are left out "

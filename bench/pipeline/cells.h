@@ -161,6 +161,9 @@ inline constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
 const VariantInfo& Info(Variant v);
 inline const ConventionInfo& Info(Convention c) { return catalog::kConventions[static_cast<int>(c)]; }
 inline const FormatInfo& Info(Format f) { return catalog::kFormats[static_cast<int>(f)]; }
+// Bytes a texel of the format takes as Vulkan stores it, and as a copy to a
+// buffer packs it: X8_D24 takes four.
+inline std::uint32_t TexelBytes(Format f) { return Info(f).bits <= 16 ? 2u : 4u; }
 // The built-in variants.
 inline std::span<const VariantInfo> AllVariants() { return catalog::kVariants; }
 inline std::span<const ConventionInfo> AllConventions() { return catalog::kConventions; }

@@ -10,6 +10,7 @@
 
 #include "bench/base/environment.h"
 #include "bench/choose/choose.h"
+#include "bench/choose/frame_cost.h"
 #include "bench/gate/gate.h"
 #include "bench/pipeline/bands.h"
 #include "bench/speed/trade.h"
@@ -397,20 +398,26 @@ ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> ca
   const SpeedResults* best = nullptr;
   std::string best_name;
   for (const auto& [path, speed] : m.speed) {
-    if (speed.gpu.empty()) continue;
+    if (speed.gpu.empty() || !CheckFrameCostable(speed, path.string()).ok()) continue;
     if (best == nullptr || (speed.run.device.kind == DeviceKind::kGpu && best->run.device.kind != DeviceKind::kGpu)) {
       best = &speed;
       best_name = path.filename().string();
     }
   }
-  CostSources sources{{}, best_name, m.static_costs};
-  if (best != nullptr) sources.measured = SpeedCostLookup(*best, best_name);
+  CostSources sources{{}, best_name, m.static_costs, ""};
+  FrameCostModel model;
+  if (best != nullptr) {
+    // The measurements outlive the screen built from them: the model
+    // refers to them without owning them.
+    model = {std::shared_ptr<const SpeedResults>(std::shared_ptr<void>(), best), best_name, kCostFrame, false};
+    sources.measured = FrameCostLookup(model);
+  }
   const CostChoice choice = ChooseCosts(sources, candidates);
   ScreenCosts costs;
   costs.lookup = choice.lookup;
   if (choice.measured) {
     costs.kind = best->run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
-    costs.unit = fmt::format("µs per {} frame on {}", ResolutionName(kCostFrame), best->run.device.name);
+    costs.unit = model.Unit();
   }
   return costs;
 }
@@ -571,11 +578,6 @@ ReportPlan ReportPlan::Quick() {
   plan.fit.samples_per_ratio = 40000;
   plan.main_samples = 100000;
   return plan;
-}
-
-bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices) {
-  return named || std::any_of(devices.begin(), devices.end(),
-                              [&](const DeviceInfo& d) { return d.name == speed.run.device.name; });
 }
 
 Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,

@@ -82,9 +82,6 @@ struct ReportMeasurements {
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
-// Whether a speed file's costs apply to a report that runs on `devices`:
-// always when the user named it, else when it was measured on one of them.
-bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices);
 
 Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Backend* const> backends,
                                            const ReportProgress& progress = {});

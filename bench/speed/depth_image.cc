@@ -56,11 +56,6 @@ std::vector<std::uint32_t> EncodeDepthRows(Encoding encoding, const Frame& frame
   return codes;
 }
 
-std::uint32_t TexelBytes(Format format) {
-  const FormatInfo& info = Info(format);
-  return info.bits <= 16 ? 2u : 4u;
-}
-
 Frame SpeedFrame(Resolution resolution) {
   Domain domain;
   domain.fov_degrees = {60.0, 60.0};

@@ -31,9 +31,6 @@ struct DepthImage {
   std::uint32_t Code(std::uint32_t x, std::uint32_t y) const;  // the texel's bits
 };
 
-// Bytes per texel as Vulkan stores the format (X8_D24 takes four).
-std::uint32_t TexelBytes(Format format);
-
 // The frame every timed pass renders at `resolution`.
 Frame SpeedFrame(Resolution resolution);
 

@@ -10,6 +10,7 @@
 #include "bench/base/files.h"
 #include "bench/base/json_fields.h"
 #include "bench/base/json_reader.h"
+#include "bench/base/resources.h"
 #include "bench/results/results.h"
 #include "bench/speed/depth_image.h"
 
@@ -334,6 +335,25 @@ json ToJson(const SpeedResults& results) {
     }
   }
   return document;
+}
+
+Expected<std::vector<std::filesystem::path>> CommittedSpeedFiles() {
+  DB_ASSIGN_OR_RETURN(const std::filesystem::path folder, DataPath("reports/speed"));
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() == ".json" && name.find(".repeat.") == std::string::npos) {
+      files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices) {
+  return named || std::any_of(devices.begin(), devices.end(),
+                              [&](const DeviceInfo& d) { return d.name == speed.run.device.name; });
 }
 
 Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& results) {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -185,7 +186,14 @@ Status WriteSpeedResults(const std::filesystem::path& path, const SpeedResults& 
 Expected<SpeedResults> ReadSpeedResults(const std::filesystem::path& path,
                                         const Catalogue& catalogue = Catalogue::BuiltIn());
 
-// "1920x1080" and back.
+// The speed files committed with depthbench (reports/speed/*.json), by
+// name; "x.repeat.json" repeats "x.json" (a repeatability check) and is
+// left out.
+Expected<std::vector<std::filesystem::path>> CommittedSpeedFiles();
+// Whether a speed file's costs may be used by a command running on
+// `devices`: when the user named it (then it is labelled as its device's),
+// or when it was measured on one of them.
+bool SpeedFileApplies(const SpeedResults& speed, bool named, std::span<const DeviceInfo> devices);
 
 // How two runs on one device rank the variants, pair by pair within each
 // group present in both.

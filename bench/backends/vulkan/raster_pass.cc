@@ -55,8 +55,6 @@ constexpr std::uint32_t kViewZConstant = 0;
 bool ClipMinusOne(Convention convention) { return (Info(convention).bits & catalog::kGl) != 0; }
 bool ReversedDepth(Convention convention) { return (Info(convention).bits & catalog::kRev) != 0; }
 
-// Bytes of a texel as a copy to a buffer packs it.
-std::uint32_t TexelBytesOf(Format format) { return Info(format).bits <= 16 ? 2 : 4; }
 VkDeviceSize AlignedTo4(VkDeviceSize bytes) { return (bytes + 3) / 4 * 4; }
 
 bool IsZero(const glm::vec4& v) { return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f && v.w == 0.0f; }
@@ -68,7 +66,7 @@ bool HasGeometry(const f32::RasterSample& sample) {
 // A texel's bits as ShaderInputs::codes holds them: X8_D24 keeps its depth
 // in the low 24 bits of the word, the other 8 are undefined.
 std::uint32_t CodeOf(Format format, const std::byte* texel) {
-  if (TexelBytesOf(format) == 2) {
+  if (TexelBytes(format) == 2) {
     std::uint16_t half = 0;
     std::memcpy(&half, texel, sizeof(half));
     return half;
@@ -463,7 +461,7 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!slots_[s].atlas) continue;
     texel_offsets_[s] = readback_bytes;
-    readback_bytes += AlignedTo4(texels * TexelBytesOf(slots_[s].encoding.format));
+    readback_bytes += AlignedTo4(texels * TexelBytes(slots_[s].encoding.format));
     coverage_offsets_[s] = readback_bytes;
     readback_bytes += AlignedTo4(texels);
   }
@@ -734,7 +732,7 @@ void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!drawn[s]) continue;
     const Format format = slots_[s].encoding.format;
-    const std::uint32_t bytes = TexelBytesOf(format);
+    const std::uint32_t bytes = TexelBytes(format);
     const std::byte* texels = readback + texel_offsets_[s];
     const std::byte* coverage = readback + coverage_offsets_[s];
     RasterAgreement& agreement = agreement_[s];
