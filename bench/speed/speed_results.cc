@@ -87,6 +87,37 @@ std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::ve
   return floors;
 }
 
+std::optional<PassCostSplit> SplitPassCost(const std::vector<GpuTiming>& timings) {
+  std::map<Cell, std::pair<const GpuTiming*, const GpuTiming*>> extremes;  // smallest, largest
+  for (const GpuTiming& t : timings) {
+    if (t.regime != Regime::kMemory || !(t.ns_per_pass.median > 0.0)) continue;
+    auto [it, added] = extremes.try_emplace(t.cell, &t, &t);
+    if (t.pixels() < it->second.first->pixels()) it->second.first = &t;
+    if (t.pixels() > it->second.second->pixels()) it->second.second = &t;
+  }
+  std::vector<double> fixed, per_pixel;
+  PassCostSplit split;
+  for (const auto& [cell, pair] : extremes) {
+    const auto [small, large] = pair;
+    if (small->pixels() == large->pixels()) continue;
+    const double slope = (large->ns_per_pass.median - small->ns_per_pass.median) / (large->pixels() - small->pixels());
+    per_pixel.push_back(slope);
+    fixed.push_back(small->ns_per_pass.median - slope * small->pixels());
+    split.smallest = small->resolution;
+    split.largest = large->resolution;
+  }
+  if (fixed.empty()) return std::nullopt;
+  const auto median = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  split.cells = fixed.size();
+  split.fixed_ns = median(fixed);
+  split.ns_per_pixel = median(per_pixel);
+  return split;
+}
+
 const MemoryFloor* SpeedResults::FindFloor(Format format, Resolution resolution) const {
   for (const MemoryFloor& f : floors)
     if (f.format == format && f.resolution == resolution) return &f;
@@ -327,12 +358,20 @@ JsonFields<SpeedResults> SpeedResultsFields(const Catalogue& catalogue) {
 
 json ToJson(const SpeedResults& results) {
   json document = WriteDocument(kSpeedSchema, SpeedResultsFields(results.variant_catalogue()), results);
-  // Memory-bound timings against their floor (derived; not read back).
+  // Memory-bound timings against their floor, and the split of a pass's
+  // cost (derived; not read back).
   for (std::size_t i = 0; i < results.gpu.size(); ++i) {
     if (const std::optional<double> times = results.TimesFloor(results.gpu[i])) {
       document["gpu"][i]["times_floor"] = *times;
       document["gpu"][i]["bandwidth_bound"] = *times <= kBandwidthBoundFactor;
     }
+  }
+  if (const std::optional<PassCostSplit> split = SplitPassCost(results.gpu)) {
+    document["pass_cost_split"] = {{"cells", split->cells},
+                                   {"fixed_ns", split->fixed_ns},
+                                   {"ns_per_pixel", split->ns_per_pixel},
+                                   {"smallest", ResolutionName(split->smallest)},
+                                   {"largest", ResolutionName(split->largest)}};
   }
   return document;
 }

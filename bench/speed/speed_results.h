@@ -101,6 +101,21 @@ inline constexpr double kBandwidthBoundFactor = 1.5;
 // The floors of every format and resolution of `timings`, from `probe`.
 std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::vector<GpuTiming>& timings);
 
+// The fixed cost of a pass, apart from its per-pixel cost: for each cell
+// timed in the memory-bound regime at two or more resolutions, the line
+// time = fixed + per_pixel * pixels through its smallest and largest
+// resolution; the medians over those cells. What a pass costs whatever its
+// size (the dispatch, the barrier after it, the timestamps' share) is the
+// intercept; a timer that measured launches rather than kernels would show
+// it as most of a pass.
+struct PassCostSplit {
+  std::size_t cells = 0;  // cells with two resolutions or more
+  double fixed_ns = 0.0;
+  double ns_per_pixel = 0.0;
+  Resolution smallest{0, 0}, largest{0, 0};
+};
+std::optional<PassCostSplit> SplitPassCost(const std::vector<GpuTiming>& timings);
+
 struct StaticCost {
   Variant variant;
   std::string function;  // the SPIR-V function counted, "<variant>_world_position"

@@ -51,6 +51,13 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
                        Readable(b->bytes_per_second() * 1e-9 * b->ns_per_pass.spread() / b->ns_per_pass.median, 2),
                        b->method, b->ns_per_pass.count);
   }
+  if (const std::optional<PassCostSplit> split = SplitPassCost(results.gpu)) {
+    out << fmt::format(
+        "fixed cost per pass: {} µs, apart from {} ps per pixel (memory-bound passes, the line through {} and {}; "
+        "median of {} cells): what a pass costs whatever its size\n",
+        Readable(split->fixed_ns * 1e-3, 2), Readable(split->ns_per_pixel * 1e3, 3), ResolutionName(split->smallest),
+        ResolutionName(split->largest), split->cells);
+  }
   out << "figures are medians ±spread (interquartile range); a rank is 1 + the variants of the same convention, "
          "format, resolution and regime that are faster by more than the spread; '=' marks a rank shared with "
          "an indistinguishable variant\n\n";

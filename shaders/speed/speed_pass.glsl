@@ -15,7 +15,7 @@
 // branch folds away as it would there.
 // The including shader defines RECONSTRUCT as its variant's
 // <variant>_world_position function from shared/variants/.
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 16, local_size_y = 16) in;
 layout(constant_id = 0) const uint TAPS = 1u;
 layout(constant_id = 1) const uint CONVENTION = 0u;
 
