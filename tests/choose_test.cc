@@ -161,36 +161,30 @@ TEST(ChooseTest, CostTiesShareARankInOrderOfAccuracy) {
   }
 }
 
-// A speed file ranks by measured GPU time when it has every candidate; a
-// file that lacks one is not mixed with the static model: the static model
+// A speed file ranks by frame cost when it has every candidate; a file
+// that lacks one is not mixed with the static model: the static model
 // ranks every candidate, and the note says why.
 TEST(ChooseTest, SpeedFileCostsAllCandidatesOrNone) {
-  const std::string speed = std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/speed/nvidia-h100.json";
+  const std::string speed = std::string(DEPTHBENCH_SOURCE_DIR) + "/reports/speed/nvidia-h200.json";
   const ChooseResult measured = ChooseFor(kScenes + "cad_viewer.toml", speed);
-  EXPECT_NE(measured.cost_unit.find("per 1920x1080 frame"), std::string::npos) << measured.cost_unit;
+  EXPECT_NE(measured.cost_unit.find("frame on NVIDIA H200"), std::string::npos) << measured.cost_unit;
   EXPECT_TRUE(measured.cost_note.empty()) << measured.cost_note;
   for (const CandidateVerdict& v : measured.ranked) {
     ASSERT_TRUE(v.cost.has_value()) << v.cell.Name();
     EXPECT_EQ(v.cost->unit, measured.cost_unit);
+    EXPECT_GT(v.cost->bytes_per_pixel, 0u) << v.cell.Name();
   }
 
-  // The same file without the trade point of the first candidate.
+  // The same file without the ALU-bound timings of the first candidate.
   auto json = ReadJsonFile(speed);
   ASSERT_TRUE(json.ok()) << json.status().message();
-  const Cell dropped = measured.ranked.front().cell;
-  bool removed = false;
-  for (auto& front : (*json)["trade"]) {
-    if (front["convention"] != Info(dropped.convention).name || front["format"] != Info(dropped.format).name) continue;
-    auto& points = front["points"];
-    for (auto it = points.begin(); it != points.end(); ++it) {
-      if ((*it)["variant"] == Info(dropped.variant).name) {
-        points.erase(it);
-        removed = true;
-        break;
-      }
-    }
+  const std::string dropped = measured.ranked.front().cell.Name();
+  auto& gpu = (*json)["gpu"];
+  const std::size_t before = gpu.size();
+  for (auto it = gpu.begin(); it != gpu.end();) {
+    it = (*it)["cell"] == dropped && (*it)["regime"] == "alu" ? gpu.erase(it) : it + 1;
   }
-  ASSERT_TRUE(removed);
+  ASSERT_LT(gpu.size(), before);
   const std::string dir = testing::MakeTempDir("partial_speed");
   std::ofstream(dir + "/partial.json") << json->dump();
   const ChooseResult partial = ChooseFor(kScenes + "cad_viewer.toml", dir + "/partial.json");
