@@ -11,6 +11,7 @@
 #include "bench/choose/choose.h"
 #include "bench/choose/frame_cost.h"
 #include "bench/speed/trade.h"
+#include "bench/sweep/sweep.h"
 #include "bench/fit/precision_fit.h"
 #include "tests/command_runner.h"
 
@@ -75,28 +76,69 @@ TEST(ChooseTest, OpenWorldIsNotGivenStandardZ) {
   }
 }
 
-// open_world's requirement is at its far end (50 km), so each candidate's
-// measured figure is a direct measurement there: the last tenth of depth
-// before it, cameras up to 20 km from the world origin. The far-end model
-// must come close to it. A model over the scene's samples alone predicted
-// 1.9 to 3.9 bits too little: its near depth decades, where the camera's
-// distance from the origin dominates and the error falls with depth,
-// pulled the fit down at the far end.
-TEST(ChooseTest, OpenWorldFarEndPredictionMatchesADirectMeasurement) {
+// The far end's figure is measured directly (the last tenth of depth before
+// it, the scene's cameras); the model's prediction there is published only
+// within 0.3 bit of it. An independent measurement of the same population
+// (another seed) must agree with every published figure to that 0.3 bit,
+// the sampling interval of a p99.9 from 1e5 samples being about 0.1 bit.
+// Before, the spot-light shadow's inverse_vp/standard/x8_d24_unorm was
+// predicted 2.5 bits low with the light 500 m out, and the flight sim's
+// D24 candidates 0.7 bit low 200 km out.
+void ExpectFarEndFiguresHold(const std::string& scene_file) {
+  const ChooseResult r = ChooseFor(scene_file, "", 100000);
+  ASSERT_FALSE(r.ranked.empty());
+  auto scene = LoadScene(scene_file);
+  ASSERT_TRUE(scene.ok());
+  SweepOptions independent;
+  independent.seed = 977;
+  independent.samples = 100000;
+  independent.domain = scene->domain;
+  const double far = scene->domain.far->max;
+  independent.domain.eye_depth = Range{far / 1.1, far};
+  independent.cells = scene->Candidates();
+  auto backend = MakeBackend("cpu", {});
+  Backend* backends[] = {backend->get()};
+  auto results = RunSweep(independent, backends);
+  ASSERT_TRUE(results.ok()) << results.status().message();
+  int published = 0;
+  for (const CandidateVerdict& v : r.ranked) {
+    const CellResult* c = results->Find(v.cell, "cpu");
+    ASSERT_NE(c, nullptr) << v.cell.Name();
+    const double direct = c->stats.All()[Metric::kAbsolute].AtLevel(Level::kP999, Metric::kAbsolute);
+    EXPECT_NEAR(std::log2(v.far_end_measured / direct), 0.0, kPublishedPredictionBits)
+        << v.cell.Name() << ": far end " << v.far_end_measured << ", independently " << direct;
+    if (std::isfinite(v.predicted)) {
+      ++published;
+      EXPECT_NEAR(std::log2(v.predicted / direct), 0.0, kPublishedPredictionBits)
+          << v.cell.Name() << ": predicted " << v.predicted << " (" << v.model << "), independently " << direct;
+    }
+  }
+  ::testing::Test::RecordProperty("published_predictions", published);
+}
+
+TEST(ChooseTest, SpotShadowFarEndFiguresHoldOnAnIndependentMeasurement) {
+  ExpectFarEndFiguresHold(kScenes + "spot_shadow.toml");
+  // The 2.5-bit miss is withheld, not published.
+  const ChooseResult r = ChooseFor(kScenes + "spot_shadow.toml", "", 100000);
+  for (const CandidateVerdict& v : r.ranked) {
+    if (v.cell.Name() == "inverse_vp/standard/x8_d24_unorm") {
+      EXPECT_FALSE(std::isfinite(v.predicted)) << v.predicted;
+      EXPECT_LT(v.prediction_off_bits, -1.0);
+    }
+  }
+}
+
+TEST(ChooseTest, FlightSimFarEndFiguresHoldOnAnIndependentMeasurement) {
+  ExpectFarEndFiguresHold(kScenes + "flight_sim.toml");
+}
+
+// open_world's camera goes 20 km from the world origin: the camera's part
+// of the far-end model is a few roundings of float32 world coordinates
+// there (2^-9 apart, about 1.6 x 2^-24 x 20000), never 16 x 2^-24 x 20000.
+TEST(ChooseTest, OpenWorldCameraTermIsAFewRoundingsOfItsWorldCoordinates) {
   const ChooseResult r = ChooseFor(kScenes + "open_world.toml", "", 100000);
   ASSERT_FALSE(r.ranked.empty());
   for (const CandidateVerdict& v : r.ranked) {
-    ASSERT_TRUE(std::isfinite(v.predicted) && v.predicted > 0.0) << v.cell.Name() << ": " << v.model;
-    // 1 bit: a depth decade's p99.9 stands for its far edge, yet most of
-    // its samples lie shallower, so where the error grows steeply with
-    // depth it reads under the p99.9 of the decade's last tenth (0.34 to
-    // 0.61 bit here, on either backend); the rest is room for both
-    // figures' sampling intervals (about 0.1 bit each at 1e5 samples).
-    EXPECT_NEAR(std::log2(v.predicted / v.measured), 0.0, 1.0)
-        << v.cell.Name() << ": predicted " << v.predicted << " (" << v.model << "), measured " << v.measured;
-    // The camera's part: a few roundings of float32 world coordinates
-    // 20 km out (2^-9 apart, about 1.6 x 2^-24 x 20000), never 16 x
-    // 2^-24 x 20000 (0.5 to 7 times that here).
     EXPECT_GT(v.camera_term, 0.0) << v.cell.Name();
     EXPECT_LT(v.camera_term, 16.0 * std::ldexp(20000.0, -24)) << v.cell.Name();
     EXPECT_NE(v.model.find("+camera"), std::string::npos) << v.model;

@@ -106,6 +106,10 @@ TEST_F(GateTest, ReciprocalRewrittenAsMultiplyAddFailsOnStandardZ) {
   EXPECT_EQ(r.out.rfind("FAIL", 0), 0u) << r.out;
   EXPECT_NE(r.out.find("worse: reciprocal/standard/"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("worse: divide/"), std::string::npos) << "only the edited variant may change";
+  // The replay is a sample where the edit shows: the shader part's worst,
+  // with that part's figure before and after (not a sample that storage
+  // dominates alike before and after).
+  EXPECT_NE(r.out.find("the worst sample of the shader's part: its band maximum"), std::string::npos) << r.out;
 
   const std::string markdown = testing::ReadText(summary);
   EXPECT_EQ(markdown.rfind("### depthbench gate: FAIL\n", 0), 0u) << markdown;
@@ -113,6 +117,19 @@ TEST_F(GateTest, ReciprocalRewrittenAsMultiplyAddFailsOnStandardZ) {
   EXPECT_EQ(markdown.find("| divide/"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("`depthbench run --seed"), std::string::npos) << "a row replays its sample: " << markdown;
   EXPECT_EQ(testing::ReadText(job), "earlier step\n" + markdown + "\n");
+}
+
+// With a machine table format the gate's table of worse cells is all that
+// standard output carries; the verdict goes to standard error.
+TEST_F(GateTest, TableFormatMarkdownPrintsTheWorseCells) {
+  Edit("shared/variants/reciprocal.h", "real inverse_w = depth.coefficients.y / (ndc_z - depth.coefficients.x);",
+       "real inverse_w = 1.0f / (ndc_z * depth.coefficients.z + depth.coefficients.w);");
+  const auto r = RunDepthbench(
+      {"--table-format", "markdown", "gate", "--baseline", kBaseline, "--shaders", root_ + "/shaders"});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(r.out.rfind("| worse cell | backend | band that changed most |", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("| reciprocal/standard/"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("\nFAIL: "), std::string::npos) << r.err;
 }
 
 TEST_F(GateTest, SixteenBitIntermediateFails) {

@@ -185,114 +185,147 @@ Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catal
       [by_variant](const Cell& cell) -> std::optional<CandidateCost> { return by_variant.at(cell.variant); });
 }
 
-Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
-                              const ChooseOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  const Requirement& req = scene.requirement;
-  const std::vector<Cell> cells = scene.Candidates();
-  Backend* backends[] = {&backend};
+namespace {
 
-  // The whole scene, and (for a requirement at a depth) that depth.
-  SweepOptions whole;
-  whole.seed = options.seed;
-  whole.samples = options.samples;
-  whole.domain = scene.domain;
-  whole.cells = cells;
-  DB_ASSIGN_OR_RETURN(Results scene_results, RunSweep(whole, backends));
-  // The scene with its camera at the world origin, for the far-end model
-  // (PredictAtFarEnd); the scene itself when its camera never leaves it.
-  Results origin_results;
-  const Results* at_origin = &scene_results;
+// The populations a choice is judged on: the whole scene; the scene with
+// its camera at the world origin (the far-end model's input); the last
+// tenth of depth before the requirement's depth, and before the far end.
+// A population not swept separately is the scene itself (a camera that
+// never leaves the origin) or the requirement's depth (at the far end).
+struct Populations {
+  Results scene, origin, depth, far;
+  bool own_origin = false, own_depth = false, own_far = false;
+  const Results& at_origin() const { return own_origin ? origin : scene; }
+  const Results& judged() const { return own_depth ? depth : scene; }
+  const Results& at_far() const { return own_far ? far : judged(); }
+};
+
+SweepOptions SceneSweep(const Domain& domain, const std::vector<Cell>& cells, const ChooseOptions& options) {
+  SweepOptions sweep;
+  sweep.seed = options.seed;
+  sweep.samples = options.samples;
+  sweep.domain = domain;
+  sweep.cells = CellsForDomain(cells, domain);
+  return sweep;
+}
+
+// The last tenth of eye depth before `depth` in `sweep`'s domain.
+SweepOptions Before(SweepOptions sweep, double depth) {
+  const Domain& d = sweep.domain;
+  const double lowest = d.eye_depth ? d.eye_depth->min : d.near.min;
+  sweep.domain.eye_depth = Range{std::max(lowest, depth / 1.1), depth};
+  return sweep;
+}
+
+Expected<Populations> Measure(const Scene& scene, Backend& backend, const std::vector<Cell>& cells,
+                              const ChooseOptions& options) {
+  Backend* backends[] = {&backend};
+  const Requirement& req = scene.requirement;
+  const SweepOptions whole = SceneSweep(scene.domain, cells, options);
+  Populations p;
+  DB_ASSIGN_OR_RETURN(p.scene, RunSweep(whole, backends));
   if (scene.domain.camera_distance.max > 0.0) {
     SweepOptions origin = whole;
     origin.domain.camera_distance = Range{0.0, 0.0};
-    DB_ASSIGN_OR_RETURN(origin_results, RunSweep(origin, backends));
-    at_origin = &origin_results;
+    DB_ASSIGN_OR_RETURN(p.origin, RunSweep(origin, backends));
+    p.own_origin = true;
   }
-  Results depth_results;
-  const Results* judged = &scene_results;
   if (req.at_depth) {
-    SweepOptions at = whole;
-    const double lowest = scene.domain.eye_depth ? scene.domain.eye_depth->min : scene.domain.near.min;
-    // The last tenth of depth before the requirement's depth.
-    at.domain.eye_depth = Range{std::max(lowest, *req.at_depth / 1.1), *req.at_depth};
-    DB_ASSIGN_OR_RETURN(depth_results, RunSweep(at, backends));
-    judged = &depth_results;
+    DB_ASSIGN_OR_RETURN(p.depth, RunSweep(Before(whole, *req.at_depth), backends));
+    p.own_depth = true;
   }
+  // The far end, directly: what a far-end prediction is checked against.
+  const double far_end = DepthLimit(scene.domain);
+  if (!req.at_depth || *req.at_depth != far_end) {
+    DB_ASSIGN_OR_RETURN(p.far, RunSweep(Before(whole, far_end), backends));
+    p.own_far = true;
+  }
+  return p;
+}
 
-  ChooseResult result;
-  result.scene = scene.name;
-  result.requirement = req.Describe();
-  result.backend = backend.name();
-  result.device = backend.device().name;
-  result.unusable_formats = scene.UnusableFormats();
-
-  // One cost unit for the whole ranking.
-  const CostChoice chosen_costs = ChooseCosts(costs, cells);
-  const CostLookup& cost_of = chosen_costs.lookup;
-  result.cost_note = chosen_costs.note;
-
-  const std::uint64_t needed = MinimumSamples(req.level);
-  for (const Cell& cell : cells) {
-    const CellResult* at_depth = judged->Find(cell, backend.name());
-    const CellResult* in_scene = scene_results.Find(cell, backend.name());
-    const CellResult* origin = at_origin->Find(cell, backend.name());
-    if (at_depth == nullptr || in_scene == nullptr || origin == nullptr) continue;
-    const BandStats band = at_depth->stats.All();
-    const BandStats whole_band = in_scene->stats.All();
-    CandidateVerdict v;
-    v.cell = cell;
-    v.samples = band.finite;
-    v.supported = band.finite >= needed;
-    v.measured_p999 = InUnit(req, band, Level::kP999);
-    v.measured_max = InUnit(req, band, Level::kMax);
-    v.measured = req.level == Level::kMax ? v.measured_max : v.measured_p999;
-    v.interval = InUnitInterval(req, band, req.level);
-    const FarEndPrediction far_end = PredictAtFarEnd(scene, *in_scene, *origin, req.level);
-    v.predicted = far_end.value;
-    v.model = far_end.model;
-    v.camera_term = far_end.camera_term;
-    // Findings only: outputs that are NaN or Inf where exact arithmetic on
-    // the same inputs is finite, for samples inside the scene's ranges.
-    v.nonfinite = band.nan + band.inf + whole_band.nan + whole_band.inf;
-    double largest = -1.0;
-    for (Metric cause : {Metric::kProduction, Metric::kStorage, Metric::kArith}) {
-      const double p999 = band[cause].AtLevel(Level::kP999, cause);
-      if (p999 > largest) {
-        largest = p999;
-        v.dominant = cause;
-      }
+// The figures of one candidate at the requirement's level and depth.
+void JudgeFigures(const Requirement& req, const BandStats& band, CandidateVerdict& v) {
+  v.samples = band.finite;
+  v.supported = band.finite >= MinimumSamples(req.level);
+  v.measured_p999 = InUnit(req, band, Level::kP999);
+  v.measured_max = InUnit(req, band, Level::kMax);
+  v.measured = req.level == Level::kMax ? v.measured_max : v.measured_p999;
+  v.interval = InUnitInterval(req, band, req.level);
+  double largest = -1.0;
+  for (Metric cause : {Metric::kProduction, Metric::kStorage, Metric::kArith}) {
+    const double p999 = band[cause].AtLevel(Level::kP999, cause);
+    if (p999 > largest) {
+      largest = p999;
+      v.dominant = cause;
     }
-    // On the upper end of the interval: a candidate meets the requirement
-    // only if the sampling error cannot be what makes it pass.
-    v.meets = v.supported && v.interval.high <= req.value && v.nonfinite == 0;
-    v.too_close = v.supported && v.nonfinite == 0 && v.measured <= req.value && !v.meets;
-    v.cost = cost_of ? cost_of(cell) : std::nullopt;
-    v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
-    result.ranked.push_back(v);
   }
-  // No candidate has the samples the level needs: no verdict can be given,
-  // and a ranking of unsupported figures would read as one.
+}
+
+// One candidate's verdict; nullopt when a population lacks it.
+std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, const Populations& p,
+                                      const std::string& backend, const CostLookup& cost_of) {
+  const Requirement& req = scene.requirement;
+  const CellResult* at_depth = p.judged().Find(cell, backend);
+  const CellResult* in_scene = p.scene.Find(cell, backend);
+  const CellResult* origin = p.at_origin().Find(cell, backend);
+  const CellResult* far = p.at_far().Find(cell, backend);
+  if (at_depth == nullptr || in_scene == nullptr || origin == nullptr || far == nullptr) return std::nullopt;
+  const BandStats band = at_depth->stats.All();
+  const BandStats whole_band = in_scene->stats.All();
+  CandidateVerdict v;
+  v.cell = cell;
+  JudgeFigures(req, band, v);
+  const FarEndPrediction prediction = PredictAtFarEnd(scene, *in_scene, *origin, req.level);
+  v.far_end_measured = InUnit(req, far->stats.All(), req.level);
+  v.predicted = prediction.value;
+  v.model = prediction.model;
+  v.camera_term = prediction.camera_term;
+  if (std::isfinite(v.predicted)) {
+    // Published only where the whole 95% interval of the measurement is
+    // within reach: another sample of the same population agrees too.
+    const auto off = [&](double measured) {
+      return req.kind == Requirement::Kind::kBitsLost ? v.predicted - measured : std::log2(v.predicted / measured);
+    };
+    const Interval far_interval = InUnitInterval(req, far->stats.All(), req.level);
+    v.prediction_off_bits = off(v.far_end_measured);
+    const double furthest = std::max({std::fabs(v.prediction_off_bits), std::fabs(off(far_interval.low)),
+                                      std::fabs(off(far_interval.high))});
+    if (!(furthest <= kPublishedPredictionBits)) v.predicted = std::nan("");
+  }
+  // Findings only: outputs that are NaN or Inf where exact arithmetic on
+  // the same inputs is finite, for samples inside the scene's ranges.
+  v.nonfinite = band.nan + band.inf + whole_band.nan + whole_band.inf;
+  // On the upper end of the interval: a candidate meets the requirement
+  // only if the sampling error cannot be what makes it pass.
+  v.meets = v.supported && v.interval.high <= req.value && v.nonfinite == 0;
+  v.too_close = v.supported && v.nonfinite == 0 && v.measured <= req.value && !v.meets;
+  v.cost = cost_of ? cost_of(cell) : std::nullopt;
+  v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
+  return v;
+}
+
+// InvalidArgument when no candidate has the samples the level needs: no
+// verdict can be given, and a ranking of unsupported figures would read
+// as one.
+Status CheckSupported(const ChooseResult& result, const Requirement& req, const ChooseOptions& options) {
   std::uint64_t most_samples = 0;
   bool any_supported = false;
   for (const CandidateVerdict& v : result.ranked) {
     most_samples = std::max(most_samples, v.samples);
     any_supported = any_supported || v.supported;
   }
-  if (!result.ranked.empty() && !any_supported) {
-    const double scale = static_cast<double>(needed) / static_cast<double>(std::max<std::uint64_t>(most_samples, 1));
-    return InvalidArgument(fmt::format(
-        "--samples {}: too few for a {} verdict: at most {} samples fall where the requirement is judged, and a {} "
-        "needs {}; raise --samples to at least {:.0f}",
-        options.samples, LevelName(req.level), most_samples, LevelName(req.level), needed,
-        RoundUpToTwoDigits(static_cast<double>(options.samples) * scale * 1.1)));
-  }
-  if (!result.ranked.empty() && result.ranked.front().cost) {
-    result.cost_unit = result.ranked.front().cost->unit;
-    result.cost_source = result.ranked.front().cost->source;
-  }
+  if (result.ranked.empty() || any_supported) return Status::Ok();
+  const std::uint64_t needed = MinimumSamples(req.level);
+  const double scale = static_cast<double>(needed) / static_cast<double>(std::max<std::uint64_t>(most_samples, 1));
+  return InvalidArgument(fmt::format(
+      "--samples {}: too few for a {} verdict: at most {} samples fall where the requirement is judged, and a {} "
+      "needs {}; raise --samples to at least {:.0f}",
+      options.samples, LevelName(req.level), most_samples, LevelName(req.level), needed,
+      RoundUpToTwoDigits(static_cast<double>(options.samples) * scale * 1.1)));
+}
 
-  // The ranking (ranking.h), on the upper end of each interval.
+// The ranking (ranking.h), on the upper end of each interval.
+void RankVerdicts(ChooseResult& result) {
   std::vector<RankInput> inputs;
   for (const CandidateVerdict& v : result.ranked) {
     inputs.push_back({v.meets, v.over_budget, v.nonfinite, v.supported, v.interval.high, v.cost});
@@ -304,9 +337,13 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     ranked.back().tied = place.tied;
   }
   result.ranked = std::move(ranked);
+}
 
+// Each verdict in one sentence.
+void Explain(const Scene& scene, ChooseResult& result) {
+  const Requirement& req = scene.requirement;
+  const std::uint64_t needed = MinimumSamples(req.level);
   const double limit = req.value;
-  const CandidateVerdict* cheapest = result.Met() ? &result.ranked.front() : nullptr;
   for (CandidateVerdict& v : result.ranked) {
     const std::string measured = InUnitText(req, v.interval.high);
     const std::string cost =
@@ -333,7 +370,13 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     }
   }
 
-  if (cheapest == nullptr && !result.ranked.empty()) {
+}
+
+// What would have to change when nothing meets the requirement, in words.
+void Suggest(const Scene& scene, ChooseResult& result) {
+  const Requirement& req = scene.requirement;
+  const double limit = req.value;
+  if (!result.Met() && !result.ranked.empty()) {
     const CandidateVerdict& closest = result.ranked.front();
     result.suggestions.push_back(fmt::format("nothing meets {}; the closest is {} at {} ({:.3g}x the limit)",
                                              req.Describe(), closest.cell.Name(), InUnitText(req, closest.measured),
@@ -371,6 +414,123 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
           distance > 0.0 ? " (subtract the camera position before, not after, reconstructing)" : ""));
     }
   }
+}
+
+// The best candidate among `cells` in `domain`, judged as the scene's
+// requirement is; nullopt when no cell runs there.
+Expected<std::optional<WhatIf>> TryWhatIf(const Scene& scene, Backend& backend, const ChooseOptions& options,
+                                          std::string change, const Domain& domain, const std::vector<Cell>& cells) {
+  const Requirement& req = scene.requirement;
+  SweepOptions sweep = SceneSweep(domain, cells, options);
+  if (sweep.cells.empty()) return std::optional<WhatIf>();
+  if (req.at_depth) sweep = Before(sweep, *req.at_depth);
+  Backend* backends[] = {&backend};
+  DB_ASSIGN_OR_RETURN(const Results results, RunSweep(sweep, backends));
+  WhatIf what_if{std::move(change), "", 0.0, false};
+  for (const CellResult& c : results.cells) {
+    const BandStats band = c.stats.All();
+    CandidateVerdict v;
+    JudgeFigures(req, band, v);
+    if (!v.supported || band.nan + band.inf > 0) continue;
+    if (what_if.candidate.empty() || v.interval.high < what_if.figure) {
+      what_if.candidate = c.cell.Name();
+      what_if.figure = v.interval.high;
+    }
+  }
+  what_if.meets = !what_if.candidate.empty() && what_if.figure <= req.value;
+  return std::optional<WhatIf>(std::move(what_if));
+}
+
+// The scene's cells with some of its engine's choices replaced.
+std::vector<Cell> CellsWith(const Scene& scene, std::vector<Convention> conventions, std::vector<Format> formats) {
+  const CellFilter filter{scene.variants, std::move(conventions), std::move(formats)};
+  std::vector<Cell> cells;
+  for (const Cell& c : (scene.catalogue != nullptr ? *scene.catalogue : Catalogue::BuiltIn()).Cells())
+    if (filter.Keeps(c)) cells.push_back(c);
+  return cells;
+}
+
+// When nothing meets the requirement: each change an engine could make,
+// measured. Reversed Z with a float buffer; a float buffer under the
+// scene's conventions; the near plane ten times further; positions
+// computed camera-relative (the camera at the world origin); the depth
+// range split in two at its geometric middle, the part that holds the
+// requirement's depth with its own near or far plane.
+Status AddWhatIfs(const Scene& scene, Backend& backend, const ChooseOptions& options, ChooseResult& result) {
+  const Domain& d = scene.domain;
+  const std::vector<Cell> cells = scene.Candidates();
+  std::vector<std::pair<std::string, std::pair<Domain, std::vector<Cell>>>> changes;
+  changes.push_back({"reversed Z with a float buffer (reversed, d32_sfloat)",
+                     {d, CellsWith(scene, {Convention::kReversed}, {Format::kD32Sfloat})}});
+  changes.push_back({"a float buffer under the scene's conventions (d32_sfloat)",
+                     {d, CellsWith(scene, scene.conventions, {Format::kD32Sfloat})}});
+  const double depth = scene.requirement.at_depth.value_or(DepthLimit(d));
+  if (d.near.fixed() && d.near.min * 10.0 < depth) {
+    Domain moved = d;
+    moved.near = Range{d.near.min * 10.0, d.near.min * 10.0};
+    if (moved.eye_depth) moved.eye_depth->min = std::max(moved.eye_depth->min, moved.near.min);
+    changes.push_back({fmt::format("the near plane at {:g} (x10)", moved.near.min), {moved, cells}});
+  }
+  if (d.camera_distance.max > 0.0) {
+    Domain relative = d;
+    relative.camera_distance = Range{0.0, 0.0};
+    changes.push_back({fmt::format("positions camera-relative (the camera {:g} out, at the origin instead)",
+                                   d.camera_distance.max),
+                       {relative, cells}});
+  }
+  if (d.near.fixed() && d.finite_far && d.far && d.far->fixed()) {
+    const double split = std::sqrt(d.near.min * d.far->min);
+    Domain part = d;
+    if (depth > split) {
+      part.near = Range{split, split};
+      part.eye_depth = Range{split, std::min(d.far->min, DepthLimit(d))};
+    } else {
+      part.far = Range{split, split};
+      part.eye_depth = Range{d.near.min, split};
+    }
+    changes.push_back({fmt::format("the depth range split at {:.3g} (each part with its own near and far plane)", split),
+                       {part, cells}});
+  }
+  for (const auto& [change, what] : changes) {
+    if (what.second.empty()) continue;
+    std::optional<WhatIf> w;
+    DB_RETURN_IF_ERROR(StoreInto(TryWhatIf(scene, backend, options, change, what.first, what.second), w));
+    if (w) result.what_ifs.push_back(std::move(*w));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSources& costs,
+                              const ChooseOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const std::vector<Cell> cells = scene.Candidates();
+  DB_ASSIGN_OR_RETURN(const Populations populations, Measure(scene, backend, cells, options));
+
+  ChooseResult result;
+  result.scene = scene.name;
+  result.requirement = scene.requirement.Describe();
+  result.backend = backend.name();
+  result.device = backend.device().name;
+  result.unusable_formats = scene.UnusableFormats();
+  // One cost unit for the whole ranking.
+  const CostChoice chosen_costs = ChooseCosts(costs, cells);
+  result.cost_note = chosen_costs.note;
+  for (const Cell& cell : cells) {
+    if (auto v = Judge(scene, cell, populations, backend.name(), chosen_costs.lookup)) result.ranked.push_back(*v);
+  }
+  DB_RETURN_IF_ERROR(CheckSupported(result, scene.requirement, options));
+  if (!result.ranked.empty() && result.ranked.front().cost) {
+    result.cost_unit = result.ranked.front().cost->unit;
+    result.cost_source = result.ranked.front().cost->source;
+  }
+  RankVerdicts(result);
+  Explain(scene, result);
+  Suggest(scene, result);
+  if (!result.Met() && !result.ranked.empty()) {
+    DB_RETURN_IF_ERROR(AddWhatIfs(scene, backend, options, result));
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
@@ -390,13 +550,33 @@ std::string Limit(const CandidateVerdict& v) {
   }
 }
 
+// Each what-if in one line.
+std::vector<std::string> WhatIfLines(const ChooseResult& r) {
+  std::vector<std::string> lines;
+  for (const WhatIf& w : r.what_ifs) {
+    lines.push_back(w.candidate.empty()
+                        ? fmt::format("{}: no candidate has the samples there", w.change)
+                        : fmt::format("{}: {} at {:.3g}, {}", w.change, w.candidate, w.figure,
+                                      w.meets ? "meets it" : "still fails"));
+  }
+  return lines;
+}
+
+// The far-end model's prediction, or why it is not published.
+std::string ModelText(const CandidateVerdict& v) {
+  if (std::isfinite(v.predicted)) return fmt::format("{:.3g} ({})", v.predicted, v.model);
+  if (v.prediction_off_bits != 0.0) return fmt::format("withheld: {:+.1f} bits off", v.prediction_off_bits);
+  return v.model;
+}
+
 // The ranked candidates, best first; at most `rows` of them.
 TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
   using Align = TextTable::Align;
   TextTable table({{"rank"},
                    {"candidate", Align::kLeft},
                    {"measured (upper)"},
-                   {"far end (model)"},
+                   {"far end"},
+                   {"model", Align::kLeft, true},
                    {"NaN/Inf"},
                    {"meets", Align::kLeft},
                    {"held back by", Align::kLeft, true},
@@ -408,8 +588,7 @@ TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
         {fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
          v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
                                       : fmt::format("{:.3g}", v.measured),
-         std::isfinite(v.predicted) ? fmt::format("{:.3g} ({})", v.predicted, v.model) : fmt::format("- ({})", v.model),
-         std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+         fmt::format("{:.3g}", v.far_end_measured), ModelText(v), std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
          v.cost && v.cost->bytes_per_pixel > 0 ? std::to_string(v.cost->bytes_per_pixel) : "-",
          v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
   }
@@ -425,6 +604,8 @@ std::string ChoiceSummaryMarkdown(const ChooseResult& r) {
     out << fmt::format("Choice: **{}** ({}).\n\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
   } else {
     out << "No candidate meets it.\n\n";
+    for (const std::string& line : WhatIfLines(r)) out << "- What if " << line << "\n";
+    if (!r.what_ifs.empty()) out << "\n";
   }
   for (const std::string& u : r.unusable_formats) out << "Not a candidate: " << u << ".\n\n";
   constexpr std::size_t kRows = 10;
@@ -454,18 +635,37 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
   }
   for (const std::string& s : r.suggestions) out.text << s << "\n";
   if (!r.suggestions.empty()) out.text << "\n";
+  if (!r.what_ifs.empty()) {
+    out.text << "what if (each change measured as the scene is, its best candidate's upper figure):\n";
+    for (const std::string& line : WhatIfLines(r)) out.text << "  " << line << "\n";
+    out.text << "\n";
+  }
   CandidateTable(r, r.ranked.size()).Print(out);
   out.text << fmt::format(
       "measured: at the requirement's level and depth, with the upper end of its 95% interval where it differs "
-      "(the verdict uses that);\nfar end: the error model's prediction at the scene's far end (constant or depth: "
-      "over eye depth, camera at the world origin; +camera: with what the scene's camera distance adds; "
-      "docs/choosing.md); NaN/Inf: findings inside the scene's ranges;\nheld back by: the part of the error that "
+      "(the verdict uses that);\nfar end: measured in the last tenth of depth before the scene's far end, with the "
+      "scene's cameras; model: the error model's prediction there (constant or depth: over eye depth, camera at the "
+      "world origin; +camera: with what the scene's camera distance adds; docs/choosing.md), published only within "
+      "0.3 bit of the far end's measurement, else withheld with how far off it was; NaN/Inf: findings inside the scene's ranges;\nheld back by: the part of the error that "
       "dominates (production, storage or shader), or what else "
       "fails it (interval: the measured value meets it, the upper end of its interval does not);\nrank: '=' marks "
       "costs that tie; B/px: bytes per pixel the depth makes a frame move (the attachment written and read, or "
       "the attachment written and the linear target written and read; none under the static model);\nexit status 0 when a candidate meets the requirement, 1 when none "
       "does\n");
 }
+
+namespace {
+nlohmann::json WhatIfsJson(const ChooseResult& r) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const WhatIf& w : r.what_ifs) {
+    list.push_back({{"change", w.change},
+                    {"candidate", w.candidate.empty() ? nlohmann::json(nullptr) : nlohmann::json(w.candidate)},
+                    {"figure", JsonNumber(w.figure)},
+                    {"meets", w.meets}});
+  }
+  return list;
+}
+}  // namespace
 
 nlohmann::json ChoiceToJson(const ChooseResult& r) {
   nlohmann::json ranked = nlohmann::json::array();
@@ -482,7 +682,9 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"interval", {JsonNumber(v.interval.low), JsonNumber(v.interval.high)}},
                       {"measured_p999", JsonNumber(v.measured_p999)},
                       {"measured_max", JsonNumber(v.measured_max)},
+                      {"far_end_measured", JsonNumber(v.far_end_measured)},
                       {"predicted_far_end", JsonNumber(v.predicted)},
+                      {"prediction_off_bits", JsonNumber(v.prediction_off_bits)},
                       {"model", v.model},
                       {"camera_term", JsonNumber(v.camera_term)},
                       {"nonfinite", v.nonfinite},
@@ -515,6 +717,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                        {"note", r.cost_note},
                        {"static_model", r.cost_unit == kStaticCostUnit ? model : nlohmann::json(nullptr)}}},
                      {"suggestions", r.suggestions},
+                     {"what_ifs", WhatIfsJson(r)},
                      {"ranked", ranked}});
 }
 

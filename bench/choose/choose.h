@@ -47,7 +47,15 @@ struct CandidateVerdict {
   Interval interval;      // its 95% sampling interval; the verdict uses `high`
   bool supported = true;  // enough samples at the requirement's depth for the level
   std::uint64_t samples = 0;
-  double predicted = 0.0;  // the model's value at the scene's far end, same unit and level
+  // The scene's far end measured directly (its last tenth of depth, the
+  // scene's cameras), in the requirement's unit and level.
+  double far_end_measured = 0.0;
+  // The model's value at the far end, same unit and level, published only
+  // within kPublishedPredictionBits of far_end_measured and of both ends of
+  // its 95% interval; NaN when withheld
+  // (prediction_off_bits says by how much it missed) or not fitted.
+  double predicted = 0.0;
+  double prediction_off_bits = 0.0;
   // The error model used for the prediction: over eye depth with the camera
   // at the world origin ("constant", "depth"), "+camera" where the scene's
   // camera distance adds its own (choose.cc PredictAtFarEnd).
@@ -68,9 +76,24 @@ struct CandidateVerdict {
   std::string reason;  // one sentence
 };
 
+// A far-end prediction further than this from the direct measurement of
+// the same population is not published: 0.3 bit is about three times the
+// sampling interval of a p99.9 from 1e5 samples (about 0.1 bit).
+inline constexpr double kPublishedPredictionBits = 0.3;
+
 struct ChooseOptions {
   std::uint64_t samples = 100000;
   std::uint64_t seed = 11;
+};
+
+// What one change to the scene would give, measured as the scene is (at
+// the requirement's level and depth): the best candidate of the changed
+// scene and its figure.
+struct WhatIf {
+  std::string change;     // "reversed Z with a float buffer (reversed, d32_sfloat)"
+  std::string candidate;  // the best candidate; empty when none has the samples
+  double figure = 0.0;    // the upper end of its 95% interval, in the requirement's unit
+  bool meets = false;
 };
 
 struct ChooseResult {
@@ -82,6 +105,7 @@ struct ChooseResult {
   std::vector<CandidateVerdict> ranked;  // best first
   std::vector<std::string> suggestions;  // when nothing meets the requirement
   std::vector<std::string> unusable_formats;  // listed but never a candidate (Scene::UnusableFormats)
+  std::vector<WhatIf> what_ifs;               // when nothing meets the requirement
   bool Met() const { return !ranked.empty() && ranked.front().meets; }
   double seconds = 0.0;
 };

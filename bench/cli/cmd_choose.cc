@@ -39,10 +39,16 @@ Status AddFrameCosts(const ChooseFlags& f, const Scene& scene, const Backend& ba
     DB_ASSIGN_OR_RETURN(model.frame, ParseResolution(f.resolution, "--resolution"));
   }
   DB_ASSIGN_OR_RETURN(model.speed, SpeedFileFor(backend.device(), f.speed, catalogue, model.source));
+  if (model.speed == nullptr && backend.name() == "cpu") {
+    costs.no_measured_note =
+        "the CPU backend renders no frame, so candidates are costed by the static model (the shader's arithmetic; "
+        "formats and extra targets cost nothing there); --speed FILE costs the frames of the device that made it";
+    return Status::Ok();
+  }
   if (model.speed == nullptr) {
     costs.no_measured_note = fmt::format(
         "no speed file of {} is committed or named (--speed), so formats and extra targets are not costed: the "
-        "static model counts the shader's arithmetic only; make one in about a minute with: depthbench speed "
+        "static model counts the shader's arithmetic only; make one in about a minute with\n  depthbench speed "
         "--quick --device '{}' --json reports/speed/NAME.json",
         backend.device().name, backend.device().name);
     return Status::Ok();

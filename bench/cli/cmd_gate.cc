@@ -206,6 +206,8 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
   if (!f.update) DB_RETURN_IF_ERROR(CheckCoverage(runs, f.allow_uncovered));
 
   PrintGateVerdict(runs, tolerance, out.text);
+  // A machine format asks for the table alone on standard output.
+  if (out.style.format != TableFormat::kText) GateCellsTable(runs, SIZE_MAX).Print(out);
   if (!f.junit.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.junit, GateJUnit(runs)));
   if (!f.json.empty()) DB_RETURN_IF_ERROR(WriteFileAtomically(f.json, GateJson(runs, tolerance).dump(1) + "\n"));
   DB_RETURN_IF_ERROR(WriteSummary(f.summary, GateSummaryMarkdown(runs, tolerance)));

@@ -26,6 +26,7 @@ BandFigures FiguresOf(const BandStats& band) {
   f.nan = band.nan;
   f.inf = band.inf;
   f.worst_index = total.worst_index;
+  f.arith_worst_index = arith.worst_index;
   f.first_nonfinite_index = band.first_nonfinite_index;
   return f;
 }
@@ -85,6 +86,8 @@ const JsonFields<BandFigures>& BandFiguresFields() {
       JsonMember("nan", &BandFigures::nan),
       JsonMember("inf", &BandFigures::inf),
       JsonMember("worst_index", &BandFigures::worst_index, JsonIndexOrNull()),
+      // (absent from baselines made before it was kept)
+      JsonMemberOr("arith_worst_index", &BandFigures::arith_worst_index, JsonIndexOrNull(), UINT64_MAX),
       JsonMember("first_nonfinite_index", &BandFigures::first_nonfinite_index, JsonIndexOrNull()),
   }};
   return fields;

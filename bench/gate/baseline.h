@@ -33,6 +33,10 @@ struct BandFigures {
   double p999_interval_bits = 0;
   std::uint64_t judged = 0, nan = 0, inf = 0;
   std::uint64_t worst_index = 0;            // the sample with the largest total error
+  // The sample with the largest error of the shader's part: where an edit
+  // of the shader shows even when storage dominates the total. UINT64_MAX
+  // when unknown (baselines made before it was kept).
+  std::uint64_t arith_worst_index = UINT64_MAX;
   std::uint64_t first_nonfinite_index = 0;  // UINT64_MAX when there is none
   friend bool operator==(const BandFigures&, const BandFigures&) = default;
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -19,11 +20,40 @@ std::string Join(const std::vector<std::string>& parts, const char* separator) {
 }
 
 // The command that replays the sample behind a worse band.
+// Whether the shader's own part of the error got worse in a band: then its
+// worst sample shows the change, where the total's worst may be a sample
+// that storage dominates alike before and after.
+bool ShaderPartWorse(const BandChange& change) {
+  return change.after.arith_max > change.before.arith_max || change.after.arith_p999 > change.before.arith_p999;
+}
+
+std::uint64_t ReplayIndex(const BandChange& change) {
+  // (NaN and Inf each: one can appear while the other goes.)
+  if (change.after.nan > change.before.nan || change.after.inf > change.before.inf) {
+    return change.after.first_nonfinite_index;
+  }
+  if (ShaderPartWorse(change) && change.after.arith_worst_index != kNone) return change.after.arith_worst_index;
+  return change.after.worst_index;
+}
+
+// What the replayed sample stands for, before and after: the band's
+// maximum of the part it is the worst of.
+std::string ReplayFigures(const BandChange& change) {
+  if (change.after.nan > change.before.nan || change.after.inf > change.before.inf) {
+    return fmt::format("the first NaN or Inf (NaN {} -> {}, Inf {} -> {})", change.before.nan, change.after.nan,
+                       change.before.inf, change.after.inf);
+  }
+  if (ShaderPartWorse(change) && change.after.arith_worst_index != kNone) {
+    return fmt::format("the worst sample of the shader's part: its band maximum {:.1f} -> {:.1f} bits lost",
+                       change.before.arith_max, change.after.arith_max);
+  }
+  return fmt::format("the worst sample of the total: its band maximum {:.1f} -> {:.1f} bits lost",
+                     change.before.total_max, change.after.total_max);
+}
+
 std::string ReproFor(const GateRun& run, const std::string& cell_name, const BandChange& change) {
   const Cell cell = (run.catalogue != nullptr ? *run.catalogue : Catalogue::BuiltIn()).ParseCell(cell_name).value();
-  // (NaN and Inf each: one can appear while the other goes.)
-  const bool nonfinite = change.after.nan > change.before.nan || change.after.inf > change.before.inf;
-  const std::uint64_t index = nonfinite ? change.after.first_nonfinite_index : change.after.worst_index;
+  const std::uint64_t index = ReplayIndex(change);
   if (index == kNone) return "";
   std::string command = ReproCommand(run.current.plan.seed, index, run.current.plan.domain, cell, run.current.backend);
   if (!run.shader_dir.empty()) command += " --shaders " + run.shader_dir;
@@ -101,13 +131,6 @@ std::vector<BandChange> WorstBandsFirst(const CellVerdict& v) {
   return bands;
 }
 
-// Text in a Markdown table cell: '|' would end the cell.
-std::string MarkdownCell(const std::string& text) {
-  std::string out;
-  for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
-  return out;
-}
-
 }  // namespace
 
 void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tolerance, std::ostream& out) {
@@ -140,7 +163,10 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
         out << fmt::format("  ... and {} more bands (--json has them all)\n", bands.size() - kShown);
       // One reproducer, for the band that changed most.
       const std::string repro = ReproFor(r, v.cell, v.worse.front());
-      if (!repro.empty()) out << "  reproduce: " << repro << "\n";
+      if (!repro.empty()) {
+        out << fmt::format("  the sample below, in band {}: {}\n  reproduce: {}\n", v.worse.front().band,
+                           ReplayFigures(v.worse.front()), repro);
+      }
     }
   }
   for (const GateRun& r : runs) {
@@ -176,40 +202,47 @@ void PrintGateVerdict(const std::vector<GateRun>& runs, const GateTolerance& tol
   }
 }
 
-std::string GateSummaryMarkdown(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
-  const GateCounts counts = CountGate(runs);
-  std::string out =
-      fmt::format("### depthbench gate: {}\n\n{}.\n\n", VerdictWord(counts), MarkdownCell(VerdictDetail(counts)));
-  for (const std::string& what : counts.uncovered) out += fmt::format("Not compared: {}.\n\n", MarkdownCell(what));
-  // The worse cells, each by the band that changed most, with the command
-  // that replays its sample; a page of them tells the story.
-  constexpr int kRows = 20;
-  int rows = 0, more = 0;
+TextTable GateCellsTable(const std::vector<GateRun>& runs, std::size_t max_rows) {
+  TextTable table({{"worse cell", TextTable::Align::kLeft},
+                   {"backend", TextTable::Align::kLeft},
+                   {"band that changed most", TextTable::Align::kLeft},
+                   {"change", TextTable::Align::kLeft},
+                   {"replayed sample", TextTable::Align::kLeft},
+                   {"replay", TextTable::Align::kLeft}});
+  std::size_t rows = 0;
   for (const GateRun& r : runs) {
     for (const CellVerdict& v : r.comparison.cells) {
-      if (!v.failed()) continue;
-      if (rows == 0) {
-        out += "| worse cell | backend | band that changed most | change | replay |\n|---|---|---|---|---|\n";
-      }
-      if (rows == kRows) {
-        ++more;
-        continue;
-      }
-      ++rows;
+      if (!v.failed() || rows++ == max_rows) continue;
       if (v.disappeared) {
-        out += fmt::format("| {} | {} | - | in the baseline, did not run | - |\n", MarkdownCell(v.cell),
-                           MarkdownCell(r.current.backend));
+        table.AddRow({v.cell, r.current.backend, "-", "in the baseline, did not run", "-", "-"});
         continue;
       }
       const BandChange worst = WorstBandsFirst(v).front();
       const std::string repro = ReproFor(r, v.cell, worst);
-      out += fmt::format("| {} | {} | {} | {} | {} |\n", MarkdownCell(v.cell), MarkdownCell(r.current.backend),
-                         MarkdownCell(worst.band), MarkdownCell(Join(worst.reasons, ", ")),
-                         repro.empty() ? "-" : "`" + MarkdownCell(repro) + "`");
+      table.AddRow({v.cell, r.current.backend, worst.band, Join(worst.reasons, ", "), ReplayFigures(worst),
+                    repro.empty() ? "-" : "`" + repro + "`"});
     }
   }
-  if (more > 0) out += fmt::format("\n... and {} more worse cells (the gate's --json has them all).\n", more);
-  if (rows > 0) out += "\n";
+  return table;
+}
+
+std::string GateSummaryMarkdown(const std::vector<GateRun>& runs, const GateTolerance& tolerance) {
+  const GateCounts counts = CountGate(runs);
+  std::string out =
+      fmt::format("### depthbench gate: {}\n\n{}.\n\n", VerdictWord(counts), VerdictDetail(counts));
+  for (const std::string& what : counts.uncovered) out += fmt::format("Not compared: {}.\n\n", what);
+  // The worse cells, each by the band that changed most, with the command
+  // that replays its sample; a page of them tells the story.
+  constexpr std::size_t kRows = 20;
+  const std::size_t worse = static_cast<std::size_t>(counts.failures);
+  if (worse > 0) {
+    std::ostringstream table;
+    GateCellsTable(runs, kRows).Print(TextOutput(table, TableStyle{TableFormat::kMarkdown, 0}));
+    out += table.str() + "\n";
+  }
+  if (worse > kRows) {
+    out += fmt::format("... and {} more worse cells (the gate's --json has them all).\n\n", worse - kRows);
+  }
   if (counts.improvements > 0) out += fmt::format("{} cells improved.\n\n", counts.improvements);
   out += fmt::format("<sub>{}.</sub>\n", ToleranceLine(tolerance));
   return out;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/base/json_reader.h"
+#include "bench/base/text_table.h"
 #include "bench/gate/gate.h"
 
 namespace depthbench {
@@ -32,6 +33,12 @@ std::string GateJUnit(const std::vector<GateRun>& runs);
 // worse cell by the band that changed most with the command that replays
 // it (at most 20 rows), then the tolerance.
 std::string GateSummaryMarkdown(const std::vector<GateRun>& runs, const GateTolerance& tolerance);
+// The worse cells as a table (the first `max_rows`): each by the band that
+// changed most, what changed, the sample replayed (where the change shows:
+// the shader part's worst sample when that part got worse) with its band
+// figure before and after, and the command that replays it. What gate
+// prints with --table-format csv, markdown or json.
+TextTable GateCellsTable(const std::vector<GateRun>& runs, std::size_t max_rows);
 nlohmann::json GateJson(const std::vector<GateRun>& runs, const GateTolerance& tolerance);
 
 }  // namespace depthbench
