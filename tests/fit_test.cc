@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bench/fit/precision_fit.h"
 #include "bench/models/error_model.h"
 
 namespace depthbench {
@@ -93,6 +94,38 @@ TEST(FitTest, IntervalsCoverTheTruthAtTheirNominalRate) {
   const double rate = static_cast<double>(covered) / kFits;
   EXPECT_GT(rate, 0.95 - 0.033);
   EXPECT_LT(rate, 0.95 + 0.033);
+}
+
+// A far/near budget is read on the upper end of the prediction's interval,
+// so that another run of the same cell gives the same answer: "never" only
+// when even the interval's lower end misses the budget at f/n 10.
+TEST(FitTest, BudgetRatiosComeFromTheInterval) {
+  const double limit = 24.0 + std::log2(1e-6);  // 4.07 bits
+  std::mt19937_64 rng(5);
+  // A constant error 0.05 bit above the budget, half a bit either side:
+  // the point estimate misses it everywhere, the interval does not say so.
+  std::vector<FitPoint> flat;
+  for (int k = 0; k < 6; ++k) flat.push_back({4.0 + k, 4.0 + k, limit + 0.05 + (k % 2 == 0 ? 0.5 : -0.5)});
+  auto near_limit = FitModel(flat, ModelKind::kConstant);
+  ASSERT_TRUE(near_limit.ok());
+  ASSERT_GT(near_limit->Predict(4.0, 4.0), limit);  // the old rule said "never" here
+  const std::optional<double> uncertain = BudgetRatioOf(*near_limit, 1e-6, 1e8);
+  ASSERT_TRUE(uncertain.has_value());
+  EXPECT_EQ(*uncertain, 10.0);  // at most the lowest ratio, not "never"
+  // Six bits above it, the interval's lower end misses too: never.
+  for (FitPoint& p : flat) p.b += 6.0;
+  auto far_above = FitModel(flat, ModelKind::kConstant);
+  ASSERT_TRUE(far_above.ok());
+  EXPECT_EQ(BudgetRatioOf(*far_above, 1e-6, 1e8), std::optional<double>(0.0));
+  // One bit lost per doubling, crossing the budget at x = 10.07 (f/n 1.07e3):
+  // the ratio given is below that crossing (the upper end crosses first).
+  auto slope = Grid(rng, 0.2, [](double x, double) { return x - 6.0; });
+  auto ratio = FitModel(slope, ModelKind::kRatio);
+  ASSERT_TRUE(ratio.ok());
+  const std::optional<double> met = BudgetRatioOf(*ratio, 1e-6, 1e8);
+  ASSERT_TRUE(met.has_value());
+  EXPECT_LT(*met, std::exp2(limit + 6.0));
+  EXPECT_GT(*met, std::exp2(limit + 6.0) / 2.0);  // 0.2-bit noise over ~80 points: well under one doubling
 }
 
 TEST(FitTest, StudentQuantiles) {

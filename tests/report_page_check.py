@@ -121,7 +121,10 @@ def check_browser(report_dir, artifact_dir):
         document = json.load(f)
     check_small_multiples(check, document)
     check_differences_and_findings(check, document)
-    check_first_screen(page, artifact_dir, chromium)
+    if check.get("split_parts") != ["arith", "production", "storage"]:
+        fail("the chart of error parts draws %s, not the three parts (production, storage, arith)" %
+             check.get("split_parts"))
+    check_first_screen(page, artifact_dir, chromium, document)
     print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
           (check["headline_rows"], check["plots"], shot))
 
@@ -184,10 +187,12 @@ def check_differences_and_findings(check, document):
     print("GPU against CPU: %r; findings: %d causes" % (check["diff_text"][:80], len(groups)))
 
 
-def check_first_screen(page, artifact_dir, chromium):
-    """At 1024x768 the first-screen table is wholly visible, with a row
-    per convention and format and the variant, cost and budget columns;
-    its screenshot is saved (docs/report-first-screen.png is one)."""
+def check_first_screen(page, artifact_dir, chromium, document):
+    """At 1024x768 the first-screen table is wholly visible: the lever
+    table, a row per convention and format with the budget, world-unit,
+    bytes and cost columns before the variant; a row that keeps nothing
+    says "do not use", never a variant; its screenshot is saved
+    (docs/report-first-screen.png is one)."""
     with tempfile.TemporaryDirectory() as profile:
         common = [chromium] + CHROMIUM_FLAGS + ["--user-data-dir=" + profile, "--virtual-time-budget=" + VIRTUAL_TIME_MS,
                                                 "--window-size=1024,768", "--hide-scrollbars"]
@@ -206,9 +211,33 @@ def check_first_screen(page, artifact_dir, chromium):
         fail("the viewport is %s, not within 1024x768" % first["window"])
     if first["rows"] < 1:
         fail("the first-screen table is empty")
-    for column in ["use", "cost", "f/n for 1e-3", "f/n for 1e-6"]:
+    for column in ["use", "cost", "f/n for 1e-3", "f/n for 1e-6", "far at 100 m", "at 10 km", "B/px"]:
         if column not in first["columns"]:
             fail("the first-screen table has no '%s' column: %s" % (column, first["columns"]))
+    if first["columns"][-1] != "use":
+        fail("the variant comes before the lever: columns %s" % first["columns"])
+    use = first["columns"].index("use")
+    recommendations = document["recommendations"]
+    if len(first["cells"]) != len(recommendations):
+        fail("the first screen shows %d rows, the document has %d" % (len(first["cells"]), len(recommendations)))
+    kept = [r["bits"] if r["bits"] is not None else 99 for r in recommendations]
+    if kept != sorted(kept):
+        fail("the first screen does not lead with the combinations that keep the most bits: %s" % kept)
+    nothing = 0
+    for row, cells in zip(recommendations, first["cells"]):
+        low = row["bits_low"] if row["bits_low"] is not None else row["bits"]
+        if low is not None and low >= 23.0 and cells[use] != "do not use":
+            fail("%s/%s keeps nothing (%.1f bits lost at least) yet says %r" %
+                 (row["convention"], row["format"], low, cells[use]))
+        if row["keeps_nothing"]:
+            nothing += 1
+            if cells[use] != "do not use":
+                fail("%s/%s: 'do not use' expected, the page says %r" % (row["convention"], row["format"], cells[use]))
+        metres = cells[first["columns"].index("far at 100 m")]
+        if row["bits"] is not None and not re.fullmatch(r"[0-9.e-]+ (mm|cm|m|km)", metres):
+            fail("%s/%s: no world units at 100 m: %r" % (row["convention"], row["format"], metres))
+    print("first screen: %d 'do not use' rows, world units such as %r" %
+          (nothing, first["cells"][0][first["columns"].index("far at 100 m")]))
     if not first["visible"]:
         fail("the first-screen table is not wholly visible at 1024x768: it ends at x %d, y %d" %
              (first["right"], first["bottom"]))

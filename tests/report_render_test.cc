@@ -38,7 +38,7 @@ Report LargestReport() {
     row.bits_low = 20.1;
     row.bits_high = 20.3;
     row.cost = 1.61;
-    row.cost_unit = "µs per 1920x1080 frame on NVIDIA H100 80GB HBM3";
+    row.cost_unit = "µs per 1920x1080 frame on NVIDIA H200";
     row.ratio_for_1e3 = {BudgetRatio::Kind::kRatio, 134.0};
     row.ratio_for_1e6 = {BudgetRatio::Kind::kNever, {}};
     report.recommendations.push_back(row);
@@ -98,6 +98,26 @@ TEST(ReportRenderTest, SummaryIsAVerdictLineThenAtMostFortyLines) {
   EXPECT_EQ(summary.find("| standard-inf |"), std::string::npos) << summary;
   EXPECT_NE(summary.find("... and 9 more: see report.html"), std::string::npos) << summary;
   EXPECT_NE(summary.find("... and 2 more causes"), std::string::npos) << summary;
+}
+
+// The first screen leads with the lever: a combination that keeps nothing
+// says "do not use", never a variant; the others name theirs, with the
+// error in world units and the bytes a frame moves.
+TEST(ReportRenderTest, FirstScreenSaysDoNotUseWhereNothingIsKept) {
+  Report report = LargestReport();
+  RecommendationRow& lost = report.recommendations.front();
+  lost.keeps_nothing = true;
+  lost.bits = lost.bits_low = lost.bits_high = 24.0;
+  RecommendationRow& kept = report.recommendations[1];
+  kept.bytes_per_pixel = 8;
+  kept.error_far_100m = 0.0031;  // 3.1 mm
+  kept.error_far_10km = 31.0;
+  const std::string summary = RenderMarkdown(report);
+  const std::string lost_line = "| " + lost.convention + " | " + lost.format + " | **do not use**: keeps nothing |";
+  EXPECT_NE(summary.find(lost_line), std::string::npos) << summary;
+  const std::string kept_line = "| " + kept.convention + " | " + kept.format + " | `inverse_vp` (= pq, reciprocal, "
+                                "divide) | 1e4 | 20.2 [20.1, 20.3] | 3.1 mm | 31 m | 8 |";
+  EXPECT_NE(summary.find(kept_line), std::string::npos) << summary;
 }
 
 // Without a history (the first run, or --no-history) it is shorter still.

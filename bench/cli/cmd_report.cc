@@ -185,7 +185,7 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
       "Examples:\n"
       "  depthbench report --out reports/out\n"
       "  depthbench report --quick --out /tmp/report --history /tmp/history.sqlite\n"
-      "  depthbench report --out out --backend vulkan --device nvidia --speed reports/speed/nvidia-h100.json");
+      "  depthbench report --out out --backend vulkan --device nvidia --speed reports/speed/nvidia-h200.json");
   cmd->add_option("--out", flags->out, "folder to write report.html, report.md and results.json into (created)")
       ->required();
   cmd->add_option("--summary", flags->summary,

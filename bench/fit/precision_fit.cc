@@ -28,11 +28,6 @@ bool InfiniteFar(const Cell& cell) {
   return c.hardware && (c.bits & 2u) != 0u;
 }
 
-// The far plane's b for a model: the point at eye depth = far, where a
-// band's point sits for the deepest band (CollectBandPoints). Bits lost
-// saturate: 24 means nothing left, whatever the model's line says beyond.
-double FarPlane(const FittedModel& m, double x) { return std::clamp(m.Predict(x, x), 0.0, kAllBitsLost); }
-
 // What `m` says at (x, y) with its 95% interval, each held to 0..24 bits:
 // the interval is the unclamped prediction's, so that a prediction held at
 // 24 keeps the interval's lower end, and clamping (monotone) keeps the
@@ -42,6 +37,30 @@ Estimate ClampedEstimate(const FittedModel& m, double x, double y) {
   const auto clamp = [](double b) { return std::isnan(b) ? b : std::clamp(b, 0.0, kAllBitsLost); };
   return {clamp(e.value), clamp(e.low), clamp(e.high)};
 }
+
+}  // namespace
+
+// The interval's ends, where the fit has no covariance (NaN), fall back to
+// the prediction.
+std::optional<double> BudgetRatioOf(const FittedModel& m, double budget, double highest_ratio) {
+  const double limit = 24.0 + std::log2(budget);
+  const double lowest = std::log2(kLowestRatio);
+  const auto ends = [&](double x) {
+    const Estimate e = ClampedEstimate(m, x, x);
+    return std::pair{std::isnan(e.low) ? e.value : e.low, std::isnan(e.high) ? e.value : e.high};
+  };
+  // The far plane: the point at eye depth = far, where the deepest band's
+  // point sits (CollectBandPoints); bits lost saturate at 24.
+  if (ends(lowest).first > limit) return 0.0;
+  std::optional<double> last_met;
+  for (double x = lowest; x <= std::log2(highest_ratio) + 1e-9; x += 0.05) {
+    if (ends(x).second > limit) return last_met.value_or(kLowestRatio);
+    last_met = std::exp2(x);
+  }
+  return std::nullopt;
+}
+
+namespace {
 
 // Points at or above this carry no slope: the error has reached the
 // distance itself (a quarter bit below 24: the statistics' resolution).
@@ -213,17 +232,7 @@ std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& p
             fit.predicted_interval[name] = {at.low, at.high};
           }
           for (const auto& [name, budget] : kBudgets) {
-            const double limit = 24.0 + std::log2(budget);
-            std::optional<double> last_met;
-            bool ever_failed = false;
-            for (double x = std::log2(kLowestRatio); x <= std::log2(highest_ratio) + 1e-9; x += 0.05) {
-              if (FarPlane(m, x) <= limit) {
-                if (!ever_failed) last_met = std::exp2(x);
-              } else {
-                ever_failed = true;
-              }
-            }
-            fit.budget_ratio[name] = !ever_failed ? std::nullopt : std::optional<double>(last_met.value_or(0.0));
+            fit.budget_ratio[name] = BudgetRatioOf(m, budget, highest_ratio);
           }
           // Hold-out: refit the chosen kind without the held-out ratios.
           std::vector<FitPoint> train, test;

@@ -88,14 +88,22 @@ struct PrecisionFit {
   // NaN where the fit has no covariance).
   std::map<std::string, std::pair<double, double>> predicted_interval;
   // The largest far/near ratio at which the far plane still meets a
-  // relative-error budget; nullopt when the budget is met throughout
-  // [10, 1e12], 0 when it is not met even at 10.
+  // relative-error budget, on the upper end of the prediction's 95%
+  // interval (so that another run of the same cell agrees); nullopt
+  // ("always") when that upper end meets it throughout the data, 0
+  // ("never") only when even the interval's lower end misses it at the
+  // lowest ratio. Where the upper end misses at the lowest ratio but the
+  // lower end does not, the lowest ratio.
   std::map<std::string, std::optional<double>> budget_ratio;  // "1e-3", "1e-6"
   // Hold-out check: fitted without the held-out ratios, how far the model
   // misses their points, in bits.
   double holdout_max_miss = 0.0, holdout_rms_miss = 0.0;
   int holdout_points = 0;
 };
+
+// PrecisionFit::budget_ratio of a fitted model for a relative-error
+// budget, over ratios from 10 to `highest_ratio`.
+std::optional<double> BudgetRatioOf(const FittedModel& model, double budget, double highest_ratio);
 
 // `progress` is told (cells fitted, cells to fit) after each (cell, backend).
 std::vector<PrecisionFit> FitPrecision(const FitSweeps& sweeps, const FitPlan& plan, std::span<const Metric> metrics,

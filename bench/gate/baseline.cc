@@ -87,7 +87,7 @@ const JsonFields<BandFigures>& BandFiguresFields() {
       JsonMember("inf", &BandFigures::inf),
       JsonMember("worst_index", &BandFigures::worst_index, JsonIndexOrNull()),
       // (absent from baselines made before it was kept)
-      JsonMemberOr("arith_worst_index", &BandFigures::arith_worst_index, JsonIndexOrNull(), UINT64_MAX),
+      JsonOptionalMember("arith_worst_index", &BandFigures::arith_worst_index, JsonIndexOrNull()),
       JsonMember("first_nonfinite_index", &BandFigures::first_nonfinite_index, JsonIndexOrNull()),
   }};
   return fields;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,9 +35,10 @@ struct BandFigures {
   std::uint64_t judged = 0, nan = 0, inf = 0;
   std::uint64_t worst_index = 0;            // the sample with the largest total error
   // The sample with the largest error of the shader's part: where an edit
-  // of the shader shows even when storage dominates the total. UINT64_MAX
-  // when unknown (baselines made before it was kept).
-  std::uint64_t arith_worst_index = UINT64_MAX;
+  // of the shader shows even when storage dominates the total (UINT64_MAX
+  // when there is none). Unknown in baselines made before it was kept,
+  // which are written back without it.
+  std::optional<std::uint64_t> arith_worst_index;
   std::uint64_t first_nonfinite_index = 0;  // UINT64_MAX when there is none
   friend bool operator==(const BandFigures&, const BandFigures&) = default;
 };

@@ -32,7 +32,9 @@ std::uint64_t ReplayIndex(const BandChange& change) {
   if (change.after.nan > change.before.nan || change.after.inf > change.before.inf) {
     return change.after.first_nonfinite_index;
   }
-  if (ShaderPartWorse(change) && change.after.arith_worst_index != kNone) return change.after.arith_worst_index;
+  if (ShaderPartWorse(change) && change.after.arith_worst_index.value_or(kNone) != kNone) {
+    return *change.after.arith_worst_index;
+  }
   return change.after.worst_index;
 }
 
@@ -43,7 +45,7 @@ std::string ReplayFigures(const BandChange& change) {
     return fmt::format("the first NaN or Inf (NaN {} -> {}, Inf {} -> {})", change.before.nan, change.after.nan,
                        change.before.inf, change.after.inf);
   }
-  if (ShaderPartWorse(change) && change.after.arith_worst_index != kNone) {
+  if (ShaderPartWorse(change) && change.after.arith_worst_index.value_or(kNone) != kNone) {
     return fmt::format("the worst sample of the shader's part: its band maximum {:.1f} -> {:.1f} bits lost",
                        change.before.arith_max, change.after.arith_max);
   }

@@ -330,11 +330,12 @@ SpeedSection Speed(const ReportMeasurements& m) {
     source.source = source_name(path, speed);
     source.kind = speed.run.device.kind == DeviceKind::kGpu ? CostKind::kMeasuredGpu : CostKind::kMeasuredSoftware;
     source.device = speed.run.device.name;
-    source.cost_unit =
-        fmt::format("GPU µs per {} frame, from the ALU-bound time per reconstruction at {} (measured {})",
-                    ResolutionName(kCostFrame), ResolutionName(speed.run.trade_resolution), speed.run.started_at);
+    source.cost_unit = fmt::format(
+        "the reconstruction's ALU time in µs per {} frame (one per pixel; no depth traffic: the first screen's cost "
+        "adds it), from the ALU-bound time per reconstruction at {} (measured {})",
+        ResolutionName(kCostFrame), ResolutionName(speed.run.trade_resolution), speed.run.started_at);
     source.cost_title =
-        fmt::format("GPU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
+        fmt::format("ALU time per {} frame (µs) on {}", ResolutionName(kCostFrame), speed.run.device.name);
     source.accuracy = accuracy;
     section.sources.push_back(std::move(source));
   }
@@ -482,8 +483,19 @@ std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
     row.cost_unit = costs.unit;
     row.ratio_for_1e3 = Budget(chosen, "1e-3");
     row.ratio_for_1e6 = Budget(chosen, "1e-6");
+    row.keeps_nothing = (row.bits_low ? *row.bits_low : bits_of(&chosen)) >= kKeepsNothingBits;
+    row.bytes_per_pixel = FrameBytesOf(chosen.cell, false).moved();
+    if (row.bits) {
+      const double relative = std::exp2(*row.bits - 24.0);
+      row.error_far_100m = Shown(100.0 * relative);
+      row.error_far_10km = Shown(10000.0 * relative);
+    }
     rows.push_back(std::move(row));
   }
+  // The lever first: the combinations that keep the most bits lead.
+  std::stable_sort(rows.begin(), rows.end(), [](const RecommendationRow& a, const RecommendationRow& b) {
+    return a.bits.value_or(kAllBitsLost) < b.bits.value_or(kAllBitsLost);
+  });
   return rows;
 }
 

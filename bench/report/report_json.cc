@@ -192,7 +192,11 @@ nlohmann::json ReportToJson(const Report& report) {
                                                             {"cost_kind", CostKindName(r.cost_kind)},
                                                             {"cost_unit", r.cost_unit},
                                                             {"ratio_for_1e-3", Budget(r.ratio_for_1e3)},
-                                                            {"ratio_for_1e-6", Budget(r.ratio_for_1e6)}};
+                                                            {"ratio_for_1e-6", Budget(r.ratio_for_1e6)},
+                                                            {"keeps_nothing", r.keeps_nothing},
+                                                            {"bytes_per_pixel", r.bytes_per_pixel},
+                                                            {"error_far_100m", Value(r.error_far_100m)},
+                                                            {"error_far_10km", Value(r.error_far_10km)}};
                                               })},
                      {"headline", Rows(report.headline, Headline)},
                      {"precision_points", Rows(report.precision_points, ModelPoint)},

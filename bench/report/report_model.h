@@ -231,9 +231,19 @@ struct RecommendationRow {
   Figure bits, bits_low, bits_high;   // p99.9 bits lost at the far plane, the model's 95% interval
   Figure cost;                        // none: no cost known
   CostKind cost_kind = CostKind::kStaticModel;
-  std::string cost_unit;  // "µs per 1920x1080 frame on NVIDIA H100", "FMA-equivalent slots"
+  std::string cost_unit;  // "µs per 1920x1080 frame on llvmpipe (...)", "FMA-equivalent slots"
   BudgetRatio ratio_for_1e3, ratio_for_1e6;
+  // Nothing survives: even the interval's lower end loses kKeepsNothingBits
+  // or more. Such a row says "do not use", never a variant.
+  bool keeps_nothing = false;
+  std::uint32_t bytes_per_pixel = 0;  // the frame's depth traffic (frame_cost.h), no stencil
+  // The far plane's error in world units (metres), at this row's far/near,
+  // with the far plane at 100 m and at 10 km.
+  Figure error_far_100m, error_far_10km;
 };
+// A combination whose p99.9 at the far plane keeps less than one bit, even
+// at the lower end of its interval, keeps nothing.
+inline constexpr double kKeepsNothingBits = 23.0;
 
 struct Report {
   ReportEnvironment environment;

@@ -32,6 +32,14 @@ constexpr std::string_view kDataMark = "/*DEPTHBENCH:DATA*/null";
 // Bits lost; a figure that is not finite means every bit is lost.
 std::string Bits(const Figure& bits) { return bits ? fmt::format("{:.1f}", *bits) : "all"; }
 std::string Number(const Figure& x) { return x ? Readable(*x) : "-"; }
+// A length in metres, in the unit that reads best: "0.31 mm", "4.2 cm", "1.5 m".
+std::string Metres(const Figure& x) {
+  if (!x) return "-";
+  if (*x < 0.01) return Readable(*x * 1e3, 2) + " mm";
+  if (*x < 1.0) return Readable(*x * 1e2, 2) + " cm";
+  if (*x < 1e3) return Readable(*x, 2) + " m";
+  return Readable(*x * 1e-3, 2) + " km";
+}
 
 std::string Budget(const BudgetRatio& b) {
   switch (b.kind) {
@@ -131,6 +139,7 @@ void WhatToUse(const Report& report, std::string& out) {
   }
   const auto use = [](const RecommendationRow* r) {
     if (r == nullptr) return std::string("-");
+    if (r->keeps_nothing) return std::string("**do not use**: keeps nothing");
     std::string text = "`" + r->variants.front() + "`";
     if (r->variants.size() > 1) {
       text +=
@@ -144,22 +153,41 @@ void WhatToUse(const Report& report, std::string& out) {
         r->bits_low && r->bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r->bits_low, *r->bits_high) : "";
     return Bits(r->bits) + interval;
   };
-  out += fmt::format("## What to use ({} backend; cost in {})\n\n", first.backend, first.cost_unit);
+  out += fmt::format("## What to use: the convention and format first ({} backend; cost in {})\n\n", first.backend,
+                     first.cost_unit);
   out +=
-      "| convention | format | use | f/n | bits lost [95%] | cost | f/n for 1e-3 | f/n for 1e-6 | infinite far: use | "
-      "bits lost [95%] |\n";
-  out += "|---|---|---|---|---:|---:|---:|---:|---|---:|\n";
+      "| convention | format | use | f/n | bits lost [95%] | far plane at 100 m | at 10 km | B/px | cost | f/n for "
+      "1e-3 | f/n for 1e-6 | infinite far: use | bits lost [95%] |\n";
+  out += "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
   for (const Line& l : lines) {
     const RecommendationRow* f = l.finite;
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", l.convention, l.format, use(f),
-                       f ? f->ratio : "-", bits(f), f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", l.convention, l.format,
+                       use(f), f ? f->ratio : "-", bits(f), f ? Metres(f->error_far_100m) : "-",
+                       f ? Metres(f->error_far_10km) : "-", f ? std::to_string(f->bytes_per_pixel) : "-",
+                       f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
                        f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite));
   }
+  // The lever in one sentence, from the rows themselves.
+  const auto find = [&](const char* convention) -> const RecommendationRow* {
+    for (const RecommendationRow& r : report.recommendations)
+      if (r.convention == convention && r.format == "d32_sfloat" && r.bits) return &r;
+    return nullptr;
+  };
+  const RecommendationRow *reversed = find("reversed"), *standard = find("standard");
+  const std::string lever =
+      reversed && standard ? fmt::format(" (with D32F at f/n {}, reversed Z loses {} bits at the far plane where "
+                                         "standard Z loses {})",
+                                         reversed->ratio, Bits(reversed->bits), Bits(standard->bits))
+                           : "";
   out += fmt::format(
-      "\nUse: the cheapest variant within {} bit of the most precise (= tied ones); bits lost at p99.9 at the far "
-      "plane, the model's 95% interval; f/n for 1e-3 and 1e-6: the far/near up to which the far plane keeps that "
-      "relative error; infinite far: the convention's -inf form, at its far end.\n\n",
-      kResolvedBits);
+      "\nThe combinations that keep the most bits first: the convention and format are the lever{}; the variant "
+      "moves it by a bit or less. Use: the cheapest variant within {} bit of the most precise (= tied ones); 'do not use' where even the "
+      "interval's lower end keeps less than one bit. Bits lost at p99.9 at the far plane at that far/near, with the "
+      "model's 95% interval, and that error in world units with the far plane at 100 m (near 1 cm) and 10 km (near "
+      "1 m); B/px: the depth bytes a frame moves per pixel (no stencil); f/n for 1e-3 and 1e-6: the far/near up to "
+      "which the upper end of the far plane's interval keeps that relative error; infinite far: the convention's "
+      "-inf form, at its far end.\n\n",
+      lever, kResolvedBits);
 }
 
 // The worst cells over the default domain and the NaN/Inf findings by
