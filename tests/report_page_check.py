@@ -238,10 +238,40 @@ def check_first_screen(page, artifact_dir, chromium, document):
             fail("%s/%s: no world units at 100 m: %r" % (row["convention"], row["format"], metres))
     print("first screen: %d 'do not use' rows, world units such as %r" %
           (nothing, first["cells"][0][first["columns"].index("far at 100 m")]))
-    if not first["visible"]:
+    scene = document.get("scene")
+    if scene is not None:
+        check_scene_screen(first, scene)
+    elif not first["visible"]:
         fail("the first-screen table is not wholly visible at 1024x768: it ends at x %d, y %d" %
              (first["right"], first["bottom"]))
     print("first screen at 1024x768: %d rows, columns %s, ends at y %d" % (first["rows"], first["columns"], first["bottom"]))
+
+
+def check_scene_screen(first, scene):
+    """A scene report opens on the scene's table, wholly visible at
+    1024x768: a row per convention and format of its engine, the measured
+    error in the requirement's unit, and "do not use" where the
+    requirement is not met, the variant where it is."""
+    page = first.get("scene")
+    if not page:
+        fail("the report has a scene, the page shows no scene table")
+    if page["bottom"] > first["window"][1]:
+        fail("the scene table is not wholly visible at 1024x768: it ends at y %d" % page["bottom"])
+    if len(page["cells"]) != len(scene["rows"]) or not scene["rows"]:
+        fail("the scene table shows %d rows, the document has %d" % (len(page["cells"]), len(scene["rows"])))
+    use = page["columns"].index("use")
+    measured = page["columns"].index("measured (upper)")
+    refused = 0
+    for row, cells in zip(scene["rows"], page["cells"]):
+        if row["meets"] and cells[use] != row["variant"]:
+            fail("%s/%s meets the requirement, the page says %r" % (row["convention"], row["format"], cells[use]))
+        if not row["meets"]:
+            refused += 1
+            if not cells[use].startswith("do not use"):
+                fail("%s/%s fails the requirement, the page says %r" % (row["convention"], row["format"], cells[use]))
+        if row["measured"] is not None and not re.fullmatch(r"[0-9.e-]+", cells[measured]):
+            fail("%s/%s: no measured figure: %r" % (row["convention"], row["format"], cells[measured]))
+    print("scene %r (%s): %d rows, %d 'do not use'" % (scene["name"], scene["requirement"], len(scene["rows"]), refused))
 
 
 if __name__ == "__main__":

@@ -511,6 +511,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   ChooseResult result;
   result.scene = scene.name;
   result.requirement = scene.requirement.Describe();
+  result.limit = scene.requirement.value;
   result.backend = backend.name();
   result.device = backend.device().name;
   result.unusable_formats = scene.UnusableFormats();

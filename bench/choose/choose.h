@@ -99,6 +99,7 @@ struct WhatIf {
 struct ChooseResult {
   std::string scene;
   std::string requirement;
+  double limit = 0.0;  // the requirement's limit, in its own unit
   std::string backend, device;
   std::string cost_unit, cost_source;
   std::string cost_note;                 // why the static model ranks, when a speed file was given

@@ -28,6 +28,7 @@ struct ReportFlags {
   std::string samples, default_samples;
   std::uint64_t seed = 7;
   std::vector<std::string> speed;
+  std::string scene;
   std::string summary;
   bool no_speed = false;
   std::string plot_library;   // default: the data folder's
@@ -68,6 +69,9 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   plan.speed_files_named = !f.speed.empty();
   for (const fs::path& file : plan.speed_files) {
     DB_RETURN_IF_ERROR(CheckReadableFile(file, kMaxJsonFileBytes).WithContext("--speed"));
+  }
+  if (!f.scene.empty()) {
+    DB_ASSIGN_OR_RETURN(plan.scene, LoadScene(f.scene, context.catalogue));
   }
 
   // Everything that can be refused is refused before the sweeps run.
@@ -205,6 +209,9 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
                   "each labelled with the device it was measured on (default: the reports/speed/*.json committed "
                   "with depthbench that were measured on a device this report runs on)");
   cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses the static cost model only");
+  cmd->add_option("--scene", flags->scene,
+                  "a scene file (TOML, see bench/scenes/): the first screen opens on its choice, as depthbench "
+                  "choose makes it: per convention and format its engine allows, whether the requirement is met");
   cmd->add_option("--plot-library", flags->plot_library,
                   "node_modules folder holding vega, vega-lite and vega-embed (default: the data folder's "
                   "reports/node_modules, which ./setup.sh installs with npm ci --prefix reports)");

@@ -395,7 +395,8 @@ struct ScreenCosts {
   CostKind kind = CostKind::kStaticModel;
   std::string unit = kStaticCostUnit;
 };
-ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> candidates) {
+ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> candidates, Resolution frame = kCostFrame,
+                           bool stencil = false) {
   const SpeedResults* best = nullptr;
   std::string best_name;
   for (const auto& [path, speed] : m.speed) {
@@ -410,7 +411,7 @@ ScreenCosts CostsForScreen(const ReportMeasurements& m, std::span<const Cell> ca
   if (best != nullptr) {
     // The measurements outlive the screen built from them: the model
     // refers to them without owning them.
-    model = {std::shared_ptr<const SpeedResults>(std::shared_ptr<void>(), best), best_name, kCostFrame, false};
+    model = {std::shared_ptr<const SpeedResults>(std::shared_ptr<void>(), best), best_name, frame, stencil};
     sources.measured = FrameCostLookup(model);
   }
   const CostChoice choice = ChooseCosts(sources, candidates);
@@ -497,6 +498,57 @@ std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
     return a.bits.value_or(kAllBitsLost) < b.bits.value_or(kAllBitsLost);
   });
   return rows;
+}
+
+// The scene's choice on the backend the first screen speaks for (the
+// Vulkan one where the report runs it), costed as the first screen is, at
+// the scene's resolution and stencil.
+Expected<ChooseResult> ChooseScene(const Scene& scene, const ReportPlan& plan, std::span<Backend* const> backends,
+                                   const ReportMeasurements& m) {
+  Backend* backend = backends.front();
+  for (Backend* b : backends)
+    if (b->name() == "vulkan") backend = b;
+  const std::vector<Cell> candidates = scene.Candidates();
+  const ScreenCosts costs = CostsForScreen(m, candidates, scene.resolution.value_or(kCostFrame), scene.stencil);
+  CostSources sources{costs.kind == CostKind::kStaticModel ? CostLookup() : costs.lookup, costs.unit, m.static_costs,
+                      ""};
+  ChooseOptions options;
+  options.samples = plan.main_samples;
+  options.seed = plan.main_seed;
+  return Choose(scene, *backend, sources, options);
+}
+
+// The scene's first screen: each convention and format once, by its best
+// candidate, in the order of the ranking.
+SceneSection SceneScreen(const ChooseResult& choice) {
+  SceneSection section{choice.scene, choice.requirement, choice.backend, choice.cost_unit, {}, {}, {}};
+  for (const CandidateVerdict& v : choice.ranked) {
+    const std::string convention(Info(v.cell.convention).name), format(Info(v.cell.format).name);
+    const bool seen = std::any_of(section.rows.begin(), section.rows.end(), [&](const SceneRow& r) {
+      return r.convention == convention && r.format == format;
+    });
+    if (seen) continue;
+    SceneRow row;
+    row.convention = convention;
+    row.format = format;
+    row.variant = std::string(v.cell.variant_info().name);
+    row.measured = Shown(v.interval.high);
+    row.far_end = Shown(v.far_end_measured);
+    row.meets = v.meets;
+    row.times_limit = choice.limit > 0.0 ? v.interval.high / choice.limit : 0.0;
+    if (v.cost) {
+      row.bytes_per_pixel = v.cost->bytes_per_pixel;
+      row.cost = Shown(v.cost->value);
+    }
+    section.rows.push_back(std::move(row));
+  }
+  for (const WhatIf& w : choice.what_ifs) {
+    section.what_ifs.push_back(w.candidate.empty() ? w.change
+                                                   : fmt::format("{}: {} at {:.3g}, {}", w.change, w.candidate,
+                                                                 w.figure, w.meets ? "meets it" : "still fails"));
+  }
+  section.not_candidates = choice.unusable_formats;
+  return section;
 }
 
 ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& m) {
@@ -644,6 +696,11 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   DB_ASSIGN_OR_RETURN(m.main, RunSweep(main, backends));
   end("default-domain sweep", fmt::format("{} cells", m.main.cells.size()));
 
+  if (plan.scene) {
+    begin("scene");
+    DB_ASSIGN_OR_RETURN(m.scene_choice, ChooseScene(*plan.scene, plan, backends, m));
+    end("scene", fmt::format("{} candidates", m.scene_choice->ranked.size()));
+  }
   begin("error models");
   const Metric metrics[] = {Metric::kTotal};
   m.fits = FitPrecision(m.sweeps, fit_plan, metrics, kAllLevels, progress.fits);
@@ -676,6 +733,7 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   Findings(m, report);
   report.speed = Speed(m);
   report.recommendations = Recommendations(m);
+  if (m.scene_choice) report.scene = SceneScreen(*m.scene_choice);
   report.worst_cells = WorstCells(report.headline);
   return report;
 }

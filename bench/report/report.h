@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -53,6 +54,8 @@ struct ReportPlan {
   bool speed_files_named = false;
   std::filesystem::path shader_dir;  // for the instruction mix
   int trend_runs = 60;               // runs of the history the trend shows
+  // A scene (--scene): its choice (choose.h) leads the first screen.
+  std::optional<Scene> scene;
 
   // The nightly plan, and the quick one (same sweeps, fewer samples).
   static ReportPlan Nightly();
@@ -80,6 +83,7 @@ struct ReportMeasurements {
   CostLookup static_costs;
   Status static_costs_status;
   std::vector<std::pair<std::string, double>> stage_seconds;
+  std::optional<ChooseResult> scene_choice;  // with ReportPlan::scene
 };
 
 

@@ -173,11 +173,30 @@ json History(const std::optional<HistorySection>& h) {
            })}};
 }
 
+json SceneJson(const std::optional<SceneSection>& scene) {
+  if (!scene) return nullptr;
+  return {{"name", scene->name},
+          {"requirement", scene->requirement},
+          {"backend", scene->backend},
+          {"cost_unit", scene->cost_unit},
+          {"rows", Rows(scene->rows,
+                        [](const SceneRow& r) {
+                          return json{{"convention", r.convention},     {"format", r.format},
+                                      {"variant", r.variant},           {"measured", Value(r.measured)},
+                                      {"far_end", Value(r.far_end)},    {"meets", r.meets},
+                                      {"times_limit", r.times_limit},   {"bytes_per_pixel", r.bytes_per_pixel},
+                                      {"cost", Value(r.cost)}};
+                        })},
+          {"what_ifs", scene->what_ifs},
+          {"not_candidates", scene->not_candidates}};
+}
+
 }  // namespace
 
 nlohmann::json ReportToJson(const Report& report) {
   return WithSchema(kReportSchema,
                     {{"environment", Environment(report.environment)},
+                     {"scene", SceneJson(report.scene)},
                      {"recommendations", Rows(report.recommendations,
                                               [](const RecommendationRow& r) {
                                                 return json{{"convention", r.convention},

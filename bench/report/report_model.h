@@ -245,8 +245,27 @@ struct RecommendationRow {
 // at the lower end of its interval, keeps nothing.
 inline constexpr double kKeepsNothingBits = 23.0;
 
+// A scene's first screen (report --scene): per convention and format the
+// scene's engine allows, its best candidate as `choose` ranks them, whether
+// it meets the scene's requirement, in the requirement's own unit.
+struct SceneRow {
+  std::string convention, format, variant;
+  Figure measured;  // the upper end of the 95% interval, at the requirement's level and depth
+  Figure far_end;   // measured at the scene's far end
+  bool meets = false;
+  double times_limit = 0.0;  // measured / the requirement's limit
+  std::uint32_t bytes_per_pixel = 0;
+  Figure cost;
+};
+struct SceneSection {
+  std::string name, requirement, backend, cost_unit;
+  std::vector<SceneRow> rows;  // the choice first, then as ranked
+  std::vector<std::string> what_ifs, not_candidates;
+};
+
 struct Report {
   ReportEnvironment environment;
+  std::optional<SceneSection> scene;  // with report --scene
   std::vector<RecommendationRow> recommendations;
   std::vector<HeadlineRow> headline;
   std::vector<ModelPointRow> precision_points;  // deepest decade of each ratio, p99.9 and max

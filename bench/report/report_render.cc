@@ -190,6 +190,29 @@ void WhatToUse(const Report& report, std::string& out) {
       lever, kResolvedBits);
 }
 
+// The scene's first screen (report --scene): per convention and format its
+// best candidate and whether it meets the scene's requirement.
+void YourScene(const Report& report, std::string& out) {
+  if (!report.scene) return;
+  const SceneSection& s = *report.scene;
+  out += fmt::format("## Your scene: {} ({}; {} backend; cost in {})\n\n", s.name, s.requirement, s.backend,
+                     s.cost_unit);
+  out += "| convention | format | measured (upper) | far end | B/px | cost | use |\n";
+  out += "|---|---|---:|---:|---:|---:|---|\n";
+  for (const SceneRow& r : s.rows) {
+    const std::string use =
+        r.meets ? "`" + r.variant + "`" : fmt::format("**do not use**: {:.3g}x the limit", r.times_limit);
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", r.convention, r.format, Number(r.measured),
+                       Number(r.far_end), r.bytes_per_pixel > 0 ? std::to_string(r.bytes_per_pixel) : "-",
+                       Number(r.cost), use);
+  }
+  for (const std::string& w : s.what_ifs) out += "- what if " + w + "\n";
+  for (const std::string& n : s.not_candidates) out += "- not a candidate: " + n + "\n";
+  out += "\nMeasured: the upper end of the 95% interval at the requirement's level and depth, in its unit; far end: "
+         "measured at the scene's far end; each convention and format by its best variant as `depthbench choose` "
+         "ranks them.\n\n";
+}
+
 // The worst cells over the default domain and the NaN/Inf findings by
 // cause, a few lines each: the page lists them all.
 void Problems(const Report& report, std::string& out) {
@@ -292,6 +315,7 @@ std::string RenderMarkdown(const Report& report) {
   const ReportEnvironment& env = report.environment;
   std::string out;
   Verdict(report, out);
+  YourScene(report, out);
   WhatToUse(report, out);
   Problems(report, out);
   std::vector<std::string> devices;
