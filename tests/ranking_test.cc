@@ -7,7 +7,14 @@
 namespace depthbench {
 namespace {
 
-CandidateCost Cost(double value, double spread = 0.0) { return {value, spread, "slots", "test"}; }
+CandidateCost Cost(double value, double spread = 0.0) {
+  CandidateCost cost;
+  cost.value = value;
+  cost.spread = spread;
+  cost.unit = "slots";
+  cost.source = "test";
+  return cost;
+}
 
 std::vector<std::size_t> Order(const std::vector<RankInput>& inputs) {
   std::vector<std::size_t> order;
