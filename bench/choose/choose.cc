@@ -441,15 +441,6 @@ Expected<std::optional<WhatIf>> TryWhatIf(const Scene& scene, Backend& backend, 
   return std::optional<WhatIf>(std::move(what_if));
 }
 
-// The scene's cells with some of its engine's choices replaced.
-std::vector<Cell> CellsWith(const Scene& scene, std::vector<Convention> conventions, std::vector<Format> formats) {
-  const CellFilter filter{scene.variants, std::move(conventions), std::move(formats)};
-  std::vector<Cell> cells;
-  for (const Cell& c : (scene.catalogue != nullptr ? *scene.catalogue : Catalogue::BuiltIn()).Cells())
-    if (filter.Keeps(c)) cells.push_back(c);
-  return cells;
-}
-
 // When nothing meets the requirement: each change an engine could make,
 // measured. Reversed Z with a float buffer; a float buffer under the
 // scene's conventions; the near plane ten times further; positions
@@ -461,9 +452,9 @@ Status AddWhatIfs(const Scene& scene, Backend& backend, const ChooseOptions& opt
   const std::vector<Cell> cells = scene.Candidates();
   std::vector<std::pair<std::string, std::pair<Domain, std::vector<Cell>>>> changes;
   changes.push_back({"reversed Z with a float buffer (reversed, d32_sfloat)",
-                     {d, CellsWith(scene, {Convention::kReversed}, {Format::kD32Sfloat})}});
+                     {d, scene.CellsWith({Convention::kReversed}, {Format::kD32Sfloat})}});
   changes.push_back({"a float buffer under the scene's conventions (d32_sfloat)",
-                     {d, CellsWith(scene, scene.conventions, {Format::kD32Sfloat})}});
+                     {d, scene.CellsWith(scene.conventions, {Format::kD32Sfloat})}});
   const double depth = scene.requirement.at_depth.value_or(DepthLimit(d));
   if (d.near.fixed() && d.near.min * 10.0 < depth) {
     Domain moved = d;

@@ -131,27 +131,21 @@ std::string Requirement::Describe() const {
   return what + fmt::format(" ({})", LevelName(level));
 }
 
-std::vector<Cell> Scene::Candidates() const {
-  CellFilter filter{variants, conventions, formats};
-  std::vector<Cell> cells;
-  for (const Cell& c : (catalogue != nullptr ? *catalogue : Catalogue::BuiltIn()).Cells())
-    if (filter.Keeps(c)) cells.push_back(c);
-  return CellsForDomain(cells, domain);
+std::vector<Cell> Scene::CellsWith(std::vector<Convention> conventions, std::vector<Format> formats) const {
+  const CellFilter filter{variants, std::move(conventions), std::move(formats)};
+  return filter.CellsOf(catalogue != nullptr ? *catalogue : Catalogue::BuiltIn());
 }
 
+std::vector<Cell> Scene::Candidates() const { return CellsForDomain(CellsWith(conventions, formats), domain); }
+
 std::vector<std::string> Scene::UnusableFormats() const {
-  const Catalogue& cat = catalogue != nullptr ? *catalogue : Catalogue::BuiltIn();
   const std::vector<Cell> candidates = Candidates();
   std::vector<std::string> unusable;
   for (const Format format : formats) {
     if (std::any_of(candidates.begin(), candidates.end(), [&](const Cell& c) { return c.format == format; })) continue;
     // The conventions that would read it, with the engine's variants, in this domain.
-    const CellFilter any_convention{variants, {}, {format}};
-    std::vector<Cell> readers;
-    for (const Cell& c : cat.Cells())
-      if (any_convention.Keeps(c)) readers.push_back(c);
     std::vector<std::string> needed;
-    for (const Cell& c : CellsForDomain(readers, domain)) {
+    for (const Cell& c : CellsForDomain(CellsWith({}, {format}), domain)) {
       const std::string name(Info(c.convention).name);
       if (std::find(needed.begin(), needed.end(), name) == needed.end()) needed.push_back(name);
     }

@@ -69,6 +69,10 @@ struct Scene {
 
   // The catalogue's cells this scene's engine can use and its domain allows.
   std::vector<Cell> Candidates() const;
+  // The catalogue's cells of the engine's variants under `conventions` and
+  // `formats` (empty: any), whatever the domain: what the engine could use
+  // with those choices changed.
+  std::vector<Cell> CellsWith(std::vector<Convention> conventions, std::vector<Format> formats) const;
   // Each listed format that no candidate has, in words: which conventions
   // would read it ("r16_sfloat: read only under linear, which
   // engine.conventions does not list"), or why the domain rules it out.

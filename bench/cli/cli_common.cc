@@ -146,9 +146,7 @@ Expected<std::vector<Cell>> CellFlags::Select(const Catalogue& catalogue) const 
     DB_RETURN_IF_ERROR(StoreInto(ParseConvention(c), filter.conventions.emplace_back()));
   }
   for (const auto& f : formats) DB_RETURN_IF_ERROR(StoreInto(ParseFormat(f), filter.formats.emplace_back()));
-  std::vector<Cell> cells;
-  for (const Cell& cell : catalogue.Cells())
-    if (filter.Keeps(cell)) cells.push_back(cell);
+  std::vector<Cell> cells = filter.CellsOf(catalogue);
   if (cells.empty()) {
     return InvalidArgument(
         "no cell matches these filters: hardware-depth variants (inverse_vp, divide, reciprocal, pq) read "

@@ -166,4 +166,11 @@ bool CellFilter::Keeps(const Cell& cell) const {
   return keeps(variants, cell.variant) && keeps(conventions, cell.convention) && keeps(formats, cell.format);
 }
 
+std::vector<Cell> CellFilter::CellsOf(const Catalogue& catalogue) const {
+  std::vector<Cell> cells;
+  for (const Cell& cell : catalogue.Cells())
+    if (Keeps(cell)) cells.push_back(cell);
+  return cells;
+}
+
 }  // namespace depthbench

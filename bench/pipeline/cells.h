@@ -264,6 +264,8 @@ struct CellFilter {
   std::vector<Convention> conventions;
   std::vector<Format> formats;
   bool Keeps(const Cell& cell) const;
+  // The catalogue's cells it keeps, in the catalogue's order.
+  std::vector<Cell> CellsOf(const Catalogue& catalogue) const;
 };
 
 }  // namespace depthbench
