@@ -34,11 +34,13 @@ struct DrawFrame {
   double eye_depth_min;  // the eye depths samples are drawn from
   double eye_depth_max;
   double log2_eye_depth_span;  // log2(eye_depth_max / eye_depth_min)
-  double tan_x;                // aspect * tan(fov_y / 2)
-  double tan_y;                // tan(fov_y / 2)
+  double tan_x;                // aspect * tan(fov_y / 2): half the frustum's width at unit eye depth
+  double tan_y;                // tan(fov_y / 2): half its height
   uint width;
   uint height;
-  dmat3 rotation;  // columns: the camera's x, y, z axes in world space
+  dmat3 rotation;   // columns: the camera's x, y, z axes in world space
+  double centre_x;  // an off-centre lens: the view ray through NDC (0, 0) is (centre_x, centre_y, -1)
+  double centre_y;
 };
 
 // One drawn sample. `pick` numbers DepthPick (sampler.h), `coverage`
@@ -163,13 +165,14 @@ DB_FN DrawnSample draw_sample(DrawUnits u, DrawFrame f) {
 }
 
 // The world-space ray through pixel (x, y)'s centre at unit eye depth:
-// rotation * (ndc.x * tan_x, ndc.y * tan_y, -1), with the pixel's texture
-// coordinate and NDC as screen.h's uv_from_pixel and ndc_from_uv take them.
+// rotation * (ndc.x * tan_x + centre_x, ndc.y * tan_y + centre_y, -1), with
+// the pixel's texture coordinate and NDC as screen.h's uv_from_pixel and
+// ndc_from_uv take them. A centred lens adds zeros, which changes no bit.
 DB_FN dvec3 draw_pixel_ray(uint x, uint y, DrawFrame f) {
   DB_PRECISE double u = (double(x) + 0.5) / double(f.width);
   DB_PRECISE double v = (double(y) + 0.5) / double(f.height);
-  DB_PRECISE double view_x = (u * 2.0 - 1.0) * f.tan_x;
-  DB_PRECISE double view_y = (1.0 - v * 2.0) * f.tan_y;
+  DB_PRECISE double view_x = (u * 2.0 - 1.0) * f.tan_x + f.centre_x;
+  DB_PRECISE double view_y = (1.0 - v * 2.0) * f.tan_y + f.centre_y;
   dvec3 ray = dvec3(0.0);
   for (int row = 0; row < 3; ++row) {
     DB_PRECISE double r = f.rotation[0][row] * view_x + f.rotation[1][row] * view_y;

@@ -39,6 +39,11 @@ struct FrameParams {
   vec4 eye_ray_world_du;
   vec4 eye_ray_world_dv;
   mat4 world_view;  // world space -> view space (the view matrix): the raster pipeline's light volumes
+  // An off-centre lens (a VR eye's field of view, TAA jitter): xy: the view
+  // ray through NDC (0, 0) at unit eye depth is (x, y, -1); zw: the
+  // projection matrix's off-centre terms, x * H and y * V. Zero for a
+  // symmetric frustum; the variants that read only `lens` assume one.
+  vec4 lens_centre;
 };
 
 // What one depth convention adds to a frame: the mapping between eye depth

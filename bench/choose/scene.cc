@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "bench/base/files.h"
+#include "bench/pipeline/projection_matrix.h"
 #include "bench/sweep/sweep.h"
 
 namespace depthbench {
@@ -168,10 +169,114 @@ double DeepestEyeDepth(const Domain& d) {
   return d.finite_far ? d.far->max : d.near.min * Domain::kInfiniteDepthSpan;
 }
 
+// projection.resolution: the render target a frame is costed at.
+Status ReadResolution(SceneReader& r, const toml::table& projection, Domain& d) {
+  if (const toml::node* res = projection.get("resolution")) {
+    const toml::array* a = res->as_array();
+    // value_exact: whole numbers only. toml++'s value<int64_t>() converts a
+    // float such as 1e300 to an integer before it checks the range, which is
+    // undefined behaviour (found by fuzz_scene).
+    auto w = a && a->size() == 2 ? a->get(0)->value_exact<std::int64_t>() : std::nullopt;
+    auto h = a && a->size() == 2 ? a->get(1)->value_exact<std::int64_t>() : std::nullopt;
+    if (!w || !h || *w < 1 || *h < 1 || *w > kMaxResolutionSide || *h > kMaxResolutionSide) {
+      return r.Error(res, "projection.resolution",
+                     fmt::format("expected [width, height] in pixels, 1 to {} each", kMaxResolutionSide));
+    }
+    d.resolutions = {{static_cast<std::uint32_t>(*w), static_cast<std::uint32_t>(*h)}};
+  }
+  return Status::Ok();
+}
+
+// projection.matrix, .api and .layout: the engine's own matrix, which
+// fixes the planes, the lens and the depth convention.
+Status ReadMatrix(SceneReader& r, const toml::table& projection, Scene& scene) {
+  const toml::node* node = projection.get("matrix");
+  for (const char* key : {"near", "far", "fov_degrees", "aspect", "eye_fov"}) {
+    if (const toml::node* other = projection.get(key)) {
+      return r.Error(other, std::string("projection.") + key, "the matrix sets it; give one or the other");
+    }
+  }
+  const toml::array* numbers = node->as_array();
+  if (numbers == nullptr || numbers->size() != 16) {
+    return r.Error(node, "projection.matrix", "expected 16 numbers, in the order projection.layout names");
+  }
+  ProjectionMatrix m;
+  for (int k = 0; k < 16; ++k) {
+    DB_ASSIGN_OR_RETURN(m.numbers[k], r.Number(numbers->get(k), fmt::format("projection.matrix[{}]", k)));
+  }
+  const auto name = [&](const char* key, std::string_view allowed) -> Expected<std::string> {
+    const toml::node* n = projection.get(key);
+    auto s = n != nullptr ? n->value<std::string>() : std::nullopt;
+    if (!s) return r.Error(n != nullptr ? n : node, std::string("projection.") + key, fmt::format("expected one of {}", allowed));
+    return *s;
+  };
+  DB_ASSIGN_OR_RETURN(const std::string api, name("api", kGraphicsApiNames));
+  DB_ASSIGN_OR_RETURN(const std::string layout, name("layout", "column-major, row-major"));
+  Expected<GraphicsApi> parsed_api = ParseGraphicsApi(api);
+  if (!parsed_api.ok()) return r.Error(projection.get("api"), "projection.api", parsed_api.status().message());
+  Expected<MatrixLayout> parsed_layout = ParseMatrixLayout(layout);
+  if (!parsed_layout.ok()) {
+    return r.Error(projection.get("layout"), "projection.layout", parsed_layout.status().message());
+  }
+  m.api = *parsed_api;
+  m.layout = *parsed_layout;
+  Expected<ProjectionFacts> facts = ReadProjectionMatrix(m);
+  if (!facts.ok()) return r.Error(node, "projection.matrix", facts.status().message());
+  const Status applied = ApplyProjection(*facts, scene.domain);
+  if (!applied.ok()) return r.Error(node, "projection.matrix", applied.message());
+  scene.domain.depth_convention = facts->convention;
+  scene.api = m.api;
+  scene.projection_facts = facts->Describe();
+  return Status::Ok();
+}
+
+// projection.eye_fov, or fov_degrees and aspect: the lens.
+Status ReadLens(SceneReader& r, const toml::table& projection, Domain& d) {
+  if (const toml::node* node = projection.get("eye_fov")) {
+    for (const char* key : {"fov_degrees", "aspect"}) {
+      if (const toml::node* other = projection.get(key)) {
+        return r.Error(other, std::string("projection.") + key, "eye_fov sets the field of view; give one or the other");
+      }
+    }
+    const toml::array* a = node->as_array();
+    if (a == nullptr || a->size() != 4) {
+      return r.Error(node, "projection.eye_fov", "expected [left, right, up, down] in degrees (left and down negative)");
+    }
+    double angles[4];
+    for (int k = 0; k < 4; ++k) {
+      DB_ASSIGN_OR_RETURN(angles[k], r.Number(a->get(k), fmt::format("projection.eye_fov[{}]", k)));
+    }
+    d.eye_fov = EyeFov{angles[0], angles[1], angles[2], angles[3]};
+    const Status valid = CheckEyeFov(*d.eye_fov, "eye_fov");
+    if (!valid.ok()) return r.Error(node, "projection.eye_fov", valid.message());
+    return Status::Ok();
+  }
+  DB_ASSIGN_OR_RETURN(d.fov_degrees, r.NumberOrRange(projection.get("fov_degrees"), "projection.fov_degrees"));
+  DB_RETURN_IF_ERROR(r.Check(d.fov_degrees, projection.get("fov_degrees"), "projection.fov_degrees", kFovLimits));
+  DB_ASSIGN_OR_RETURN(d.aspect, r.NumberOrRange(projection.get("aspect"), "projection.aspect"));
+  return r.Check(d.aspect, projection.get("aspect"), "projection.aspect", kAspectLimits);
+}
+
 // [projection]: the planes, the lens and the render target.
-Status ReadProjection(SceneReader& r, const toml::table& root, Domain& d) {
+Status ReadProjection(SceneReader& r, const toml::table& root, Scene& scene) {
+  Domain& d = scene.domain;
   DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
-  DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection", {"near", "far", "fov_degrees", "aspect", "resolution"}));
+  DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection",
+                                {"near", "far", "fov_degrees", "aspect", "eye_fov", "matrix", "api", "layout",
+                                 "jitter", "resolution"}));
+  if (const toml::node* node = projection->get("jitter")) {
+    DB_ASSIGN_OR_RETURN(d.jitter, r.Number(node, "projection.jitter"));
+    if (!(d.jitter >= 0.0 && d.jitter <= kMostJitterPixels)) {
+      return r.Error(node, "projection.jitter", fmt::format("allowed [0, {:g}] pixels", kMostJitterPixels));
+    }
+  }
+  DB_RETURN_IF_ERROR(ReadResolution(r, *projection, d));
+  if (projection->get("matrix") != nullptr) return ReadMatrix(r, *projection, scene);
+  for (const char* key : {"api", "layout"}) {
+    if (const toml::node* other = projection->get(key)) {
+      return r.Error(other, std::string("projection.") + key, "describes projection.matrix, which is not given");
+    }
+  }
   const toml::node* near_node = projection->get("near");
   DB_ASSIGN_OR_RETURN(double near, r.Number(near_node, "projection.near"));
   if (!(near > 0.0))
@@ -193,26 +298,9 @@ Status ReadProjection(SceneReader& r, const toml::table& root, Domain& d) {
     d.finite_far = true;
     d.infinite_far = false;
   }
-  DB_ASSIGN_OR_RETURN(d.fov_degrees, r.NumberOrRange(projection->get("fov_degrees"), "projection.fov_degrees"));
-  DB_RETURN_IF_ERROR(r.Check(d.fov_degrees, projection->get("fov_degrees"), "projection.fov_degrees", kFovLimits));
-  DB_ASSIGN_OR_RETURN(d.aspect, r.NumberOrRange(projection->get("aspect"), "projection.aspect"));
-  DB_RETURN_IF_ERROR(r.Check(d.aspect, projection->get("aspect"), "projection.aspect", kAspectLimits));
-  if (const toml::node* res = projection->get("resolution")) {
-    const toml::array* a = res->as_array();
-    // value_exact: whole numbers only. toml++'s value<int64_t>() converts a
-    // float such as 1e300 to an integer before it checks the range, which is
-    // undefined behaviour (found by fuzz_scene).
-    auto w = a && a->size() == 2 ? a->get(0)->value_exact<std::int64_t>() : std::nullopt;
-    auto h = a && a->size() == 2 ? a->get(1)->value_exact<std::int64_t>() : std::nullopt;
-    if (!w || !h || *w < 1 || *h < 1 || *w > kMaxResolutionSide || *h > kMaxResolutionSide) {
-      return r.Error(res, "projection.resolution",
-                     fmt::format("expected [width, height] in pixels, 1 to {} each", kMaxResolutionSide));
-    }
-    d.resolutions = {{static_cast<std::uint32_t>(*w), static_cast<std::uint32_t>(*h)}};
-  }
-
-  return Status::Ok();
+  return ReadLens(r, *projection, d);
 }
+
 
 // [camera] and [depth]: where the camera stands and which eye depths matter.
 Status ReadCameraAndDepth(SceneReader& r, const toml::table& root, Domain& d) {
@@ -346,7 +434,7 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
   Domain& d = scene.domain;
   d.name = "scene " + scene.name;
 
-  DB_RETURN_IF_ERROR(ReadProjection(r, root, d));
+  DB_RETURN_IF_ERROR(ReadProjection(r, root, scene));
   // projection.resolution leaves the one it names; the default domain has several.
   if (d.resolutions.size() == 1) scene.resolution = d.resolutions.front();
   DB_RETURN_IF_ERROR(ReadCameraAndDepth(r, root, d));

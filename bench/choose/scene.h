@@ -9,6 +9,12 @@
 //   fov_degrees = [60, 90]    # a value or [min, max]
 //   aspect = [1.33, 2.39]
 //   resolution = [2560, 1440]
+//   jitter = 0.5              # TAA: pixels the projection moves each frame (default 0)
+//   # Instead of fov_degrees and aspect, an off-centre VR eye (OpenXR's
+//   # XrFovf order, degrees): eye_fov = [-50, 45, 48, -52]  # left, right, up, down
+//   # Or instead of near, far and the lens, the engine's matrix (16 numbers):
+//   # matrix = [...]; api = "vulkan"; layout = "column-major"
+//   # (projection_matrix.h; it also fixes the depth convention)
 //   [camera]
 //   distance_from_origin = [0, 20000]
 //   [depth]
@@ -35,6 +41,7 @@
 #include "bench/base/status.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
+#include "bench/pipeline/projection_matrix.h"
 #include "bench/pipeline/stats.h"
 
 namespace depthbench {
@@ -66,6 +73,10 @@ struct Scene {
   std::optional<Resolution> resolution;  // projection.resolution, the frame a cost is for
   Requirement requirement;
   std::optional<double> max_cost;
+  // projection.matrix's API and what the matrix holds (projection_matrix.h),
+  // one line a fact; empty without a matrix.
+  std::optional<GraphicsApi> api;
+  std::vector<std::string> projection_facts;
 
   // The catalogue's cells this scene's engine can use and its domain allows.
   std::vector<Cell> Candidates() const;

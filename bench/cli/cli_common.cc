@@ -16,6 +16,7 @@
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
 #include "bench/choose/scene.h"
+#include "bench/pipeline/projection_matrix.h"
 
 namespace depthbench::cli {
 
@@ -35,6 +36,23 @@ void DomainFlags::Add(CLI::App& app) {
       ->group("Domain");
   app.add_option("--aspect", aspect, "aspect ratio width/height: VALUE or MIN:MAX (log-uniform)")
       ->type_name("RANGE")
+      ->group("Domain");
+  app.add_option("--eye-fov", eye_fov,
+                 "an off-centre frustum, as a VR runtime gives each eye's (OpenXR's XrFovf): LEFT,RIGHT,UP,DOWN "
+                 "angles in degrees from the view axis, left and down negative; replaces --fov and --aspect")
+      ->type_name("L,R,U,D")
+      ->group("Domain");
+  app.add_option("--jitter", jitter,
+                 "TAA jitter: every frame's projection shifted by up to this many pixels in x and y (uniform), as "
+                 "temporal anti-aliasing does (0 to 4; e.g. 0.5)")
+      ->type_name("PIXELS")
+      ->group("Domain");
+  app.add_option("--projection", projection,
+                 "the engine's projection matrix, API:LAYOUT:N0,...,N15 with API d3d, vulkan, metal, opengl "
+                 "(clip depth [-1, 1]) or opengl-clip-control, LAYOUT column-major (GLM, GLSL, a D3D matrix in "
+                 "memory) or row-major (as written on paper). Sets near, far, the field of view and its "
+                 "off-centre terms, and runs only the depth convention the matrix stores (with the linear cells)")
+      ->type_name("MATRIX")
       ->group("Domain");
   app.add_option("--camera-distance", camera_distance,
                  "camera distance from the world origin: VALUE or MIN:MAX (log-uniform; 0 puts the camera at the "
@@ -84,7 +102,8 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
   if (!domain.empty()) DB_RETURN_IF_ERROR(StoreInto(DomainByName(domain, catalogue), d));
   const bool narrowed =
       !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() && camera_distance.empty() &&
-        eye_depth.empty() && resolution.empty() && production.empty() && constants.empty() && pipeline.empty());
+        eye_depth.empty() && resolution.empty() && production.empty() && constants.empty() && pipeline.empty() &&
+        eye_fov.empty() && jitter.empty() && projection.empty());
   if (narrowed) d.name += " (narrowed)";
   if (!production.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseProductionModel(production), d.production).WithContext("--production"));
@@ -102,6 +121,21 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
   } else if (!pipeline.empty()) {
     return InvalidArgument(fmt::format("--pipeline: '{}' is not one of compute, raster", pipeline));
   }
+  if (!projection.empty()) {
+    if (!fov.empty() || !aspect.empty() || !eye_fov.empty() || !near.empty() || !far.empty() || !ratio.empty()) {
+      return InvalidArgument("--projection sets near, far and the field of view; it takes no --fov, --aspect, "
+                             "--eye-fov, --near, --far or --ratio");
+    }
+    DB_ASSIGN_OR_RETURN(const ProjectionMatrix matrix, ParseProjectionFlag(projection));
+    DB_ASSIGN_OR_RETURN(const ProjectionFacts facts, ReadProjectionMatrix(matrix));
+    DB_RETURN_IF_ERROR(ApplyProjection(facts, d).WithContext("--projection"));
+    d.depth_convention = facts.convention;
+  }
+  if (!eye_fov.empty()) {
+    if (!fov.empty() || !aspect.empty()) return InvalidArgument("--eye-fov replaces --fov and --aspect");
+    DB_RETURN_IF_ERROR(StoreInto(ParseEyeFov(eye_fov, "--eye-fov"), d.eye_fov.emplace()));
+  }
+  if (!jitter.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseNumber(jitter, "--jitter"), d.jitter));
   if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");
   if (!far.empty()) {
@@ -127,6 +161,13 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
   Status valid = d.Validate();
   if (!valid.ok()) return valid;
   return d;
+}
+
+Expected<std::vector<std::string>> DomainFlags::DescribeProjection() const {
+  if (projection.empty()) return std::vector<std::string>{};
+  DB_ASSIGN_OR_RETURN(const ProjectionMatrix matrix, ParseProjectionFlag(projection));
+  DB_ASSIGN_OR_RETURN(const ProjectionFacts facts, ReadProjectionMatrix(matrix));
+  return facts.Describe();
 }
 
 void CellFlags::Add(CLI::App& app) {

@@ -39,7 +39,10 @@ inline constexpr const char* kThreadsHelp =
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;
+  std::string eye_fov, jitter, projection;
   void Add(CLI::App& app);
+  // What --projection's matrix holds, one line a fact (nothing without it).
+  Expected<std::vector<std::string>> DescribeProjection() const;
   // The domain --domain names (or `base`), narrowed by the range flags.
   Expected<Domain> Apply(Domain base, const Catalogue& catalogue) const;
 };

@@ -2,6 +2,7 @@
 // high-precision reference.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "bench/base/files.h"
 #include "bench/base/parse_number.h"
@@ -84,6 +85,10 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
   }
   DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}, context.catalogue));
   DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
+  DB_ASSIGN_OR_RETURN(const std::vector<std::string> projection, f.domain.DescribeProjection());
+  if (!projection.empty() && !f.quiet) {
+    out.text << "projection matrix: " << fmt::format("{}", fmt::join(projection, "\n  ")) << "\n";
+  }
   std::vector<BandFamily> splits;
   for (const std::string& s : f.split) {
     if (s == "ratio")

@@ -40,7 +40,7 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
 static_assert(sizeof(L::JudgePass) == 60);
-static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9);  // shared/draw.h's DrawFrame, its rotation's nine
+static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9 + 2);  // shared/draw.h's DrawFrame, its rotation's nine
 static_assert(L::DB_JUDGE_TEXEL_UNORM == static_cast<unsigned>(TexelKind::kUnorm) &&
               L::DB_JUDGE_TEXEL_FLOAT32 == static_cast<unsigned>(TexelKind::kFloat32) &&
               L::DB_JUDGE_TEXEL_FLOAT16 == static_cast<unsigned>(TexelKind::kFloat16));
@@ -497,6 +497,8 @@ Status DeviceJudge::State::UploadForStorage(const Batch& batch, const DeviceJudg
     for (int column = 0; column < 3; ++column) {
       for (int row = 0; row < 3; ++row) *draws++ = draw.rotation[column][row];
     }
+    *draws++ = draw.centre_x;
+    *draws++ = draw.centre_y;
     std::uint32_t* words = frame_constants + f * L::DB_JUDGE_FRAME_WORDS;
     words[0] = planes.ratio_band;
     words[1] = std::bit_cast<std::uint32_t>(batch.frame_params[f].camera_position.w);

@@ -80,6 +80,15 @@ Expected<FuzzCase> CaseFromJson(const JsonReader& r) {
     interest = Range{range[0], range[1]};
   }
   CompleteFrame(f, interest);
+  if (frame.Has("lens_centre")) {
+    // An off-centre lens, in tangents at unit depth (sampler.h's Frame).
+    DB_ASSIGN_OR_RETURN(std::vector<double> centre, Numbers(frame, "lens_centre", 2));
+    if (!(std::abs(centre[0]) < 1e6 && std::abs(centre[1]) < 1e6)) {
+      return frame.Error("lens_centre: expected [x, y], each within (-1e6, 1e6)");
+    }
+    f.centre_x = centre[0];
+    f.centre_y = centre[1];
+  }
   DB_ASSIGN_OR_RETURN(std::vector<double> rotation, Numbers(frame, "rotation", 9));
   for (int col = 0; col < 3; ++col) {
     for (int row = 0; row < 3; ++row) f.rotation[col][row] = rotation[col * 3 + row];
@@ -143,6 +152,7 @@ nlohmann::json CaseToJson(const FuzzCase& c) {
                           {"width", f.width},
                           {"height", f.height},
                           {"volume_depth", f.volume_depth}};
+  if (f.centre_x != 0.0 || f.centre_y != 0.0) frame["lens_centre"] = {f.centre_x, f.centre_y};
   if (f.depth_restricted) frame["eye_depth_range"] = {f.eye_depth_min, f.eye_depth_max};
   nlohmann::json sample = {{"x", c.sample.x}, {"y", c.sample.y}, {"pick", PickName(c.sample.pick)}};
   if (c.sample.pick == DepthPick::kEyeDepth) sample["eye_depth"] = c.sample.eye_depth;
@@ -163,7 +173,8 @@ Domain FuzzDomain() {
 
 double& UnitOf(FuzzPoint& p, int k) {
   // Both unit structs are plain arrays of doubles in declaration order.
-  static_assert(std::is_standard_layout_v<FrameUnits> && sizeof(FrameUnits) == 13 * sizeof(double));
+  // The jitter units come last and are left out (the fuzz domain has none).
+  static_assert(std::is_standard_layout_v<FrameUnits> && sizeof(FrameUnits) == 15 * sizeof(double));
   static_assert(std::is_standard_layout_v<SampleUnits> && sizeof(SampleUnits) == 5 * sizeof(double));
   return k < 13 ? reinterpret_cast<double*>(&p.frame)[k] : reinterpret_cast<double*>(&p.sample)[k - 13];
 }

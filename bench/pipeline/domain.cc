@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -19,8 +20,6 @@ const RangeLimits kRatioLimits{1.0, 1e15, true, false, ""};
 const RangeLimits kCameraDistanceLimits{0.0, 1e9, false, false, "world units"};
 const RangeLimits kEyeDepthLimits{0.0, 1e30, true, false, "world units"};
 
-namespace {
-
 Expected<double> ParseNumber(std::string_view text, std::string_view what) {
   std::string s(text);
   if (s.empty()) return InvalidArgument(fmt::format("{}: empty value", what));
@@ -32,6 +31,8 @@ Expected<double> ParseNumber(std::string_view text, std::string_view what) {
   }
   return value;
 }
+
+namespace {
 
 std::string DescribeLimits(const RangeLimits& limits) {
   return fmt::format("{}{:g}, {:g}{}{}{}", limits.lowest_exclusive ? "(" : "[", limits.lowest, limits.highest,
@@ -125,7 +126,8 @@ bool operator==(const Domain& a, const Domain& b) {
   return a.fov_degrees == b.fov_degrees && a.aspect == b.aspect && a.near == b.near && a.ratio == b.ratio &&
          a.finite_far == b.finite_far && a.infinite_far == b.infinite_far && a.far == b.far &&
          a.camera_distance == b.camera_distance && a.eye_depth == b.eye_depth && a.resolutions == b.resolutions &&
-         a.production == b.production && a.constants == b.constants;
+         a.production == b.production && a.constants == b.constants && a.eye_fov == b.eye_fov &&
+         a.jitter == b.jitter && a.depth_convention == b.depth_convention;
 }
 
 Domain TypicalDomain() { return Domain{}; }
@@ -194,6 +196,11 @@ Status Domain::Validate() const {
                                          eye_depth->ToString(), deepest));
     }
   }
+  if (eye_fov) DB_RETURN_IF_ERROR(CheckEyeFov(*eye_fov, "eye fov"));
+  if (!(jitter >= 0.0 && jitter <= kMostJitterPixels)) {
+    return InvalidArgument(fmt::format("jitter: {:g} pixels is out of range; allowed [0, {:g}] pixels", jitter,
+                                       kMostJitterPixels));
+  }
   if (resolutions.empty()) return InvalidArgument("the domain has no resolution");
   for (const auto& r : resolutions) {
     if (r.width == 0 || r.height == 0 || r.width > kMaxResolutionSide || r.height > kMaxResolutionSide) {
@@ -206,7 +213,10 @@ Status Domain::Validate() const {
 
 std::string Domain::ToFlags() const {
   auto range = [](const Range& r) { return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max); };
-  std::string flags = fmt::format("--fov {} --aspect {} --near {}", range(fov_degrees), range(aspect), range(near));
+  std::string flags = eye_fov ? "--eye-fov " + eye_fov->ToString()
+                              : fmt::format("--fov {} --aspect {}", range(fov_degrees), range(aspect));
+  flags += " --near " + range(near);
+  if (jitter > 0.0) flags += fmt::format(" --jitter {}", jitter);
   if (!finite_far) {
     flags += " --ratio inf";
   } else if (far) {
@@ -238,12 +248,60 @@ std::string Domain::Describe() const {
   } else {
     far_text = "infinite far";
   }
-  std::string text = fmt::format("fov {} deg, aspect {}, near {}, {}, camera distance {}", fov_degrees.ToString(),
-                                 aspect.ToString(), near.ToString(), far_text, camera_distance.ToString());
+  const std::string lens = eye_fov ? fmt::format("eye fov {} deg (left, right, up, down)", eye_fov->ToString())
+                                   : fmt::format("fov {} deg, aspect {}", fov_degrees.ToString(), aspect.ToString());
+  std::string text = fmt::format("{}, near {}, {}, camera distance {}", lens, near.ToString(), far_text,
+                                 camera_distance.ToString());
+  if (jitter > 0.0) text += fmt::format(", TAA jitter up to {:g} px", jitter);
+  if (depth_convention) text += fmt::format(", {} depth only (the projection matrix's)", Info(*depth_convention).name);
   if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
   if (production != ProductionModel::kFloat32) text += fmt::format(", {} production", ProductionModelName(production));
   if (constants != ConstantsModel::kExact) text += fmt::format(", {} constants", ConstantsModelName(constants));
   return fmt::format("{}: {}", name, text);
+}
+
+namespace {
+double TanDegrees(double degrees) { return std::tan(degrees * std::numbers::pi / 180.0); }
+}  // namespace
+
+double EyeFov::TanLeft() const { return TanDegrees(left); }
+double EyeFov::TanRight() const { return TanDegrees(right); }
+double EyeFov::TanUp() const { return TanDegrees(up); }
+double EyeFov::TanDown() const { return TanDegrees(down); }
+std::string EyeFov::ToString() const { return fmt::format("{},{},{},{}", left, right, up, down); }
+
+Status CheckEyeFov(const EyeFov& fov, std::string_view what) {
+  for (const double angle : {fov.left, fov.right, fov.up, fov.down}) {
+    if (!(std::abs(angle) <= kMostEyeFovAngle)) {
+      return InvalidArgument(fmt::format("{}: angle {:g} is out of range; each side lies within [-{:g}, {:g}] degrees "
+                                         "of the view axis",
+                                         what, angle, kMostEyeFovAngle, kMostEyeFovAngle));
+    }
+  }
+  if (!(fov.right > fov.left) || !(fov.up > fov.down)) {
+    return InvalidArgument(fmt::format("{}: {} has no area: right must exceed left and up must exceed down "
+                                       "(left and down are negative for a frustum around the view axis)",
+                                       what, fov.ToString()));
+  }
+  return Status::Ok();
+}
+
+Expected<EyeFov> ParseEyeFov(std::string_view text, std::string_view what) {
+  double angles[4];
+  std::size_t start = 0;
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t comma = k < 3 ? text.find(',', start) : text.size();
+    if (comma == std::string_view::npos || (k == 3 && text.find(',', start) != std::string_view::npos)) {
+      return InvalidArgument(fmt::format("{}: '{}' is not LEFT,RIGHT,UP,DOWN in degrees (four numbers, e.g. "
+                                         "-50,45,48,-52)",
+                                         what, text));
+    }
+    DB_ASSIGN_OR_RETURN(angles[k], ParseNumber(text.substr(start, comma - start), what));
+    start = comma + 1;
+  }
+  const EyeFov fov{angles[0], angles[1], angles[2], angles[3]};
+  DB_RETURN_IF_ERROR(CheckEyeFov(fov, what));
+  return fov;
 }
 
 std::string ResolutionName(Resolution resolution) { return fmt::format("{}x{}", resolution.width, resolution.height); }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bench/base/status.h"
+#include "bench/pipeline/cells.h"
 
 namespace depthbench {
 
@@ -24,6 +25,9 @@ struct Range {
   friend bool operator==(const Range&, const Range&) = default;
 };
 
+// One finite number in any form strtod takes; `what` names the input in
+// the error.
+Expected<double> ParseNumber(std::string_view text, std::string_view what);
 // Parses "VALUE" or "MIN:MAX" (numbers in any form strtod takes, e.g. 1e-4).
 // `what` names the flag or field for the message; the result must lie in
 // [lowest, highest] (exclusive bounds where the flags say so).
@@ -86,6 +90,33 @@ enum class ConstantsModel : std::uint8_t { kExact, kFloat32 };
 const char* ConstantsModelName(ConstantsModel model);  // "exact", "float32"
 Expected<ConstantsModel> ParseConstantsModel(std::string_view name);
 
+// An off-centre field of view, as a VR runtime gives one per eye (OpenXR's
+// XrFovf, in that order): the angle of each side of the frustum from the
+// view axis, in degrees; left and down are negative for a frustum around
+// the axis. The projection is then fixed: a domain's fov and aspect ranges
+// do not apply.
+struct EyeFov {
+  double left = 0.0;
+  double right = 0.0;
+  double up = 0.0;
+  double down = 0.0;
+  // The tangents of the four sides at unit eye depth.
+  double TanLeft() const;
+  double TanRight() const;
+  double TanUp() const;
+  double TanDown() const;
+  std::string ToString() const;  // "-50,45,48,-52"
+  friend bool operator==(const EyeFov&, const EyeFov&) = default;
+};
+// "LEFT,RIGHT,UP,DOWN" in degrees; `what` names the input in the error.
+Expected<EyeFov> ParseEyeFov(std::string_view text, std::string_view what);
+Status CheckEyeFov(const EyeFov& fov, std::string_view what);
+// The largest angle a side may make with the view axis, in degrees.
+inline constexpr double kMostEyeFovAngle = 89.0;
+// The largest TAA jitter, in pixels: jitter is sub-pixel, a few pixels
+// already means something else.
+inline constexpr double kMostJitterPixels = 4.0;
+
 // The members' defaults are the `typical` domain (TypicalDomain).
 struct Domain {
   std::string name = "typical";    // the named domain or scene it started from ("custom" once narrowed)
@@ -105,6 +136,17 @@ struct Domain {
   // [max * 1e-6, max]; otherwise log-uniform in [min, max] (or fixed).
   Range camera_distance{0.0, 0.0};
   std::optional<Range> eye_depth;  // absolute eye-depth range of interest (clipped to the frustum)
+  // An off-centre frustum (a VR eye, a projection matrix's), in place of
+  // fov and aspect.
+  std::optional<EyeFov> eye_fov;
+  // TAA jitter: each frame's projection is shifted by an offset drawn
+  // uniformly from [-jitter, jitter] pixels in x and in y, as temporal
+  // anti-aliasing shifts it by a sub-pixel amount every frame.
+  double jitter = 0.0;
+  // The one projective convention an engine's projection matrix stores
+  // (projection_matrix.h); the others' cells do not run. Not among
+  // ToFlags' flags: a cell names its convention itself.
+  std::optional<Convention> depth_convention;
   std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}};
   ProductionModel production = ProductionModel::kFloat32;
   ConstantsModel constants = ConstantsModel::kExact;

@@ -37,7 +37,7 @@ std::optional<glm::vec<2, L>> ExactScreen(const Frame& frame, const LVec3& q) {
   const LVec3 view = Unrotate(frame.rotation, q - ToLong(frame.camera_position));
   if (!(view.z < 0.0L)) return std::nullopt;
   const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
-  const L ndc_x = view.x / (-view.z * tan_x), ndc_y = view.y / (-view.z * tan_y);
+  const L ndc_x = (view.x / -view.z - frame.centre_x) / tan_x, ndc_y = (view.y / -view.z - frame.centre_y) / tan_y;
   return glm::vec<2, L>((ndc_x + 1.0L) * frame.width / 2.0L, (1.0L - ndc_y) * frame.height / 2.0L);
 }
 
@@ -137,7 +137,9 @@ RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample)
   const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
   const glm::vec<2, L> ndc = PixelNdc(frame, sample.x, sample.y);
   const LVec3 camera = ToLong(frame.camera_position);
-  const LVec3 centre_view(ndc.x * tan_x * d, ndc.y * tan_y * d, -d);
+  // The pixel's ray at unit eye depth, through an off-centre lens too.
+  const LVec3 ray_view(ndc.x * tan_x + frame.centre_x, ndc.y * tan_y + frame.centre_y, -1.0L);
+  const LVec3 centre_view = ray_view * d;
   // One pixel in view units at this depth, along x and (screen y down) y.
   const L pixel_x = 2.0L * tan_x * d / frame.width, pixel_y = 2.0L * tan_y * d / frame.height;
   // An equilateral triangle whose inscribed circle is centred on the pixel
@@ -168,7 +170,7 @@ RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample)
   }
 
   // The truth: the pixel's ray meets the plane of the float corners.
-  const LVec3 ray = Rotate(frame.rotation, LVec3(ndc.x * tan_x, ndc.y * tan_y, -1.0L));
+  const LVec3 ray = Rotate(frame.rotation, ray_view);
   const LVec3 c0 = Xyz(corners[0]);
   const LVec3 normal = glm::cross(Xyz(corners[1]) - c0, Xyz(corners[2]) - c0);
   const L t = glm::dot(normal, c0 - camera) / glm::dot(normal, ray);

@@ -24,6 +24,7 @@ enum Stream : std::uint32_t {
   kFrameDistance = 1018,   // and 1020 (origin or not)
   kFrameResolution = 1022,
   kFrameVolume = 1024,
+  kFrameJitter = 1026,  // two uniforms: 1026..1029
 };
 
 double LogUniform(double u, const Range& range) {
@@ -82,6 +83,7 @@ FrameUnits Sampler::FrameUnitsAt(std::uint64_t i) const {
   u.at_origin = Unit(state, kFrameDistance + 2);
   u.resolution = Bits(state, kFrameResolution) * 0x1.0p-32;  // exact: the pick below is floor(bits * n / 2^32)
   u.volume = Unit(state, kFrameVolume);
+  for (int k = 0; k < 2; ++k) u.jitter[k] = Unit(state, kFrameJitter + 2 * k);
   return u;
 }
 
@@ -114,8 +116,18 @@ void CompleteFrame(Frame& f, const std::optional<Range>& eye_depth) {
 Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_index) {
   Frame f;
   f.index = frame_index;
-  f.fov_y_degrees = d.fov_degrees.min + u.fov * (d.fov_degrees.max - d.fov_degrees.min);
-  f.aspect = LogUniform(u.aspect, d.aspect);
+  if (d.eye_fov) {
+    // The frustum's half extents and centre, in tangents at unit depth.
+    const double half_x = (d.eye_fov->TanRight() - d.eye_fov->TanLeft()) / 2.0;
+    const double half_y = (d.eye_fov->TanUp() - d.eye_fov->TanDown()) / 2.0;
+    f.fov_y_degrees = 2.0 * std::atan(half_y) * 180.0 / std::numbers::pi;
+    f.aspect = half_x / half_y;
+    f.centre_x = (d.eye_fov->TanRight() + d.eye_fov->TanLeft()) / 2.0;
+    f.centre_y = (d.eye_fov->TanUp() + d.eye_fov->TanDown()) / 2.0;
+  } else {
+    f.fov_y_degrees = d.fov_degrees.min + u.fov * (d.fov_degrees.max - d.fov_degrees.min);
+    f.aspect = LogUniform(u.aspect, d.aspect);
+  }
   f.near = LogUniform(u.near, d.near);
   if (!d.finite_far) {
     f.far = INFINITY;
@@ -155,6 +167,13 @@ Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_i
   f.width = d.resolutions[pick].width;
   f.height = d.resolutions[pick].height;
   f.volume_depth = LogUniform(u.volume, f.near, f.depth_limit);
+  if (d.jitter > 0.0) {
+    // A shift of j pixels moves NDC by 2j / width, the view ray by that
+    // times the half extent.
+    const double tan_x = f.aspect * f.tan_half_fov_y;
+    f.centre_x += (2.0 * u.jitter[0] - 1.0) * d.jitter * 2.0 / f.width * tan_x;
+    f.centre_y += (2.0 * u.jitter[1] - 1.0) * d.jitter * 2.0 / f.height * f.tan_half_fov_y;
+  }
   return f;
 }
 
@@ -177,6 +196,8 @@ draw::DrawFrame DrawFrameOf(const Frame& frame) {
   f.width = frame.width;
   f.height = frame.height;
   f.rotation = frame.rotation;
+  f.centre_x = frame.centre_x;
+  f.centre_y = frame.centre_y;
   return f;
 }
 

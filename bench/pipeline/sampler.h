@@ -29,6 +29,12 @@ struct Frame {
   double fov_y_degrees = 0.0;
   double tan_half_fov_y = 0.0;  // the exact lens parameter (tan computed once, then taken as exact)
   double aspect = 0.0;
+  // An off-centre lens (a VR eye, TAA jitter): the view ray through NDC
+  // (0, 0) is (centre_x, centre_y, -1), and NDC (x, y) sees
+  // (x * tan_x + centre_x, y * tan_y + centre_y, -1) with tan_x = aspect *
+  // tan_half_fov_y. Zero for a symmetric frustum.
+  double centre_x = 0.0;
+  double centre_y = 0.0;
   double near = 0.0;
   // Far plane of the finite-far conventions (+infinity when the domain has
   // infinite far planes only; finite-far cells then do not apply).
@@ -96,6 +102,9 @@ struct FrameUnits {
   double direction[2] = {0, 0};
   double distance = 0, at_origin = 0;  // at_origin < 0.25 puts the camera at the origin (when the range allows)
   double resolution = 0, volume = 0;
+  // TAA jitter in x and y (used when the domain has jitter). Last, and
+  // not among the units a search or fuzz case moves (fuzz_case.h).
+  double jitter[2] = {0, 0};
 };
 struct SampleUnits {
   double pick = 0, depth = 0;

@@ -22,7 +22,7 @@ using RealOf = typename decltype(Params::lens)::value_type;
 // reads.
 template <class Real>
 struct FrameValues {
-  Real tan_half_fov_y, aspect, near, far, volume_depth, width, height;
+  Real tan_half_fov_y, aspect, centre_x, centre_y, near, far, volume_depth, width, height;
   glm::vec<3, Real> camera_position;
   glm::mat<3, 3, Real> rotation;
 };
@@ -34,6 +34,8 @@ FrameValues<Real> LiftFrameValues(Lift lift) {
   FrameValues<Real> v;
   v.tan_half_fov_y = lift([](const Frame& f) { return f.tan_half_fov_y; });
   v.aspect = lift([](const Frame& f) { return f.aspect; });
+  v.centre_x = lift([](const Frame& f) { return f.centre_x; });
+  v.centre_y = lift([](const Frame& f) { return f.centre_y; });
   v.near = lift([](const Frame& f) { return f.near; });
   v.far = lift([](const Frame& f) { return f.finite() ? f.far : 0.0; });
   v.volume_depth = lift([](const Frame& f) { return f.volume_depth; });
@@ -114,11 +116,16 @@ Params FrameParamsIn(const FrameValues<RealOf<Params>>& frame) {
   }
   p.world_view[3][3] = Real(1.0);
   p.lens = Vec4(tan_x, tan_y, Real(1.0) / tan_x, Real(1.0) / tan_y);
+  const Real cx = frame.centre_x, cy = frame.centre_y;
+  p.lens_centre = Vec4(cx, cy, cx * p.lens.z, cy * p.lens.w);
   p.resolution = Vec4(frame.width, frame.height, Real(1.0) / frame.width, Real(1.0) / frame.height);
 
-  // View-space point of the pixel ray at eye depth `depth`.
+  // View-space point of the pixel ray at eye depth `depth` (a centred lens
+  // adds zeros, which changes no bit).
   auto view_at = [&](Real depth) {
-    return [=](Real ndc_x, Real ndc_y) { return Vec3(ndc_x * tan_x * depth, ndc_y * tan_y * depth, -depth); };
+    return [=](Real ndc_x, Real ndc_y) {
+      return Vec3((ndc_x * tan_x + cx) * depth, (ndc_y * tan_y + cy) * depth, -depth);
+    };
   };
   // Pettineo 2009: far-plane corners rotated to world space.
   ScreenAttribute<Real>([&](Real x, Real y) { return Rotate(r, view_at(far)(x, y)); }, p.frustum_ray_origin,
@@ -156,9 +163,10 @@ DepthParams DepthParamsIn(RealOf<FrameParams> near, RealOf<FrameParams> far, con
   d.convention = convention;
   d.reserved0 = d.reserved1 = d.reserved2 = 0;
 
-  // Inverse projection for view = (x/H, y/V, -1) * z and ndc_z = A + B/z:
-  // (ndc.x, ndc.y, ndc_z, 1) -> (ndc.x/H, ndc.y/V, -1, (ndc_z - A)/B), whose
-  // columns are (1/H, 0, 0, 0), (0, 1/V, 0, 0), (0, 0, 0, P), (0, 0, -1, Q).
+  // Inverse projection for view = (x/H + cx, y/V + cy, -1) * z and ndc_z =
+  // A + B/z: (ndc.x, ndc.y, ndc_z, 1) -> (ndc.x/H + cx, ndc.y/V + cy, -1,
+  // (ndc_z - A)/B), whose columns are (1/H, 0, 0, 0), (0, 1/V, 0, 0),
+  // (0, 0, 0, P), (cx, cy, -1, Q).
   // Both products below are written out over the sparse matrix's nonzero
   // entries, in the order glm's full product adds them (left to right, the
   // left matrix's entry first): adding a zero product is exact, so every
@@ -168,13 +176,15 @@ DepthParams DepthParamsIn(RealOf<FrameParams> near, RealOf<FrameParams> far, con
   d.inverse_view_projection[0] = cw[0] * f.lens.x;  // 1/H = tan_x
   d.inverse_view_projection[1] = cw[1] * f.lens.y;  // 1/V = tan_y
   d.inverse_view_projection[2] = cw[3] * d.coefficients.z;
-  d.inverse_view_projection[3] = cw[2] * Real(-1.0) + cw[3] * d.coefficients.w;
+  d.inverse_view_projection[3] =
+      cw[0] * f.lens_centre.x + cw[1] * f.lens_centre.y + cw[2] * Real(-1.0) + cw[3] * d.coefficients.w;
   // The projection (EngineProjectionMatrix's layout: columns (H, 0, 0, 0),
-  // (0, V, 0, 0), (0, 0, -A, -1), (0, 0, B, 0)) times the view.
+  // (0, V, 0, 0), (cx H, cy V, -A, -1), (0, 0, B, 0)) times the view.
   const Real minus_a = -a, minus_one(-1.0);
   for (int c = 0; c < 4; ++c) {
     const Vec4& v = f.world_view[c];
-    d.view_projection[c] = Vec4(f.lens.z * v.x, f.lens.w * v.y, minus_a * v.z + b * v.w, minus_one * v.z);
+    d.view_projection[c] = Vec4(f.lens.z * v.x + f.lens_centre.z * v.z, f.lens.w * v.y + f.lens_centre.w * v.z,
+                                minus_a * v.z + b * v.w, minus_one * v.z);
   }
   return d;
 }
@@ -187,6 +197,7 @@ void ForEachFrameParamsMember(Visit visit) {
   visit([](auto& p) -> auto& { return p.camera_world; });
   visit([](auto& p) -> auto& { return p.camera_position; });
   visit([](auto& p) -> auto& { return p.lens; });
+  visit([](auto& p) -> auto& { return p.lens_centre; });
   visit([](auto& p) -> auto& { return p.resolution; });
   visit([](auto& p) -> auto& { return p.frustum_ray_origin; });
   visit([](auto& p) -> auto& { return p.frustum_ray_du; });
@@ -319,6 +330,8 @@ glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention) {
   glm::mat4 projection(0.0f);
   projection[0][0] = 1.0f / tan_x;
   projection[1][1] = 1.0f / tan_y;
+  projection[2][0] = static_cast<float>(frame.centre_x) * projection[0][0];
+  projection[2][1] = static_cast<float>(frame.centre_y) * projection[1][1];
   projection[2][2] = -ab.x;
   projection[2][3] = -1.0f;
   projection[3][2] = ab.y;

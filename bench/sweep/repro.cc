@@ -71,6 +71,9 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
       "{:.9g}) at {:.4g} from the origin, render target {}x{}",
       frame.index, frame.fov_y_degrees, frame.aspect, frame.near, frame.far, frame.ratio(), frame.camera_position.x,
       frame.camera_position.y, frame.camera_position.z, frame.camera_distance(), frame.width, frame.height);
+  if (frame.centre_x != 0.0 || frame.centre_y != 0.0) {
+    repro.frame += fmt::format(", lens centre ({:.9g}, {:.9g})", frame.centre_x, frame.centre_y);
+  }
   repro.sample = sample.pick == DepthPick::kEyeDepth
                      ? fmt::format("pixel ({}, {}), eye depth {:.17g}", sample.x, sample.y, sample.eye_depth)
                      : fmt::format("pixel ({}, {}), {}", sample.x, sample.y, PickName(sample.pick));

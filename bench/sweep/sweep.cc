@@ -211,6 +211,7 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
     bool needs_infinite = c.hardware && (c.bits & f32::DB_CONVENTION_INFINITE) != 0u;
     if (needs_finite && !domain.finite_far) continue;
     if (needs_infinite && !domain.infinite_far) continue;
+    if (c.hardware && domain.depth_convention && *domain.depth_convention != c.id) continue;
     out.push_back(cell);
   }
   return out;
@@ -224,7 +225,8 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
   if (cells.empty()) {
     return InvalidArgument(
         "none of the selected cells can run in this domain (finite-far conventions and linear formats need "
-        "a finite far plane; infinite-far conventions need --ratio to allow inf)");
+        "a finite far plane; infinite-far conventions need --ratio to allow inf; a projection matrix runs its own "
+        "convention only)");
   }
   const RunLayout layout = MakeRunLayout(cells);
   for (Backend* backend : backends) {

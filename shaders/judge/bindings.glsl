@@ -81,7 +81,8 @@ layout(std430, set = 0, binding = 15) buffer Unwritten { uint unwritten[]; };
 layout(std430, set = 0, binding = 16) readonly buffer EdgeTexels { uint edge_texel_bits[]; };
 // Per frame, DB_JUDGE_FRAME_DRAWS doubles: what the sample pass draws from
 // (shared/draw.h's DrawFrame): the eye-depth range and its log2 span,
-// tan_x, tan_y, width, height, and the rotation's columns.
+// tan_x, tan_y, width, height, the rotation's columns, and the lens's
+// centre (x, y).
 layout(std430, set = 0, binding = 17) readonly buffer FrameDraws { double frame_draws[]; };
 // The pixels the reconstruction pass reads (the Vulkan backend's: x | y <<
 // 16 at element lead + i), written by the sample pass.

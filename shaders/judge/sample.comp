@@ -36,6 +36,8 @@ DrawFrame frame_draw(uint frame) {
       f.rotation[column][row] = frame_draws[at + 7u + uint(3 * column + row)];
     }
   }
+  f.centre_x = frame_draws[at + 16u];
+  f.centre_y = frame_draws[at + 17u];
   return f;
 }
 
