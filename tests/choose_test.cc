@@ -276,6 +276,35 @@ TEST(ChooseTest, CadViewerWantsReversedFloatDepth) {
   EXPECT_EQ(Info(r.ranked.front().cell.convention).bits & 1u, 1u);  // reversed
 }
 
+// The literature's answer for a VR eye (reversed Z with a float buffer),
+// and a variant that assumes a symmetric frustum is named as wrong for the
+// eye rather than blamed on its arithmetic.
+TEST(ChooseTest, VrEyeWantsReversedFloatDepthAndAFrustumAwareVariant) {
+  const ChooseResult r = ChooseFor(kScenes + "vr_asymmetric.toml");
+  ASSERT_TRUE(r.Met()) << r.ranked.front().reason;
+  EXPECT_EQ(r.ranked.front().cell.format, Format::kD32Sfloat);
+  EXPECT_EQ(r.ranked.front().cell.convention, Convention::kReversed);
+  EXPECT_FALSE(r.ranked.front().cell.variant_info().assumes_symmetric_frustum);
+  EXPECT_NE(r.api_recipe.find("glClipControl"), std::string::npos) << r.api_recipe;
+  EXPECT_FALSE(r.lens.empty());
+  bool saw_wrong_lens = false;
+  for (const CandidateVerdict& v : r.ranked) {
+    if (!v.cell.variant_info().assumes_symmetric_frustum) continue;
+    saw_wrong_lens = true;
+    EXPECT_TRUE(v.wrong_lens) << v.cell.Name();
+    EXPECT_FALSE(v.meets) << v.cell.Name();
+    EXPECT_NE(v.reason.find("symmetric frustum"), std::string::npos) << v.reason;
+  }
+  EXPECT_TRUE(saw_wrong_lens);
+}
+
+TEST(ChooseTest, TaaJitterRulesOutTheSymmetricFormulas) {
+  const ChooseResult r = ChooseFor(kScenes + "taa_jitter.toml");
+  ASSERT_TRUE(r.Met());
+  EXPECT_FALSE(r.ranked.front().cell.variant_info().assumes_symmetric_frustum);
+  for (const CandidateVerdict& v : r.ranked) EXPECT_EQ(v.wrong_lens, v.cell.variant_info().assumes_symmetric_frustum);
+}
+
 TEST(ChooseTest, BadSceneFileExitsWithTwo) {
   const auto r = testing::RunDepthbench({"choose", "--scene", kScenes + "missing.toml"});
   EXPECT_EQ(r.exit_code, 2);

@@ -48,7 +48,8 @@ TEST(SceneTest, ParsesEveryFieldIntoTheDomain) {
 }
 
 TEST(SceneTest, ExampleScenesLoad) {
-  for (const char* name : {"indoor_shooter", "open_world", "space_game", "cad_viewer"}) {
+  for (const char* name : {"indoor_shooter", "open_world", "space_game", "cad_viewer", "spot_shadow", "flight_sim",
+                           "engine_matrix", "vr_asymmetric", "taa_jitter"}) {
     auto scene = LoadScene(kScenes + name + ".toml");
     EXPECT_TRUE(scene.ok()) << name << ": " << scene.status().message();
   }
@@ -56,6 +57,44 @@ TEST(SceneTest, ExampleScenesLoad) {
   ASSERT_TRUE(space.ok());
   EXPECT_FALSE(space->domain.finite_far);  // far = "inf"
   for (const Cell& c : space->Candidates()) EXPECT_NE(Info(c.format).stores, DepthInput::kLinear) << c.Name();
+}
+
+TEST(SceneTest, EngineMatrixFixesPlanesLensAndConvention) {
+  auto scene = LoadScene(kScenes + "engine_matrix.toml");
+  ASSERT_TRUE(scene.ok()) << scene.status().message();
+  const Domain& d = scene->domain;
+  EXPECT_EQ(d.near, (Range{0.1, 0.1}));
+  EXPECT_FALSE(d.finite_far);  // reversed infinite
+  ASSERT_TRUE(d.depth_convention.has_value());
+  EXPECT_EQ(*d.depth_convention, Convention::kReversedInf);
+  ASSERT_TRUE(d.eye_fov.has_value());
+  // The 60-degree lens: the baked jitter (2e-4 of the ray) changes the
+  // angle it spans only in the second order, by about 1e-6 degree.
+  EXPECT_NEAR(d.eye_fov->up - d.eye_fov->down, 60.0, 1e-5);
+  EXPECT_TRUE(d.OffCentre());                                  // the jitter baked into the matrix, and jitter = 0.5
+  EXPECT_EQ(d.jitter, 0.5);
+  EXPECT_EQ(scene->api, GraphicsApi::kVulkan);
+  // Only the matrix's convention among the projective ones.
+  for (const Cell& c : scene->Candidates()) {
+    if (Info(c.convention).hardware) {
+      EXPECT_EQ(c.convention, Convention::kReversedInf) << c.Name();
+    }
+  }
+}
+
+TEST(SceneTest, EyeFovAndJitterAreTheDomainsLens) {
+  auto scene = LoadScene(kScenes + "vr_asymmetric.toml");
+  ASSERT_TRUE(scene.ok()) << scene.status().message();
+  ASSERT_TRUE(scene->domain.eye_fov.has_value());
+  EXPECT_EQ(*scene->domain.eye_fov, (EyeFov{-52, 43, 47, -53}));
+  EXPECT_TRUE(scene->domain.OffCentre());
+  auto taa = LoadScene(kScenes + "taa_jitter.toml");
+  ASSERT_TRUE(taa.ok()) << taa.status().message();
+  EXPECT_EQ(taa->domain.jitter, 0.5);
+  EXPECT_TRUE(taa->domain.OffCentre());
+  auto plain = LoadScene(kScenes + "indoor_shooter.toml");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain->domain.OffCentre());
 }
 
 struct BadScene {
@@ -114,7 +153,25 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"resolution = [1920, 1080]", "resolution = [1920]",
                  "projection.resolution: expected [width, height] in pixels"},
         BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\""},
-        BadScene{"name = \"test\"", "name = \"test\"\nbroken = = 1", "bad.toml:2:"}),
+        BadScene{"name = \"test\"", "name = \"test\"\nbroken = = 1", "bad.toml:2:"},
+        BadScene{"aspect = 1.78", "aspect = 1.78\neye_fov = [-40, 40, 30, -30]",
+                 "eye_fov sets the field of view; give one or the other"},
+        BadScene{"fov_degrees = [50, 90]\naspect = 1.78", "eye_fov = [40, -40, 30, -30]",
+                 "projection.eye_fov: eye_fov: 40,-40,30,-30 has no area"},
+        BadScene{"aspect = 1.78", "aspect = 1.78\njitter = 9", "projection.jitter: allowed [0, 4] pixels"},
+        BadScene{"near = 0.5\nfar = 50000\nfov_degrees = [50, 90]\naspect = 1.78",
+                 "matrix = [1, 0, 0.5, 0, 0, 1, 0, 0, 0, 0, -1, -1, 0, 0, -0.2, 0]\napi = \"vulkan\"\n"
+                 "layout = \"column-major\"",
+                 "projection.matrix: projection matrix: an oblique near plane"},
+        BadScene{"near = 0.5\nfar = 50000\nfov_degrees = [50, 90]\naspect = 1.78",
+                 "matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, -1, 0, 0, -0.2, 0]\napi = \"dx12\"\n"
+                 "layout = \"column-major\"",
+                 "projection.api: API 'dx12' is not one of d3d, vulkan"},
+        BadScene{"near = 0.5\nfar = 50000", "near = 0.5\nfar = 50000\napi = \"vulkan\"",
+                 "projection.api: describes projection.matrix, which is not given"},
+        BadScene{"near = 0.5\nfar = 50000\nfov_degrees = [50, 90]\naspect = 1.78",
+                 "matrix = [1, 0, 0]\napi = \"vulkan\"\nlayout = \"column-major\"",
+                 "projection.matrix: expected 16 numbers"}),
     [](const ::testing::TestParamInfo<BadScene>& info) { return TestNameOf(info.param.message, info.index); });
 
 }  // namespace

@@ -274,6 +274,7 @@ std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, cons
   const BandStats whole_band = in_scene->stats.All();
   CandidateVerdict v;
   v.cell = cell;
+  v.wrong_lens = cell.variant_info().assumes_symmetric_frustum && scene.domain.OffCentre();
   JudgeFigures(req, band, v);
   const FarEndPrediction prediction = PredictAtFarEnd(scene, *in_scene, *origin, req.level);
   v.far_end_measured = InUnit(req, far->stats.All(), req.level);
@@ -339,6 +340,21 @@ void RankVerdicts(ChooseResult& result) {
   result.ranked = std::move(ranked);
 }
 
+// The scene's lens when it is off-centre, in words.
+std::string LensText(const Domain& d) {
+  if (!d.OffCentre()) return "";
+  std::vector<std::string> parts;
+  if (d.eye_fov && (d.eye_fov->left != -d.eye_fov->right || d.eye_fov->up != -d.eye_fov->down)) {
+    parts.push_back(fmt::format("an off-centre field of view ({:.4g}, {:.4g}, {:.4g}, {:.4g} degrees left, right, up, "
+                                "down)",
+                                d.eye_fov->left, d.eye_fov->right, d.eye_fov->up, d.eye_fov->down));
+  }
+  if (d.jitter > 0.0) parts.push_back(fmt::format("TAA jitter of up to {:g} px", d.jitter));
+  return fmt::format("{}: variants that assume a symmetric frustum (tan_aspect, divide, reciprocal, pq) are measured "
+                     "with the error that assumption makes",
+                     fmt::join(parts, " and "));
+}
+
 // Each verdict in one sentence.
 void Explain(const Scene& scene, ChooseResult& result) {
   const Requirement& req = scene.requirement;
@@ -365,8 +381,10 @@ void Explain(const Scene& scene, ChooseResult& result) {
       v.reason = fmt::format("fails: {} measured, but the interval reaches {}: too close to call",
                              InUnitText(req, v.measured), measured);
     } else {
-      v.reason =
-          fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.interval.high / limit, CauseText(v.dominant));
+      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.interval.high / limit,
+                             v.wrong_lens ? "its formula assumes a symmetric frustum, and this scene's is off-centre "
+                                            "(it puts NDC (0, 0) on the view axis)"
+                                          : CauseText(v.dominant));
     }
   }
 
@@ -518,6 +536,9 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
     result.cost_source = result.ranked.front().cost->source;
   }
   RankVerdicts(result);
+  result.projection_facts = scene.projection_facts;
+  result.lens = LensText(scene.domain);
+  if (result.Met()) result.api_recipe = ApiRecipe(result.ranked.front().cell.convention);
   Explain(scene, result);
   Suggest(scene, result);
   if (!result.Met() && !result.ranked.empty()) {
@@ -533,6 +554,7 @@ namespace {
 std::string Limit(const CandidateVerdict& v) {
   if (v.meets) return "";
   if (!v.supported) return "samples";
+  if (v.wrong_lens) return "symmetric lens";
   if (v.nonfinite > 0) return "NaN/Inf";
   if (v.too_close) return "interval";
   switch (v.dominant) {
@@ -592,8 +614,10 @@ TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
 std::string ChoiceSummaryMarkdown(const ChooseResult& r) {
   std::ostringstream out;
   out << fmt::format("### depthbench choose: scene '{}'\n\n{}.\n\n", r.scene, r.requirement);
+  if (!r.lens.empty()) out << "Lens: " << r.lens << ".\n\n";
   if (r.Met()) {
-    out << fmt::format("Choice: **{}** ({}).\n\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+    out << fmt::format("Choice: **{}** ({}).\n\nTo store {}: {}.\n\n", r.ranked.front().cell.Name(),
+                       r.ranked.front().reason, Info(r.ranked.front().cell.convention).name, r.api_recipe);
   } else {
     out << "No candidate meets it.\n\n";
     for (const std::string& line : WhatIfLines(r)) out << "- What if " << line << "\n";
@@ -616,9 +640,14 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
   out.text << fmt::format("cost: {} ({})\n", r.cost_unit, r.cost_source);
   if (!r.cost_note.empty()) out.text << "note: " << r.cost_note << "\n";
   for (const std::string& u : r.unusable_formats) out.text << "not a candidate: " << u << "\n";
+  if (!r.projection_facts.empty()) {
+    out.text << fmt::format("projection matrix: {}\n", fmt::join(r.projection_facts, "\n  "));
+  }
+  if (!r.lens.empty()) out.text << "lens: " << r.lens << "\n";
   out.text << "\n";
   if (r.Met()) {
     out.text << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
+    out.text << fmt::format("to store {}: {}\n", Info(r.ranked.front().cell.convention).name, r.api_recipe);
     std::vector<std::string> tied;
     for (const CandidateVerdict& v : r.ranked)
       if (v.rank == 1 && &v != &r.ranked.front()) tied.push_back(v.cell.Name());
@@ -640,7 +669,8 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
       "world origin; +camera: with what the scene's camera distance adds; docs/choosing.md), published only within "
       "0.3 bit of the far end's measurement, else withheld with how far off it was; NaN/Inf: findings inside the scene's ranges;\nheld back by: the part of the error that "
       "dominates (production, storage or shader), or what else "
-      "fails it (interval: the measured value meets it, the upper end of its interval does not);\nrank: '=' marks "
+      "fails it (interval: the measured value meets it, the upper end of its interval does not; symmetric lens: the "
+      "variant's formula assumes a symmetric frustum and the scene's is off-centre);\nrank: '=' marks "
       "costs that tie; B/px: bytes per pixel the depth makes a frame move (the attachment written and read, or "
       "the attachment written and the linear target written and read; none under the static model);\nexit status 0 when a candidate meets the requirement, 1 when none "
       "does\n");
@@ -682,6 +712,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"nonfinite", v.nonfinite},
                       {"dominant_cause", MetricName(v.dominant)},
                       {"meets", v.meets},
+                      {"wrong_lens", v.wrong_lens},
                       {"too_close", v.too_close},
                       {"over_budget", v.over_budget},
                       {"cost", v.cost ? nlohmann::json{{"value", v.cost->value},
@@ -703,6 +734,9 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                      {"met", r.Met()},
                      {"unusable_formats", r.unusable_formats},
                      {"choice", r.Met() ? nlohmann::json(r.ranked.front().cell.Name()) : nlohmann::json(nullptr)},
+                     {"api_recipe", r.api_recipe},
+                     {"lens", r.lens},
+                     {"projection_matrix", r.projection_facts},
                      {"cost",
                       {{"unit", r.cost_unit},
                        {"source", r.cost_source},

@@ -66,6 +66,10 @@ struct CandidateVerdict {
   // kProduction, kStorage or kArith (the shader's part).
   Metric dominant = Metric::kArith;
   bool meets = false;
+  // The variant assumes a symmetric frustum and the scene's is off-centre
+  // (VariantInfo::assumes_symmetric_frustum, Domain::OffCentre): what it
+  // measures is that assumption's error.
+  bool wrong_lens = false;
   // The point estimate is within the limit but the interval's upper end is
   // not: more samples could tell.
   bool too_close = false;
@@ -107,6 +111,11 @@ struct ChooseResult {
   std::vector<std::string> suggestions;  // when nothing meets the requirement
   std::vector<std::string> unusable_formats;  // listed but never a candidate (Scene::UnusableFormats)
   std::vector<WhatIf> what_ifs;               // when nothing meets the requirement
+  std::vector<std::string> projection_facts;  // what the scene's projection matrix holds (Scene)
+  std::string lens;                           // the scene's off-centre lens, in words; empty when centred
+  // What Direct3D, Vulkan, Metal and OpenGL must do to store the choice's
+  // depth (projection_matrix.h ApiRecipe); empty when nothing meets it.
+  std::string api_recipe;
   bool Met() const { return !ranked.empty() && ranked.front().meets; }
   double seconds = 0.0;
 };

@@ -87,9 +87,12 @@ void DomainFlags::Add(CLI::App& app) {
       ->group("Domain");
 }
 
+bool IsSceneFile(const std::string& name_or_file) {
+  return name_or_file.find('/') != std::string::npos || name_or_file.ends_with(".toml");
+}
+
 Expected<Domain> DomainByName(const std::string& name_or_file, const Catalogue& catalogue) {
-  const bool file = name_or_file.find('/') != std::string::npos || name_or_file.ends_with(".toml");
-  if (!file) {
+  if (!IsSceneFile(name_or_file)) {
     Expected<Domain> named = NamedDomain(name_or_file);
     if (!named.ok()) return named.status().WithContext("--domain");
     return named;
@@ -174,7 +177,13 @@ void CellFlags::Add(CLI::App& app) {
   app.add_option("--variant", variants, "variants to run (several, or comma-separated; default all)")
       ->delimiter(',')
       ->group("Cells");
-  app.add_option("--convention", conventions, "depth conventions to run (default all)")->delimiter(',')->group("Cells");
+  app.add_option("--convention", conventions,
+                 "depth conventions to run (default all): standard and reversed (and -inf) are what Direct3D, "
+                 "Vulkan and Metal store, and OpenGL after glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE); the -gl ones "
+                 "are OpenGL's default [-1, 1] clip depth; linear is a shader's G-buffer write ('depthbench list' "
+                 "says what each API must do)")
+      ->delimiter(',')
+      ->group("Cells");
   app.add_option("--format", formats, "storage formats to run (default all)")->delimiter(',')->group("Cells");
 }
 

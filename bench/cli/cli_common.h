@@ -36,6 +36,10 @@ inline constexpr const char* kThreadsHelp =
     "threads in all (default: one per core); where the device judges, a quarter of them, at most 4, feed it while "
     "the rest build the next batch";
 
+// Whether --domain names a scene file (a path, or NAME.toml) rather than a
+// named domain.
+bool IsSceneFile(const std::string& name_or_file);
+
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;

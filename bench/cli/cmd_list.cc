@@ -6,6 +6,7 @@
 #include "bench/base/text_table.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
+#include "bench/pipeline/projection_matrix.h"
 
 namespace depthbench::cli {
 namespace {
@@ -22,18 +23,28 @@ const char* InputName(DepthInput input) {
 Expected<int> List(const CommandContext& context) {
   const TextOutput& out = context.output;
   using Align = TextTable::Align;
-  TextTable variants(
-      {{"variant", Align::kLeft}, {"source", Align::kLeft}, {"reads", Align::kLeft}, {"idea", Align::kLeft}});
+  TextTable variants({{"variant", Align::kLeft},
+                      {"source", Align::kLeft},
+                      {"reads", Align::kLeft},
+                      {"frustum", Align::kLeft},
+                      {"idea", Align::kLeft}});
   for (const auto& v : context.catalogue.variants()) {
-    variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input), std::string(v.idea)});
+    variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input),
+                     v.assumes_symmetric_frustum ? "symmetric" : "any", std::string(v.idea)});
   }
   out.text << "Variants (their sources: docs/sources.md)\n";
   variants.Print(out);
+
+  out.text << "frustum: 'symmetric' variants put NDC (0, 0) on the view axis, as their sources write them, and are "
+              "wrong for an off-centre frustum (a VR eye, TAA jitter); 'any' follow the frustum's own corners or "
+              "matrix\n";
 
   TextTable conventions({{"convention", Align::kLeft}, {"meaning", Align::kLeft}});
   for (const auto& c : AllConventions()) conventions.AddRow({std::string(c.name), std::string(c.description)});
   out.text << "\nDepth conventions\n";
   conventions.Print(out);
+  out.text << "\nWhat each graphics API must do to store them\n";
+  for (const auto& c : AllConventions()) out.text << fmt::format("  {}: {}\n", c.name, ApiRecipe(c.id));
 
   TextTable formats(
       {{"format", Align::kLeft}, {"short", Align::kLeft}, {"Vulkan", Align::kLeft}, {"stores", Align::kLeft}});

@@ -70,8 +70,10 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   for (const fs::path& file : plan.speed_files) {
     DB_RETURN_IF_ERROR(CheckReadableFile(file, kMaxJsonFileBytes).WithContext("--speed"));
   }
-  if (!f.scene.empty()) {
-    DB_ASSIGN_OR_RETURN(plan.scene, LoadScene(f.scene, context.catalogue));
+  // A scene file given as the domain is the scene the report opens on too.
+  const std::string& scene_file = !f.scene.empty() || !IsSceneFile(f.domain.domain) ? f.scene : f.domain.domain;
+  if (!scene_file.empty()) {
+    DB_ASSIGN_OR_RETURN(plan.scene, LoadScene(scene_file, context.catalogue));
   }
 
   // Everything that can be refused is refused before the sweeps run.
@@ -211,7 +213,8 @@ void AddReportCommand(CLI::App& app, CommandAction& action) {
   cmd->add_flag("--no-speed", flags->no_speed, "no speed files: the front uses the static cost model only");
   cmd->add_option("--scene", flags->scene,
                   "a scene file (TOML, see bench/scenes/): the first screen opens on its choice, as depthbench "
-                  "choose makes it: per convention and format its engine allows, whether the requirement is met");
+                  "choose makes it: per convention and format its engine allows, whether the requirement is met. "
+                  "--domain SCENE.toml opens on that scene too, and sweeps its domain");
   cmd->add_option("--plot-library", flags->plot_library,
                   "node_modules folder holding vega, vega-lite and vega-embed (default: the data folder's "
                   "reports/node_modules, which ./setup.sh installs with npm ci --prefix reports)");

@@ -69,7 +69,7 @@ Catalogue::Catalogue(std::vector<UserVariant> user_variants)
   // into its strings stay valid for the catalogue's life.
   for (const UserVariant& user : user_variants_) {
     variants_.push_back(
-        {static_cast<Variant>(variants_.size()), user.name, user.source, user.input, user.idea, &user.shader});
+        {static_cast<Variant>(variants_.size()), user.name, user.source, user.input, user.idea, false, &user.shader});
   }
 }
 

@@ -54,6 +54,10 @@ struct VariantInfo {
   std::string_view source;  // the article it restates, by its short name in docs/sources.md
   DepthInput input;
   std::string_view idea;
+  // The formula puts NDC (0, 0) on the view axis (it reads the lens's
+  // half extents only, as its source writes it): wrong for an off-centre
+  // frustum, a VR eye's or a jittered one (Domain::OffCentre).
+  bool assumes_symmetric_frustum = false;
   // A variant from the user's shader file (--variant-file); null for the
   // built-in ones. It runs on Vulkan only.
   const UserShader* user = nullptr;
@@ -109,21 +113,21 @@ struct FormatInfo {
 namespace catalog {
 inline constexpr std::array<VariantInfo, kVariantCount> kVariants = {{
     {Variant::kFrustumRay, "frustum_ray", "Pettineo 2009", DepthInput::kLinear,
-     "full-screen pass: world-space far-plane frustum ray, interpolated; camera + depth * ray"},
+     "full-screen pass: world-space far-plane frustum ray, interpolated; camera + depth * ray", false},
     {Variant::kVolumeRay, "volume_ray", "Pettineo 2009", DepthInput::kLinear,
-     "light-volume geometry: ray = view position * (far / -view.z); view = depth * ray"},
+     "light-volume geometry: ray = view position * (far / -view.z); view = depth * ray", false},
     {Variant::kTanAspect, "tan_aspect", "Coluna 2011", DepthInput::kLinear,
-     "similar triangles: view.xy = (tan*aspect, tan) * ndc.xy * z, no matrix"},
+     "similar triangles: view.xy = (tan*aspect, tan) * ndc.xy * z, no matrix", true},
     {Variant::kEyeRay, "eye_ray", "eye-ray post 2011", DepthInput::kViewZ,
-     "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside"},
+     "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside", false},
     {Variant::kInverseVp, "inverse_vp", "Unity URP", DepthInput::kHardware,
-     "inverse view-projection times (ndc, depth, 1), divide by w"},
+     "inverse view-projection times (ndc, depth, 1), divide by w", false},
     {Variant::kDivide, "divide", "engine shader notes", DepthInput::kHardware,
-     "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)"},
+     "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)", true},
     {Variant::kReciprocal, "reciprocal", "engine shader notes", DepthInput::kHardware,
-     "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW"},
+     "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW", true},
     {Variant::kPq, "pq", "engine shader notes", DepthInput::kHardware,
-     "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed"},
+     "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed", true},
 }};
 
 // The DB_CONVENTION_* bits of shared/params.h (cells.cc checks they agree).

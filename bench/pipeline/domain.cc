@@ -211,6 +211,11 @@ Status Domain::Validate() const {
   return Status::Ok();
 }
 
+bool Domain::OffCentre() const {
+  const bool eye = eye_fov && (eye_fov->left != -eye_fov->right || eye_fov->up != -eye_fov->down);
+  return eye || jitter > 0.0;
+}
+
 std::string Domain::ToFlags() const {
   auto range = [](const Range& r) { return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max); };
   std::string flags = eye_fov ? "--eye-fov " + eye_fov->ToString()

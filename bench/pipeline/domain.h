@@ -155,6 +155,9 @@ struct Domain {
   static constexpr double kInfiniteDepthSpan = 1e8;
 
   Status Validate() const;
+  // Whether frames may have an off-centre lens: an eye fov not centred on
+  // the view axis, or TAA jitter.
+  bool OffCentre() const;
   std::string Describe() const;
   // The command-line flags that rebuild this domain exactly (numbers with
   // 17 significant digits), e.g. "--fov 1:179 --near 0.0001:10 ...".
