@@ -125,6 +125,8 @@ def check_browser(report_dir, artifact_dir):
         fail("the chart of error parts draws %s, not the three parts (production, storage, arith)" %
              check.get("split_parts"))
     check_first_screen(page, artifact_dir, chromium, document)
+    if document.get("scene") is not None:
+        check_scene_chart(check, document["scene"])
     print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
           (check["headline_rows"], check["plots"], shot))
 
@@ -245,6 +247,20 @@ def check_first_screen(page, artifact_dir, chromium, document):
         fail("the first-screen table is not wholly visible at 1024x768: it ends at x %d, y %d" %
              (first["right"], first["bottom"]))
     print("first screen at 1024x768: %d rows, columns %s, ends at y %d" % (first["rows"], first["columns"], first["bottom"]))
+
+
+def check_scene_chart(check, scene):
+    """The scene's chart draws every candidate's error against eye depth
+    that the document holds, and the requirement's rule."""
+    points = sum(1 for r in scene["rows"] for p in r["by_depth"] if p["value"] is not None and p["value"] > 0)
+    if points == 0:
+        fail("the scene has no error against eye depth to draw")
+    drawn = check["plots"].get("scene")
+    if drawn is None or drawn < points:
+        fail("the scene chart drew %s data marks for %d points" % (drawn, points))
+    if check.get("scene_requirement", 0) < 1:
+        fail("the scene chart does not draw the requirement")
+    print("scene chart: %d points, %d requirement rules" % (points, check["scene_requirement"]))
 
 
 def check_scene_screen(first, scene):

@@ -261,6 +261,25 @@ void JudgeFigures(const Requirement& req, const BandStats& band, CandidateVerdic
   }
 }
 
+// A candidate's figure per decade of eye depth over the scene's own
+// population, where the decade holds enough samples for the level.
+std::vector<DepthFigure> ByDepth(const Scene& scene, const CellResult& in_scene) {
+  const Requirement& req = scene.requirement;
+  const Domain& d = scene.domain;
+  const double lowest = d.eye_depth ? d.eye_depth->min : d.near.min, deepest = DepthLimit(d);
+  std::vector<DepthFigure> figures;
+  for (int k = 0; k < kDepthBands; ++k) {
+    const BandStats band = in_scene.stats.ForDepth(k);
+    if (band.finite < MinimumSamples(req.level)) continue;
+    DepthFigure f;
+    f.depth_min = std::max(lowest, d.near.min * std::pow(10.0, k));
+    f.depth_max = std::min(deepest, d.near.max * std::pow(10.0, k + 1));
+    f.value = InUnit(req, band, req.level);
+    if (f.depth_max > f.depth_min && std::isfinite(f.value)) figures.push_back(f);
+  }
+  return figures;
+}
+
 // One candidate's verdict; nullopt when a population lacks it.
 std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, const Populations& p,
                                       const std::string& backend, const CostLookup& cost_of) {
@@ -276,6 +295,7 @@ std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, cons
   v.cell = cell;
   v.wrong_lens = cell.variant_info().assumes_symmetric_frustum && scene.domain.OffCentre();
   JudgeFigures(req, band, v);
+  v.by_depth = ByDepth(scene, *in_scene);
   const FarEndPrediction prediction = PredictAtFarEnd(scene, *in_scene, *origin, req.level);
   v.far_end_measured = InUnit(req, far->stats.All(), req.level);
   v.predicted = prediction.value;
@@ -521,6 +541,10 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   result.scene = scene.name;
   result.requirement = scene.requirement.Describe();
   result.limit = scene.requirement.value;
+  result.at_depth = scene.requirement.at_depth;
+  result.unit = scene.requirement.kind == Requirement::Kind::kAbsolute ? "world units"
+                : scene.requirement.kind == Requirement::Kind::kRelative ? "relative error"
+                                                                          : "bits lost";
   result.backend = backend.name();
   result.device = backend.device().name;
   result.unusable_formats = scene.UnusableFormats();

@@ -39,6 +39,14 @@ inline constexpr const char* kStaticCostUnit = "FMA-equivalent slots";
 // For every variant of `catalogue`.
 Expected<CostLookup> StaticCostLookup(const std::string& shader_dir, const Catalogue& catalogue = Catalogue::BuiltIn());
 
+// A candidate's error over one decade of eye depth in the scene (z/near in
+// [10^k, 10^(k+1)), clipped to the scene's depths), at the requirement's
+// level and in its unit.
+struct DepthFigure {
+  double depth_min = 0.0, depth_max = 0.0;  // eye depths, world units
+  double value = 0.0;
+};
+
 struct CandidateVerdict {
   Cell cell;
   // In the requirement's own unit (world units, relative error or bits).
@@ -70,6 +78,9 @@ struct CandidateVerdict {
   // (VariantInfo::assumes_symmetric_frustum, Domain::OffCentre): what it
   // measures is that assumption's error.
   bool wrong_lens = false;
+  // The error against eye depth over the scene's cameras: the decades with
+  // enough samples for the level.
+  std::vector<DepthFigure> by_depth;
   // The point estimate is within the limit but the interval's upper end is
   // not: more samples could tell.
   bool too_close = false;
@@ -104,6 +115,8 @@ struct ChooseResult {
   std::string scene;
   std::string requirement;
   double limit = 0.0;  // the requirement's limit, in its own unit
+  std::optional<double> at_depth;  // the eye depth the requirement applies at, if any
+  std::string unit;                // the requirement's unit: "world units", "relative error" or "bits lost"
   std::string backend, device;
   std::string cost_unit, cost_source;
   std::string cost_note;                 // why the static model ranks, when a speed file was given

@@ -521,7 +521,8 @@ Expected<ChooseResult> ChooseScene(const Scene& scene, const ReportPlan& plan, s
 // The scene's first screen: each convention and format once, by its best
 // candidate, in the order of the ranking.
 SceneSection SceneScreen(const ChooseResult& choice) {
-  SceneSection section{choice.scene, choice.requirement, choice.backend, choice.cost_unit, {}, {}, {}};
+  SceneSection section{choice.scene, choice.requirement, choice.backend, choice.cost_unit, choice.unit,
+                       choice.limit, choice.at_depth, {}, {}, {}};
   for (const CandidateVerdict& v : choice.ranked) {
     const std::string convention(Info(v.cell.convention).name), format(Info(v.cell.format).name);
     const bool seen = std::any_of(section.rows.begin(), section.rows.end(), [&](const SceneRow& r) {
@@ -540,6 +541,7 @@ SceneSection SceneScreen(const ChooseResult& choice) {
       row.bytes_per_pixel = v.cost->bytes_per_pixel;
       row.cost = Shown(v.cost->value);
     }
+    for (const DepthFigure& f : v.by_depth) row.by_depth.push_back({f.depth_min, f.depth_max, Shown(f.value)});
     section.rows.push_back(std::move(row));
   }
   for (const WhatIf& w : choice.what_ifs) {

@@ -179,13 +179,21 @@ json SceneJson(const std::optional<SceneSection>& scene) {
           {"requirement", scene->requirement},
           {"backend", scene->backend},
           {"cost_unit", scene->cost_unit},
+          {"unit", scene->unit},
+          {"limit", scene->limit},
+          {"at_depth", scene->at_depth ? json(*scene->at_depth) : json(nullptr)},
           {"rows", Rows(scene->rows,
                         [](const SceneRow& r) {
                           return json{{"convention", r.convention},     {"format", r.format},
                                       {"variant", r.variant},           {"measured", Value(r.measured)},
                                       {"far_end", Value(r.far_end)},    {"meets", r.meets},
                                       {"times_limit", r.times_limit},   {"bytes_per_pixel", r.bytes_per_pixel},
-                                      {"cost", Value(r.cost)}};
+                                      {"cost", Value(r.cost)},
+                                      {"by_depth", Rows(r.by_depth, [](const SceneRow::DepthPoint& p) {
+                                         return json{{"depth_min", p.depth_min},
+                                                     {"depth_max", p.depth_max},
+                                                     {"value", Value(p.value)}};
+                                       })}};
                         })},
           {"what_ifs", scene->what_ifs},
           {"not_candidates", scene->not_candidates}};

@@ -256,9 +256,18 @@ struct SceneRow {
   double times_limit = 0.0;  // measured / the requirement's limit
   std::uint32_t bytes_per_pixel = 0;
   Figure cost;
+  // The error against eye depth (choose.h DepthFigure), for the chart.
+  struct DepthPoint {
+    double depth_min, depth_max;
+    Figure value;
+  };
+  std::vector<DepthPoint> by_depth;
 };
 struct SceneSection {
   std::string name, requirement, backend, cost_unit;
+  std::string unit;                // the requirement's
+  double limit = 0.0;              // in that unit
+  std::optional<double> at_depth;  // where it applies, if anywhere in particular
   std::vector<SceneRow> rows;  // the choice first, then as ranked
   std::vector<std::string> what_ifs, not_candidates;
 };
