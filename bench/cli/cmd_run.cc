@@ -86,7 +86,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(Domain{}, context.catalogue));
   DB_ASSIGN_OR_RETURN(options.cells, f.cells.Select(context.catalogue));
   DB_ASSIGN_OR_RETURN(const std::vector<std::string> projection, f.domain.DescribeProjection());
-  if (!projection.empty() && !f.quiet) {
+  if (!projection.empty()) {
     out.text << "projection matrix: " << fmt::format("{}", fmt::join(projection, "\n  ")) << "\n";
   }
   std::vector<BandFamily> splits;

@@ -253,7 +253,8 @@ std::string Domain::Describe() const {
   } else {
     far_text = "infinite far";
   }
-  const std::string lens = eye_fov ? fmt::format("eye fov {} deg (left, right, up, down)", eye_fov->ToString())
+  const std::string lens = eye_fov ? fmt::format("eye fov {:.6g}, {:.6g}, {:.6g}, {:.6g} deg (left, right, up, down)",
+                                                 eye_fov->left, eye_fov->right, eye_fov->up, eye_fov->down)
                                    : fmt::format("fov {} deg, aspect {}", fov_degrees.ToString(), aspect.ToString());
   std::string text = fmt::format("{}, near {}, {}, camera distance {}", lens, near.ToString(), far_text,
                                  camera_distance.ToString());
