@@ -189,6 +189,15 @@ TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
   ExpectSameStatistics(ExtremesDomain(), "extremes, workgroup table", {.bins = JudgeBinMerge::kWorkgroupTable});
 }
 
+// An off-centre lens (a VR eye, with TAA jitter on top): the device draws
+// each pixel's ray through the frame's centre as the host does.
+TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsThroughAnOffCentreLens) {
+  Domain domain = WideDomain();
+  domain.eye_fov = EyeFov{-52.0, 43.0, 47.0, -53.0};
+  domain.jitter = 0.5;
+  ExpectSameStatistics(domain, "wide, an off-centre eye with jitter", {.bins = JudgeBinMerge::kDeviceCounters});
+}
+
 // One batch of `domain` (every cell it allows), its reference computed by
 // the host (in `batch`) and by the device (returned), which draws the
 // samples itself where it can (float32 production: BatchFor::kDeviceDraws),
