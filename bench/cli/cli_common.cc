@@ -138,7 +138,13 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
     if (!fov.empty() || !aspect.empty()) return InvalidArgument("--eye-fov replaces --fov and --aspect");
     DB_RETURN_IF_ERROR(StoreInto(ParseEyeFov(eye_fov, "--eye-fov"), d.eye_fov.emplace()));
   }
-  if (!jitter.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseNumber(jitter, "--jitter"), d.jitter));
+  if (!jitter.empty()) {
+    DB_RETURN_IF_ERROR(StoreInto(ParseNumber(jitter, "--jitter"), d.jitter));
+    if (!(d.jitter >= 0.0 && d.jitter <= kMostJitterPixels)) {
+      return InvalidArgument(fmt::format("--jitter: {} pixels is out of range; allowed [0, {:g}] pixels", jitter,
+                                         kMostJitterPixels));
+    }
+  }
   if (!near.empty()) DB_RETURN_IF_ERROR(StoreInto(ParseRange(near, "--near", kNearLimits), d.near));
   if (!far.empty() && !ratio.empty()) return InvalidArgument("--far and --ratio cannot be used together");
   if (!far.empty()) {

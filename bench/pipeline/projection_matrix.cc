@@ -219,8 +219,9 @@ Expected<ProjectionMatrix> ParseProjectionFlag(std::string_view text) {
   const std::size_t second = first == std::string_view::npos ? first : text.find(':', first + 1);
   if (second == std::string_view::npos) return usage(fmt::format("'{}' has no API and layout", text));
   ProjectionMatrix m;
-  DB_ASSIGN_OR_RETURN(m.api, ParseGraphicsApi(text.substr(0, first)));
-  DB_ASSIGN_OR_RETURN(m.layout, ParseMatrixLayout(text.substr(first + 1, second - first - 1)));
+  DB_RETURN_IF_ERROR(StoreInto(ParseGraphicsApi(text.substr(0, first)), m.api).WithContext("--projection"));
+  DB_RETURN_IF_ERROR(
+      StoreInto(ParseMatrixLayout(text.substr(first + 1, second - first - 1)), m.layout).WithContext("--projection"));
   std::size_t start = second + 1;
   for (int k = 0; k < 16; ++k) {
     const std::size_t comma = std::min(text.find(',', start), text.size());
