@@ -298,6 +298,20 @@ TEST(ChooseTest, VrEyeWantsReversedFloatDepthAndAFrustumAwareVariant) {
   EXPECT_TRUE(saw_wrong_lens);
 }
 
+// When only symmetric-frustum formulas are allowed on an off-centre eye,
+// the advice names the lens, not the depth buffer or the arithmetic.
+TEST(ChooseTest, OnlySymmetricFormulasOnAnOffCentreEyeAreToldWhy) {
+  const std::string dir = testing::MakeTempDir("symmetric_only");
+  const std::string path = dir + "/eye.toml";
+  std::ofstream(path) << "name = \"eye\"\n[projection]\neye_fov = [-52, 43, 47, -53]\nnear = 0.05\nfar = 1000\n"
+                         "[engine]\nvariants = [\"divide\", \"pq\"]\nformats = [\"d32_sfloat\"]\n"
+                         "[requirement]\nabsolute_error = 0.002\nat_depth = 10\n";
+  const ChooseResult r = ChooseFor(path);
+  ASSERT_FALSE(r.Met());
+  ASSERT_GE(r.suggestions.size(), 2u);
+  EXPECT_NE(r.suggestions[1].find("assumes a symmetric frustum"), std::string::npos) << r.suggestions[1];
+}
+
 TEST(ChooseTest, TaaJitterRulesOutTheSymmetricFormulas) {
   const ChooseResult r = ChooseFor(kScenes + "taa_jitter.toml");
   ASSERT_TRUE(r.Met());

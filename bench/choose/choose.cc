@@ -422,7 +422,12 @@ void Suggest(const Scene& scene, ChooseResult& result) {
     const bool depth = closest.dominant != Metric::kArith;  // production or storage: the depth buffer's own
     const bool reversed_float =
         closest.cell.format == Format::kD32Sfloat && (Info(closest.cell.convention).bits & 1u) != 0u;
-    if (depth && !reversed_float) {
+    if (closest.wrong_lens) {
+      result.suggestions.push_back(
+          "its formula assumes a symmetric frustum and this scene's is off-centre: a variant that follows the "
+          "frustum (inverse_vp, or the rays of frustum_ray, volume_ray, eye_ray), or the same formula with the "
+          "frustum's centre added back (a variant file), removes that error");
+    } else if (depth && !reversed_float) {
       result.suggestions.push_back(fmt::format(
           "{}: a float depth buffer with reversed Z (d32_sfloat, reversed, clip depth [0,1]) keeps the relative "
           "error of the stored depth flat across depth; with a unorm or standard-Z format it grows with z/near",
