@@ -360,19 +360,29 @@ void RankVerdicts(ChooseResult& result) {
   result.ranked = std::move(ranked);
 }
 
+// The built-in variants that assume a symmetric frustum (or that do not),
+// by name: "tan_aspect, divide, reciprocal, pq".
+std::string BuiltInVariantsWhere(bool assume_symmetric_frustum) {
+  std::vector<std::string_view> names;
+  for (const VariantInfo& v : AllVariants()) {
+    if (v.assumes_symmetric_frustum == assume_symmetric_frustum) names.push_back(v.name);
+  }
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
 // The scene's lens when it is off-centre, in words.
 std::string LensText(const Domain& d) {
   if (!d.OffCentre()) return "";
   std::vector<std::string> parts;
-  if (d.eye_fov && (d.eye_fov->left != -d.eye_fov->right || d.eye_fov->up != -d.eye_fov->down)) {
+  if (d.eye_fov && d.eye_fov->OffAxis()) {
     parts.push_back(fmt::format("an off-centre field of view ({:.4g}, {:.4g}, {:.4g}, {:.4g} degrees left, right, up, "
                                 "down)",
                                 d.eye_fov->left, d.eye_fov->right, d.eye_fov->up, d.eye_fov->down));
   }
   if (d.jitter > 0.0) parts.push_back(fmt::format("TAA jitter of up to {:g} px", d.jitter));
-  return fmt::format("{}: variants that assume a symmetric frustum (tan_aspect, divide, reciprocal, pq) are measured "
-                     "with the error that assumption makes",
-                     fmt::join(parts, " and "));
+  return fmt::format("{}: variants that assume a symmetric frustum ({}) are measured with the error that assumption "
+                     "makes",
+                     fmt::join(parts, " and "), BuiltInVariantsWhere(true));
 }
 
 // Each verdict in one sentence.
@@ -423,10 +433,11 @@ void Suggest(const Scene& scene, ChooseResult& result) {
     const bool reversed_float =
         closest.cell.format == Format::kD32Sfloat && (Info(closest.cell.convention).bits & 1u) != 0u;
     if (closest.wrong_lens) {
-      result.suggestions.push_back(
+      result.suggestions.push_back(fmt::format(
           "its formula assumes a symmetric frustum and this scene's is off-centre: a variant that follows the "
-          "frustum (inverse_vp, or the rays of frustum_ray, volume_ray, eye_ray), or the same formula with the "
-          "frustum's centre added back (a variant file), removes that error");
+          "frustum ({}), or the same formula with the frustum's centre added back (a variant file), removes that "
+          "error",
+          BuiltInVariantsWhere(false)));
     } else if (depth && !reversed_float) {
       result.suggestions.push_back(fmt::format(
           "{}: a float depth buffer with reversed Z (d32_sfloat, reversed, clip depth [0,1]) keeps the relative "

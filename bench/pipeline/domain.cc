@@ -212,8 +212,7 @@ Status Domain::Validate() const {
 }
 
 bool Domain::OffCentre() const {
-  const bool eye = eye_fov && (eye_fov->left != -eye_fov->right || eye_fov->up != -eye_fov->down);
-  return eye || jitter > 0.0;
+  return (eye_fov && eye_fov->OffAxis()) || jitter > 0.0;
 }
 
 std::string Domain::ToFlags() const {

@@ -106,6 +106,8 @@ struct EyeFov {
   double TanUp() const;
   double TanDown() const;
   std::string ToString() const;  // "-50,45,48,-52"
+  // Whether the frustum's centre is off the view axis.
+  bool OffAxis() const { return left != -right || up != -down; }
   friend bool operator==(const EyeFov&, const EyeFov&) = default;
 };
 // "LEFT,RIGHT,UP,DOWN" in degrees; `what` names the input in the error.
