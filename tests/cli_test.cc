@@ -8,6 +8,7 @@
 #include "bench/base/text_table.h"
 #include "bench/results/results.h"
 #include "tests/command_runner.h"
+#include "tests/sanitized_stage.h"
 
 namespace depthbench {
 namespace {
@@ -172,6 +173,7 @@ namespace {
 // Every line a subcommand prints fits a terminal of 120 columns: tables
 // leave out their secondary columns and wrap their text, and say so.
 TEST(CliTest, OutputFitsOneHundredTwentyColumns) {
+  DEPTHBENCH_FIGURES_ONLY("each command's own test");
   const std::string dir = testing::MakeTempDir("cli_width");
   const std::string root = DEPTHBENCH_SOURCE_DIR;
   const std::vector<std::vector<std::string>> commands{

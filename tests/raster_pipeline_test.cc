@@ -19,12 +19,15 @@
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/sweep/sweep.h"
+#include "tests/sanitized_stage.h"
 
 namespace depthbench {
 namespace {
 
 constexpr int kDeepestDecade = 3;  // z/n in [1e3, 1e4): the far plane's decade at f/n 1e4
-constexpr std::uint64_t kSamples = 60000;
+// The figures need 1e4 samples in the deepest decade; the sanitized stage
+// runs only the tests that check what runs (sanitized_stage.h), on fewer.
+constexpr std::uint64_t kSamples = testing::kSanitized ? 6000 : 60000;
 
 class RasterPipelineTest : public ::testing::Test {
  protected:
@@ -159,6 +162,7 @@ TEST_F(RasterPipelineTest, TheRasterAgreementIsKeptInTheResults) {
 }
 
 TEST_F(RasterPipelineTest, FarPlaneFiguresFollowTheComputeFormAndTheHostModel) {
+  DEPTHBENCH_FIGURES_ONLY("EveryCellRunsAndIsJudged");
   int compared = 0;
   for (const CellResult& c : Compute().cells) {
     if (c.backend != "vulkan") continue;
@@ -195,6 +199,7 @@ TEST_F(RasterPipelineTest, FarPlaneFiguresFollowTheComputeFormAndTheHostModel) {
 }
 
 TEST_F(RasterPipelineTest, TheShaderPartIsTheComputeFormsOnTheDevicesTexels) {
+  DEPTHBENCH_FIGURES_ONLY("EveryCellRunsAndIsJudged");
   // The device's texels (and its fetch's conversion to float) are adopted
   // into the reference, so with clip depth [0, 1] the shader part of a
   // variant without rays is its arithmetic alone, as in the compute form:
@@ -214,6 +219,7 @@ TEST_F(RasterPipelineTest, TheShaderPartIsTheComputeFormsOnTheDevicesTexels) {
 }
 
 TEST_F(RasterPipelineTest, RasterizedFloatDepthShowsTheCostOfTheGlRemap) {
+  DEPTHBENCH_FIGURES_ONLY("EveryCellRunsAndIsJudged");
   // What only the raster form shows: with GL-style clip depth the shader
   // maps window depth d back to NDC as -1 + 2d. The compute form's d was
   // made as 0.5 * ndc + 0.5 from a float NDC, so that map gives the NDC
