@@ -13,7 +13,7 @@ packages=(
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-tools
   libglm-dev libceres-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfmt-dev
-  libmpfr-dev libgmp-dev libsqlite3-dev libbenchmark-dev
+  libmpfr-dev libgmp-dev libsqlite3-dev libbenchmark-dev libopenexr-dev libpng-dev
   # The Vulkan backend's tests run with the validation layer on; the
   # libFuzzer targets and the sanitizer build need clang's runtime.
   vulkan-validationlayers googletest libgtest-dev clang-14 libclang-rt-14-dev

@@ -127,6 +127,8 @@ def check_browser(report_dir, artifact_dir):
     check_first_screen(page, artifact_dir, chromium, document)
     if document.get("scene") is not None:
         check_scene_chart(check, document["scene"])
+        if document["scene"].get("capture") is not None:
+            check_capture_picture(check, report_dir, document["scene"]["capture"])
     print("report.html: %d headline rows; data marks per plot: %s; screenshot %s" %
           (check["headline_rows"], check["plots"], shot))
 
@@ -261,6 +263,28 @@ def check_scene_chart(check, scene):
     if check.get("scene_requirement", 0) < 1:
         fail("the scene chart does not draw the requirement")
     print("scene chart: %d points, %d requirement rules" % (points, check["scene_requirement"]))
+
+
+def check_capture_picture(check, report_dir, capture):
+    """A captured frame's bits lost per pixel: the PNG beside the page is
+    the one the page shows, decoded at its own size and drawn."""
+    path = os.path.join(report_dir, capture["image"])
+    with open(path, "rb") as f:
+        header = f.read(24)
+    if header[:8] != b"\x89PNG\r\n\x1a\n":
+        fail("%s is not a PNG" % path)
+    width, height = int.from_bytes(header[16:20], "big"), int.from_bytes(header[20:24], "big")
+    shown = check.get("capture_image")
+    if shown is None:
+        fail("the page does not show the capture's picture")
+    if (shown["width"], shown["height"]) != (width, height):
+        fail("the page decoded the picture at %dx%d, the file is %dx%d" % (shown["width"], shown["height"], width,
+                                                                          height))
+    if shown["shown"] < width:
+        fail("the picture is drawn %d pixels wide, narrower than the frame (%d)" % (shown["shown"], width))
+    print("capture picture: %dx%d, drawn %d wide; %s by %s: median %.1f, p99.9 %.1f, worst %.1f bits" %
+          (width, height, shown["shown"], capture["source"], capture["cell"], capture["median_bits"],
+           capture["p999_bits"], capture["worst_bits"]))
 
 
 def check_scene_screen(first, scene):

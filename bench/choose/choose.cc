@@ -14,6 +14,7 @@
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/resources.h"
 #include "bench/base/text_table.h"
+#include "bench/pipeline/captured.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/speed_results.h"
 #include "bench/speed/trade.h"
@@ -62,9 +63,13 @@ std::string InUnitText(const Requirement& req, double v) {
   return "";
 }
 
+// The deepest eye depth the scene's population reaches: the end of its
+// range of interest, or the far plane; a capture's farthest pixel if that
+// is nearer.
 double DepthLimit(const Domain& d) {
-  if (d.eye_depth) return d.eye_depth->max;
-  return d.finite_far ? d.far->max : d.near.max * Domain::kInfiniteDepthSpan;
+  double limit = d.eye_depth ? d.eye_depth->max : d.finite_far ? d.far->max : d.near.max * Domain::kInfiniteDepthSpan;
+  if (d.capture) limit = std::min(limit, DeepestPixel(*d.capture));
+  return limit;
 }
 
 // A band's figure of `metric` at `level`, as a fit point's b (log2 + 24);
@@ -578,6 +583,10 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   RankVerdicts(result);
   result.projection_facts = scene.projection_facts;
   result.lens = LensText(scene.domain);
+  if (const auto& capture = scene.domain.capture) {
+    result.population = fmt::format("the {} drawn pixels of {} within the frustum ({})",
+                                    CapturedSource(scene.domain).sample_count(), capture->source, capture->description);
+  }
   if (result.Met()) result.api_recipe = ApiRecipe(result.ranked.front().cell.convention);
   Explain(scene, result);
   Suggest(scene, result);
@@ -684,6 +693,7 @@ void PrintChoice(const ChooseResult& r, const TextOutput& out) {
     out.text << fmt::format("projection matrix: {}\n", fmt::join(r.projection_facts, "\n  "));
   }
   if (!r.lens.empty()) out.text << "lens: " << r.lens << "\n";
+  if (!r.population.empty()) out.text << "population: " << r.population << "\n";
   out.text << "\n";
   if (r.Met()) {
     out.text << fmt::format("choice: {} ({})\n", r.ranked.front().cell.Name(), r.ranked.front().reason);
@@ -776,6 +786,7 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                      {"choice", r.Met() ? nlohmann::json(r.ranked.front().cell.Name()) : nlohmann::json(nullptr)},
                      {"api_recipe", r.api_recipe},
                      {"lens", r.lens},
+                     {"population", r.population},
                      {"projection_matrix", r.projection_facts},
                      {"cost",
                       {{"unit", r.cost_unit},

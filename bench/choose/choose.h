@@ -126,6 +126,9 @@ struct ChooseResult {
   std::vector<WhatIf> what_ifs;               // when nothing meets the requirement
   std::vector<std::string> projection_facts;  // what the scene's projection matrix holds (Scene)
   std::string lens;                           // the scene's off-centre lens, in words; empty when centred
+  // The scene's population when it is a captured frame's pixels, in
+  // words; empty for the random draw over the scene's ranges.
+  std::string population;
   // What Direct3D, Vulkan, Metal and OpenGL must do to store the choice's
   // depth (projection_matrix.h ApiRecipe); empty when nothing meets it.
   std::string api_recipe;

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "bench/base/files.h"
+#include "bench/capture/depth_capture.h"
 #include "bench/pipeline/projection_matrix.h"
 #include "bench/sweep/sweep.h"
 
@@ -332,6 +333,66 @@ Status ReadCameraAndDepth(SceneReader& r, const toml::table& root, Domain& d) {
   return Status::Ok();
 }
 
+// [capture]: a depth buffer saved from a real frame, whose pixels are the
+// scene's population (bench/capture/depth_capture.h).
+Status ReadCapture(SceneReader& r, const toml::table& root, Scene& scene) {
+  DB_ASSIGN_OR_RETURN(const toml::table* capture, r.Table(root, "capture", false));
+  if (capture == nullptr) return Status::Ok();
+  DB_RETURN_IF_ERROR(r.OnlyKeys(*capture, "capture", {"file", "stores", "channel", "camera_position"}));
+  const auto text = [&](const char* key, std::string fallback) -> Expected<std::string> {
+    const toml::node* node = capture->get(key);
+    if (node == nullptr) return fallback;
+    if (auto v = node->value<std::string>()) return *v;
+    return r.Error(node, std::string("capture.") + key, "expected a string");
+  };
+  DB_ASSIGN_OR_RETURN(const std::string file, text("file", ""));
+  if (file.empty()) return r.Error(capture, "capture.file", "missing: the OpenEXR file of the frame's depth buffer");
+  DB_ASSIGN_OR_RETURN(const std::string stores_name, text("stores", CaptureStoresName(CaptureStores::kWindowDepth)));
+  const Expected<CaptureStores> stores = ParseCaptureStores(stores_name);
+  if (!stores.ok()) return r.Error(capture->get("stores"), "capture.stores", stores.status().message());
+  DB_ASSIGN_OR_RETURN(const std::string channel, text("channel", ""));
+  Domain& d = scene.domain;
+  if (*stores == CaptureStores::kWindowDepth && !d.depth_convention) {
+    return r.Error(capture, "capture.stores",
+                   "window depth is decoded through the frame's projection: give projection.matrix (or store "
+                   "eye-depth)");
+  }
+  glm::dvec3 camera(0.0);
+  if (const toml::node* node = capture->get("camera_position")) {
+    const toml::array* xyz = node->as_array();
+    if (xyz == nullptr || xyz->size() != 3) {
+      return r.Error(node, "capture.camera_position", "expected [x, y, z], the camera's world position");
+    }
+    for (int k = 0; k < 3; ++k) {
+      DB_ASSIGN_OR_RETURN(camera[k], r.Number(xyz->get(k), fmt::format("capture.camera_position[{}]", k)));
+      camera[k] = static_cast<float>(camera[k]);  // as an engine stores it
+    }
+    if (root.get("camera") != nullptr) {
+      return r.Error(node, "capture.camera_position", "[camera] places the camera too; give one or the other");
+    }
+    if (!(glm::length(camera) <= kCameraDistanceLimits.highest)) {
+      return r.Error(node, "capture.camera_position",
+                     fmt::format("at most {:g} from the origin", kCameraDistanceLimits.highest));
+    }
+  }
+  // The file is found beside the scene file.
+  const std::filesystem::path path = std::filesystem::path(scene.source).parent_path() / file;
+  const Expected<DepthImage> image = ReadDepthExr(path, channel);
+  if (!image.ok()) return r.Error(capture->get("file"), "capture.file", image.status().message());
+  const Convention convention = d.depth_convention.value_or(Convention::kStandard);
+  const double far = d.finite_far ? (d.far ? d.far->min : d.near.min * d.ratio.min) : INFINITY;
+  Expected<CapturedPixels> pixels = DecodeCapture(*image, path.string(), *stores, convention, d.near.min, far);
+  if (!pixels.ok()) return r.Error(capture->get("file"), "capture.file", pixels.status().message());
+  pixels->camera_position = camera;
+  pixels->description = fmt::format("{}x{} {} ({} channel {}), {} background", image->width, image->height,
+                                    CaptureStoresName(*stores), image->channel_type, image->channel,
+                                    pixels->background);
+  Expected<Domain> captured = CaptureDomain(d, std::make_shared<const CapturedPixels>(std::move(pixels).value()));
+  if (!captured.ok()) return r.Error(capture->get("file"), "capture.file", captured.status().message());
+  d = std::move(captured).value();
+  return Status::Ok();
+}
+
 // [engine]: the variants, conventions and formats the engine allows.
 Status ReadEngine(SceneReader& r, const toml::table& root, const Catalogue& catalogue, Scene& scene) {
   DB_ASSIGN_OR_RETURN(const toml::table* engine, r.Table(root, "engine", false));
@@ -426,7 +487,8 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
     return InvalidArgument(fmt::format("{}:{}:{}: not valid TOML: {}", source, e.source().begin.line,
                                        e.source().begin.column, e.description()));
   }
-  DB_RETURN_IF_ERROR(r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "engine", "requirement", "cost"}));
+  DB_RETURN_IF_ERROR(
+      r.OnlyKeys(root, "", {"name", "projection", "camera", "depth", "capture", "engine", "requirement", "cost"}));
   Scene scene;
   scene.catalogue = &catalogue;
   scene.source = source;
@@ -438,6 +500,8 @@ Expected<Scene> ParseScene(std::string_view text, const std::string& source, con
   // projection.resolution leaves the one it names; the default domain has several.
   if (d.resolutions.size() == 1) scene.resolution = d.resolutions.front();
   DB_RETURN_IF_ERROR(ReadCameraAndDepth(r, root, d));
+  DB_RETURN_IF_ERROR(ReadCapture(r, root, scene));
+  if (d.capture) scene.resolution = d.resolutions.front();
   DB_RETURN_IF_ERROR(ReadEngine(r, root, catalogue, scene));
   DB_RETURN_IF_ERROR(ReadRequirement(r, root, d, scene.requirement));
   DB_RETURN_IF_ERROR(ReadCost(r, root, scene));

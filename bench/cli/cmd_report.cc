@@ -9,6 +9,7 @@
 #include "bench/base/files.h"
 #include "bench/base/progress.h"
 #include "bench/base/resources.h"
+#include "bench/capture/depth_capture.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/report/report.h"
@@ -152,6 +153,15 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(const std::string page, RenderHtml(report, page_template, library));
   const std::string markdown = RenderMarkdown(report);
   const fs::path out(f.out);
+  if (const auto& capture = measured->capture_bits) {
+    // Written under a temporary name and renamed, as the other files are, and
+    // before the page that shows it.
+    const fs::path image = out / kCaptureImageName, partial = out / (std::string(kCaptureImageName) + ".partial");
+    DB_RETURN_IF_ERROR(WriteBitsLostPng(partial, capture->width, capture->height, capture->bits));
+    std::error_code ec;
+    fs::rename(partial, image, ec);
+    if (ec) return IoError(fmt::format("--out: cannot write '{}': {}", image.string(), ec.message()));
+  }
   for (const auto& [name, text] :
        {std::pair<const char*, std::string>{"results.json", ReportToJson(report).dump(1) + "\n"},
         {"report.md", markdown},

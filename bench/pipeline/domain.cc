@@ -9,6 +9,7 @@
 
 #include "bench/base/parse_number.h"
 #include "bench/base/suggest.h"
+#include "bench/pipeline/captured.h"
 
 namespace depthbench {
 
@@ -127,7 +128,7 @@ bool operator==(const Domain& a, const Domain& b) {
          a.finite_far == b.finite_far && a.infinite_far == b.infinite_far && a.far == b.far &&
          a.camera_distance == b.camera_distance && a.eye_depth == b.eye_depth && a.resolutions == b.resolutions &&
          a.production == b.production && a.constants == b.constants && a.eye_fov == b.eye_fov &&
-         a.jitter == b.jitter && a.depth_convention == b.depth_convention;
+         a.jitter == b.jitter && a.depth_convention == b.depth_convention && a.capture == b.capture;
 }
 
 Domain TypicalDomain() { return Domain{}; }
@@ -260,6 +261,7 @@ std::string Domain::Describe() const {
   if (jitter > 0.0) text += fmt::format(", TAA jitter up to {:g} px", jitter);
   if (depth_convention) text += fmt::format(", {} depth only (the projection matrix's)", Info(*depth_convention).name);
   if (eye_depth) text += fmt::format(", eye depth {}", eye_depth->ToString());
+  if (capture) text += fmt::format(", the pixels of {} ({}x{})", capture->source, capture->width, capture->height);
   if (production != ProductionModel::kFloat32) text += fmt::format(", {} production", ProductionModelName(production));
   if (constants != ConstantsModel::kExact) text += fmt::format(", {} constants", ConstantsModelName(constants));
   return fmt::format("{}: {}", name, text);

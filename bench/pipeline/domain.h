@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -120,6 +121,8 @@ inline constexpr double kMostEyeFovAngle = 89.0;
 inline constexpr double kMostJitterPixels = 4.0;
 
 // The members' defaults are the `typical` domain (TypicalDomain).
+struct CapturedPixels;  // captured.h
+
 struct Domain {
   std::string name = "typical";    // the named domain or scene it started from ("custom" once narrowed)
   Range fov_degrees{30.0, 100.0};  // vertical field of view, uniform in degrees
@@ -152,6 +155,10 @@ struct Domain {
   std::vector<Resolution> resolutions{{1280, 720}, {1920, 1080}, {2560, 1440}, {3840, 2160}};
   ProductionModel production = ProductionModel::kFloat32;
   ConstantsModel constants = ConstantsModel::kExact;
+  // A captured frame (captured.h, made by CaptureDomain): its pixels are
+  // the population, in place of random draws. Not among ToFlags' flags: a
+  // scene file names it.
+  std::shared_ptr<const CapturedPixels> capture;
 
   // Far/near span used by frames whose far plane is infinite only.
   static constexpr double kInfiniteDepthSpan = 1e8;

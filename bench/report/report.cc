@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/environment.h"
+#include "bench/capture/depth_capture.h"
 #include "bench/choose/choose.h"
 #include "bench/choose/frame_cost.h"
 #include "bench/gate/gate.h"
@@ -518,11 +519,27 @@ Expected<ChooseResult> ChooseScene(const Scene& scene, const ReportPlan& plan, s
   return Choose(scene, *backend, sources, options);
 }
 
+// Bits lost per pixel of the scene's capture by its choice (or closest
+// candidate), on the backend the choice was made on.
+Expected<ReportMeasurements::CaptureBits> CaptureBitsOf(const Scene& scene, const ChooseResult& choice,
+                                                        std::span<Backend* const> backends) {
+  Backend* backend = backends.front();
+  for (Backend* b : backends)
+    if (b->name() == choice.backend) backend = b;
+  ReportMeasurements::CaptureBits out;
+  out.cell = choice.ranked.front().cell;
+  out.backend = backend->name();
+  out.width = scene.domain.capture->width;
+  out.height = scene.domain.capture->height;
+  DB_ASSIGN_OR_RETURN(out.bits, BitsLostPerPixel(scene.domain, out.cell, *backend));
+  return out;
+}
+
 // The scene's first screen: each convention and format once, by its best
 // candidate, in the order of the ranking.
 SceneSection SceneScreen(const ChooseResult& choice) {
   SceneSection section{choice.scene, choice.requirement, choice.backend, choice.cost_unit, choice.unit,
-                       choice.limit, choice.at_depth, {}, {}, {}};
+                       choice.limit, choice.at_depth, {}, {}, {}, std::nullopt};
   for (const CandidateVerdict& v : choice.ranked) {
     const std::string convention(Info(v.cell.convention).name), format(Info(v.cell.format).name);
     const bool seen = std::any_of(section.rows.begin(), section.rows.end(), [&](const SceneRow& r) {
@@ -701,6 +718,9 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   if (plan.scene) {
     begin("scene");
     DB_ASSIGN_OR_RETURN(m.scene_choice, ChooseScene(*plan.scene, plan, backends, m));
+    if (plan.scene->domain.capture && !m.scene_choice->ranked.empty()) {
+      DB_ASSIGN_OR_RETURN(m.capture_bits, CaptureBitsOf(*plan.scene, *m.scene_choice, backends));
+    }
     end("scene", fmt::format("{} candidates", m.scene_choice->ranked.size()));
   }
   begin("error models");
@@ -736,6 +756,18 @@ Report BuildReport(const ReportPlan& plan, const ReportMeasurements& m) {
   report.speed = Speed(m);
   report.recommendations = Recommendations(m);
   if (m.scene_choice) report.scene = SceneScreen(*m.scene_choice);
+  if (m.capture_bits && report.scene) {
+    std::vector<float> judged;
+    for (float b : m.capture_bits->bits)
+      if (!std::isnan(b)) judged.push_back(b);
+    std::sort(judged.begin(), judged.end());
+    const auto at = [&](double q) {
+      return judged.empty() ? 0.0 : judged[std::min(judged.size() - 1, static_cast<std::size_t>(q * judged.size()))];
+    };
+    report.scene->capture = SceneSection::CapturePicture{
+        kCaptureImageName, m.capture_bits->cell.Name(), m.capture_bits->backend, plan.scene->domain.capture->source,
+        judged.size(),     at(0.5),                     at(0.999),               judged.empty() ? 0.0 : judged.back()};
+  }
   report.worst_cells = WorstCells(report.headline);
   return report;
 }

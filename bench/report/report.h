@@ -84,6 +84,16 @@ struct ReportMeasurements {
   Status static_costs_status;
   std::vector<std::pair<std::string, double>> stage_seconds;
   std::optional<ChooseResult> scene_choice;  // with ReportPlan::scene
+  // With a captured frame as the scene's population: bits lost per pixel
+  // by the scene's choice (or, when nothing meets the requirement, the
+  // closest candidate), on the backend the choice was made on.
+  struct CaptureBits {
+    Cell cell;
+    std::string backend;
+    std::uint32_t width = 0, height = 0;
+    std::vector<float> bits;  // row by row from the top; NaN: background or outside the frustum
+  };
+  std::optional<CaptureBits> capture_bits;
 };
 
 

@@ -196,7 +196,16 @@ json SceneJson(const std::optional<SceneSection>& scene) {
                                        })}};
                         })},
           {"what_ifs", scene->what_ifs},
-          {"not_candidates", scene->not_candidates}};
+          {"not_candidates", scene->not_candidates},
+          {"capture", scene->capture ? json{{"image", scene->capture->image},
+                                            {"cell", scene->capture->cell},
+                                            {"backend", scene->capture->backend},
+                                            {"source", scene->capture->source},
+                                            {"pixels", scene->capture->pixels},
+                                            {"median_bits", scene->capture->median_bits},
+                                            {"p999_bits", scene->capture->p999_bits},
+                                            {"worst_bits", scene->capture->worst_bits}}
+                                     : json(nullptr)}};
 }
 
 }  // namespace

@@ -270,7 +270,19 @@ struct SceneSection {
   std::optional<double> at_depth;  // where it applies, if anywhere in particular
   std::vector<SceneRow> rows;  // the choice first, then as ranked
   std::vector<std::string> what_ifs, not_candidates;
+  // A captured frame's bits lost per pixel (ReportMeasurements::capture_bits),
+  // as the picture the page shows.
+  struct CapturePicture {
+    std::string image;  // the PNG's name beside report.html
+    std::string cell, backend, source;
+    std::uint64_t pixels = 0;  // judged
+    double median_bits = 0.0, p999_bits = 0.0, worst_bits = 0.0;
+  };
+  std::optional<CapturePicture> capture;
 };
+
+// The PNG of a capture's bits lost per pixel, beside report.html.
+inline constexpr const char* kCaptureImageName = "capture-bits.png";
 
 struct Report {
   ReportEnvironment environment;

@@ -206,6 +206,13 @@ void YourScene(const Report& report, std::string& out) {
                        Number(r.far_end), r.bytes_per_pixel > 0 ? std::to_string(r.bytes_per_pixel) : "-",
                        Number(r.cost), use);
   }
+  if (s.capture) {
+    const auto& c = *s.capture;
+    out += fmt::format("![bits lost per pixel]({})\n\nBits lost per pixel of `{}` by `{}` on {} ({} pixels judged: "
+                       "median {:.1f}, p99.9 {:.1f}, worst {:.1f}; grey: nothing drawn). The bar under it runs from 0 "
+                       "to 24 bits lost, a tick every 4.\n\n",
+                       c.image, c.source, c.cell, c.backend, c.pixels, c.median_bits, c.p999_bits, c.worst_bits);
+  }
   for (const std::string& w : s.what_ifs) out += "- what if " + w + "\n";
   for (const std::string& n : s.not_candidates) out += "- not a candidate: " + n + "\n";
   out += "\nMeasured: the upper end of the 95% interval at the requirement's level and depth, in its unit; far end: "

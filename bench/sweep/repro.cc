@@ -6,6 +6,7 @@
 
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
+#include "bench/pipeline/captured.h"
 #include "bench/pipeline/judge.h"
 #include "bench/pipeline/stats.h"
 #include "bench/pipeline/user_variant.h"
@@ -39,8 +40,11 @@ const char* PickName(DepthPick p) {
 Expected<Repro> Reproduce(std::uint64_t seed, std::uint64_t index, const Domain& domain, std::span<const Cell> cells,
                           std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(domain.Validate());
-  const Sampler sampler(seed, domain);
-  DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(sampler, index, cells, backends));
+  const std::unique_ptr<const SampleSource> source = SourceFor(seed, domain);
+  if (index >= SamplesFor(index + 1, *source)) {
+    return InvalidArgument(fmt::format("--index {}: the capture has {} samples", index, SamplesFor(0, *source)));
+  }
+  DB_ASSIGN_OR_RETURN(Repro repro, ReproduceFrom(*source, index, cells, backends));
   repro.seed = seed;
   repro.domain = domain;
   repro.origin = fmt::format("sample {} of seed {}", index, seed);

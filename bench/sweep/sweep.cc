@@ -10,6 +10,7 @@
 #include "bench/base/interrupt.h"
 #include "bench/base/thread_pool.h"
 #include "bench/pipeline/batch.h"
+#include "bench/pipeline/captured.h"
 #include "bench/pipeline/sampler.h"
 #include "bench/sweep/judging_stage.h"
 #include "bench/sweep/sweep_plan.h"
@@ -217,8 +218,16 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
   return out;
 }
 
-Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const> backends) {
-  DB_RETURN_IF_ERROR(options.Validate());
+Expected<Results> RunSweep(const SweepOptions& requested, std::span<Backend* const> backends) {
+  DB_RETURN_IF_ERROR(requested.Validate());
+  // A captured frame's pixels are the population: all of them, once each.
+  SweepOptions options = requested;
+  const std::unique_ptr<const SampleSource> source = SourceFor(options.seed, options.domain);
+  options.samples = SamplesFor(options.samples, *source);
+  if (options.samples == 0) {
+    return InvalidArgument(fmt::format("{}: no drawn pixel lies in {}", options.domain.capture->source,
+                                       options.domain.Describe()));
+  }
   const std::vector<Cell> all = AllCells();
   const std::vector<Cell> cells = CellsForDomain(
       options.cells.empty() ? std::span<const Cell>(all) : std::span<const Cell>(options.cells), options.domain);
@@ -245,8 +254,7 @@ Expected<Results> RunSweep(const SweepOptions& options, std::span<Backend* const
     traits.push_back(stages[b]->traits());
     if (traits.back().site == JudgeSite::kDevice) results.run.backends[b].judge = JudgedOn::kDevice;
   }
-  const Sampler sampler(options.seed, options.domain);
-  const BatchBuilder builder(sampler, layout.encodings, options.isa);
+  const BatchBuilder builder(*source, layout.encodings, options.isa);
   SweepPlan plan;
   DB_RETURN_IF_ERROR(StoreInto(PlanSweep(options, traits, builder.DevicesCanDraw()), plan));
 
