@@ -280,6 +280,52 @@ Status WriteSummary(const std::string& path, const std::string& markdown) {
   return Status::Ok();
 }
 
+namespace {
+
+// Whether two paths name one file: the same inode where both exist, else
+// the same place once links and relative parts are resolved.
+bool SameFile(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ec && ca == cb;
+}
+
+}  // namespace
+
+FileRoles& FileRoles::Input(const std::string& path, std::string flag) {
+  if (!path.empty() && path != kStandardOutputName) inputs_.push_back({path, std::move(flag)});
+  return *this;
+}
+
+FileRoles& FileRoles::Output(const std::string& path, std::string flag) {
+  if (!path.empty() && path != kStandardOutputName) outputs_.push_back({path, std::move(flag)});
+  return *this;
+}
+
+Status FileRoles::Check() const {
+  for (std::size_t k = 0; k < outputs_.size(); ++k) {
+    const Named& out = outputs_[k];
+    for (const Named& in : inputs_) {
+      if (SameFile(out.path, in.path)) {
+        return InvalidArgument(fmt::format("{} '{}' names the file read as {} '{}': writing it would replace it; "
+                                           "write somewhere else",
+                                           out.flag, out.path, in.flag, in.path));
+      }
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+      if (SameFile(out.path, outputs_[j].path)) {
+        return InvalidArgument(fmt::format("{} '{}' and {} '{}' are one file: one would be lost; give each its own",
+                                           outputs_[j].flag, outputs_[j].path, out.flag, out.path));
+      }
+    }
+  }
+  return Status::Ok();
+}
+
 Status CheckWritable(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   const bool to_standard_output_allowed = what == "--json";

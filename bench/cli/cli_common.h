@@ -94,6 +94,26 @@ Expected<std::uint64_t> ParseCount(const std::string& text, const std::string& w
 // a user pipes, "-" (standard output) is accepted.
 Status CheckWritable(const std::string& path, const std::string& what);
 
+// The files one command reads and writes, each by the flag that names it.
+// Check refuses an output that is one of the inputs (writing it would
+// replace what is being read, as a compiler refuses -o x.c x.c), and two
+// outputs that are one file (one would be lost). Files are compared as
+// files, not as spellings: a relative path, a link or a second name of an
+// existing file is that file. Empty paths (a flag not given) and "-"
+// (standard output) are left out.
+class FileRoles {
+ public:
+  FileRoles& Input(const std::string& path, std::string flag);
+  FileRoles& Output(const std::string& path, std::string flag);
+  Status Check() const;
+
+ private:
+  struct Named {
+    std::string path, flag;
+  };
+  std::vector<Named> inputs_, outputs_;
+};
+
 // A command's Markdown summary for CI: written to `path` (--summary; none
 // when empty), and added to the job's summary page when the job has one
 // (StepSummaryFile: GitHub Actions' $GITHUB_STEP_SUMMARY).

@@ -66,6 +66,12 @@ Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
   options.seed = f.seed;
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
   if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
+  DB_RETURN_IF_ERROR(FileRoles()
+                         .Input(f.scene, "--scene")
+                         .Input(f.speed, "--speed")
+                         .Output(f.json, "--json")
+                         .Output(f.summary, "--summary")
+                         .Check());
   DB_ASSIGN_OR_RETURN(const std::unique_ptr<Backend> backend, MakeBackend(f.backend, {f.device, f.shaders, false}));
   CostSources costs;
   DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders, context.catalogue));

@@ -198,6 +198,16 @@ Expected<int> Gate(const GateFlags& f, const CommandContext& context) {
     if (path.empty()) continue;
     DB_RETURN_IF_ERROR(CheckWritable(path, what));
   }
+  // With --update the baselines are written too; otherwise they are read.
+  FileRoles roles;
+  for (const std::string& path : f.baselines) {
+    if (f.update) {
+      roles.Output(path, "--baseline");
+    } else {
+      roles.Input(path, "--baseline");
+    }
+  }
+  DB_RETURN_IF_ERROR(roles.Output(f.junit, "--junit").Output(f.json, "--json").Output(f.summary, "--summary").Check());
   DB_ASSIGN_OR_RETURN(const std::vector<BaselineSlot> slots, ReadBaselines(f, context.catalogue));
   DB_ASSIGN_OR_RETURN(const BackendSet made, MakeGateBackends(f, slots, context.catalogue));
   DB_ASSIGN_OR_RETURN(const Results results, RunGateSweep(f, made.view(), context.catalogue));

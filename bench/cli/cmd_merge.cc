@@ -19,6 +19,9 @@ struct MergeFlags {
 Expected<int> Merge(const MergeFlags& f, const CommandContext& context) {
   const TextOutput& out = context.output;
   DB_RETURN_IF_ERROR(CheckWritable(f.output, "--json"));
+  FileRoles roles;
+  for (const std::string& path : f.inputs) roles.Input(path, "the input");
+  DB_RETURN_IF_ERROR(roles.Output(f.output, "--json").Check());
   // Every input is looked at before any is read (a missing last shard is
   // said at once).
   for (const std::string& path : f.inputs) {

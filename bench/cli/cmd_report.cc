@@ -97,6 +97,16 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
     DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / name).string(), "--out"));
   }
   if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
+  {
+    // The history is read and written in place; the pages are written.
+    FileRoles roles;
+    roles.Input(f.history, "--history").Input(f.scene, "--scene").Input(f.page_template, "--template");
+    for (const std::string& speed : f.speed) roles.Input(speed, "--speed");
+    for (const char* name : {"results.json", "report.md", "report.html", kCaptureImageName}) {
+      roles.Output((fs::path(f.out) / name).string(), "--out");
+    }
+    DB_RETURN_IF_ERROR(roles.Output(f.summary, "--summary").Check());
+  }
   PlotLibrary library{f.plot_library};
   if (library.node_modules.empty())
     DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));

@@ -101,6 +101,7 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
       return InvalidArgument(fmt::format("--split: '{}' is not one of ratio, depth, distance", s));
   }
   if (!f.json.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.json, "--json"));
+  DB_RETURN_IF_ERROR(FileRoles().Input(f.repro, "--repro").Output(f.json, "--json").Check());
   DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make(context.catalogue));
   const std::span<Backend* const> backends = made.view();
 
