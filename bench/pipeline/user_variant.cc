@@ -1,6 +1,7 @@
 #include "bench/pipeline/user_variant.h"
 
 #include <algorithm>
+#include <cctype>
 #include <optional>
 #include <sstream>
 
@@ -64,6 +65,68 @@ Status ApplyKey(std::string_view key, std::string_view value, UserShader& shader
 
 const char* kExample = "// depthbench: input=hardware entry=reconstruct uv=top-left view=right-handed";
 
+// The first word of `text` that only the other language has, with its
+// line: a GLSL type or layout in a file named .hlsl, an HLSL type or
+// cbuffer in a file named .glsl. glslang's HLSL front end accepts much
+// GLSL and gives it another meaning (`m * v` is component-wise there), so
+// the extension alone must not decide. Only types and declarations are
+// looked for (a function of the user's may be called `saturate` or `mix`
+// in either language); comments and preprocessor lines are skipped, and a
+// name the file #defines (a port's `#define float3 vec3`) is its own.
+struct ForeignWord {
+  std::string word;
+  int line = 0;
+};
+std::optional<ForeignWord> WordOfTheOtherLanguage(const std::string& text, ShaderLanguage named) {
+  static const std::vector<std::string> kGlslOnly = {"vec2", "vec3", "vec4", "mat3", "mat4",  "uvec2",
+                                                     "ivec2", "dvec3", "dmat4", "layout"};
+  static const std::vector<std::string> kHlslOnly = {"float2", "float3", "float4", "float3x3", "float4x4",
+                                                     "half2",  "half3",  "half4",  "cbuffer"};
+  std::vector<std::string> foreign = named == ShaderLanguage::kHlsl ? kGlslOnly : kHlslOnly;
+  std::istringstream lines(text);
+  std::string directive;
+  while (std::getline(lines, directive)) {
+    std::istringstream words(directive);
+    std::string hash, name;
+    if (words >> hash >> name && (hash == "#define" || (hash == "#" && name == "define" && words >> name))) {
+      name = name.substr(0, name.find('('));
+      std::erase(foreign, name);
+    }
+  }
+  int line = 1;
+  bool block_comment = false;
+  bool line_start = true;  // only blanks since the line began
+  for (std::size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (line_start && c == '#') {  // a preprocessor line
+      while (i < text.size() && text[i] != '\n') ++i;
+      continue;
+    }
+    if (c != ' ' && c != '\t') line_start = c == '\n';
+    if (c == '\n') {
+      ++line;
+      ++i;
+    } else if (block_comment) {
+      block_comment = text.compare(i, 2, "*/") != 0;
+      i += block_comment ? 1 : 2;
+    } else if (text.compare(i, 2, "/*") == 0) {
+      block_comment = true;
+      i += 2;
+    } else if (text.compare(i, 2, "//") == 0) {
+      while (i < text.size() && text[i] != '\n') ++i;
+    } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      std::size_t end = i;
+      while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_')) ++end;
+      const std::string word = text.substr(i, end - i);
+      if (std::find(foreign.begin(), foreign.end(), word) != foreign.end()) return ForeignWord{word, line};
+      i = end;
+    } else {
+      ++i;
+    }
+  }
+  return std::nullopt;
+}
+
 // The absolute, normal form of a path the user gave.
 std::filesystem::path Absolute(const std::string& given) {
   std::error_code error;
@@ -84,6 +147,21 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
         fmt::format("--variant-file {}: the file's extension says its language: .glsl or .hlsl", given));
   }
   DB_ASSIGN_OR_RETURN(const std::string text, ReadFile(path, kMaxSourceFileBytes, "--variant-file"));
+  // Visual Studio saves UTF-8 with a byte-order mark; glslang reads it as
+  // a stray character at the file's first token.
+  if (text.starts_with("\xEF\xBB\xBF")) {
+    return InvalidArgument(fmt::format(
+        "{}:1: the file starts with a UTF-8 byte-order mark, which the shader compiler cannot read; save it as "
+        "UTF-8 without a signature (Visual Studio: File > Save As > Save with Encoding)",
+        given));
+  }
+  if (const std::optional<ForeignWord> foreign = WordOfTheOtherLanguage(text, shader.language)) {
+    const bool hlsl = shader.language == ShaderLanguage::kHlsl;
+    return InvalidArgument(fmt::format("{}:{}: '{}' is {}, but the file is named {}: it would be compiled as {}, "
+                                       "where it means something else or nothing; rename the file {}",
+                                       given, foreign->line, foreign->word, hlsl ? "GLSL" : "HLSL", extension,
+                                       hlsl ? "HLSL" : "GLSL", hlsl ? ".glsl" : ".hlsl"));
+  }
   // The path goes into an #include "..." line of the generated program.
   if (path.string().find_first_of("\"\n\\") != std::string::npos) {
     return InvalidArgument(
@@ -96,22 +174,37 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
   std::istringstream lines(text);
   std::string line;
   int number = 0;
-  bool declared = false;
-  while (!declared && number < kDeclarationLines && std::getline(lines, line)) {
+  int declared_at = 0;  // the contract's line; 0 before it is found
+  while (std::getline(lines, line)) {
     ++number;
     const std::size_t at = line.find(kMarker);
     if (at == std::string::npos) continue;
-    declared = true;
+    // One contract a file: a second line would otherwise be ignored, and
+    // whichever the author edited last might not be the one that counts.
+    if (declared_at != 0) {
+      return InvalidArgument(fmt::format("{}:{}: a second '// depthbench:' line (the first is line {}); a file "
+                                         "declares one contract",
+                                         given, number, declared_at));
+    }
+    if (number > kDeclarationLines) break;  // too late to be the header's; said below
+    declared_at = number;
     std::istringstream words(line.substr(at + kMarker.size()));
     std::string word;
+    std::vector<std::string> keys;
     while (words >> word) {
       const std::size_t equals = word.find('=');
       const std::string key = word.substr(0, equals);
       const std::string value = equals == std::string::npos ? "" : word.substr(equals + 1);
+      if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+        return InvalidArgument(fmt::format("{}:{}: '{}' is given twice; a contract gives each key once", given,
+                                           number, key));
+      }
+      keys.push_back(key);
       Status applied = ApplyKey(key, value, shader, input, name);
       if (!applied.ok()) return InvalidArgument(fmt::format("{}:{}: {}", given, number, applied.message()));
     }
   }
+  const bool declared = declared_at != 0;
   if (!declared || !input) {
     return InvalidArgument(
         fmt::format("{}: {} the contract in its first {} lines; for example\n  {}\n(see docs/variant-files.md)", given,
