@@ -131,6 +131,22 @@ struct JsonReal {
   Status Read(const JsonReader& r, double& out) const { return StoreInto(r.Number(), out); }
 };
 
+// A finite double within [lowest, highest]: a figure with a known range
+// (bits lost), where "nan" or a value outside would be a damaged file.
+struct JsonRealIn {
+  double lowest;
+  double highest;
+  nlohmann::json Write(double value) const { return JsonNumber(value); }
+  Status Read(const JsonReader& r, double& out) const {
+    DB_ASSIGN_OR_RETURN(const double value, r.Number());
+    if (!(value >= lowest && value <= highest)) {
+      return r.Error(fmt::format("{} is outside [{:g}, {:g}]", JsonNumber(value).dump(), lowest, highest));
+    }
+    out = value;
+    return Status::Ok();
+  }
+};
+
 // An integer within [min, max], the type's whole range unless narrowed.
 // Unsigned ones read null as UINT64_MAX (JsonReader::Unsigned).
 template <std::integral Int>

@@ -75,13 +75,16 @@ const JsonFields<SamplePlan>& SamplePlanFields() {
 }
 
 const JsonFields<BandFigures>& BandFiguresFields() {
+  static constexpr JsonRealIn kBits{0.0, kAllBitsLost};
   static const JsonFields<BandFigures> fields{{
-      JsonMember("total_p999_bits", &BandFigures::total_p999),
-      JsonMember("total_max_bits", &BandFigures::total_max),
-      JsonMember("arith_p999_bits", &BandFigures::arith_p999),
-      JsonMember("arith_max_bits", &BandFigures::arith_max),
+      // Bits lost lie in [0, 24]: a value outside, or "nan", is a damaged
+      // file that would make a false "worse" or a band that never fails.
+      JsonMember("total_p999_bits", &BandFigures::total_p999, kBits),
+      JsonMember("total_max_bits", &BandFigures::total_max, kBits),
+      JsonMember("arith_p999_bits", &BandFigures::arith_p999, kBits),
+      JsonMember("arith_max_bits", &BandFigures::arith_max, kBits),
       // (absent from baselines made before the interval was kept)
-      JsonMemberOr("p999_interval_bits", &BandFigures::p999_interval_bits, JsonReal(), 0.0),
+      JsonMemberOr("p999_interval_bits", &BandFigures::p999_interval_bits, kBits, 0.0),
       JsonMember("judged", &BandFigures::judged),
       JsonMember("nan", &BandFigures::nan),
       JsonMember("inf", &BandFigures::inf),

@@ -112,14 +112,27 @@ struct BinsCodec {
     for (const auto& [slot, count] : bins) out.push_back(json::array({slot, count}));
     return out;
   }
+  // As written: slots ascending, each once, each count at least 1, and
+  // their sum within 64 bits; anything else is a changed or damaged file.
   Status Read(const JsonReader& r, std::map<int, std::uint64_t>& out) const {
     out.clear();
+    std::uint64_t sum = 0;
     return r.ForEach([&](const JsonReader& pair) -> Status {
       DB_ASSIGN_OR_RETURN(const auto elements, TwoElements(pair, "[slot, count]"));
       int slot = 0;
       DB_RETURN_IF_ERROR((JsonInteger<int>{0, kDenseBins - 1}.Read(elements.first, slot)));
       if (out.contains(slot)) return elements.first.Error(fmt::format("bin {} is given twice", slot));
-      return JsonInteger<std::uint64_t>().Read(elements.second, out[slot]);
+      if (!out.empty() && slot < out.rbegin()->first) {
+        return elements.first.Error(fmt::format("bin {} follows bin {}: bins are listed in ascending order", slot,
+                                                out.rbegin()->first));
+      }
+      std::uint64_t count = 0;
+      DB_RETURN_IF_ERROR((JsonInteger<std::uint64_t>{1}.Read(elements.second, count)));
+      if (__builtin_add_overflow(sum, count, &sum)) {
+        return elements.second.Error("the bins' counts add up past 2^64");
+      }
+      out[slot] = count;
+      return Status::Ok();
     });
   }
 };
@@ -423,8 +436,81 @@ json ToJson(const Results& results) {
   return WriteDocument(kResultsSchema, ResultsFields(Catalogue::BuiltIn()), results);
 }
 
+namespace {
+
+// Every band's histogram of the total error holds one value per finite
+// sample, and that of the shader's part at most as many (none where the
+// stored value denotes no point float32 holds: judge.cc); the other
+// metrics are the encoding's, copied into its cells, and hold their own
+// counts. A band's counts add up within 64 bits. A histogram changed by hand, or a file damaged, fails
+// here with the cell and the band named, before any figure is drawn from it.
+Status CheckHistograms(const Results& results, const std::string& source) {
+  for (const CellResult& c : results.cells) {
+    const auto check = [&](const std::map<int, BandStats>& bands, const char* family,
+                           std::string (*band_name)(int)) -> Status {
+      for (const auto& [key, band] : bands) {
+        const auto where = [&] {
+          return fmt::format("{}: cell {} ({} backend), {} band {}", source, c.cell.Name(), c.backend, family,
+                             band_name(key));
+        };
+        std::uint64_t counted = 0;
+        for (std::uint64_t n : {band.finite, band.nan, band.inf, band.stored_nonfinite, band.degenerate, band.outside}) {
+          if (__builtin_add_overflow(counted, n, &counted)) {
+            return InvalidArgument(fmt::format("{}: its counts add up past 2^64", where()));
+          }
+        }
+        for (Metric m : {Metric::kTotal, Metric::kArith}) {
+          const std::uint64_t in_bins = band[m].Count();
+          if (m == Metric::kTotal ? in_bins != band.finite : in_bins > band.finite) {
+            return InvalidArgument(fmt::format(
+                "{}: the {} histogram holds {} samples where the band judged {} finite; the file was changed or "
+                "damaged",
+                where(), MetricName(m), in_bins, band.finite));
+          }
+        }
+      }
+      return Status::Ok();
+    };
+    DB_RETURN_IF_ERROR(check(c.stats.joint, "joint", [](int joint) {
+      return RatioBandName(RatioOfJoint(joint)) + " x " + DepthBandName(DepthOfJoint(joint));
+    }));
+    DB_RETURN_IF_ERROR(check(c.stats.distance, "distance", DistanceBandName));
+    DB_RETURN_IF_ERROR(check(c.stats.coverage, "coverage", CoverageBandName));
+  }
+  return Status::Ok();
+}
+
+// Whether adding `b` to `a` keeps every count within 64 bits.
+bool AddsWithinRange(const CellStats& a, const CellStats& b) {
+  const auto fits = [](std::uint64_t x, std::uint64_t y) {
+    std::uint64_t sum;
+    return !__builtin_add_overflow(x, y, &sum);
+  };
+  const auto bands_fit = [&](const std::map<int, BandStats>& x, const std::map<int, BandStats>& y) {
+    for (const auto& [key, band] : y) {
+      const auto it = x.find(key);
+      if (it == x.end()) continue;
+      const BandStats& held = it->second;
+      if (!fits(held.finite, band.finite) || !fits(held.nan, band.nan) || !fits(held.inf, band.inf) ||
+          !fits(held.stored_nonfinite, band.stored_nonfinite) || !fits(held.degenerate, band.degenerate) ||
+          !fits(held.outside, band.outside)) {
+        return false;
+      }
+      for (int m = 0; m < kMetricCount; ++m) {
+        if (!fits(held.metrics[m].Count(), band.metrics[m].Count())) return false;
+      }
+    }
+    return true;
+  };
+  return bands_fit(a.joint, b.joint) && bands_fit(a.distance, b.distance) && bands_fit(a.coverage, b.coverage);
+}
+
+}  // namespace
+
 Expected<Results> ResultsFromJson(const json& j, const std::string& source, const Catalogue& catalogue) {
-  return ReadDocument(kResultsSchema, ResultsFields(catalogue), j, source);
+  DB_ASSIGN_OR_RETURN(Results results, ReadDocument(kResultsSchema, ResultsFields(catalogue), j, source));
+  DB_RETURN_IF_ERROR(CheckHistograms(results, source));
+  return results;
 }
 
 Status WriteResults(const std::filesystem::path& path, const Results& results) {
@@ -559,6 +645,10 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
                              [&](const CellResult& m) { return m.cell == c.cell && m.backend == c.backend; });
       if (it == merged.cells.end()) {
         merged.cells.push_back(c);
+      } else if (!AddsWithinRange(it->stats, c.stats)) {
+        return InvalidArgument(fmt::format("{}: cell {} ({} backend): added to the other parts, its counts would pass "
+                                           "2^64",
+                                           name(p), c.cell.Name(), c.backend));
       } else {
         it->stats.Merge(c.stats);
       }
