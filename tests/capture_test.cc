@@ -108,11 +108,11 @@ TEST(CaptureTest, DecodesWindowDepthThroughTheProjection) {
     DepthImage image{static_cast<std::uint32_t>(depths.size()) + 1, 1, "Z", "float", {}};
     for (double z : depths) {
       const DoubleDouble dd_far = std::isfinite(f) ? DoubleDouble(f) : DoubleDouble(0.0);
-      image.values.push_back(RoundToFloat(hp::window_depth_from_eye_depth(DoubleDouble(near), dd_far, bits, DoubleDouble(z))));
+      image.values.push_back(
+          RoundToFloat(hp::window_depth_from_eye_depth(DoubleDouble(near), dd_far, bits, DoubleDouble(z))));
     }
     image.values.push_back((bits & f32::DB_CONVENTION_REVERSED) != 0u ? 0.0f : 1.0f);  // the clear value
-    const Expected<CapturedPixels> pixels =
-        DecodeCapture(image, "t.exr", CaptureStores::kWindowDepth, c, near, f);
+    const Expected<CapturedPixels> pixels = DecodeCapture(image, "t.exr", CaptureStores::kWindowDepth, c, near, f);
     ASSERT_TRUE(pixels.ok()) << pixels.status().message();
     EXPECT_EQ(pixels->background, 1u) << Info(c).name;
     EXPECT_TRUE(std::isnan(pixels->eye_depth.back()));
@@ -131,7 +131,8 @@ TEST(CaptureTest, DecodesWindowDepthThroughTheProjection) {
       << message;
   // Linear depth: eye depth itself; 0 and infinity are nothing drawn.
   DepthImage linear{4, 1, "Z", "float", {2.5f, 0.0f, INFINITY, 700.0f}};
-  const Expected<CapturedPixels> eye = DecodeCapture(linear, "l.exr", CaptureStores::kEyeDepth, Convention::kStandard, near, far);
+  const Expected<CapturedPixels> eye =
+      DecodeCapture(linear, "l.exr", CaptureStores::kEyeDepth, Convention::kStandard, near, far);
   ASSERT_TRUE(eye.ok());
   EXPECT_EQ(eye->eye_depth[0], 2.5);
   EXPECT_EQ(eye->eye_depth[3], 700.0);

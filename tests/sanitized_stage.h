@@ -28,7 +28,7 @@ inline constexpr bool kSanitized = false;
 
 // First statement of such a test; WHERE names the test that runs its paths.
 #define DEPTHBENCH_FIGURES_ONLY(WHERE)                                                        \
-  if (::depthbench::testing::kSanitized) {                                                   \
+  if (::depthbench::testing::kSanitized) {                                                    \
     GTEST_SKIP() << "figures only: checked in the release stage; " WHERE " runs these paths"; \
   }
 

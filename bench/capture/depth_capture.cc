@@ -71,9 +71,9 @@ Expected<DepthImage> ReadDepthExr(const std::filesystem::path& path, const std::
     } else if (names.size() == 1) {
       pick = 0;
     } else {
-      return InvalidArgument(fmt::format(
-          "{}: {} channels ({}); name the depth channel (capture.channel in a scene file)", name, names.size(),
-          fmt::join(names, ", ")));
+      return InvalidArgument(
+          fmt::format("{}: {} channels ({}); name the depth channel (capture.channel in a scene file)", name,
+                      names.size(), fmt::join(names, ", ")));
     }
     DepthImage image;
     image.width = static_cast<std::uint32_t>(width);
@@ -101,8 +101,9 @@ Status WriteDepthExr(const std::filesystem::path& path, const DepthImage& image)
     Imf::OutputFile file(name.c_str(), header);
     Imf::FrameBuffer buffer;
     // OpenEXR's slices take a writable pointer; writing only reads it.
-    buffer.insert(image.channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.values.data())),
-                                            sizeof(float), sizeof(float) * image.width));
+    buffer.insert(image.channel,
+                  Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.values.data())),
+                             sizeof(float), sizeof(float) * image.width));
     file.setFrameBuffer(buffer);
     file.writePixels(static_cast<int>(image.height));
   } catch (const std::exception& e) {
@@ -119,9 +120,10 @@ Expected<CaptureStores> ParseCaptureStores(std::string_view text) {
   for (CaptureStores s : {CaptureStores::kWindowDepth, CaptureStores::kEyeDepth}) {
     if (text == CaptureStoresName(s)) return s;
   }
-  return InvalidArgument(fmt::format("'{}' is not what a capture stores: window-depth (the depth buffer's values) "
-                                     "or eye-depth (linear depth in world units)",
-                                     text));
+  return InvalidArgument(
+      fmt::format("'{}' is not what a capture stores: window-depth (the depth buffer's values) "
+                  "or eye-depth (linear depth in world units)",
+                  text));
 }
 
 Expected<CapturedPixels> DecodeCapture(const DepthImage& image, const std::string& source, CaptureStores stores,
@@ -195,7 +197,8 @@ std::array<std::uint8_t, 3> BitsColour(float bits) {
   const float t = (b - kStops[k - 1].bits) / (kStops[k].bits - kStops[k - 1].bits);
   std::array<std::uint8_t, 3> out;
   for (int c = 0; c < 3; ++c) {
-    out[c] = static_cast<std::uint8_t>(std::lround(kStops[k - 1].rgb[c] + t * (kStops[k].rgb[c] - kStops[k - 1].rgb[c])));
+    out[c] =
+        static_cast<std::uint8_t>(std::lround(kStops[k - 1].rgb[c] + t * (kStops[k].rgb[c] - kStops[k - 1].rgb[c])));
   }
   return out;
 }

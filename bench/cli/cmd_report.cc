@@ -7,6 +7,7 @@
 
 #include "bench/base/environment.h"
 #include "bench/base/files.h"
+#include "bench/base/interrupt.h"
 #include "bench/base/progress.h"
 #include "bench/base/resources.h"
 #include "bench/capture/depth_capture.h"
@@ -136,6 +137,11 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
 
   const std::string started_at = CurrentTimeUtc();
   auto measured = MeasureReport(plan, backends, progress);
+  // A report is made of whole sweeps: one cut short by a signal would be
+  // written as if whole and compared with the history as if it were.
+  if (Interrupted()) {
+    return InterruptedError("nothing was written or recorded: the report's sweeps were cut short");
+  }
   if (!measured.ok()) return measured.status();
 
   progress.begin("write");
@@ -182,6 +188,13 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   // The run is kept in the history only now that its report is written.
   if (history) DB_RETURN_IF_ERROR(history->Commit().WithContext("--history"));
   progress.end(fmt::format("{} (report.html, report.md, results.json)", out.string()));
+  // Writing takes a moment and is not cut short by a first signal (a
+  // second one removes what is being written); a signal that came during
+  // it stops nothing that was left.
+  if (Interrupted()) {
+    return InterruptedError(fmt::format("the report was whole: it is written to {}{}", out.string(),
+                                        history ? " and recorded in the history" : ""));
+  }
 
   context.output.text << markdown;
   return worse > 0 && f.fail_on_regression ? kExitFinding : kExitOk;

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/base/interrupt.h"
 #include "bench/base/text_table.h"
 #include "bench/pipeline/bands.h"
 
@@ -92,6 +93,9 @@ Expected<FitSweeps> RunFitSweeps(const FitPlan& plan, std::span<Backend* const> 
   total.samples_total = plan.samples_per_ratio * ratios.size();
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < ratios.size(); ++k) {
+    // After a signal the sweep just cut short is the last: what was
+    // measured is returned, and the caller says it is partial.
+    if (Interrupted()) break;
     SweepOptions options;
     // A seed of its own per ratio: with one seed every ratio would draw the
     // same pixels and depth units, their errors would move together, and

@@ -62,9 +62,9 @@ std::uint64_t SamplesFor(std::uint64_t requested, const SampleSource& source) {
 
 Expected<Domain> CaptureDomain(Domain d, std::shared_ptr<const CapturedPixels> pixels) {
   const auto unfixed = [&](const char* what) {
-    return InvalidArgument(fmt::format(
-        "{}: a captured frame needs its projection's {} fixed (give the frame's projection matrix)",
-        pixels->source, what));
+    return InvalidArgument(
+        fmt::format("{}: a captured frame needs its projection's {} fixed (give the frame's projection matrix)",
+                    pixels->source, what));
   };
   if (!d.eye_fov && (!d.fov_degrees.fixed() || !d.aspect.fixed())) return unfixed("field of view");
   if (!d.near.fixed()) return unfixed("near plane");

@@ -78,8 +78,8 @@ struct ForeignWord {
   int line = 0;
 };
 std::optional<ForeignWord> WordOfTheOtherLanguage(const std::string& text, ShaderLanguage named) {
-  static const std::vector<std::string> kGlslOnly = {"vec2", "vec3", "vec4", "mat3", "mat4",  "uvec2",
-                                                     "ivec2", "dvec3", "dmat4", "layout"};
+  static const std::vector<std::string> kGlslOnly = {"vec2",  "vec3",  "vec4",  "mat3",  "mat4",
+                                                     "uvec2", "ivec2", "dvec3", "dmat4", "layout"};
   static const std::vector<std::string> kHlslOnly = {"float2", "float3", "float4", "float3x3", "float4x4",
                                                      "half2",  "half3",  "half4",  "cbuffer"};
   std::vector<std::string> foreign = named == ShaderLanguage::kHlsl ? kGlslOnly : kHlslOnly;
@@ -157,10 +157,11 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
   }
   if (const std::optional<ForeignWord> foreign = WordOfTheOtherLanguage(text, shader.language)) {
     const bool hlsl = shader.language == ShaderLanguage::kHlsl;
-    return InvalidArgument(fmt::format("{}:{}: '{}' is {}, but the file is named {}: it would be compiled as {}, "
-                                       "where it means something else or nothing; rename the file {}",
-                                       given, foreign->line, foreign->word, hlsl ? "GLSL" : "HLSL", extension,
-                                       hlsl ? "HLSL" : "GLSL", hlsl ? ".glsl" : ".hlsl"));
+    return InvalidArgument(
+        fmt::format("{}:{}: '{}' is {}, but the file is named {}: it would be compiled as {}, "
+                    "where it means something else or nothing; rename the file {}",
+                    given, foreign->line, foreign->word, hlsl ? "GLSL" : "HLSL", extension, hlsl ? "HLSL" : "GLSL",
+                    hlsl ? ".glsl" : ".hlsl"));
   }
   // The path goes into an #include "..." line of the generated program.
   if (path.string().find_first_of("\"\n\\") != std::string::npos) {
@@ -182,9 +183,10 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
     // One contract a file: a second line would otherwise be ignored, and
     // whichever the author edited last might not be the one that counts.
     if (declared_at != 0) {
-      return InvalidArgument(fmt::format("{}:{}: a second '// depthbench:' line (the first is line {}); a file "
-                                         "declares one contract",
-                                         given, number, declared_at));
+      return InvalidArgument(
+          fmt::format("{}:{}: a second '// depthbench:' line (the first is line {}); a file "
+                      "declares one contract",
+                      given, number, declared_at));
     }
     if (number > kDeclarationLines) break;  // too late to be the header's; said below
     declared_at = number;
@@ -196,8 +198,8 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
       const std::string key = word.substr(0, equals);
       const std::string value = equals == std::string::npos ? "" : word.substr(equals + 1);
       if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
-        return InvalidArgument(fmt::format("{}:{}: '{}' is given twice; a contract gives each key once", given,
-                                           number, key));
+        return InvalidArgument(
+            fmt::format("{}:{}: '{}' is given twice; a contract gives each key once", given, number, key));
       }
       keys.push_back(key);
       Status applied = ApplyKey(key, value, shader, input, name);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "bench/base/environment.h"
+#include "bench/base/interrupt.h"
 #include "bench/capture/depth_capture.h"
 #include "bench/choose/choose.h"
 #include "bench/choose/frame_cost.h"
@@ -704,6 +705,10 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   begin("sweeps at fixed far/near");
   DB_ASSIGN_OR_RETURN(m.sweeps, RunFitSweeps(fit_plan, backends, progress.sweep));
   end("sweeps at fixed far/near", fmt::format("{} far/near ratios", m.sweeps.ratios.size()));
+  // After a signal no further stage starts: a report is made of whole
+  // sweeps, and the command writes nothing of a cut one.
+  const auto stopped = [] { return InterruptedError("nothing was written or recorded: the report's sweeps were cut short"); };
+  if (Interrupted()) return stopped();
 
   begin("default-domain sweep");
   SweepOptions main;
@@ -714,6 +719,7 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   main.progress = progress.sweep;
   DB_ASSIGN_OR_RETURN(m.main, RunSweep(main, backends));
   end("default-domain sweep", fmt::format("{} cells", m.main.cells.size()));
+  if (Interrupted()) return stopped();
 
   if (plan.scene) {
     begin("scene");
@@ -722,6 +728,7 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
       DB_ASSIGN_OR_RETURN(m.capture_bits, CaptureBitsOf(*plan.scene, *m.scene_choice, backends));
     }
     end("scene", fmt::format("{} candidates", m.scene_choice->ranked.size()));
+    if (Interrupted()) return stopped();
   }
   begin("error models");
   const Metric metrics[] = {Metric::kTotal};
