@@ -65,40 +65,22 @@ Status ApplyKey(std::string_view key, std::string_view value, UserShader& shader
 
 const char* kExample = "// depthbench: input=hardware entry=reconstruct uv=top-left view=right-handed";
 
-// The first word of `text` that only the other language has, with its
-// line: a GLSL type or layout in a file named .hlsl, an HLSL type or
-// cbuffer in a file named .glsl. glslang's HLSL front end accepts much
-// GLSL and gives it another meaning (`m * v` is component-wise there), so
-// the extension alone must not decide. Only types and declarations are
-// looked for (a function of the user's may be called `saturate` or `mix`
-// in either language); comments and preprocessor lines are skipped, and a
-// name the file #defines (a port's `#define float3 vec3`) is its own.
-struct ForeignWord {
+// The words of a shader source outside comments and preprocessor lines,
+// each with its line; a number in brackets (an array's size) is given as
+// the word "[" and its value.
+struct SourceToken {
   std::string word;
   int line = 0;
+  std::uint64_t size = 0;  // for "["
 };
-std::optional<ForeignWord> WordOfTheOtherLanguage(const std::string& text, ShaderLanguage named) {
-  static const std::vector<std::string> kGlslOnly = {"vec2",  "vec3",  "vec4",  "mat3",  "mat4",
-                                                     "uvec2", "ivec2", "dvec3", "dmat4", "layout"};
-  static const std::vector<std::string> kHlslOnly = {"float2", "float3", "float4", "float3x3", "float4x4",
-                                                     "half2",  "half3",  "half4",  "cbuffer"};
-  std::vector<std::string> foreign = named == ShaderLanguage::kHlsl ? kGlslOnly : kHlslOnly;
-  std::istringstream lines(text);
-  std::string directive;
-  while (std::getline(lines, directive)) {
-    std::istringstream words(directive);
-    std::string hash, name;
-    if (words >> hash >> name && (hash == "#define" || (hash == "#" && name == "define" && words >> name))) {
-      name = name.substr(0, name.find('('));
-      std::erase(foreign, name);
-    }
-  }
+std::vector<SourceToken> Tokens(const std::string& text) {
+  std::vector<SourceToken> tokens;
   int line = 1;
   bool block_comment = false;
   bool line_start = true;  // only blanks since the line began
   for (std::size_t i = 0; i < text.size();) {
     const char c = text[i];
-    if (line_start && c == '#') {  // a preprocessor line
+    if (line_start && !block_comment && c == '#') {  // a preprocessor line
       while (i < text.size() && text[i] != '\n') ++i;
       continue;
     }
@@ -117,14 +99,114 @@ std::optional<ForeignWord> WordOfTheOtherLanguage(const std::string& text, Shade
     } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       std::size_t end = i;
       while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_')) ++end;
-      const std::string word = text.substr(i, end - i);
-      if (std::find(foreign.begin(), foreign.end(), word) != foreign.end()) return ForeignWord{word, line};
+      tokens.push_back({text.substr(i, end - i), line, 0});
       i = end;
+    } else if (c == '[') {
+      std::size_t end = i + 1;
+      while (end < text.size() && (text[end] == ' ' || text[end] == '\t')) ++end;
+      std::uint64_t size = 0;
+      bool digits = false;
+      for (; end < text.size() && std::isdigit(static_cast<unsigned char>(text[end])); ++end) {
+        digits = true;
+        size = std::min<std::uint64_t>(size * 10 + static_cast<std::uint64_t>(text[end] - '0'), UINT64_MAX / 20);
+      }
+      if (digits) tokens.push_back({"[", line, size});
+      ++i;
     } else {
       ++i;
     }
   }
-  return std::nullopt;
+  return tokens;
+}
+
+// The names a source #defines: a port's `#define float3 vec3` makes
+// float3 the file's own word.
+std::vector<std::string> DefinedNames(const std::string& text) {
+  std::vector<std::string> names;
+  std::istringstream lines(text);
+  std::string directive;
+  while (std::getline(lines, directive)) {
+    std::istringstream words(directive);
+    std::string hash, name;
+    if (words >> hash >> name && (hash == "#define" || (hash == "#" && name == "define" && words >> name))) {
+      names.push_back(name.substr(0, name.find('(')));
+    }
+  }
+  return names;
+}
+
+// The largest array a variant function may declare, in elements: a
+// reconstruction needs a few values, and a private array is every
+// invocation's own (50 million floats took the process to 24 GB).
+constexpr std::uint64_t kMostArrayElements = 4096;
+
+// What a variant file may not hold, checked before it is compiled; the
+// error names the line.
+//  - Words of the other language: a GLSL type or layout in a file named
+//    .hlsl, an HLSL type or cbuffer in a file named .glsl. glslang's HLSL
+//    front end accepts much GLSL and gives it another meaning (`m * v` is
+//    component-wise there), so the extension alone must not decide. Only
+//    types and declarations are looked for (a function of the user's may
+//    be called `saturate` or `mix` in either language), and a name the
+//    file #defines is its own.
+//  - Resources: a variant is a function of its arguments and the named
+//    constants. A buffer, image or shared-memory declaration could take a
+//    binding of the bench's own (set 0, binding 5 is the positions every
+//    cell writes) and change other cells' figures.
+//  - Arrays over kMostArrayElements elements.
+Status CheckVariantSource(const std::string& text, ShaderLanguage named, const std::string& given,
+                          const std::string& extension) {
+  static const std::vector<std::string> kGlslOnly = {"vec2",  "vec3",  "vec4",  "mat3",  "mat4",
+                                                     "uvec2", "ivec2", "dvec3", "dmat4", "layout"};
+  static const std::vector<std::string> kHlslOnly = {"float2", "float3", "float4", "float3x3", "float4x4",
+                                                     "half2",  "half3",  "half4",  "cbuffer"};
+  static const std::vector<std::string> kGlslResources = {"layout",  "buffer",    "uniform",  "shared",
+                                                          "image2D", "sampler2D", "texture2D"};
+  static const std::vector<std::string> kHlslResources = {"register",
+                                                          "groupshared",
+                                                          "cbuffer",
+                                                          "tbuffer",
+                                                          "ConstantBuffer",
+                                                          "StructuredBuffer",
+                                                          "RWStructuredBuffer",
+                                                          "ByteAddressBuffer",
+                                                          "RWByteAddressBuffer",
+                                                          "Texture2D",
+                                                          "RWTexture2D",
+                                                          "SamplerState",
+                                                          "vk"};
+  const bool hlsl = named == ShaderLanguage::kHlsl;
+  std::vector<std::string> foreign = hlsl ? kGlslOnly : kHlslOnly;
+  std::vector<std::string> resources = hlsl ? kHlslResources : kGlslResources;
+  for (const std::string& name : DefinedNames(text)) {
+    std::erase(foreign, name);
+    std::erase(resources, name);
+  }
+  const auto has = [](const std::vector<std::string>& list, const std::string& word) {
+    return std::find(list.begin(), list.end(), word) != list.end();
+  };
+  for (const SourceToken& t : Tokens(text)) {
+    if (t.word == "[") {
+      if (t.size > kMostArrayElements) {
+        return InvalidArgument(
+            fmt::format("{}:{}: an array of {} elements; a variant function may declare arrays "
+                        "of at most {} (each invocation holds its own)",
+                        given, t.line, t.size, kMostArrayElements));
+      }
+    } else if (has(foreign, t.word)) {
+      return InvalidArgument(fmt::format(
+          "{}:{}: '{}' is {}, but the file is named {}: it would be compiled as {}, "
+          "where it means something else or nothing; rename the file {}",
+          given, t.line, t.word, hlsl ? "GLSL" : "HLSL", extension, hlsl ? "HLSL" : "GLSL", hlsl ? ".glsl" : ".hlsl"));
+    } else if (has(resources, t.word)) {
+      return InvalidArgument(
+          fmt::format("{}:{}: '{}' declares a resource (a buffer, image, binding or shared "
+                      "memory); a variant is a function of its arguments and the constants "
+                      "docs/variant-files.md lists, and may not reach the bench's bindings",
+                      given, t.line, t.word));
+    }
+  }
+  return Status::Ok();
 }
 
 // The absolute, normal form of a path the user gave.
@@ -155,14 +237,7 @@ Expected<UserVariant> ReadVariantFile(const std::string& given) {
         "UTF-8 without a signature (Visual Studio: File > Save As > Save with Encoding)",
         given));
   }
-  if (const std::optional<ForeignWord> foreign = WordOfTheOtherLanguage(text, shader.language)) {
-    const bool hlsl = shader.language == ShaderLanguage::kHlsl;
-    return InvalidArgument(
-        fmt::format("{}:{}: '{}' is {}, but the file is named {}: it would be compiled as {}, "
-                    "where it means something else or nothing; rename the file {}",
-                    given, foreign->line, foreign->word, hlsl ? "GLSL" : "HLSL", extension, hlsl ? "HLSL" : "GLSL",
-                    hlsl ? ".glsl" : ".hlsl"));
-  }
+  DB_RETURN_IF_ERROR(CheckVariantSource(text, shader.language, given, extension));
   // The path goes into an #include "..." line of the generated program.
   if (path.string().find_first_of("\"\n\\") != std::string::npos) {
     return InvalidArgument(
