@@ -135,10 +135,6 @@ std::vector<std::string> DefinedNames(const std::string& text) {
   return names;
 }
 
-// The largest array a variant function may declare, in elements: a
-// reconstruction needs a few values, and a private array is every
-// invocation's own (50 million floats took the process to 24 GB).
-constexpr std::uint64_t kMostArrayElements = 4096;
 
 // What a variant file may not hold, checked before it is compiled; the
 // error names the line.
@@ -153,7 +149,7 @@ constexpr std::uint64_t kMostArrayElements = 4096;
 //    constants. A buffer, image or shared-memory declaration could take a
 //    binding of the bench's own (set 0, binding 5 is the positions every
 //    cell writes) and change other cells' figures.
-//  - Arrays over kMostArrayElements elements.
+//  - Arrays over kMostVariantArrayElements elements.
 Status CheckVariantSource(const std::string& text, ShaderLanguage named, const std::string& given,
                           const std::string& extension) {
   static const std::vector<std::string> kGlslOnly = {"vec2",  "vec3",  "vec4",  "mat3",  "mat4",
@@ -187,11 +183,11 @@ Status CheckVariantSource(const std::string& text, ShaderLanguage named, const s
   };
   for (const SourceToken& t : Tokens(text)) {
     if (t.word == "[") {
-      if (t.size > kMostArrayElements) {
+      if (t.size > kMostVariantArrayElements) {
         return InvalidArgument(
             fmt::format("{}:{}: an array of {} elements; a variant function may declare arrays "
                         "of at most {} (each invocation holds its own)",
-                        given, t.line, t.size, kMostArrayElements));
+                        given, t.line, t.size, kMostVariantArrayElements));
       }
     } else if (has(foreign, t.word)) {
       return InvalidArgument(fmt::format(

@@ -29,6 +29,13 @@
 
 namespace depthbench {
 
+// The largest array a variant function may declare, in elements: a
+// reconstruction needs a few values, and a private array is every
+// invocation's own (50 million floats took the process to 24 GB). The
+// source is checked before compiling (a literal size, with its line), the
+// compiled module after (any size).
+inline constexpr std::uint64_t kMostVariantArrayElements = 4096;
+
 enum class ShaderLanguage : std::uint8_t { kGlsl, kHlsl };
 
 // What a user's shader file declares, and where it is.

@@ -1,5 +1,8 @@
 #include "bench/backends/vulkan/variant_program.h"
 
+#include <algorithm>
+#include <unordered_map>
+
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/shader_compiler.h"
@@ -74,6 +77,36 @@ std::string VariantProgramName(const VariantInfo& variant, VariantPass pass, con
   return fmt::format("<{}'s {} program>", variant.name, PassName(pass));
 }
 
+namespace {
+
+// The most elements of any array type in a compiled module (counting the
+// elements of nested arrays): what the source scan of a variant file
+// (user_variant.cc) cannot see when a size is a #define'd name or a
+// constant expression. Read from the words: OpConstant (43) gives the
+// sizes, OpTypeArray (28) their element types and sizes.
+std::uint64_t LargestArray(const std::vector<std::uint32_t>& words) {
+  constexpr std::uint32_t kOpTypeArray = 28, kOpConstant = 43;
+  std::unordered_map<std::uint32_t, std::uint64_t> constants, arrays;
+  std::uint64_t largest = 0;
+  for (std::size_t at = 5; at < words.size();) {
+    const std::uint32_t count = words[at] >> 16, opcode = words[at] & 0xFFFFu;
+    if (count == 0 || at + count > words.size()) break;
+    if (opcode == kOpConstant && count >= 4) constants[words[at + 2]] = words[at + 3];
+    if (opcode == kOpTypeArray && count == 4) {
+      const auto length = constants.find(words[at + 3]);
+      const auto inner = arrays.find(words[at + 2]);
+      const std::uint64_t n = (length != constants.end() ? length->second : 0) *
+                              (inner != arrays.end() ? inner->second : 1);
+      arrays[words[at + 1]] = n;
+      largest = std::max(largest, n);
+    }
+    at += count;
+  }
+  return largest;
+}
+
+}  // namespace
+
 Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources) {
@@ -86,6 +119,11 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
       CompileShaderSource(GeneratedProgram(variant, pass, dir), program, dir,
                           user != nullptr ? user->language : ShaderLanguage::kGlsl,
                           raster ? ShaderStage::kFragment : ShaderStage::kCompute, sources);
+  if (user != nullptr && compiled.ok() && LargestArray(*compiled) > kMostVariantArrayElements) {
+    return InvalidArgument(fmt::format("{}: the compiled function declares an array of {} elements; a variant "
+                                       "function may declare arrays of at most {} (each invocation holds its own)",
+                                       user->path.string(), LargestArray(*compiled), kMostVariantArrayElements));
+  }
   if (user == nullptr || compiled.ok() || compiled.status().code() != StatusCode::kCompileError) return compiled;
   // A mistake in the user's file often makes the parser stumble again in
   // the generated lines after it: those follow-on messages only confuse.
