@@ -448,7 +448,8 @@ Status CheckHistograms(const Results& results, const std::string& source) {
   for (const CellResult& c : results.cells) {
     const auto check = [&](const std::map<int, BandStats>& bands, const char* family,
                            std::string (*band_name)(int)) -> Status {
-      for (const auto& [key, band] : bands) {
+      for (const auto& [band_key, band] : bands) {
+        const int key = band_key;  // (clang 14 lambdas cannot capture a structured binding)
         const auto where = [&] {
           return fmt::format("{}: cell {} ({} backend), {} band {}", source, c.cell.Name(), c.backend, family,
                              band_name(key));
