@@ -84,9 +84,9 @@ class RasterPipelineTest : public ::testing::Test {
     return BitsLost(Summarize(band, metric).p999);
   }
 
-  // Each sweep is run when a test first asks for it: CTest runs every test
-  // in a process of its own, so a sweep no test of the process reads is
-  // time lost (a minute under ASan).
+  // Each sweep is run once, when a test first asks for it: CTest runs the
+  // binary as one test (ONE_PROCESS, vulkan_tests.cmake), and a sweep no
+  // test reads (under the sanitizers most are skipped) is time lost.
   static const Results& Lazy(Results*& results, ProductionModel production, bool with_vulkan) {
     if (results == nullptr) results = new Results(Sweep(production, with_vulkan));
     return *results;
