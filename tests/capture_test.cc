@@ -33,9 +33,9 @@ std::string Read(const std::string& path) {
 // model or the scene that moves one value fails here until the file is
 // rendered again (depthbench_example_capture).
 TEST(CaptureTest, TheCommittedExampleIsWhatTheToolRenders) {
-  const Expected<DepthImage> committed = ReadDepthExr(kScenes + "captured_frame.exr");
+  const Expected<CaptureImage> committed = ReadDepthExr(kScenes + "captured_frame.exr");
   ASSERT_TRUE(committed.ok()) << committed.status().message();
-  const DepthImage rendered = RenderExampleCapture();
+  const CaptureImage rendered = RenderExampleCapture();
   EXPECT_EQ(committed->channel, "Z");
   EXPECT_EQ(committed->channel_type, "float");
   ASSERT_EQ(committed->width, rendered.width);
@@ -54,15 +54,15 @@ TEST(CaptureTest, TheCommittedExampleIsWhatTheToolRenders) {
 
 TEST(CaptureTest, WritesAndReadsBackEveryBit) {
   const std::string dir = testing::MakeTempDir("capture_roundtrip");
-  DepthImage image{3, 2, "depth", "float", {0.0f, 1.0f, 0.5f, 1e-30f, std::nextafter(1.0f, 0.0f), 0.25f}};
+  CaptureImage image{3, 2, "depth", "float", {0.0f, 1.0f, 0.5f, 1e-30f, std::nextafter(1.0f, 0.0f), 0.25f}};
   ASSERT_TRUE(WriteDepthExr(dir + "/a.exr", image).ok());
-  const Expected<DepthImage> back = ReadDepthExr(dir + "/a.exr");
+  const Expected<CaptureImage> back = ReadDepthExr(dir + "/a.exr");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->values, image.values);
   EXPECT_EQ(back->channel, "depth");
   // Asked for by name, and a name it does not have.
   EXPECT_TRUE(ReadDepthExr(dir + "/a.exr", "depth").ok());
-  const Expected<DepthImage> wrong = ReadDepthExr(dir + "/a.exr", "dept");
+  const Expected<CaptureImage> wrong = ReadDepthExr(dir + "/a.exr", "dept");
   ASSERT_FALSE(wrong.ok());
   EXPECT_NE(wrong.status().message().find("no channel 'dept'; it has depth; did you mean 'depth'?"), std::string::npos)
       << wrong.status().message();
@@ -90,7 +90,7 @@ TEST(CaptureTest, FilesItCannotUseAreRefusedByName) {
   }
   const std::string two = ReadDepthExr(dir + "/rg.exr").status().message();
   EXPECT_NE(two.find("2 channels (G, R); name the depth channel"), std::string::npos) << two;
-  const Expected<DepthImage> green = ReadDepthExr(dir + "/rg.exr", "G");
+  const Expected<CaptureImage> green = ReadDepthExr(dir + "/rg.exr", "G");
   ASSERT_TRUE(green.ok());
   EXPECT_EQ(green->values, std::vector<float>(4, 0.25f));
   std::filesystem::remove_all(dir);
@@ -105,7 +105,7 @@ TEST(CaptureTest, DecodesWindowDepthThroughTheProjection) {
   for (Convention c : {Convention::kStandard, Convention::kReversed, Convention::kReversedInf}) {
     const std::uint32_t bits = Info(c).bits;
     const double f = (bits & f32::DB_CONVENTION_INFINITE) != 0u ? INFINITY : far;
-    DepthImage image{static_cast<std::uint32_t>(depths.size()) + 1, 1, "Z", "float", {}};
+    CaptureImage image{static_cast<std::uint32_t>(depths.size()) + 1, 1, "Z", "float", {}};
     for (double z : depths) {
       const DoubleDouble dd_far = std::isfinite(f) ? DoubleDouble(f) : DoubleDouble(0.0);
       image.values.push_back(
@@ -123,14 +123,14 @@ TEST(CaptureTest, DecodesWindowDepthThroughTheProjection) {
       EXPECT_NEAR(pixels->eye_depth[k] / depths[k], 1.0, 1e-3) << Info(c).name << " z " << depths[k];
     }
   }
-  DepthImage bad{2, 2, "Z", "float", {0.5f, 0.5f, 0.5f, 1.5f}};
+  CaptureImage bad{2, 2, "Z", "float", {0.5f, 0.5f, 0.5f, 1.5f}};
   const std::string message =
       DecodeCapture(bad, "b.exr", CaptureStores::kWindowDepth, Convention::kStandard, near, far).status().message();
   EXPECT_NE(message.find("b.exr: pixel (1, 1) holds 1.5; a depth buffer holds window depth in [0, 1]"),
             std::string::npos)
       << message;
   // Linear depth: eye depth itself; 0 and infinity are nothing drawn.
-  DepthImage linear{4, 1, "Z", "float", {2.5f, 0.0f, INFINITY, 700.0f}};
+  CaptureImage linear{4, 1, "Z", "float", {2.5f, 0.0f, INFINITY, 700.0f}};
   const Expected<CapturedPixels> eye =
       DecodeCapture(linear, "l.exr", CaptureStores::kEyeDepth, Convention::kStandard, near, far);
   ASSERT_TRUE(eye.ok());

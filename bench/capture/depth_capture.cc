@@ -37,7 +37,7 @@ constexpr std::uint64_t kMostCapturePixels = std::uint64_t{16384} * 16384;
 
 }  // namespace
 
-Expected<DepthImage> ReadDepthExr(const std::filesystem::path& path, const std::string& channel) {
+Expected<CaptureImage> ReadDepthExr(const std::filesystem::path& path, const std::string& channel) {
   const std::string name = path.string();
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
@@ -75,7 +75,7 @@ Expected<DepthImage> ReadDepthExr(const std::filesystem::path& path, const std::
           fmt::format("{}: {} channels ({}); name the depth channel (capture.channel in a scene file)", name,
                       names.size(), fmt::join(names, ", ")));
     }
-    DepthImage image;
+    CaptureImage image;
     image.width = static_cast<std::uint32_t>(width);
     image.height = static_cast<std::uint32_t>(height);
     image.channel = names[pick];
@@ -92,7 +92,7 @@ Expected<DepthImage> ReadDepthExr(const std::filesystem::path& path, const std::
   }
 }
 
-Status WriteDepthExr(const std::filesystem::path& path, const DepthImage& image) {
+Status WriteDepthExr(const std::filesystem::path& path, const CaptureImage& image) {
   const std::string name = path.string();
   try {
     Imf::Header header(static_cast<int>(image.width), static_cast<int>(image.height));
@@ -126,7 +126,7 @@ Expected<CaptureStores> ParseCaptureStores(std::string_view text) {
                   text));
 }
 
-Expected<CapturedPixels> DecodeCapture(const DepthImage& image, const std::string& source, CaptureStores stores,
+Expected<CapturedPixels> DecodeCapture(const CaptureImage& image, const std::string& source, CaptureStores stores,
                                        Convention convention, double near, double far) {
   const std::uint32_t bits = Info(convention).bits;
   const bool reversed = (bits & f32::DB_CONVENTION_REVERSED) != 0u;

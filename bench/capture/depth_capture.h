@@ -23,7 +23,7 @@ namespace depthbench {
 
 // One channel of an EXR image, converted to float32 (half and uint
 // channels convert exactly), row by row from the top.
-struct DepthImage {
+struct CaptureImage {
   std::uint32_t width = 0;
   std::uint32_t height = 0;
   std::string channel;
@@ -33,9 +33,9 @@ struct DepthImage {
 
 // `channel` empty: the file's only channel; a file with several must name
 // one. Errors name the file and, where the file is readable, its channels.
-Expected<DepthImage> ReadDepthExr(const std::filesystem::path& path, const std::string& channel = "");
+Expected<CaptureImage> ReadDepthExr(const std::filesystem::path& path, const std::string& channel = "");
 // One float channel named `image.channel`, ZIP-compressed.
-Status WriteDepthExr(const std::filesystem::path& path, const DepthImage& image);
+Status WriteDepthExr(const std::filesystem::path& path, const CaptureImage& image);
 
 // What a capture's values are.
 enum class CaptureStores : std::uint8_t {
@@ -51,7 +51,7 @@ Expected<CaptureStores> ParseCaptureStores(std::string_view text);
 // depth, 0 and infinity are background. A value no frame of the
 // projection can store (below 0 or above 1, NaN, a negative eye depth) is
 // an error naming the pixel.
-Expected<CapturedPixels> DecodeCapture(const DepthImage& image, const std::string& source, CaptureStores stores,
+Expected<CapturedPixels> DecodeCapture(const CaptureImage& image, const std::string& source, CaptureStores stores,
                                        Convention convention, double near, double far);
 
 // Bits lost (BitsLost of the total error, as the judge measures it) at each

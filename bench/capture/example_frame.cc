@@ -75,7 +75,7 @@ glm::mat4 ExampleCaptureProjection() {
   return EngineProjectionMatrix(ExampleCaptureFrame(), kExampleCaptureEncoding.convention);
 }
 
-DepthImage RenderExampleCapture() {
+CaptureImage RenderExampleCapture() {
   const Frame frame = ExampleCaptureFrame();
   f32::FrameParams frame_params;
   std::array<f32::DepthParams, kHardwareConventionCount> depth_params;
@@ -83,7 +83,7 @@ DepthImage RenderExampleCapture() {
   const f32::DepthParams& depth = depth_params[static_cast<int>(kExampleCaptureEncoding.convention)];
   const std::vector<Triangle> scene = ExampleScene();
 
-  DepthImage image;
+  CaptureImage image;
   image.width = frame.width;
   image.height = frame.height;
   image.channel = "Z";

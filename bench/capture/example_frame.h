@@ -23,6 +23,6 @@ glm::mat4 ExampleCaptureProjection();
 // The depth buffer: a ground plane, a far wall and boxes from 4 to 500
 // units away, each pixel the nearest surface's window depth as the host's
 // raster model computes it; the sky keeps the clear value.
-DepthImage RenderExampleCapture();
+CaptureImage RenderExampleCapture();
 
 }  // namespace depthbench

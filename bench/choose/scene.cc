@@ -377,7 +377,7 @@ Status ReadCapture(SceneReader& r, const toml::table& root, Scene& scene) {
   }
   // The file is found beside the scene file.
   const std::filesystem::path path = std::filesystem::path(scene.source).parent_path() / file;
-  const Expected<DepthImage> image = ReadDepthExr(path, channel);
+  const Expected<CaptureImage> image = ReadDepthExr(path, channel);
   if (!image.ok()) return r.Error(capture->get("file"), "capture.file", image.status().message());
   const Convention convention = d.depth_convention.value_or(Convention::kStandard);
   const double far = d.finite_far ? (d.far ? d.far->min : d.near.min * d.ratio.min) : INFINITY;
