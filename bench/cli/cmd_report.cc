@@ -50,6 +50,42 @@ Expected<std::vector<fs::path>> SpeedFiles(const ReportFlags& f) {
   return CommittedSpeedFiles();
 }
 
+// The files a report writes can be written, and none is a file it reads
+// (the history is read and written in place; the pages are written).
+Status CheckReportFiles(const ReportFlags& f) {
+  FileRoles roles;
+  roles.Input(f.history, "--history").Input(f.scene, "--scene").Input(f.page_template, "--template");
+  for (const std::string& speed : f.speed) roles.Input(speed, "--speed");
+  for (const char* name : {"results.json", "report.md", "report.html", kCaptureImageName}) {
+    const std::string path = (fs::path(f.out) / name).string();
+    DB_RETURN_IF_ERROR(CheckWritable(path, "--out"));
+    roles.Output(path, "--out");
+  }
+  if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
+  return roles.Output(f.summary, "--summary").Check();
+}
+
+// The report's files under `out`: the capture's picture first (before the
+// page that shows it), each under a temporary name and renamed.
+Status WriteReportFiles(const fs::path& out, const Report& report,
+                        const std::optional<ReportMeasurements::CaptureBits>& capture, const std::string& markdown,
+                        const std::string& page) {
+  if (capture) {
+    const fs::path image = out / kCaptureImageName, partial = out / (std::string(kCaptureImageName) + ".partial");
+    DB_RETURN_IF_ERROR(WriteBitsLostPng(partial, capture->width, capture->height, capture->bits));
+    std::error_code ec;
+    fs::rename(partial, image, ec);
+    if (ec) return IoError(fmt::format("--out: cannot write '{}': {}", image.string(), ec.message()));
+  }
+  for (const auto& [name, text] :
+       {std::pair<const char*, std::string>{"results.json", ReportToJson(report).dump(1) + "\n"},
+        {"report.md", markdown},
+        {"report.html", page}}) {
+    DB_RETURN_IF_ERROR(WriteFileAtomically(out / name, text));
+  }
+  return Status::Ok();
+}
+
 Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   ReportPlan plan = f.quick ? ReportPlan::Quick() : ReportPlan::Nightly();
   if (!f.samples.empty()) {
@@ -94,20 +130,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
       if (!folder.empty() && fs::is_empty(folder, ignored)) fs::remove(folder, ignored);
     }
   } made_out{out_existed ? fs::path() : fs::path(f.out)};
-  for (const char* name : {"results.json", "report.md", "report.html"}) {
-    DB_RETURN_IF_ERROR(CheckWritable((fs::path(f.out) / name).string(), "--out"));
-  }
-  if (!f.summary.empty()) DB_RETURN_IF_ERROR(CheckWritable(f.summary, "--summary"));
-  {
-    // The history is read and written in place; the pages are written.
-    FileRoles roles;
-    roles.Input(f.history, "--history").Input(f.scene, "--scene").Input(f.page_template, "--template");
-    for (const std::string& speed : f.speed) roles.Input(speed, "--speed");
-    for (const char* name : {"results.json", "report.md", "report.html", kCaptureImageName}) {
-      roles.Output((fs::path(f.out) / name).string(), "--out");
-    }
-    DB_RETURN_IF_ERROR(roles.Output(f.summary, "--summary").Check());
-  }
+  DB_RETURN_IF_ERROR(CheckReportFiles(f));
   PlotLibrary library{f.plot_library};
   if (library.node_modules.empty())
     DB_RETURN_IF_ERROR(StoreInto(DataPath("reports/node_modules"), library.node_modules));
@@ -169,21 +192,7 @@ Expected<int> RunReport(const ReportFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(const std::string page, RenderHtml(report, page_template, library));
   const std::string markdown = RenderMarkdown(report);
   const fs::path out(f.out);
-  if (const auto& capture = measured->capture_bits) {
-    // Written under a temporary name and renamed, as the other files are, and
-    // before the page that shows it.
-    const fs::path image = out / kCaptureImageName, partial = out / (std::string(kCaptureImageName) + ".partial");
-    DB_RETURN_IF_ERROR(WriteBitsLostPng(partial, capture->width, capture->height, capture->bits));
-    std::error_code ec;
-    fs::rename(partial, image, ec);
-    if (ec) return IoError(fmt::format("--out: cannot write '{}': {}", image.string(), ec.message()));
-  }
-  for (const auto& [name, text] :
-       {std::pair<const char*, std::string>{"results.json", ReportToJson(report).dump(1) + "\n"},
-        {"report.md", markdown},
-        {"report.html", page}}) {
-    DB_RETURN_IF_ERROR(WriteFileAtomically(out / name, text));
-  }
+  DB_RETURN_IF_ERROR(WriteReportFiles(out, report, measured->capture_bits, markdown, page));
   DB_RETURN_IF_ERROR(WriteSummary(f.summary, markdown));
   // The run is kept in the history only now that its report is written.
   if (history) DB_RETURN_IF_ERROR(history->Commit().WithContext("--history"));
