@@ -706,10 +706,7 @@ Status DeviceJudge::State::MergeMaxima(std::uint32_t from, std::span<CellAccumul
   const auto* unwritten = reinterpret_cast<const std::uint32_t*>(words + 2 * maxima());
   for (std::size_t k = 0; k < cell_count(); ++k) {
     if (unwritten[k] == 0) continue;
-    return InvalidArgument(fmt::format(
-        "the {} shader did not write its output for {} samples (cell {}): it returns before writing, or writes "
-        "another element; nothing it did not write is judged",
-        run_cells[k].variant_info().name, unwritten[k], run_cells[k].Name()));
+    return UnwrittenOutputs(run_cells[k], std::to_string(unwritten[k]));
   }
   for (std::size_t at = 0; at < maxima(); ++at) {
     if (words[at] == 0) continue;

@@ -201,13 +201,14 @@ double CompileSeconds() {
 Expected<std::vector<std::uint32_t>> CompileOnThisThread(const std::string& source, const std::string& name,
                                                          const std::filesystem::path& include_dir,
                                                          ShaderLanguage language, ShaderStage stage,
-                                                         std::vector<std::string>* sources) {
+                                                         std::vector<std::string>* sources, bool source_lines) {
   if (sources != nullptr) sources->push_back(source);
   DB_ASSIGN_OR_RETURN(std::unique_ptr<LinkedShader> linked,
                       ParseAndLink(source, name, include_dir, sources, language, LanguageOf(stage)));
   std::vector<std::uint32_t> spirv;
   spv::SpvBuildLogger logger;
   glslang::SpvOptions options;
+  options.generateDebugInfo = source_lines;
   glslang::GlslangToSpv(*linked->program.getIntermediate(LanguageOf(stage)), spirv, &logger, &options);
   if (spirv.empty()) {
     return CompileError(fmt::format("{}: error: SPIR-V generation failed: {}", name, logger.getAllMessages()));
@@ -224,7 +225,8 @@ Expected<std::vector<std::uint32_t>> CompileShader(const std::filesystem::path& 
 
 Expected<std::vector<std::uint32_t>> CompileShaderSource(std::string source, std::string name,
                                                          std::filesystem::path include_dir, ShaderLanguage language,
-                                                         ShaderStage stage, std::vector<std::string>* sources) {
+                                                         ShaderStage stage, std::vector<std::string>* sources,
+                                                         bool source_lines) {
   // glslang cannot be stopped, so the compile runs on a thread of its own
   // that is given up on when it takes too long (the program then ends
   // without waiting for it: base/interrupt.h). The thread owns what it
@@ -232,8 +234,8 @@ Expected<std::vector<std::uint32_t>> CompileShaderSource(std::string source, std
   using Words = Expected<std::vector<std::uint32_t>>;
   auto read = std::make_shared<std::vector<std::string>>();
   std::packaged_task<Words()> task(
-      [source = std::move(source), name, include_dir = std::move(include_dir), language, stage, read] {
-        return CompileOnThisThread(source, name, include_dir, language, stage, read.get());
+      [source = std::move(source), name, include_dir = std::move(include_dir), language, stage, read, source_lines] {
+        return CompileOnThisThread(source, name, include_dir, language, stage, read.get(), source_lines);
       });
   std::future<Words> compiled = task.get_future();
   std::thread compiler(std::move(task));

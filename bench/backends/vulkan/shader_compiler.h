@@ -36,11 +36,15 @@ Expected<std::vector<std::uint32_t>> CompileShader(const std::filesystem::path& 
 // The same for source text in `language` that glslang reports as `name`,
 // whose includes resolve relative to `include_dir` (absolute include paths
 // as they are): how a program generated around a user's function compiles.
-// HLSL's entry point is main().
+// HLSL's entry point is main(). With `source_lines`, the module carries
+// OpString and OpLine instructions (which file and line each instruction
+// came from), for checks that name a line of the user's file; drivers
+// ignore them.
 Expected<std::vector<std::uint32_t>> CompileShaderSource(std::string source, std::string name,
                                                          std::filesystem::path include_dir, ShaderLanguage language,
                                                          ShaderStage stage = ShaderStage::kCompute,
-                                                         std::vector<std::string>* sources = nullptr);
+                                                         std::vector<std::string>* sources = nullptr,
+                                                         bool source_lines = false);
 
 // One member of a buffer block as glslang lays it out: its reflected name
 // ("frame.camera_world" for member camera_world of a block member `frame`)

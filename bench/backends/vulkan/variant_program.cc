@@ -1,6 +1,7 @@
 #include "bench/backends/vulkan/variant_program.h"
 
 #include <algorithm>
+#include <string>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -105,6 +106,37 @@ std::uint64_t LargestArray(const std::vector<std::uint32_t>& words) {
   return largest;
 }
 
+// The line of the first loop in a compiled module whose source line lies in
+// `file` (0 where none does), read from a module compiled with source lines:
+// OpString (7) names the files, OpLine (8) says where the instructions after
+// it came from until OpNoLine (317), and OpLoopMerge (246) opens each loop.
+// The compiled module, not the text, is read, so a loop a macro writes is
+// found at the line that uses the macro.
+std::uint32_t FirstLoopLine(const std::vector<std::uint32_t>& words, const std::filesystem::path& file) {
+  constexpr std::uint32_t kOpString = 7, kOpLine = 8, kOpLoopMerge = 246, kOpNoLine = 317;
+  std::unordered_map<std::uint32_t, std::string> strings;
+  std::uint32_t line_file = 0, line = 0;
+  for (std::size_t at = 5; at < words.size();) {
+    const std::uint32_t count = words[at] >> 16, opcode = words[at] & 0xFFFFu;
+    if (count == 0 || at + count > words.size()) break;
+    if (opcode == kOpString && count >= 3) {
+      std::string text(reinterpret_cast<const char*>(&words[at + 2]), (count - 2) * sizeof(std::uint32_t));
+      text.resize(text.find('\0') == std::string::npos ? text.size() : text.find('\0'));
+      strings[words[at + 1]] = std::move(text);
+    } else if (opcode == kOpLine && count >= 3) {
+      line_file = words[at + 1];
+      line = words[at + 2];
+    } else if (opcode == kOpNoLine) {
+      line_file = 0;
+    } else if (opcode == kOpLoopMerge && line_file != 0) {
+      const auto name = strings.find(line_file);
+      if (name != strings.end() && std::filesystem::path(name->second) == file) return line;
+    }
+    at += count;
+  }
+  return 0;
+}
+
 }  // namespace
 
 Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
@@ -118,7 +150,23 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
   Expected<std::vector<std::uint32_t>> compiled =
       CompileShaderSource(GeneratedProgram(variant, pass, dir), program, dir,
                           user != nullptr ? user->language : ShaderLanguage::kGlsl,
-                          raster ? ShaderStage::kFragment : ShaderStage::kCompute, sources);
+                          raster ? ShaderStage::kFragment : ShaderStage::kCompute, sources, user != nullptr);
+  // A variant is straight-line code. How long a loop runs is the data's
+  // to say, and devices end one that runs too long each in its own way:
+  // lavapipe leaves every loop of an invocation after 65535 iterations in
+  // all and goes on with what the loop had computed (the raster form judges
+  // that) or drops what the invocation would have stored (the compute form
+  // finds outputs unwritten); a desktop GPU runs until its driver resets the
+  // device. Refused in every form, before anything runs.
+  if (user != nullptr && compiled.ok()) {
+    if (const std::uint32_t line = FirstLoopLine(*compiled, user->path); line != 0) {
+      return InvalidArgument(fmt::format(
+          "{}:{}: a loop; a variant function must be straight-line code (unroll it): a loop that runs too "
+          "long is cut short by the device (lavapipe after 65535 iterations, a GPU by resetting), and the "
+          "figures would describe the cut, not the function",
+          user->path.string(), line));
+    }
+  }
   if (user != nullptr && compiled.ok() && LargestArray(*compiled) > kMostVariantArrayElements) {
     return InvalidArgument(fmt::format("{}: the compiled function declares an array of {} elements; a variant "
                                        "function may declare arrays of at most {} (each invocation holds its own)",

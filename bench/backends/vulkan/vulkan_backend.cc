@@ -527,11 +527,7 @@ Status VulkanBackend::CheckEveryOutputWritten(const float* positions, const Shad
   for (std::size_t k = 0; k < which.size(); ++k) {
     const std::size_t unwritten = UnwrittenSamples(positions, slices, k, batch.count);
     if (unwritten == 0) continue;
-    const Cell& cell = cells_[which[k]].cell;
-    return InvalidArgument(fmt::format(
-        "the {} shader did not write its output for {} of {} samples (cell {}): it returns before writing, or "
-        "writes another element; nothing it did not write is judged",
-        cell.variant_info().name, unwritten, batch.count, cell.Name()));
+    return UnwrittenOutputs(cells_[which[k]].cell, fmt::format("{} of {}", unwritten, batch.count));
   }
   return Status::Ok();
 }
@@ -690,6 +686,14 @@ void VulkanBackend::Record(VkCommandBuffer commands, const StagedRun& run) const
 }
 
 }  // namespace
+
+Status UnwrittenOutputs(const Cell& cell, const std::string& unwritten) {
+  return InvalidArgument(fmt::format(
+      "the {} shader did not write its output for {} samples (cell {}): the program returns before storing "
+      "it or stores another element, or the device cut the invocation short (lavapipe ends the loops of an "
+      "invocation after 65535 iterations); nothing it did not write is judged",
+      cell.variant_info().name, unwritten, cell.Name()));
+}
 
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& options) {
   VulkanContextOptions context_options;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "bench/backends/backend.h"
@@ -27,6 +28,11 @@ Expected<std::unique_ptr<Backend>> MakeVulkanBackend(const BackendOptions& optio
 // options.device and options.validation do not apply (the context decided).
 Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanContext> context,
                                                      const BackendOptions& options);
+
+// Why a cell's shader left `unwritten` outputs unwritten ("12 of 1000"),
+// in the message that refuses its batch: the host's check and the device
+// judge's say the same.
+Status UnwrittenOutputs(const Cell& cell, const std::string& unwritten);
 
 // The buffers of a staged run of the compute form (DeviceResidentRuns),
 // in device memory. Its positions: component c (x, y, z) of sample i of
