@@ -164,19 +164,28 @@ DB_FN DrawnSample draw_sample(DrawUnits u, DrawFrame f) {
   return s;
 }
 
-// The world-space ray through pixel (x, y)'s centre at unit eye depth:
-// rotation * (ndc.x * tan_x + centre_x, ndc.y * tan_y + centre_y, -1), with
+// The world-space point of pixel (x, y)'s centre at `w`, camera-relative:
+// rotation * (ndc.x * tan_x + centre_x, ndc.y * tan_y + centre_y, -w), with
 // the pixel's texture coordinate and NDC as screen.h's uv_from_pixel and
-// ndc_from_uv take them. A centred lens adds zeros, which changes no bit.
-DB_FN dvec3 draw_pixel_ray(uint x, uint y, DrawFrame f) {
+// ndc_from_uv take them. A centred lens adds zeros, and w = 1 multiplies
+// exactly, which changes no bit.
+DB_FN dvec3 draw_pixel_point(uint x, uint y, DrawFrame f, double w) {
   DB_PRECISE double u = (double(x) + 0.5) / double(f.width);
   DB_PRECISE double v = (double(y) + 0.5) / double(f.height);
   DB_PRECISE double view_x = (u * 2.0 - 1.0) * f.tan_x + f.centre_x;
   DB_PRECISE double view_y = (1.0 - v * 2.0) * f.tan_y + f.centre_y;
-  dvec3 ray = dvec3(0.0);
+  dvec3 point = dvec3(0.0);
   for (int row = 0; row < 3; ++row) {
     DB_PRECISE double r = f.rotation[0][row] * view_x + f.rotation[1][row] * view_y;
-    ray[row] = r - f.rotation[2][row];
+    DB_PRECISE double depth_part = f.rotation[2][row] * w;
+    point[row] = r - depth_part;
   }
-  return ray;
+  return point;
 }
+
+// The world-space ray through pixel (x, y)'s centre at unit eye depth
+// (w = 1): the scene point at eye depth z is z times it. For an
+// orthographic frame (tan_x and tan_y are then the view volume's half
+// extents) the point at eye depth 0 is draw_pixel_point(x, y, f, 0.0), and
+// z adds z times the view axis, -rotation[2].
+DB_FN dvec3 draw_pixel_ray(uint x, uint y, DrawFrame f) { return draw_pixel_point(x, y, f, 1.0); }

@@ -11,16 +11,25 @@
 // No include guard: see compat.h.
 
 // Bits of DepthParams.convention. A depth convention is a combination of
-// these three choices.
+// these choices. The low three bits number a frame's DepthParams slots: an
+// orthographic frame's conventions take the slots of their perspective
+// namesakes (a frame is one or the other, and has no infinite far plane).
 DB_CONST_UINT(DB_CONVENTION_REVERSED, 1u)        // near maps to 1, far to 0
 DB_CONST_UINT(DB_CONVENTION_INFINITE, 2u)        // the far plane is at infinity
 DB_CONST_UINT(DB_CONVENTION_CLIP_MINUS_ONE, 4u)  // GL clip depth: NDC z in [-1, 1]
+DB_CONST_UINT(DB_CONVENTION_ORTHOGRAPHIC, 8u)    // depth linear in eye depth, w = 1
+DB_CONST_UINT(DB_CONVENTION_SLOTS, 7u)           // the bits that number a DepthParams slot
 
 // Everything about one frame that does not depend on the depth convention:
 // the camera, the lens, the render target, and the per-vertex values that the
 // rasterizer would interpolate for the ray-based variants. All "origin"
 // members are the attribute's value at uv (0, 0) (the top-left corner of the
 // screen); "du"/"dv" are its change from uv (0, 0) to uv (1, 0) and (0, 1).
+//
+// An orthographic frame's lens is the view volume's half extents: `lens`
+// xy is half its width and height in view units (at every depth, where a
+// perspective lens gives them at unit eye depth), and `lens_centre` xy the
+// view-space offset of NDC (0, 0).
 struct FrameParams {
   mat4 camera_world;        // view space -> world space (rotation + translation)
   vec4 camera_position;     // xyz: camera position in world space; w: far plane distance (0 when infinite)
@@ -44,10 +53,16 @@ struct FrameParams {
   // projection matrix's off-centre terms, x * H and y * V. Zero for a
   // symmetric frustum; the variants that read only `lens` assume one.
   vec4 lens_centre;
+  // x: the near plane's eye depth, y: the far plane's (0 when infinite);
+  // zw: 0. What an engine hands its shaders as the clip planes (Unity's
+  // _ProjectionParams y and z), read by the orthographic linear map.
+  vec4 clip_planes;
 };
 
 // What one depth convention adds to a frame: the mapping between eye depth
-// z (= -view.z > 0) and NDC depth, which is  ndc_z = A + B / z.
+// z (= -view.z > 0) and NDC depth, which is  ndc_z = A + B / z  (and
+// ndc_z = A + B * z  under an orthographic projection, where P and Q then
+// give z = P * ndc_z + Q).
 struct DepthParams {
   mat4 inverse_view_projection;  // Unity URP: NDC (x, y, ndc_z, 1) -> homogeneous world position
   mat4 view_projection;          // world position -> clip space: what the raster pipeline draws with

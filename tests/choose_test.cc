@@ -319,6 +319,25 @@ TEST(ChooseTest, TaaJitterRulesOutTheSymmetricFormulas) {
   for (const CandidateVerdict& v : r.ranked) EXPECT_EQ(v.wrong_lens, v.cell.variant_info().assumes_symmetric_frustum);
 }
 
+// A directional light's cascade: orthographic, so its depth is linear and
+// D16's step over 399 m (6.1 mm, half of it 3 mm) fails 1 mm anywhere,
+// while 24 bits or a float pass; only orthographic cells are candidates,
+// and the API advice says the projection is an orthographic one.
+TEST(ChooseTest, OrthographicCascadeRulesOutD16AndRunsOnlyOrthographicCells) {
+  const ChooseResult r = ChooseFor(kScenes + "shadow_ortho.toml");
+  ASSERT_TRUE(r.Met()) << r.ranked.front().reason;
+  EXPECT_NE(r.ranked.front().cell.format, Format::kD16Unorm);
+  EXPECT_NE(r.api_recipe.find("an orthographic projection"), std::string::npos) << r.api_recipe;
+  bool saw_d16 = false;
+  for (const CandidateVerdict& v : r.ranked) {
+    EXPECT_TRUE(Info(v.cell.convention).orthographic()) << v.cell.Name();
+    if (v.cell.format != Format::kD16Unorm) continue;
+    saw_d16 = true;
+    EXPECT_FALSE(v.meets) << v.cell.Name();
+  }
+  EXPECT_TRUE(saw_d16);
+}
+
 TEST(ChooseTest, BadSceneFileExitsWithTwo) {
   const auto r = testing::RunDepthbench({"choose", "--scene", kScenes + "missing.toml"});
   EXPECT_EQ(r.exit_code, 2);

@@ -107,7 +107,8 @@ TEST(CliTest, ListNamesVariantsWithSourcesAndDevices) {
   const auto r = RunDepthbench({"list"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   for (const char* text : {"frustum_ray", "Pettineo 2009", "pq", "engine shader notes", "reversed-inf-gl",
-                           "x8_d24_unorm", "106 cells", "llvmpipe"}) {
+                           "x8_d24_unorm", "130 cells", "106 of them perspective", "ortho-reversed-gl",
+                           "ortho_lerp", "llvmpipe"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text;
   }
 }

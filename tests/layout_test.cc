@@ -85,7 +85,8 @@ TEST_F(LayoutTest, FrameParamsMatchesStd430) {
   EXPECT_MEMBER_AT(frame, FrameParams, eye_ray_world_dv);
   EXPECT_MEMBER_AT(frame, FrameParams, world_view);
   EXPECT_MEMBER_AT(frame, FrameParams, lens_centre);
-  EXPECT_EQ(MembersOf("frame"), 18) << "a FrameParams member is not listed above";
+  EXPECT_MEMBER_AT(frame, FrameParams, clip_planes);
+  EXPECT_EQ(MembersOf("frame"), 19) << "a FrameParams member is not listed above";
   EXPECT_EQ(Offset("frame_end"), static_cast<int>(sizeof(f32::FrameParams)));
 }
 

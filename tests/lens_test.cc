@@ -8,26 +8,18 @@
 
 #include <gtest/gtest.h>
 
-#include "bench/backends/cpu/cpu_backend.h"
 #include "bench/sweep/sweep.h"
+#include "tests/cpu_sweep.h"
 
 namespace depthbench {
 namespace {
 
 // p99.9 bits lost, over the natural samples, of each of `cells`.
 std::vector<double> P999Bits(const Domain& domain, const std::vector<std::string>& cells) {
-  SweepOptions options;
-  options.seed = 40;
-  options.samples = 100000;
-  options.domain = domain;
-  for (const std::string& name : cells) options.cells.push_back(*ParseCell(name));
-  auto cpu = MakeCpuBackend();
-  Backend* backends[] = {cpu.get()};
-  auto run = RunSweep(options, backends);
-  EXPECT_TRUE(run.ok()) << run.status().message();
   std::vector<double> bits;
-  if (!run.ok()) return bits;
-  for (const CellResult& c : run->cells) bits.push_back(BitsLost(Summarize(c.stats.All(), Metric::kTotal).p999));
+  for (const CellResult& c : testing_support::CpuSweep(domain, cells, 40).cells) {
+    bits.push_back(BitsLost(Summarize(c.stats.All(), Metric::kTotal).p999));
+  }
   return bits;
 }
 

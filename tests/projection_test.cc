@@ -113,19 +113,33 @@ TEST(ProjectionMatrixTest, OffCentreAndJitteredMatricesAreOffCentre) {
   EXPECT_FALSE(flip_facts->off_centre());
 }
 
-TEST(ProjectionMatrixTest, OrthographicIsRecognisedAndNotYetMeasured) {
-  const glm::mat4 m = glm::orthoRH_ZO(-50.0f, 50.0f, -50.0f, 50.0f, 1.0f, 400.0f);
+TEST(ProjectionMatrixTest, OrthographicMatrixMakesAnOrthographicDomain) {
+  // A shadow cascade's volume, off the view axis in x, as glm builds it for
+  // Vulkan; and the same for OpenGL, reversed.
+  const glm::mat4 m = glm::orthoRH_ZO(-30.0f, 70.0f, -50.0f, 50.0f, 1.0f, 400.0f);
   auto facts = ReadProjectionMatrix(FromGlm(m, GraphicsApi::kVulkan));
   ASSERT_TRUE(facts.ok()) << facts.status().message();
   EXPECT_TRUE(facts->orthographic);
-  EXPECT_EQ(facts->convention, Convention::kStandard);
+  EXPECT_EQ(facts->convention, Convention::kOrthoStandard);
   EXPECT_NEAR(facts->near, 1.0, 1e-5);
   EXPECT_NEAR(facts->far, 400.0, 400.0 * 1e-5);
-  EXPECT_NEAR(facts->right, 50.0, 1e-4);
+  EXPECT_NEAR(facts->left, -30.0, 1e-4);
+  EXPECT_NEAR(facts->right, 70.0, 1e-4);
   Domain d;
-  const Status applied = ApplyProjection(*facts, d);
-  EXPECT_FALSE(applied.ok());
-  EXPECT_NE(applied.message().find("orthographic"), std::string::npos) << applied.message();
+  ASSERT_TRUE(ApplyProjection(*facts, d).ok());
+  ASSERT_TRUE(d.orthographic.has_value());
+  EXPECT_NEAR(d.orthographic->left, -30.0, 1e-4);
+  EXPECT_FALSE(d.eye_fov.has_value());
+  EXPECT_FALSE(d.infinite_far);
+  EXPECT_TRUE(d.OffCentre());
+  EXPECT_TRUE(d.Validate().ok());
+
+  // Reversed: near and far swapped in glm's call maps near to 1.
+  const glm::mat4 reversed = glm::orthoRH_NO(-50.0f, 50.0f, -50.0f, 50.0f, 400.0f, 1.0f);
+  auto gl = ReadProjectionMatrix(FromGlm(reversed, GraphicsApi::kOpenGL));
+  ASSERT_TRUE(gl.ok()) << gl.status().message();
+  EXPECT_EQ(gl->convention, Convention::kOrthoReversedGl);
+  EXPECT_NEAR(gl->near, 1.0, 1e-4);
 }
 
 void ExpectRefused(const ProjectionMatrix& m, const std::string& names) {

@@ -33,6 +33,9 @@ mp::real TextbookDecode(Convention c, double near, double far, const mp::real& d
   mp::real a, b;
   const std::uint32_t bits = Info(c).bits;
   const bool reversed = bits & 1u, infinite = bits & 2u;
+  if (bits & 8u) {  // orthographic: d = (z - n) / (f - n), or (f - z) / (f - n) reversed
+    return reversed ? f - d * (f - n) : n + d * (f - n);
+  }
   if (infinite) {
     a = reversed ? mp::real(0.0) : mp::real(1.0);
     b = reversed ? n : -n;
@@ -153,10 +156,16 @@ TEST(ReferenceTest, NaiveDoubleDecodeIsNotEnoughAtHighRatios) {
 // constants, must land on the point the stored value denotes: this checks
 // the algebra of each restated seed independently of float rounding.
 TEST(ReferenceTest, EveryVariantFormulaIsExactInHighPrecision) {
-  Domain domain;
-  domain.camera_distance = {0.0, 1e3};
-  const Sampler sampler(5, domain);
+  Domain perspective;
+  perspective.camera_distance = {0.0, 1e3};
+  // An off-centre view volume, as a shadow map fitted to a view's frustum
+  // has.
+  Domain orthographic = perspective;
+  orthographic.orthographic = ViewVolume{-40.0, 60.0, -20.0, 35.0};
+  orthographic.infinite_far = false;
+  const Sampler perspective_sampler(5, perspective), orthographic_sampler(5, orthographic);
   for (const Cell& cell : AllCells()) {
+    const Sampler& sampler = Info(cell.convention).orthographic() ? orthographic_sampler : perspective_sampler;
     hp::WorldPositionFn formula = nullptr;
     switch (cell.variant) {
       case Variant::kFrustumRay: formula = hp::frustum_ray_world_position; break;
@@ -167,6 +176,7 @@ TEST(ReferenceTest, EveryVariantFormulaIsExactInHighPrecision) {
       case Variant::kDivide: formula = hp::divide_world_position; break;
       case Variant::kReciprocal: formula = hp::reciprocal_world_position; break;
       case Variant::kPq: formula = hp::pq_world_position; break;
+      case Variant::kOrthoLerp: formula = hp::ortho_lerp_world_position; break;
     }
     double worst = 0.0;
     for (std::uint64_t f = 0; f < 40; ++f) {
@@ -185,11 +195,12 @@ TEST(ReferenceTest, EveryVariantFormulaIsExactInHighPrecision) {
         hp::vec2 uv = hp::uv_from_pixel(DD(sample.x), DD(sample.y), params.resolution);
         hp::vec3 p = formula(params, depth, uv, value);
         const glm::dvec3 ray = PixelRay(frame, sample.x, sample.y);
-        const double distance = z * glm::length(ray);
+        const glm::dvec3 offset = PixelOffset(frame, sample.x, sample.y);
+        const double distance = glm::length(offset + z * ray);
         for (int k = 0; k < 3; ++k) {
           // Camera-relative, so that world magnitudes do not enter.
           const double relative = (p[k] - DD(frame.camera_position[k])).ToDouble();
-          worst = std::max(worst, std::fabs(relative - z * ray[k]) / distance);
+          worst = std::max(worst, std::fabs(relative - offset[k] - z * ray[k]) / distance);
         }
       }
     }

@@ -49,7 +49,7 @@ TEST(SceneTest, ParsesEveryFieldIntoTheDomain) {
 
 TEST(SceneTest, ExampleScenesLoad) {
   for (const char* name : {"indoor_shooter", "open_world", "space_game", "cad_viewer", "spot_shadow", "flight_sim",
-                           "engine_matrix", "vr_asymmetric", "taa_jitter"}) {
+                           "engine_matrix", "vr_asymmetric", "taa_jitter", "shadow_ortho"}) {
     auto scene = LoadScene(kScenes + name + ".toml");
     EXPECT_TRUE(scene.ok()) << name << ": " << scene.status().message();
   }
@@ -155,7 +155,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\""},
         BadScene{"name = \"test\"", "name = \"test\"\nbroken = = 1", "bad.toml:2:"},
         BadScene{"aspect = 1.78", "aspect = 1.78\neye_fov = [-40, 40, 30, -30]",
-                 "eye_fov sets the field of view; give one or the other"},
+                 "eye_fov sets the lens; give one or the other"},
+        BadScene{"aspect = 1.78", "aspect = 1.78\northo = [-40, 40, -30, 30]",
+                 "projection.fov_degrees: ortho sets the lens; give one or the other"},
+        BadScene{"fov_degrees = [50, 90]\naspect = 1.78", "ortho = [-40, 40, 30, -30]",
+                 "projection.ortho: ortho: -40,40,30,-30 has no area"},
         BadScene{"fov_degrees = [50, 90]\naspect = 1.78", "eye_fov = [40, -40, 30, -30]",
                  "projection.eye_fov: eye_fov: 40,-40,30,-30 has no area"},
         BadScene{"aspect = 1.78", "aspect = 1.78\njitter = 9", "projection.jitter: allowed [0, 4] pixels"},

@@ -1,6 +1,7 @@
 #include "bench/choose/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <initializer_list>
 
@@ -192,7 +193,7 @@ Status ReadResolution(SceneReader& r, const toml::table& projection, Domain& d) 
 // fixes the planes, the lens and the depth convention.
 Status ReadMatrix(SceneReader& r, const toml::table& projection, Scene& scene) {
   const toml::node* node = projection.get("matrix");
-  for (const char* key : {"near", "far", "fov_degrees", "aspect", "eye_fov"}) {
+  for (const char* key : {"near", "far", "fov_degrees", "aspect", "eye_fov", "ortho"}) {
     if (const toml::node* other = projection.get(key)) {
       return r.Error(other, std::string("projection.") + key, "the matrix sets it; give one or the other");
     }
@@ -231,25 +232,46 @@ Status ReadMatrix(SceneReader& r, const toml::table& projection, Scene& scene) {
   return Status::Ok();
 }
 
-// projection.eye_fov, or fov_degrees and aspect: the lens.
+// projection.KEY as four numbers, `shape` saying what they are.
+Expected<std::array<double, 4>> ReadFour(SceneReader& r, const toml::node* node, const std::string& key,
+                                         std::string_view shape) {
+  const toml::array* a = node->as_array();
+  if (a == nullptr || a->size() != 4) return r.Error(node, key, fmt::format("expected {}", shape));
+  std::array<double, 4> numbers;
+  for (int k = 0; k < 4; ++k) {
+    DB_ASSIGN_OR_RETURN(numbers[k], r.Number(a->get(k), fmt::format("{}[{}]", key, k)));
+  }
+  return numbers;
+}
+
+// projection.eye_fov, projection.ortho, or fov_degrees and aspect: the lens.
 Status ReadLens(SceneReader& r, const toml::table& projection, Domain& d) {
-  if (const toml::node* node = projection.get("eye_fov")) {
-    for (const char* key : {"fov_degrees", "aspect"}) {
-      if (const toml::node* other = projection.get(key)) {
-        return r.Error(other, std::string("projection.") + key, "eye_fov sets the field of view; give one or the other");
+  for (const char* lens : {"eye_fov", "ortho"}) {
+    const toml::node* node = projection.get(lens);
+    if (node == nullptr) continue;
+    for (const char* key : {"fov_degrees", "aspect", "eye_fov"}) {
+      const toml::node* other = projection.get(key);
+      if (other != nullptr && key != std::string_view(lens)) {
+        return r.Error(other, std::string("projection.") + key,
+                       fmt::format("{} sets the lens; give one or the other", lens));
       }
     }
-    const toml::array* a = node->as_array();
-    if (a == nullptr || a->size() != 4) {
-      return r.Error(node, "projection.eye_fov", "expected [left, right, up, down] in degrees (left and down negative)");
+    const std::string key = std::string("projection.") + lens;
+    if (lens == std::string_view("eye_fov")) {
+      DB_ASSIGN_OR_RETURN(const auto angles,
+                          ReadFour(r, node, key, "[left, right, up, down] in degrees (left and down negative)"));
+      d.eye_fov = EyeFov{angles[0], angles[1], angles[2], angles[3]};
+      const Status valid = CheckEyeFov(*d.eye_fov, "eye_fov");
+      if (!valid.ok()) return r.Error(node, key, valid.message());
+      return Status::Ok();
     }
-    double angles[4];
-    for (int k = 0; k < 4; ++k) {
-      DB_ASSIGN_OR_RETURN(angles[k], r.Number(a->get(k), fmt::format("projection.eye_fov[{}]", k)));
+    DB_ASSIGN_OR_RETURN(const auto sides, ReadFour(r, node, key, "[left, right, bottom, top] in view units"));
+    d.orthographic = ViewVolume{sides[0], sides[1], sides[2], sides[3]};
+    const Status valid = CheckViewVolume(*d.orthographic, "ortho");
+    if (!valid.ok()) return r.Error(node, key, valid.message());
+    if (d.infinite_far) {
+      return r.Error(projection.get("far"), "projection.far", "an orthographic projection needs a finite far plane");
     }
-    d.eye_fov = EyeFov{angles[0], angles[1], angles[2], angles[3]};
-    const Status valid = CheckEyeFov(*d.eye_fov, "eye_fov");
-    if (!valid.ok()) return r.Error(node, "projection.eye_fov", valid.message());
     return Status::Ok();
   }
   DB_ASSIGN_OR_RETURN(d.fov_degrees, r.NumberOrRange(projection.get("fov_degrees"), "projection.fov_degrees"));
@@ -263,8 +285,8 @@ Status ReadProjection(SceneReader& r, const toml::table& root, Scene& scene) {
   Domain& d = scene.domain;
   DB_ASSIGN_OR_RETURN(const toml::table* projection, r.Table(root, "projection", true));
   DB_RETURN_IF_ERROR(r.OnlyKeys(*projection, "projection",
-                                {"near", "far", "fov_degrees", "aspect", "eye_fov", "matrix", "api", "layout",
-                                 "jitter", "resolution"}));
+                                {"near", "far", "fov_degrees", "aspect", "eye_fov", "ortho", "matrix", "api",
+                                 "layout", "jitter", "resolution"}));
   if (const toml::node* node = projection->get("jitter")) {
     DB_ASSIGN_OR_RETURN(d.jitter, r.Number(node, "projection.jitter"));
     if (!(d.jitter >= 0.0 && d.jitter <= kMostJitterPixels)) {

@@ -42,6 +42,12 @@ void DomainFlags::Add(CLI::App& app) {
                  "angles in degrees from the view axis, left and down negative; replaces --fov and --aspect")
       ->type_name("L,R,U,D")
       ->group("Domain");
+  app.add_option("--ortho", ortho,
+                 "an orthographic projection (a directional light's shadow map, a CAD view): its view volume "
+                 "LEFT,RIGHT,BOTTOM,TOP in view units, with --near and --far (or a finite --ratio) for its depth; "
+                 "replaces --fov and --aspect, and runs the ortho-* conventions only")
+      ->type_name("L,R,B,T")
+      ->group("Domain");
   app.add_option("--jitter", jitter,
                  "TAA jitter: every frame's projection shifted by up to this many pixels in x and y (uniform), as "
                  "temporal anti-aliasing does (0 to 4; e.g. 0.5)")
@@ -106,7 +112,7 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
   const bool narrowed =
       !(near.empty() && far.empty() && ratio.empty() && fov.empty() && aspect.empty() && camera_distance.empty() &&
         eye_depth.empty() && resolution.empty() && production.empty() && constants.empty() && pipeline.empty() &&
-        eye_fov.empty() && jitter.empty() && projection.empty());
+        eye_fov.empty() && ortho.empty() && jitter.empty() && projection.empty());
   if (narrowed) d.name += " (narrowed)";
   if (!production.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseProductionModel(production), d.production).WithContext("--production"));
@@ -125,9 +131,10 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
     return InvalidArgument(fmt::format("--pipeline: '{}' is not one of compute, raster", pipeline));
   }
   if (!projection.empty()) {
-    if (!fov.empty() || !aspect.empty() || !eye_fov.empty() || !near.empty() || !far.empty() || !ratio.empty()) {
-      return InvalidArgument("--projection sets near, far and the field of view; it takes no --fov, --aspect, "
-                             "--eye-fov, --near, --far or --ratio");
+    if (!fov.empty() || !aspect.empty() || !eye_fov.empty() || !ortho.empty() || !near.empty() || !far.empty() ||
+        !ratio.empty()) {
+      return InvalidArgument("--projection sets near, far and the field of view or view volume; it takes no --fov, "
+                             "--aspect, --eye-fov, --ortho, --near, --far or --ratio");
     }
     DB_ASSIGN_OR_RETURN(const ProjectionMatrix matrix, ParseProjectionFlag(projection));
     DB_ASSIGN_OR_RETURN(const ProjectionFacts facts, ReadProjectionMatrix(matrix));
@@ -137,6 +144,16 @@ Expected<Domain> DomainFlags::Apply(Domain d, const Catalogue& catalogue) const 
   if (!eye_fov.empty()) {
     if (!fov.empty() || !aspect.empty()) return InvalidArgument("--eye-fov replaces --fov and --aspect");
     DB_RETURN_IF_ERROR(StoreInto(ParseEyeFov(eye_fov, "--eye-fov"), d.eye_fov.emplace()));
+  }
+  if (!ortho.empty()) {
+    if (!fov.empty() || !aspect.empty() || !eye_fov.empty()) {
+      return InvalidArgument("--ortho replaces --fov, --aspect and --eye-fov");
+    }
+    DB_RETURN_IF_ERROR(StoreInto(ParseViewVolume(ortho, "--ortho"), d.orthographic.emplace()));
+    d.eye_fov.reset();
+    // An orthographic projection has no infinite far plane: an unset far
+    // keeps the domain's finite ratios.
+    if (far.empty() && ratio.empty()) d.infinite_far = false;
   }
   if (!jitter.empty()) {
     DB_RETURN_IF_ERROR(StoreInto(ParseNumber(jitter, "--jitter"), d.jitter));

@@ -43,7 +43,7 @@ bool IsSceneFile(const std::string& name_or_file);
 struct DomainFlags {
   std::string domain;  // a named domain or a scene file
   std::string near, far, ratio, fov, aspect, camera_distance, eye_depth, resolution, production, constants, pipeline;
-  std::string eye_fov, jitter, projection;
+  std::string eye_fov, ortho, jitter, projection;
   void Add(CLI::App& app);
   // What --projection's matrix holds, one line a fact (nothing without it).
   Expected<std::vector<std::string>> DescribeProjection() const;

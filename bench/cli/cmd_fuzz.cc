@@ -19,6 +19,15 @@
 namespace depthbench::cli {
 namespace {
 
+// Fuzz cases and the search's candidates are perspective frames (a field
+// of view, the arithmetic bound's ray): an orthographic domain is measured
+// by run, fit and choose, not fuzzed.
+Status CheckFuzzable(const Domain& domain) {
+  if (!domain.orthographic) return Status::Ok();
+  return InvalidArgument("fuzz: orthographic domains are not fuzzed yet (its cases and bounds are perspective "
+                         "frames); measure one with run, fit or choose");
+}
+
 struct FuzzFlags {
   double seconds = 30;
   std::string cases;
@@ -105,6 +114,7 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
   }
   options.out = f.out;
   DB_ASSIGN_OR_RETURN(options.domain, f.domain.Apply(FuzzDomain(), context.catalogue));
+  DB_RETURN_IF_ERROR(CheckFuzzable(options.domain));
   // The campaign's cases (and the reproducers it writes) carry no pipeline
   // model: they are produced as a GPU does, with exactly rounded constants.
   const Domain defaults;
@@ -182,6 +192,7 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
                      const CommandContext& context) {
   const TextOutput& out = context.output;
   DB_ASSIGN_OR_RETURN(const Domain domain, f.domain.Apply(Domain{}, context.catalogue));
+  DB_RETURN_IF_ERROR(CheckFuzzable(domain));
   std::uint64_t random_samples = 0;
   if (!f.against_random.empty()) {
     DB_ASSIGN_OR_RETURN(random_samples, ParseCount(f.against_random, "--against-random"));

@@ -1,5 +1,7 @@
 // depthbench list: the catalog (variants with their seeds, conventions,
 // formats, cells) and the Vulkan devices this machine has.
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/vulkan_context.h"
@@ -26,10 +28,14 @@ Expected<int> List(const CommandContext& context) {
   TextTable variants({{"variant", Align::kLeft},
                       {"source", Align::kLeft},
                       {"reads", Align::kLeft},
+                      {"projection", Align::kLeft},
                       {"frustum", Align::kLeft},
                       {"idea", Align::kLeft}});
   for (const auto& v : context.catalogue.variants()) {
-    variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input),
+    const char* projection = v.projections == Projections::kBoth           ? "both"
+                             : v.projections == Projections::kOrthographic ? "orthographic"
+                                                                           : "perspective";
+    variants.AddRow({std::string(v.name), std::string(v.source), InputName(v.input), projection,
                      v.assumes_symmetric_frustum ? "symmetric" : "any", std::string(v.idea)});
   }
   out.text << "Variants (their sources: docs/sources.md)\n";
@@ -37,7 +43,8 @@ Expected<int> List(const CommandContext& context) {
 
   out.text << "frustum: 'symmetric' variants put NDC (0, 0) on the view axis, as their sources write them, and are "
               "wrong for an off-centre frustum (a VR eye, TAA jitter); 'any' follow the frustum's own corners or "
-              "matrix\n";
+              "matrix; projection: the projections the formula is written for (an orthographic one, --ortho or a "
+              "matrix, runs the ortho-* conventions)\n";
 
   TextTable conventions({{"convention", Align::kLeft}, {"meaning", Align::kLeft}});
   for (const auto& c : AllConventions()) conventions.AddRow({std::string(c.name), std::string(c.description)});
@@ -53,8 +60,13 @@ Expected<int> List(const CommandContext& context) {
   }
   out.text << "\nStorage formats\n";
   formats.Print(out);
-  out.text << fmt::format("\n{} cells (variant/convention/format) per backend; backends: cpu, vulkan\n",
-                          context.catalogue.Cells().size());
+  const std::vector<Cell> cells = context.catalogue.Cells();
+  const auto orthographic = std::count_if(cells.begin(), cells.end(),
+                                          [](const Cell& c) { return Info(c.convention).orthographic(); });
+  out.text << fmt::format(
+      "\n{} cells (variant/convention/format) per backend, {} of them perspective (a perspective domain runs them) "
+      "and {} orthographic (an orthographic one does); backends: cpu, vulkan\n",
+      cells.size(), cells.size() - static_cast<std::size_t>(orthographic), orthographic);
 
   out.text << "\nVulkan devices\n";
   auto devices = ListVulkanDevices();

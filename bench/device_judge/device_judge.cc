@@ -114,7 +114,7 @@ constexpr std::uint32_t JudgeSlot(std::uint32_t lane) { return 2 * lane + 1; }
 // slot's pipeline.
 std::uint32_t EncodingWord(Encoding encoding, std::uint32_t pipeline) {
   const ConventionInfo& convention = Info(encoding.convention);
-  const auto hardware = convention.hardware ? static_cast<std::uint32_t>(encoding.convention) : 0u;
+  const auto hardware = convention.hardware ? DepthSlot(encoding.convention) : 0u;
   // As reference.cc's ReferencesBody reads a far plane at infinity.
   const bool infinite_far = convention.hardware && (convention.bits & f32::DB_CONVENTION_INFINITE) != 0u;
   return L::db_encoding_word(static_cast<std::uint32_t>(Info(encoding.format).stores), convention.bits, hardware,
@@ -334,6 +334,12 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   const std::shared_ptr<VulkanContext>& context = runs->context();
   if (production == ProductionModel::kRaster) {
     return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
+  }
+  for (const Encoding& encoding : layout.encodings) {
+    if (Info(encoding.convention).orthographic()) {
+      return Unavailable("the device judge's reference follows rays through a perspective frustum; orthographic "
+                         "projections are judged on the host (--judge host)");
+    }
   }
   if (!context->shader_float64() || !context->int64_atomics()) {
     return Unavailable(fmt::format(

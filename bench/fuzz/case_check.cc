@@ -102,7 +102,7 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
               j.total = j.arith = NAN;
               continue;
             }
-            const SampleErrors e = ErrorsOf(r, ray, frame.camera_position, p);
+            const SampleErrors e = ErrorsOf(r, ray, batch_.Offset(i), frame.camera_position, p);
             j.total = std::sqrt(e.total_sq);
             j.arith = std::sqrt(e.arith_sq);
           }

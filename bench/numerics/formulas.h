@@ -89,7 +89,7 @@ using mat4 = glm::mat<4, 4, DoubleDouble4>;
 namespace depthbench {
 
 // The std430 contract: these sizes are what the shaders' buffers index by.
-static_assert(sizeof(f32::FrameParams) == 16 * 16 + 2 * 64, "FrameParams std430 size");
+static_assert(sizeof(f32::FrameParams) == 17 * 16 + 2 * 64, "FrameParams std430 size");
 static_assert(sizeof(f32::DepthParams) == 2 * 64 + 16 + 16, "DepthParams std430 size");
 static_assert(sizeof(f32::PassConstants) == 32, "PassConstants size");
 static_assert(sizeof(f32::CellSlice) == 16, "CellSlice std430 size");

@@ -17,7 +17,7 @@ RunLayout MakeRunLayout(std::span<const Cell> cells) {
     auto it = std::find(layout.encodings.begin(), layout.encodings.end(), cell.encoding());
     auto slot = static_cast<std::uint32_t>(it - layout.encodings.begin());
     if (it == layout.encodings.end()) layout.encodings.push_back(cell.encoding());
-    std::uint32_t convention_slot = Info(cell.convention).hardware ? static_cast<std::uint32_t>(cell.convention) : 0u;
+    std::uint32_t convention_slot = Info(cell.convention).hardware ? DepthSlot(cell.convention) : 0u;
     layout.cells.push_back({cell, slot, convention_slot});
   }
   return layout;
@@ -97,6 +97,8 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   batch.raster.assign(raster ? count : 0, f32::RasterSample{});
   batch.pixels.resize(drawn);
   for (auto* v : {&batch.ray_x, &batch.ray_y, &batch.ray_z}) v->resize(drawn);
+  const bool orthographic = !batch.frames.empty() && batch.frames.front().orthographic;  // a domain's are all alike
+  for (auto* v : {&batch.offset_x, &batch.offset_y, &batch.offset_z}) v->resize(orthographic ? drawn : 0);
   // (A judge on the device produces float32 depths itself, and computes
   // from the frame and the ray what the reference needs beyond what was
   // drawn.)
@@ -122,12 +124,21 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
             if (geometry.rendered_depth) sample.eye_depth = *geometry.rendered_depth;
           }
           batch.pixels[i] = sample.x | (sample.y << 16);
-          const glm::dvec3 ray = draw::draw_pixel_ray(sample.x, sample.y, draw);
+          const glm::dvec3 ray =
+              orthographic ? -frame.rotation[2] : draw::draw_pixel_ray(sample.x, sample.y, draw);
           batch.ray_x[i] = ray.x;
           batch.ray_y[i] = ray.y;
           batch.ray_z[i] = ray.z;
+          double offset_sq = 0.0;
+          if (orthographic) {
+            const glm::dvec3 offset = draw::draw_pixel_point(sample.x, sample.y, draw, 0.0);
+            batch.offset_x[i] = offset.x;
+            batch.offset_y[i] = offset.y;
+            batch.offset_z[i] = offset.z;
+            offset_sq = glm::dot(offset, offset);
+          }
           if (fields == SampleFields::kAll) {
-            batch.samples.Set(i, frame, sample, ray);
+            batch.samples.Set(i, frame, sample, ray, offset_sq);
           } else {
             batch.samples.SetDrawn(i, frame, sample);
           }
@@ -192,7 +203,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       const std::size_t k = job / chunks;
       const std::size_t lo = (job % chunks) * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
       const Encoding encoding = encodings_[pipeline_slots_[k]];
-      const std::size_t convention = static_cast<std::size_t>(encoding.convention);
+      const std::size_t convention = DepthSlot(encoding.convention);  // its DepthParams slot
       const DepthInput stores = Info(encoding.format).stores;
       // One frame's samples at a time: they share its constants.
       for (std::size_t i = lo; i < lo + n;) {

@@ -28,6 +28,9 @@ struct Batch : ShaderInputs {
   std::vector<Frame> frames;                 // [frame]: exact parameters
   std::vector<std::uint8_t> distance_bands;  // [frame]: DistanceBand of the camera
   std::vector<double> ray_x, ray_y, ray_z;   // [sample]: world-space ray at unit eye depth
+  // [sample]: the camera-relative point at eye depth 0 (reference.h
+  // PixelOffset) when the frames are orthographic; empty when perspective.
+  std::vector<double> offset_x, offset_y, offset_z;
   SampleArrays samples;                      // [sample]: the depth pick and what the reference needs
   ReferenceArrays reference;                 // [depth slot * count + sample]; empty where a device judges (BatchFor)
   // The float32 each pipeline produced (PipelineOfSlots), [pipeline *
@@ -35,6 +38,9 @@ struct Batch : ShaderInputs {
   std::vector<float> pipeline_floats;
 
   glm::dvec3 Ray(std::uint32_t sample) const { return {ray_x[sample], ray_y[sample], ray_z[sample]}; }
+  glm::dvec3 Offset(std::uint32_t sample) const {
+    return offset_x.empty() ? glm::dvec3(0.0) : glm::dvec3(offset_x[sample], offset_y[sample], offset_z[sample]);
+  }
 };
 
 // What a judge on the device (bench/device_judge/) reads of a batch beyond

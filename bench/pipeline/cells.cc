@@ -10,7 +10,8 @@
 namespace depthbench {
 
 static_assert(catalog::kRev == f32::DB_CONVENTION_REVERSED && catalog::kInf == f32::DB_CONVENTION_INFINITE &&
-                  catalog::kGl == f32::DB_CONVENTION_CLIP_MINUS_ONE,
+                  catalog::kGl == f32::DB_CONVENTION_CLIP_MINUS_ONE &&
+                  catalog::kOrtho == f32::DB_CONVENTION_ORTHOGRAPHIC && f32::DB_CONVENTION_SLOTS == 7u,
               "convention bits must match shared/params.h");
 
 namespace {
@@ -46,11 +47,13 @@ std::string Suggest(std::string_view word, const Catalogue& catalogue) {
 
 const VariantInfo& Info(Variant v) { return catalog::kVariants.at(static_cast<std::size_t>(v)); }
 
-bool Reads(DepthInput input, Convention c, Format f) {
-  return Info(f).stores == input && Info(c).hardware == (input == DepthInput::kHardware);
+bool Reads(const VariantInfo& v, Convention c, Format f) {
+  const Projections needed = Info(c).orthographic() ? Projections::kOrthographic : Projections::kPerspective;
+  return Info(f).stores == v.input && Info(c).hardware == (v.input == DepthInput::kHardware) &&
+         (v.projections == Projections::kBoth || v.projections == needed);
 }
 
-bool Reads(Variant v, Convention c, Format f) { return Reads(Info(v).input, c, f); }
+bool Reads(Variant v, Convention c, Format f) { return Reads(Info(v), c, f); }
 
 const VariantInfo& Cell::variant_info() const {
   return catalogue != nullptr ? catalogue->Info(variant) : depthbench::Info(variant);
@@ -68,8 +71,8 @@ Catalogue::Catalogue(std::vector<UserVariant> user_variants)
   // The vector holding the user's variants never changes again: the views
   // into its strings stay valid for the catalogue's life.
   for (const UserVariant& user : user_variants_) {
-    variants_.push_back(
-        {static_cast<Variant>(variants_.size()), user.name, user.source, user.input, user.idea, false, &user.shader});
+    variants_.push_back({static_cast<Variant>(variants_.size()), user.name, user.source, user.input, user.idea, false,
+                         Projections::kPerspective, &user.shader});
   }
 }
 
@@ -82,7 +85,7 @@ const Catalogue& Catalogue::BuiltIn() {
 
 const VariantInfo& Catalogue::Info(Variant v) const { return variants_.at(static_cast<std::size_t>(v)); }
 
-bool Catalogue::Reads(Variant v, Convention c, Format f) const { return depthbench::Reads(Info(v).input, c, f); }
+bool Catalogue::Reads(Variant v, Convention c, Format f) const { return depthbench::Reads(Info(v), c, f); }
 
 std::vector<Cell> Catalogue::Cells() const {
   std::vector<Cell> cells;

@@ -35,10 +35,11 @@ enum class Variant : std::uint8_t {
   kDivide,
   kReciprocal,
   kPq,
+  kOrthoLerp,
 };
 // The built-in variants; a Catalogue's variants from the user's shader
 // files follow them, so that a Variant is an index into its catalogue.
-inline constexpr int kVariantCount = 8;
+inline constexpr int kVariantCount = 9;
 // Variant ids are a byte; far more user variants than anyone passes on a
 // command line.
 inline constexpr int kMostUserVariants = 64;
@@ -47,6 +48,11 @@ inline constexpr int kMostVariants = kVariantCount + kMostUserVariants;
 
 struct UserShader;   // bench/pipeline/user_variant.h
 struct UserVariant;  // bench/pipeline/user_variant.h
+
+// The projections a variant's formula is written for: a ray through a
+// perspective frustum, the linear map of an orthographic view volume, or
+// any (a matrix inverse that covers both).
+enum class Projections : std::uint8_t { kPerspective, kOrthographic, kBoth };
 
 struct VariantInfo {
   Variant id;
@@ -58,6 +64,7 @@ struct VariantInfo {
   // half extents only, as its source writes it): wrong for an off-centre
   // frustum, a VR eye's or a jittered one (Domain::OffCentre).
   bool assumes_symmetric_frustum = false;
+  Projections projections = Projections::kPerspective;
   // A variant from the user's shader file (--variant-file); null for the
   // built-in ones. It runs on Vulkan only.
   const UserShader* user = nullptr;
@@ -73,17 +80,26 @@ enum class Convention : std::uint8_t {
   kStandardInfGl,
   kReversedInfGl,
   kLinear,  // not a projective mapping: the value stored is linear in depth
+  // An orthographic projection's depth buffer: linear in eye depth too,
+  // but written by the hardware (no infinite far plane).
+  kOrthoStandard,
+  kOrthoReversed,
+  kOrthoStandardGl,
+  kOrthoReversedGl,
 };
-inline constexpr int kConventionCount = 9;
-// The projective conventions are the first eight; DepthParams exist for them.
+inline constexpr int kConventionCount = 13;
+// A frame's DepthParams slots: one per perspective convention, numbered by
+// its DB_CONVENTION_* bits; an orthographic frame's conventions take the
+// slots of their perspective namesakes (DepthSlot).
 inline constexpr int kHardwareConventionCount = 8;
 
 struct ConventionInfo {
   Convention id;
   std::string_view name;
   std::uint32_t bits;  // DB_CONVENTION_* of shared/params.h
-  bool hardware;
+  bool hardware;  // a depth buffer's: the frame has DepthParams for it
   std::string_view description;
+  bool orthographic() const { return (bits & 8u) != 0u; }  // DB_CONVENTION_ORTHOGRAPHIC
 };
 
 enum class Format : std::uint8_t {
@@ -121,17 +137,20 @@ inline constexpr std::array<VariantInfo, kVariantCount> kVariants = {{
     {Variant::kEyeRay, "eye_ray", "eye-ray post 2011", DepthInput::kViewZ,
      "eye ray divided by its z in the pixel stage, times stored view z; world-space ray alongside", false},
     {Variant::kInverseVp, "inverse_vp", "Unity URP", DepthInput::kHardware,
-     "inverse view-projection times (ndc, depth, 1), divide by w", false},
+     "inverse view-projection times (ndc, depth, 1), divide by w", false, Projections::kBoth},
     {Variant::kDivide, "divide", "engine shader notes", DepthInput::kHardware,
      "view = (ndc.x/H, ndc.y/V, -1) / (depth/B - A/B)", true},
     {Variant::kReciprocal, "reciprocal", "engine shader notes", DepthInput::kHardware,
      "invW = B / (depth - A); view = (ndc.x/H, ndc.y/V, -1) * invW", true},
     {Variant::kPq, "pq", "engine shader notes", DepthInput::kHardware,
      "invW = 1 / (depth*P + Q), P = 1/B, Q = -A/B precomputed", true},
+    {Variant::kOrthoLerp, "ortho_lerp", "Unity orthographic", DepthInput::kHardware,
+     "orthographic: z = lerp(near, far, depth) (1 - depth if reversed); view.xy = half extents * ndc.xy + centre",
+     false, Projections::kOrthographic},
 }};
 
 // The DB_CONVENTION_* bits of shared/params.h (cells.cc checks they agree).
-inline constexpr std::uint32_t kRev = 1, kInf = 2, kGl = 4;
+inline constexpr std::uint32_t kRev = 1, kInf = 2, kGl = 4, kOrtho = 8;
 
 inline constexpr std::array<ConventionInfo, kConventionCount> kConventions = {{
     {Convention::kStandard, "standard", 0, true, "near -> 0, far -> 1, clip depth [0,1]"},
@@ -145,6 +164,14 @@ inline constexpr std::array<ConventionInfo, kConventionCount> kConventions = {{
     {Convention::kReversedInfGl, "reversed-inf-gl", kRev | kInf | kGl, true,
      "near -> 1, infinite far -> -1, clip depth [-1,1]"},
     {Convention::kLinear, "linear", 0, false, "no projective mapping: the stored value is linear in eye depth"},
+    {Convention::kOrthoStandard, "ortho-standard", kOrtho, true,
+     "orthographic: near -> 0, far -> 1, linear in eye depth, clip depth [0,1]"},
+    {Convention::kOrthoReversed, "ortho-reversed", kOrtho | kRev, true,
+     "orthographic: near -> 1, far -> 0, linear in eye depth, clip depth [0,1]"},
+    {Convention::kOrthoStandardGl, "ortho-standard-gl", kOrtho | kGl, true,
+     "orthographic: near -> -1, far -> 1, linear in eye depth, clip depth [-1,1]"},
+    {Convention::kOrthoReversedGl, "ortho-reversed-gl", kOrtho | kRev | kGl, true,
+     "orthographic: near -> 1, far -> -1, linear in eye depth, clip depth [-1,1]"},
 }};
 
 inline constexpr std::array<FormatInfo, kFormatCount> kFormats = {{
@@ -173,12 +200,17 @@ inline std::span<const VariantInfo> AllVariants() { return catalog::kVariants; }
 inline std::span<const ConventionInfo> AllConventions() { return catalog::kConventions; }
 inline std::span<const FormatInfo> AllFormats() { return catalog::kFormats; }
 
-// The pairing rule, the one place that decides it: a variant that consumes
-// `input` reads a format when the format stores that kind of depth, and the
-// convention is a projective one exactly when that depth is hardware depth.
-bool Reads(DepthInput input, Convention c, Format f);
+// The pairing rule, the one place that decides it: a variant reads a format
+// when the format stores the kind of depth the variant consumes, the
+// convention is a projective one exactly when that depth is hardware depth,
+// and the variant's formula is written for the convention's projection
+// (perspective or orthographic).
+bool Reads(const VariantInfo& v, Convention c, Format f);
 // The rule for a built-in variant.
 bool Reads(Variant v, Convention c, Format f);
+// The DepthParams slot of a frame that holds a projective convention's
+// constants (its DB_CONVENTION_* bits less the orthographic one).
+inline std::uint32_t DepthSlot(Convention c) { return Info(c).bits & 7u; }
 
 // A depth buffer's content: what a convention and format make of a scene.
 struct Encoding {

@@ -1,5 +1,6 @@
 #include "bench/pipeline/domain.h"
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -128,7 +129,8 @@ bool operator==(const Domain& a, const Domain& b) {
          a.finite_far == b.finite_far && a.infinite_far == b.infinite_far && a.far == b.far &&
          a.camera_distance == b.camera_distance && a.eye_depth == b.eye_depth && a.resolutions == b.resolutions &&
          a.production == b.production && a.constants == b.constants && a.eye_fov == b.eye_fov &&
-         a.jitter == b.jitter && a.depth_convention == b.depth_convention && a.capture == b.capture;
+         a.orthographic == b.orthographic && a.jitter == b.jitter && a.depth_convention == b.depth_convention &&
+         a.capture == b.capture;
 }
 
 Domain TypicalDomain() { return Domain{}; }
@@ -198,6 +200,16 @@ Status Domain::Validate() const {
     }
   }
   if (eye_fov) DB_RETURN_IF_ERROR(CheckEyeFov(*eye_fov, "eye fov"));
+  if (orthographic) {
+    DB_RETURN_IF_ERROR(CheckViewVolume(*orthographic, "orthographic view volume"));
+    if (eye_fov) return InvalidArgument("an orthographic view volume has no field of view; give one or the other");
+    if (!finite_far || infinite_far) {
+      return InvalidArgument("an orthographic projection has no infinite far plane; give --far or a finite --ratio");
+    }
+    if (production == ProductionModel::kRaster) {
+      return InvalidArgument("the raster form does not draw orthographic projections yet; use the compute form");
+    }
+  }
   if (!(jitter >= 0.0 && jitter <= kMostJitterPixels)) {
     return InvalidArgument(fmt::format("jitter: {:g} pixels is out of range; allowed [0, {:g}] pixels", jitter,
                                        kMostJitterPixels));
@@ -213,13 +225,14 @@ Status Domain::Validate() const {
 }
 
 bool Domain::OffCentre() const {
-  return (eye_fov && eye_fov->OffAxis()) || jitter > 0.0;
+  return (eye_fov && eye_fov->OffAxis()) || (orthographic && orthographic->OffAxis()) || jitter > 0.0;
 }
 
 std::string Domain::ToFlags() const {
   auto range = [](const Range& r) { return r.fixed() ? fmt::format("{}", r.min) : fmt::format("{}:{}", r.min, r.max); };
-  std::string flags = eye_fov ? "--eye-fov " + eye_fov->ToString()
-                              : fmt::format("--fov {} --aspect {}", range(fov_degrees), range(aspect));
+  std::string flags = orthographic ? "--ortho " + orthographic->ToString()
+                     : eye_fov    ? "--eye-fov " + eye_fov->ToString()
+                                  : fmt::format("--fov {} --aspect {}", range(fov_degrees), range(aspect));
   flags += " --near " + range(near);
   if (jitter > 0.0) flags += fmt::format(" --jitter {}", jitter);
   if (!finite_far) {
@@ -253,9 +266,12 @@ std::string Domain::Describe() const {
   } else {
     far_text = "infinite far";
   }
-  const std::string lens = eye_fov ? fmt::format("eye fov {:.6g}, {:.6g}, {:.6g}, {:.6g} deg (left, right, up, down)",
-                                                 eye_fov->left, eye_fov->right, eye_fov->up, eye_fov->down)
-                                   : fmt::format("fov {} deg, aspect {}", fov_degrees.ToString(), aspect.ToString());
+  const std::string lens =
+      orthographic ? fmt::format("orthographic, view volume x {:.6g} to {:.6g}, y {:.6g} to {:.6g}", orthographic->left,
+                                 orthographic->right, orthographic->bottom, orthographic->top)
+      : eye_fov    ? fmt::format("eye fov {:.6g}, {:.6g}, {:.6g}, {:.6g} deg (left, right, up, down)", eye_fov->left,
+                                 eye_fov->right, eye_fov->up, eye_fov->down)
+                   : fmt::format("fov {} deg, aspect {}", fov_degrees.ToString(), aspect.ToString());
   std::string text = fmt::format("{}, near {}, {}, camera distance {}", lens, near.ToString(), far_text,
                                  camera_distance.ToString());
   if (jitter > 0.0) text += fmt::format(", TAA jitter up to {:g} px", jitter);
@@ -293,22 +309,57 @@ Status CheckEyeFov(const EyeFov& fov, std::string_view what) {
   return Status::Ok();
 }
 
-Expected<EyeFov> ParseEyeFov(std::string_view text, std::string_view what) {
-  double angles[4];
+namespace {
+
+// Four comma-separated numbers; `usage` says what they are in the error.
+Expected<std::array<double, 4>> ParseFourNumbers(std::string_view text, std::string_view what, std::string_view usage) {
+  std::array<double, 4> numbers;
   std::size_t start = 0;
   for (int k = 0; k < 4; ++k) {
     const std::size_t comma = k < 3 ? text.find(',', start) : text.size();
     if (comma == std::string_view::npos || (k == 3 && text.find(',', start) != std::string_view::npos)) {
-      return InvalidArgument(fmt::format("{}: '{}' is not LEFT,RIGHT,UP,DOWN in degrees (four numbers, e.g. "
-                                         "-50,45,48,-52)",
-                                         what, text));
+      return InvalidArgument(fmt::format("{}: '{}' is not {}", what, text, usage));
     }
-    DB_ASSIGN_OR_RETURN(angles[k], ParseNumber(text.substr(start, comma - start), what));
+    DB_ASSIGN_OR_RETURN(numbers[k], ParseNumber(text.substr(start, comma - start), what));
     start = comma + 1;
   }
+  return numbers;
+}
+
+}  // namespace
+
+Expected<EyeFov> ParseEyeFov(std::string_view text, std::string_view what) {
+  DB_ASSIGN_OR_RETURN(const auto angles,
+                      ParseFourNumbers(text, what, "LEFT,RIGHT,UP,DOWN in degrees (four numbers, e.g. -50,45,48,-52)"));
   const EyeFov fov{angles[0], angles[1], angles[2], angles[3]};
   DB_RETURN_IF_ERROR(CheckEyeFov(fov, what));
   return fov;
+}
+
+std::string ViewVolume::ToString() const { return fmt::format("{},{},{},{}", left, right, bottom, top); }
+
+Status CheckViewVolume(const ViewVolume& volume, std::string_view what) {
+  for (const double side : {volume.left, volume.right, volume.bottom, volume.top}) {
+    if (!(std::abs(side) <= kMostViewVolumeSide)) {
+      return InvalidArgument(fmt::format("{}: side {:g} is out of range; each side lies within [-{:g}, {:g}] view "
+                                         "units of the view axis",
+                                         what, side, kMostViewVolumeSide, kMostViewVolumeSide));
+    }
+  }
+  if (!(volume.right > volume.left) || !(volume.top > volume.bottom)) {
+    return InvalidArgument(fmt::format("{}: {} has no area: right must exceed left and top must exceed bottom", what,
+                                       volume.ToString()));
+  }
+  return Status::Ok();
+}
+
+Expected<ViewVolume> ParseViewVolume(std::string_view text, std::string_view what) {
+  DB_ASSIGN_OR_RETURN(
+      const auto sides,
+      ParseFourNumbers(text, what, "LEFT,RIGHT,BOTTOM,TOP in view units (four numbers, e.g. -50,50,-30,30)"));
+  const ViewVolume volume{sides[0], sides[1], sides[2], sides[3]};
+  DB_RETURN_IF_ERROR(CheckViewVolume(volume, what));
+  return volume;
 }
 
 std::string ResolutionName(Resolution resolution) { return fmt::format("{}x{}", resolution.width, resolution.height); }

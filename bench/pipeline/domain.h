@@ -114,6 +114,26 @@ struct EyeFov {
 // "LEFT,RIGHT,UP,DOWN" in degrees; `what` names the input in the error.
 Expected<EyeFov> ParseEyeFov(std::string_view text, std::string_view what);
 Status CheckEyeFov(const EyeFov& fov, std::string_view what);
+// An orthographic projection's view volume across the view axis: x from
+// left to right and y from bottom to top, in view-space units (world units:
+// the view is a rigid transform). Its depth range is the domain's near and
+// far.
+struct ViewVolume {
+  double left = 0.0;
+  double right = 0.0;
+  double bottom = 0.0;
+  double top = 0.0;
+  std::string ToString() const;  // "-50,50,-30,30"
+  bool OffAxis() const { return left != -right || bottom != -top; }
+  friend bool operator==(const ViewVolume&, const ViewVolume&) = default;
+};
+// "LEFT,RIGHT,BOTTOM,TOP" in view units; `what` names the input in the error.
+Expected<ViewVolume> ParseViewVolume(std::string_view text, std::string_view what);
+Status CheckViewVolume(const ViewVolume& volume, std::string_view what);
+// The largest side of a view volume, in view units: float32 world
+// coordinates hold 1e7 to about a metre's 1/1000 (2^-24 of it is 0.6).
+inline constexpr double kMostViewVolumeSide = 1e7;
+
 // The largest angle a side may make with the view axis, in degrees.
 inline constexpr double kMostEyeFovAngle = 89.0;
 // The largest TAA jitter, in pixels: jitter is sub-pixel, a few pixels
@@ -144,6 +164,10 @@ struct Domain {
   // An off-centre frustum (a VR eye, a projection matrix's), in place of
   // fov and aspect.
   std::optional<EyeFov> eye_fov;
+  // An orthographic projection (a directional light's shadow map, a CAD
+  // view), in place of fov and aspect: only the orthographic conventions'
+  // cells run, with a finite far plane.
+  std::optional<ViewVolume> orthographic;
   // TAA jitter: each frame's projection is shifted by an offset drawn
   // uniformly from [-jitter, jitter] pixels in x and in y, as temporal
   // anti-aliasing shifts it by a sub-pixel amount every frame.

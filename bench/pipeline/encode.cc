@@ -113,13 +113,24 @@ void Float32PipelineFloats(Encoding encoding, const double* a, const double* b, 
                            float* out) {
   const auto f = [](double x) { return static_cast<float>(x); };
   switch (Info(encoding.format).stores) {
-    case DepthInput::kHardware:
-      if ((Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u) {
+    case DepthInput::kHardware: {
+      const std::uint32_t bits = Info(encoding.convention).bits;
+      const bool gl = (bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u;
+      if ((bits & f32::DB_CONVENTION_ORTHOGRAPHIC) != 0u) {
+        // glm::ortho's clip z, -B * view.z + A with view.z = -z (the sign
+        // flips exactly), and w = 1: no divide.
+        if (!gl) {
+          for (std::size_t i = 0; i < n; ++i) out[i] = f(b[i]) * f(z[i]) + f(a[i]);
+        } else {
+          for (std::size_t i = 0; i < n; ++i) out[i] = (f(b[i]) * f(z[i]) + f(a[i])) * 0.5f + 0.5f;
+        }
+      } else if (!gl) {
         for (std::size_t i = 0; i < n; ++i) out[i] = (f(a[i]) * f(z[i]) + f(b[i])) / f(z[i]);
       } else {
         for (std::size_t i = 0; i < n; ++i) out[i] = (f(a[i]) * f(z[i]) + f(b[i])) / f(z[i]) * 0.5f + 0.5f;
       }
       return;
+    }
     case DepthInput::kLinear:
       for (std::size_t i = 0; i < n; ++i) out[i] = f(z[i]) / f(a[i]);
       return;
@@ -366,7 +377,9 @@ namespace {
         return hp4::eye_depth_from_window_depth(wide(near), wide(far), bits, wide(value), DD(1.0) - wide(value));
       }
       const DD ndc = (bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) == 0u ? wide(value) : wide(value) * DD(2.0) - DD(1.0);
-      return wide(b) / (ndc - wide(a));  // the difference of two floats is exact in double-double
+      // (The difference of two floats is exact in double-double.)
+      if ((bits & f32::DB_CONVENTION_ORTHOGRAPHIC) != 0u) return (ndc - wide(a)) / wide(b);
+      return wide(b) / (ndc - wide(a));
     }
     case DepthInput::kLinear: return wide(value) * wide(model == ProductionModel::kExact ? far : a);
     case DepthInput::kViewZ: return -wide(value);

@@ -10,7 +10,8 @@
 //        shaders receive too (A and B of ndc = A + B / z, the far plane):
 //        z = float(eye depth); clip = A * z + B, ndc = clip / z (w = z),
 //        each operation rounded to float32; GL-style clip depth then the
-//        viewport transform 0.5 * ndc + 0.5 in float32;
+//        viewport transform 0.5 * ndc + 0.5 in float32; an orthographic
+//        convention's ndc = B * z + A (w = 1, no divide);
 //      kExact: the exact value correctly rounded (GL-style: exact NDC depth
 //        rounded, then the viewport transform in float32);
 //   3. the format converts that float: unorm round-to-nearest-even of
@@ -79,7 +80,8 @@ StoredDepth EncodeEdge(Encoding encoding, const Frame& frame, DepthPick pick);
 // denotes, in double-double: under kExact through the cancellation-free
 // decode of shared/depth_mapping.h (relative error below 2^-100;
 // tests/reference_test.cc checks it against MPFR), under kFloat32 as
-// B / (ndc - A) with the float constants. Zero or +infinity for values that
+// B / (ndc - A) with the float constants ((ndc - A) / B when orthographic).
+// Zero or +infinity for values that
 // denote the camera or infinity.
 DoubleDouble DecodeEyeDepth(Encoding encoding, ProductionModel model, const Frame& frame, float value);
 // The same for n values, four lanes at a time, as the two parts of each

@@ -12,16 +12,17 @@ namespace {
 // and for N SIMD lanes (Lanes<N>::Double), each lane computing exactly what
 // the scalar form does. The output minus the camera position is exact in
 // double (both are float32 values), so world-space magnitudes never enter
-// the error; both reference points lie on the pixel's ray.
+// the error; both reference points lie on the pixel's line, the offset
+// (0 unless the frame is orthographic) plus eye depth times the ray.
 template <class Real>
 struct ErrorLanes {
   Real total_sq, arith_sq, absolute_sq;
 };
 template <class Real>
-[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera, Real ray_x,
-                                                      Real ray_y, Real ray_z, Real true_depth, Real denoted_depth,
-                                                      Real inverse_distance_sq) {
-  const Real qx = px - camera.x, qy = py - camera.y, qz = pz - camera.z;
+[[gnu::always_inline]] inline ErrorLanes<Real> Errors(Real px, Real py, Real pz, const glm::dvec3& camera, Real ox,
+                                                      Real oy, Real oz, Real ray_x, Real ray_y, Real ray_z,
+                                                      Real true_depth, Real denoted_depth, Real inverse_distance_sq) {
+  const Real qx = (px - camera.x) - ox, qy = (py - camera.y) - oy, qz = (pz - camera.z) - oz;
   const Real tx = qx - true_depth * ray_x, ty = qy - true_depth * ray_y, tz = qz - true_depth * ray_z;
   const Real ax = qx - denoted_depth * ray_x, ay = qy - denoted_depth * ray_y, az = qz - denoted_depth * ray_z;
   const Real absolute_sq = tx * tx + ty * ty + tz * tz;
@@ -50,6 +51,7 @@ constexpr int kAbsolute = static_cast<int>(Metric::kAbsolute);
 struct RunInputs {
   const float *x, *y, *z;  // the cell's output components
   const double *ray_x, *ray_y, *ray_z;
+  const double *offset_x, *offset_y, *offset_z;  // null when the frame is perspective (offset 0)
   const double *true_depth, *denoted_depth, *inverse_distance_sq;
   const std::uint8_t* joint_band;
   const ReferenceStatus* status;
@@ -57,8 +59,9 @@ struct RunInputs {
   const Coverage* coverage;
 };
 
-// Pass 1: errors and bins of a run of samples, N at a time.
-template <int N>
+// Pass 1: errors and bins of a run of samples, N at a time; kOffset: the
+// samples have offsets (an orthographic frame's).
+template <int N, bool kOffset>
 [[gnu::always_inline]] inline void Measure(const RunInputs& in, const glm::dvec3& camera, std::uint32_t n,
                                            RunScratch& s) {
   using D = typename Lanes<N>::Double;
@@ -80,9 +83,11 @@ template <int N>
       std::memcpy(&d, p + i, sizeof(d));
       return d;
     };
+    const D zero{};
     const ErrorLanes<D> e =
-        Errors(wide(in.x), wide(in.y), wide(in.z), camera, load(in.ray_x), load(in.ray_y), load(in.ray_z),
-               load(in.true_depth), load(in.denoted_depth), load(in.inverse_distance_sq));
+        Errors(wide(in.x), wide(in.y), wide(in.z), camera, kOffset ? load(in.offset_x) : zero,
+               kOffset ? load(in.offset_y) : zero, kOffset ? load(in.offset_z) : zero, load(in.ray_x), load(in.ray_y),
+               load(in.ray_z), load(in.true_depth), load(in.denoted_depth), load(in.inverse_distance_sq));
     store(&s.total[i], e.total_sq);
     store(&s.arith[i], e.arith_sq);
     store(&s.absolute[i], e.absolute_sq);
@@ -91,9 +96,10 @@ template <int N>
     store(&s.absolute_bin[i], bins(e.absolute_sq, kAbsolute));
   }
   for (; i < n; ++i) {  // the tail of a batch that ends inside a frame
-    const ErrorLanes<double> e =
-        Errors<double>(in.x[i], in.y[i], in.z[i], camera, in.ray_x[i], in.ray_y[i], in.ray_z[i], in.true_depth[i],
-                       in.denoted_depth[i], in.inverse_distance_sq[i]);
+    const ErrorLanes<double> e = Errors<double>(
+        in.x[i], in.y[i], in.z[i], camera, kOffset ? in.offset_x[i] : 0.0, kOffset ? in.offset_y[i] : 0.0,
+        kOffset ? in.offset_z[i] : 0.0, in.ray_x[i], in.ray_y[i], in.ray_z[i], in.true_depth[i], in.denoted_depth[i],
+        in.inverse_distance_sq[i]);
     s.total[i] = e.total_sq;
     s.arith[i] = e.arith_sq;
     s.absolute[i] = e.absolute_sq;
@@ -180,10 +186,11 @@ template <class Run>
 
 }  // namespace
 
-SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm::dvec3& camera,
-                      const float* position) {
-  const ErrorLanes<double> e = Errors<double>(position[0], position[1], position[2], camera, ray.x, ray.y, ray.z,
-                                              r.true_depth, r.denoted_depth, r.inverse_distance_sq);
+SampleErrors ErrorsOf(const ReferenceSample& r, const glm::dvec3& ray, const glm::dvec3& offset,
+                      const glm::dvec3& camera, const float* position) {
+  const ErrorLanes<double> e =
+      Errors<double>(position[0], position[1], position[2], camera, offset.x, offset.y, offset.z, ray.x, ray.y, ray.z,
+                     r.true_depth, r.denoted_depth, r.inverse_distance_sq);
   return {e.total_sq, e.arith_sq, e.absolute_sq};
 }
 
@@ -195,6 +202,7 @@ template <int N>
   const std::uint32_t count = batch.count;
   const std::size_t offset = static_cast<std::size_t>(depth_slot) * count;
   const ReferenceArrays& ref = batch.reference;
+  const bool offsets = !batch.offset_x.empty();
   RunScratch scratch;
   // A few frames at a time: their reference stays in cache while every
   // cell reads it, and each cell records them in one go, while the lines
@@ -214,6 +222,9 @@ template <int N>
                                batch.ray_x.data() + begin,
                                batch.ray_y.data() + begin,
                                batch.ray_z.data() + begin,
+                               offsets ? batch.offset_x.data() + begin : nullptr,
+                               offsets ? batch.offset_y.data() + begin : nullptr,
+                               offsets ? batch.offset_z.data() + begin : nullptr,
                                ref.true_depth.data() + at,
                                ref.denoted_depth.data() + at,
                                ref.inverse_distance_sq.data() + at,
@@ -222,7 +233,11 @@ template <int N>
                                ref.stored_holdable.data() + at,
                                batch.samples.coverage.data() + begin};
             const std::uint32_t n = end - begin;
-            Measure<N>(in, batch.frames[frame].camera_position, n, scratch);
+            if (offsets) {
+              Measure<N, true>(in, batch.frames[frame].camera_position, n, scratch);
+            } else {
+              Measure<N, false>(in, batch.frames[frame].camera_position, n, scratch);
+            }
             CellAccumulator& accumulator = *cell.accumulator;
             CellAccumulator::Slot& distance = accumulator.Distance(batch.distance_bands[frame]);
             if (accumulator.records_distances()) {

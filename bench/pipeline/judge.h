@@ -31,13 +31,14 @@ void RecordEncodingErrors(const Batch& batch, std::uint32_t depth_slot, CellAccu
                           Isa isa = Isa::kWidest);
 
 // The squared errors of one output (for reproducers and tests): relative
-// total, relative arithmetic, absolute total.
+// total, relative arithmetic, absolute total. `offset` is the sample's
+// point at eye depth 0 (Batch::Offset; 0 unless orthographic).
 struct SampleErrors {
   double total_sq = 0.0;
   double arith_sq = 0.0;
   double absolute_sq = 0.0;
 };
-SampleErrors ErrorsOf(const ReferenceSample& reference, const glm::dvec3& ray, const glm::dvec3& camera,
-                      const float* position);
+SampleErrors ErrorsOf(const ReferenceSample& reference, const glm::dvec3& ray, const glm::dvec3& offset,
+                      const glm::dvec3& camera, const float* position);
 
 }  // namespace depthbench

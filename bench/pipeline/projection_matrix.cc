@@ -55,9 +55,13 @@ Status DepthPlanes(double a, double b, bool orthographic, ProjectionFacts& facts
   const double infinite_depth = reversed ? 0.0 : 1.0;  // the window depth an infinite far plane stores
   facts.near = eye_at(reversed ? 1.0 : 0.0);
   facts.far = !orthographic && a == infinite_depth ? INFINITY : eye_at(reversed ? 0.0 : 1.0);
-  facts.convention = ConventionWithBits((reversed ? catalog::kRev : 0u) | (std::isinf(facts.far) ? catalog::kInf : 0u));
+  facts.convention = ConventionWithBits((reversed ? catalog::kRev : 0u) | (std::isinf(facts.far) ? catalog::kInf : 0u) |
+                                        (orthographic ? catalog::kOrtho : 0u));
   if (!(facts.near > 0.0) || !std::isfinite(facts.near)) {
-    return Refuse(fmt::format("its near plane lies at eye depth {:g}, not in front of the eye", facts.near));
+    return Refuse(fmt::format("its near plane lies at eye depth {:g}, not in front of the eye{}", facts.near,
+                              orthographic ? " (eye depths are drawn log-uniformly from near: move the view's origin "
+                                             "back until near is positive)"
+                                           : ""));
   }
   if (!(facts.far > facts.near)) {
     return Refuse(fmt::format("its far plane (eye depth {:g}) is not beyond its near plane ({:g}): depth never "
@@ -189,22 +193,23 @@ std::vector<std::string> ProjectionFacts::Describe() const {
                                 (left + right) / 2.0, (bottom + top) / 2.0,
                                 orthographic ? "view units" : "at unit eye depth"));
   } else {
-    lines.push_back("symmetric frustum");
+    lines.push_back(orthographic ? "view volume centred on the view axis" : "symmetric frustum");
   }
   if (y_flipped) lines.push_back("y flipped in clip space (as Vulkan engines flip it): mirrors the image, no precision change");
   return lines;
 }
 
 Status ApplyProjection(const ProjectionFacts& facts, Domain& domain) {
-  if (facts.orthographic) {
-    return Refuse("it is orthographic; depthbench's depth conventions and variants are perspective ones, so an "
-                  "orthographic projection (a directional light's shadow map, a CAD orthographic view) cannot be "
-                  "measured yet");
-  }
   domain.near = {facts.near, facts.near};
   domain.finite_far = std::isfinite(facts.far);
   domain.infinite_far = !domain.finite_far;
   if (domain.finite_far) domain.far = Range{facts.far, facts.far};
+  if (facts.orthographic) {
+    domain.eye_fov.reset();
+    domain.orthographic = ViewVolume{facts.left, facts.right, facts.bottom, facts.top};
+    return CheckViewVolume(*domain.orthographic, "projection matrix");
+  }
+  domain.orthographic.reset();
   domain.eye_fov = EyeFov{Degrees(facts.left), Degrees(facts.right), Degrees(facts.top), Degrees(facts.bottom)};
   return CheckEyeFov(*domain.eye_fov, "projection matrix");
 }
@@ -239,8 +244,8 @@ std::string ApiRecipe(Convention c) {
   if (!info.hardware) return "any API: a shader writes eye depth / far (or view z) to a colour target";
   const bool reversed = (info.bits & catalog::kRev) != 0u, infinite = (info.bits & catalog::kInf) != 0u;
   const std::string projection =
-      fmt::format("a projection that maps near to {}{}", reversed ? "1 and far to 0" : "0 and far to 1",
-                  infinite ? ", with its far plane at infinity" : "");
+      fmt::format("{} projection that maps near to {}{}", info.orthographic() ? "an orthographic" : "a",
+                  reversed ? "1 and far to 0" : "0 and far to 1", infinite ? ", with its far plane at infinity" : "");
   const std::string test = reversed ? ", depth test GREATER, depth cleared to 0" : ", depth test LESS, cleared to 1";
   if ((info.bits & catalog::kGl) != 0u) {
     return fmt::format("OpenGL without glClipControl (its default [-1, 1] clip depth), {}{}; Direct3D, Vulkan and "

@@ -66,9 +66,8 @@ Expected<ProjectionFacts> ReadProjectionMatrix(const ProjectionMatrix& matrix);
 
 // The domain the matrix fixes: its near and far planes (or an infinite
 // far), and its frustum as an eye field of view (which carries any
-// off-centre term, a TAA jitter baked into the matrix included). Refuses
-// what the bench cannot model yet (an orthographic projection), with the
-// reason.
+// off-centre term, a TAA jitter baked into the matrix included), or its
+// orthographic view volume.
 Status ApplyProjection(const ProjectionFacts& facts, Domain& domain);
 
 // "API:LAYOUT:N0,N1,...,N15" (the --projection flag), e.g.

@@ -46,7 +46,8 @@ void SampleArrays::Resize(std::size_t n, SampleFields fields) {
   eye_depth.resize(n);
   coverage.resize(n);
   const std::size_t rest = fields == SampleFields::kAll ? n : 0;
-  for (auto* v : {&near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq, &inverse_distance_sq}) {
+  for (auto* v : {&near, &far, &depth_limit, &interest_min, &interest_max, &ray_length_sq, &offset_length_sq,
+                  &inverse_distance_sq}) {
     v->resize(rest);
   }
   depth_band.resize(rest);
@@ -59,7 +60,8 @@ void SampleArrays::SetDrawn(std::size_t i, const Frame& frame, const PixelSample
   coverage[i] = sample.coverage;
 }
 
-void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray) {
+void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray,
+                       double offset_sq) {
   SetDrawn(i, frame, sample);
   const FramePlanes planes = PlanesOf(frame);
   near[i] = planes.near;
@@ -68,13 +70,18 @@ void SampleArrays::Set(std::size_t i, const Frame& frame, const PixelSample& sam
   interest_min[i] = planes.interest_min;
   interest_max[i] = planes.interest_max;
   ray_length_sq[i] = glm::dot(ray, ray);
-  inverse_distance_sq[i] = 1.0 / (eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
+  offset_length_sq[i] = offset_sq;
+  inverse_distance_sq[i] = 1.0 / (offset_sq + eye_depth[i] * eye_depth[i] * ray_length_sq[i]);
   depth_band[i] = static_cast<std::uint8_t>(DepthBand(eye_depth[i] / frame.near));
   ratio_band[i] = planes.ratio_band;
 }
 
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y) {
-  return draw::draw_pixel_ray(x, y, DrawFrameOf(frame));
+  return frame.orthographic ? -frame.rotation[2] : draw::draw_pixel_ray(x, y, DrawFrameOf(frame));
+}
+
+glm::dvec3 PixelOffset(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+  return frame.orthographic ? draw::draw_pixel_point(x, y, DrawFrameOf(frame), 0.0) : glm::dvec3(0.0);
 }
 
 namespace {
@@ -93,8 +100,8 @@ struct ReferenceLanes {
 template <class D, class I>
 [[gnu::always_inline]] inline ReferenceLanes<D, I> ReferenceOf(D eye_pick, D eye_depth, D denoted_hi, D produced_hi,
                                                                D near, D depth_limit, D interest_min, D interest_max,
-                                                               D ray_length_sq, D eye_inverse_distance_sq,
-                                                               bool infinite_far) {
+                                                               D ray_length_sq, D offset_length_sq,
+                                                               D eye_inverse_distance_sq, bool infinite_far) {
   const auto eye = eye_pick != 0.0;
   // Stored-value picks have no scene point of their own: the truth is what
   // the stored value denotes, and their storage and production errors are
@@ -108,7 +115,9 @@ template <class D, class I>
   // A point float32 world coordinates cannot hold (an overflowing
   // reconstruction is then the right answer) is no more judged than one at
   // infinity.
-  const auto holdable = (t > 0.0) & (t * t * ray_length_sq < kLargestFloatSquared);
+  // (Squared distances from the camera: the offset is 0 unless the frame
+  // is orthographic, and adding it then changes no bit.)
+  const auto holdable = (t > 0.0) & (offset_length_sq + t * t * ray_length_sq < kLargestFloatSquared);
   const D limit = infinite_far ? zero + INFINITY : depth_limit;
   const D far = interest_max < limit ? interest_max : limit;    // std::min(limit, interest_max)
   const D nearest = near < interest_min ? interest_min : near;  // std::max(near, interest_min)
@@ -118,16 +127,16 @@ template <class D, class I>
   const I outside_status = I{} + static_cast<std::int64_t>(ReferenceStatus::kOutside);
   out.status = holdable ? (outside ? outside_status : judged) : degenerate;
   const D s = denoted_hi;
-  const auto stored_holdable = (s > 0.0) & (s * s * ray_length_sq < kLargestFloatSquared);
+  const auto stored_holdable = (s > 0.0) & (offset_length_sq + s * s * ray_length_sq < kLargestFloatSquared);
   out.stored_holdable = stored_holdable ? I{} + 1 : I{};
-  const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (t * t * ray_length_sq);
+  const D inverse = eye ? eye_inverse_distance_sq : 1.0 / (offset_length_sq + t * t * ray_length_sq);
   out.inverse_distance_sq = out.status == judged ? inverse : zero;
-  // Both points lie on the same ray, so the relative error of the
-  // position is the relative error of the depth. The differences need no
+  // Both points lie on the pixel's line, so the error of the position is
+  // the error of the depth times the ray's length. The differences need no
   // more than double: an error below 2^-53 of the depth reads as 0 bits
   // lost, and two equal decodes (a float format's texel is the pipeline's
   // float) differ by exactly 0.
-  const D scale = out.inverse_distance_sq * ray_length_sq;  // 1 / t^2 where judged
+  const D scale = out.inverse_distance_sq * ray_length_sq;  // 1 / t^2 where judged (perspective)
   const D storage = denoted_hi - produced, production = produced - t;
   out.storage_square = storage * storage * scale;
   out.production_square = production * production * scale;
@@ -146,6 +155,7 @@ template <class D, class I>
                *depth_limit = samples.depth_limit.data() + first, *interest_min = samples.interest_min.data() + first,
                *interest_max = samples.interest_max.data() + first,
                *ray_length_sq = samples.ray_length_sq.data() + first,
+               *offset_length_sq = samples.offset_length_sq.data() + first,
                *eye_inverse_distance_sq = samples.inverse_distance_sq.data() + first;
   double *true_depth = out.true_depth.data() + out_first, *denoted_depth = out.denoted_depth.data() + out_first,
          *inverse_distance_sq = out.inverse_distance_sq.data() + out_first,
@@ -171,7 +181,8 @@ template <class D, class I>
     for (int lane = 0; lane < 4; ++lane) eye_pick[lane] = pick[k + lane] == DepthPick::kEyeDepth;
     const ReferenceLanes<Double4, Int4> lanes = ReferenceOf<Double4, Int4>(
         eye_pick, load(eye_depth), load(denoted_hi), load(produced_hi), load(near), load(depth_limit),
-        load(interest_min), load(interest_max), load(ray_length_sq), load(eye_inverse_distance_sq), infinite_far);
+        load(interest_min), load(interest_max), load(ray_length_sq), load(offset_length_sq),
+        load(eye_inverse_distance_sq), infinite_far);
     store(k, lanes, [](double* to, Double4 v) { std::memcpy(to, &v, sizeof(v)); });
     for (int lane = 0; lane < 4; ++lane) {
       status[k + lane] = static_cast<ReferenceStatus>(lanes.status[lane]);
@@ -181,7 +192,8 @@ template <class D, class I>
   for (; k < n; ++k) {  // the tail
     const ReferenceLanes<double, std::int64_t> one = ReferenceOf<double, std::int64_t>(
         pick[k] == DepthPick::kEyeDepth, eye_depth[k], denoted_hi[k], produced_hi[k], near[k], depth_limit[k],
-        interest_min[k], interest_max[k], ray_length_sq[k], eye_inverse_distance_sq[k], infinite_far);
+        interest_min[k], interest_max[k], ray_length_sq[k], offset_length_sq[k], eye_inverse_distance_sq[k],
+        infinite_far);
     store(k, one, [](double* to, double v) { *to = v; });
     status[k] = static_cast<ReferenceStatus>(one.status);
     stored_holdable[k] = static_cast<std::uint8_t>(one.stored_holdable != 0);

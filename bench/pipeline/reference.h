@@ -3,9 +3,12 @@
 // denotes (stored), the last two under the pipeline's own mapping
 // (encode.h).
 //
-// Both points lie on the pixel's ray through the camera, so the reference
-// keeps, per sample, the world-space ray at unit eye depth, and per
-// (encoding, sample) two eye depths: the true one and the denoted one.
+// Both points lie on the pixel's line: its ray through the camera, or in an
+// orthographic frame the line along the view axis through the pixel's
+// point at eye depth 0 (its offset). So the reference keeps, per sample, the
+// world-space direction per unit of eye depth (the ray) and the offset's
+// squared length (0 for a ray), and per (encoding, sample) two eye depths:
+// the true one and the denoted one.
 // The ray runs in long double (the ld:: instantiation of shared/: pixel
 // centre and NDC) and the decode in double-double (hp4::, the
 // cancellation-free depth mapping), so every figure is accurate to 2^-60 or
@@ -84,23 +87,32 @@ struct SampleArrays {
   std::vector<double> depth_limit;                 // the frame's largest eye depth
   std::vector<double> interest_min, interest_max;  // eye depths the domain is about (near..inf when unrestricted)
   std::vector<double> ray_length_sq;               // |PixelRay|^2
-  std::vector<double> inverse_distance_sq;         // 1 / (eye depth * |ray|)^2, for eye-depth picks
+  std::vector<double> offset_length_sq;            // |PixelOffset|^2 (0 in a perspective frame)
+  std::vector<double> inverse_distance_sq;         // 1 / (|offset|^2 + (eye depth * |ray|)^2), for eye-depth picks
   std::vector<std::uint8_t> depth_band;            // of the eye depth, for eye-depth picks
   std::vector<std::uint8_t> ratio_band;            // the frame's far/near band
   std::vector<Coverage> coverage;                  // natural, or the coverage kind (bands.h)
 
   // Sizes the arrays `fields` fills to n samples, the others to none.
   void Resize(std::size_t n, SampleFields fields = SampleFields::kAll);
-  // Fills entry i for a sample of `frame` whose ray is `ray`: every field,
-  // or what was drawn only.
-  void Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray);
+  // Fills entry i for a sample of `frame` whose ray is `ray` (and whose
+  // offset has squared length `offset_length_sq`): every field, or what was
+  // drawn only.
+  void Set(std::size_t i, const Frame& frame, const PixelSample& sample, const glm::dvec3& ray,
+           double offset_length_sq = 0.0);
   void SetDrawn(std::size_t i, const Frame& frame, const PixelSample& sample);
 };
 
 // The world-space ray through pixel (x, y)'s centre at unit eye depth,
 // R * (ndc.x * tan_x, ndc.y * tan_y, -1), in float64 as a device draws it
-// too (shared/draw.h's draw_pixel_ray).
+// too (shared/draw.h's draw_pixel_ray); in an orthographic frame, the view
+// axis -R[2], the same for every pixel.
 glm::dvec3 PixelRay(const Frame& frame, std::uint32_t x, std::uint32_t y);
+// The camera-relative world point of the pixel at eye depth 0: 0 in a
+// perspective frame; R * (ndc.x * half width + centre x, ndc.y * half
+// height + centre y, 0) in an orthographic one. The pixel's scene point at
+// eye depth z is camera + PixelOffset + z * PixelRay.
+glm::dvec3 PixelOffset(const Frame& frame, std::uint32_t x, std::uint32_t y);
 
 // The references of samples [first, first + n) under an encoding whose
 // stored values denote eye depths `denoted` and whose pipeline floats

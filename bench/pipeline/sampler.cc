@@ -101,7 +101,7 @@ PixelSample Sampler::SampleAt(std::uint64_t index, const Frame& frame) const {
 }
 
 void CompleteFrame(Frame& f, const std::optional<Range>& eye_depth) {
-  f.tan_half_fov_y = std::tan(f.fov_y_degrees * std::numbers::pi / 360.0);
+  if (!f.orthographic) f.tan_half_fov_y = std::tan(f.fov_y_degrees * std::numbers::pi / 360.0);
   f.depth_limit = f.finite() ? f.far : f.near * Domain::kInfiniteDepthSpan;
   f.eye_depth_min = f.near;
   f.eye_depth_max = f.depth_limit;
@@ -116,7 +116,14 @@ void CompleteFrame(Frame& f, const std::optional<Range>& eye_depth) {
 Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_index) {
   Frame f;
   f.index = frame_index;
-  if (d.eye_fov) {
+  if (d.orthographic) {
+    const ViewVolume& v = *d.orthographic;
+    f.orthographic = true;
+    f.tan_half_fov_y = (v.top - v.bottom) / 2.0;
+    f.aspect = (v.right - v.left) / (v.top - v.bottom);
+    f.centre_x = (v.right + v.left) / 2.0;
+    f.centre_y = (v.top + v.bottom) / 2.0;
+  } else if (d.eye_fov) {
     // The frustum's half extents and centre, in tangents at unit depth.
     const double half_x = (d.eye_fov->TanRight() - d.eye_fov->TanLeft()) / 2.0;
     const double half_y = (d.eye_fov->TanUp() - d.eye_fov->TanDown()) / 2.0;

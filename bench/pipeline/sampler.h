@@ -26,6 +26,12 @@ inline constexpr std::uint32_t kSamplesPerFrame = 64;
 // constants computed from them (shader_constants.h).
 struct Frame {
   std::uint64_t index = 0;
+  // An orthographic frame: tan_half_fov_y and aspect * tan_half_fov_y are
+  // then the view volume's half height and half width in view units (the
+  // half extents at every depth, where a perspective lens gives them at
+  // unit eye depth), centre_x and centre_y its centre's offset, and
+  // fov_y_degrees is 0.
+  bool orthographic = false;
   double fov_y_degrees = 0.0;
   double tan_half_fov_y = 0.0;  // the exact lens parameter (tan computed once, then taken as exact)
   double aspect = 0.0;

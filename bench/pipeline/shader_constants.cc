@@ -119,6 +119,7 @@ Params FrameParamsIn(const FrameValues<RealOf<Params>>& frame) {
   const Real cx = frame.centre_x, cy = frame.centre_y;
   p.lens_centre = Vec4(cx, cy, cx * p.lens.z, cy * p.lens.w);
   p.resolution = Vec4(frame.width, frame.height, Real(1.0) / frame.width, Real(1.0) / frame.height);
+  p.clip_planes = Vec4(frame.near, far, Real(0.0), Real(0.0));
 
   // View-space point of the pixel ray at eye depth `depth` (a centred lens
   // adds zeros, which changes no bit).
@@ -173,6 +174,25 @@ DepthParams DepthParamsIn(RealOf<FrameParams> near, RealOf<FrameParams> far, con
   // entry equals the full product's, at a fifth of the cost (this runs for
   // every frame and convention). tests/constants_test.cc holds them equal.
   const glm::mat<4, 4, Real>& cw = f.camera_world;
+  if ((convention & f32::DB_CONVENTION_ORTHOGRAPHIC) != 0u) {
+    // view = (ndc.x * hw + cx, ndc.y * hh + cy, -(P * ndc_z + Q)) with the
+    // half extents (hw, hh) in `lens` xy and w = 1: the inverse projection's
+    // columns are (hw, 0, 0, 0), (0, hh, 0, 0), (0, 0, -P, 0), (cx, cy, -Q,
+    // 1). The same sparse products as below.
+    d.inverse_view_projection[0] = cw[0] * f.lens.x;
+    d.inverse_view_projection[1] = cw[1] * f.lens.y;
+    d.inverse_view_projection[2] = cw[2] * -d.coefficients.z;
+    d.inverse_view_projection[3] =
+        cw[0] * f.lens_centre.x + cw[1] * f.lens_centre.y + cw[2] * -d.coefficients.w + cw[3];
+    // The projection: columns (H, 0, 0, 0), (0, V, 0, 0), (0, 0, -B, 0),
+    // (-cx H, -cy V, A, 1), times the view.
+    for (int c = 0; c < 4; ++c) {
+      const Vec4& v = f.world_view[c];
+      d.view_projection[c] = Vec4(f.lens.z * v.x - f.lens_centre.z * v.w, f.lens.w * v.y - f.lens_centre.w * v.w,
+                                  -b * v.z + a * v.w, v.w);
+    }
+    return d;
+  }
   d.inverse_view_projection[0] = cw[0] * f.lens.x;  // 1/H = tan_x
   d.inverse_view_projection[1] = cw[1] * f.lens.y;  // 1/V = tan_y
   d.inverse_view_projection[2] = cw[3] * d.coefficients.z;
@@ -212,6 +232,7 @@ void ForEachFrameParamsMember(Visit visit) {
   visit([](auto& p) -> auto& { return p.eye_ray_world_du; });
   visit([](auto& p) -> auto& { return p.eye_ray_world_dv; });
   visit([](auto& p) -> auto& { return p.world_view; });
+  visit([](auto& p) -> auto& { return p.clip_planes; });
 }
 // The same for DepthParams; its uints are copied.
 template <class Visit>
@@ -256,10 +277,19 @@ void RoundLanes(const hp4::DepthParams& p, Out out) {
   }
 }
 
-bool HasConstants(const Frame& frame, Convention convention) {
+// The convention bits of a frame's DepthParams slot: the perspective
+// convention numbered `slot`, or its orthographic namesake in an
+// orthographic frame.
+std::uint32_t SlotBits(const Frame& frame, int slot) {
+  return static_cast<std::uint32_t>(slot) | (frame.orthographic ? f32::DB_CONVENTION_ORTHOGRAPHIC : 0u);
+}
+
+bool HasConstants(const Frame& frame, std::uint32_t bits) {
   // Conventions with a finite far plane have no constants on frames that
-  // have none (infinite-only domains).
-  return frame.finite() || (Info(convention).bits & f32::DB_CONVENTION_INFINITE) != 0u;
+  // have none (infinite-only domains); an orthographic frame has no
+  // infinite far plane.
+  const bool infinite = (bits & f32::DB_CONVENTION_INFINITE) != 0u;
+  return frame.orthographic ? !infinite : frame.finite() || infinite;
 }
 
 // BuildShaderConstants under kExact for four frames at once, frames[k] in
@@ -271,15 +301,17 @@ void BuildExactConstants4(const std::array<const Frame*, 4>& frames, f32::FrameP
   const hp4::FrameParams exact = FrameParamsIn<hp4::FrameParams>(values);
   RoundLanes(exact, [&](int k) -> f32::FrameParams& { return frame_params[k]; });
   for (int c = 0; c < kHardwareConventionCount; ++c) {
-    const auto convention = static_cast<Convention>(c);
+    // (The four frames are all perspective or all orthographic: the
+    // caller checks.)
+    const std::uint32_t bits = SlotBits(*frames[0], c);
     auto out = [&](int k) -> f32::DepthParams& { return depth_params[k * kHardwareConventionCount + c]; };
     // Lanes of frames without this convention's constants compute with far
     // 0, which no other lane sees, and are then zeroed as one frame's are.
     bool any = false;
-    for (int k = 0; k < 4; ++k) any = any || HasConstants(*frames[k], convention);
-    if (any) RoundLanes(DepthParamsIn<hp4::DepthParams>(values.near, values.far, exact, Info(convention).bits), out);
+    for (int k = 0; k < 4; ++k) any = any || HasConstants(*frames[k], bits);
+    if (any) RoundLanes(DepthParamsIn<hp4::DepthParams>(values.near, values.far, exact, bits), out);
     for (int k = 0; k < 4; ++k) {
-      if (!HasConstants(*frames[k], convention)) out(k) = f32::DepthParams{};
+      if (!HasConstants(*frames[k], bits)) out(k) = f32::DepthParams{};
     }
   }
 }
@@ -291,6 +323,14 @@ hp::FrameParams BuildFrameParams(const Frame& frame) { return FrameParamsIn<hp::
 hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
   return DepthParamsIn<hp::DepthParams>(DD(frame.near), frame.finite() ? DD(frame.far) : DD(0.0), f,
                                         Info(convention).bits);
+}
+
+Convention SlotConvention(const Frame& frame, int slot) {
+  const std::uint32_t bits = SlotBits(frame, slot);
+  for (const ConventionInfo& c : AllConventions()) {
+    if (c.hardware && c.bits == bits) return c.id;
+  }
+  return static_cast<Convention>(slot);  // an orthographic frame's infinite slots: never built
 }
 
 f32::FrameParams RoundToFloat(const hp::FrameParams& p) {
@@ -330,6 +370,16 @@ glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention) {
   glm::mat4 projection(0.0f);
   projection[0][0] = 1.0f / tan_x;
   projection[1][1] = 1.0f / tan_y;
+  if (Info(convention).orthographic()) {
+    // glm::ortho's layout with the convention's depth row: clip z = -B *
+    // view.z + A, w = 1; tan_x and tan_y are the half extents.
+    projection[3][0] = -static_cast<float>(frame.centre_x) * projection[0][0];
+    projection[3][1] = -static_cast<float>(frame.centre_y) * projection[1][1];
+    projection[2][2] = -ab.y;
+    projection[3][2] = ab.x;
+    projection[3][3] = 1.0f;
+    return projection;
+  }
   projection[2][0] = static_cast<float>(frame.centre_x) * projection[0][0];
   projection[2][1] = static_cast<float>(frame.centre_y) * projection[1][1];
   projection[2][2] = -ab.x;
@@ -346,7 +396,9 @@ f32::FrameParams EngineFrameParams(const Frame& frame) {
 
 f32::DepthParams EngineDepthParams(const Frame& frame, Convention convention) {
   const glm::mat4 projection = EngineProjectionMatrix(frame, convention);
-  const float a = -projection[2][2], b = projection[3][2];
+  const bool orthographic = Info(convention).orthographic();
+  const float a = orthographic ? projection[3][2] : -projection[2][2];
+  const float b = orthographic ? -projection[2][2] : projection[3][2];
   f32::DepthParams d;
   d.view_projection = projection * EngineViewMatrix(frame);
   d.inverse_view_projection = glm::inverse(d.view_projection);
@@ -362,8 +414,8 @@ void BuildShaderConstants(const Frame& frame, ConstantsModel model, f32::FramePa
   const hp::FrameParams exact_params = exact ? BuildFrameParams(frame) : hp::FrameParams{};
   frame_params = exact ? RoundToFloat(exact_params) : EngineFrameParams(frame);
   for (int c = 0; c < kHardwareConventionCount; ++c) {
-    const auto convention = static_cast<Convention>(c);
-    depth_params[c] = !HasConstants(frame, convention) ? f32::DepthParams{}
+    const Convention convention = SlotConvention(frame, c);
+    depth_params[c] = !HasConstants(frame, SlotBits(frame, c)) ? f32::DepthParams{}
                       : exact                          ? RoundToFloat(BuildDepthParams(frame, exact_params, convention))
                                                        : EngineDepthParams(frame, convention);
   }
@@ -376,7 +428,11 @@ void BuildShaderConstants(std::span<const Frame> frames, ConstantsModel model, s
     const std::size_t lanes = std::min(kLanes, frames.size() - first);
     f32::FrameParams* frame_out = frame_params.data() + first;
     f32::DepthParams* depth_out = depth_params.data() + first * kHardwareConventionCount;
-    if (model != ConstantsModel::kExact) {
+    // The four-lane arithmetic takes one convention per slot: the frames of
+    // a group must be all perspective or all orthographic (a domain's are).
+    const bool one_kind = std::all_of(frames.begin() + first, frames.begin() + first + lanes,
+                                      [&](const Frame& f) { return f.orthographic == frames[first].orthographic; });
+    if (model != ConstantsModel::kExact || !one_kind) {
       for (std::size_t k = 0; k < lanes; ++k) {
         BuildShaderConstants(frames[first + k], model, frame_out[k],
                              std::span<f32::DepthParams, kHardwareConventionCount>(

@@ -32,7 +32,8 @@ f32::DepthParams RoundToFloat(const hp::DepthParams& params);
 
 // The float32 path: the engine's view and projection matrices (right-handed
 // view looking down -Z; the projection maps view z to clip depth
-// A * z + B over w = z, so ndc = A + B / z), and the constants an engine
+// A * z + B over w = z, so ndc = A + B / z; glm::ortho's for an
+// orthographic convention, ndc = A + B * z at w = 1), and the constants an engine
 // derives from them.
 glm::mat4 EngineViewMatrix(const Frame& frame);
 glm::mat4 EngineProjectionMatrix(const Frame& frame, Convention convention);

@@ -76,7 +76,7 @@ Expected<std::vector<CpuCost>> MeasureCpuCosts(std::span<const Cell> cells, cons
     return InvalidArgument("CPU timing needs at least one sample and one repetition");
   }
   for (const Cell& cell : cells) {
-    if (!Reads(cell.variant_info().input, cell.convention, cell.format)) {
+    if (!Reads(cell.variant_info(), cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention; no CPU path to time",
                                          cell.variant_info().name, Info(cell.format).name, Info(cell.convention).name));
     }

@@ -287,7 +287,7 @@ Expected<std::vector<PassTiming>> GpuPassTimer::TimePasses(std::span<const Varia
   if (!loaded_) return InvalidArgument("no depth image is loaded: LoadImage first");
   if (variants.empty()) return InvalidArgument("no variant to time");
   for (const VariantInfo& variant : variants) {
-    if (!Reads(variant.input, encoding_.convention, encoding_.format)) {
+    if (!Reads(variant, encoding_.convention, encoding_.format)) {
       return InvalidArgument(
           fmt::format("{} does not read {} under the {} convention (see 'depthbench list'); "
                       "such a pass is not timed",

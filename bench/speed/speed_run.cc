@@ -35,7 +35,7 @@ Status ValidateSpeedOptions(const SpeedOptions& o) {
   }
   if (o.cpu.repetitions < 3) return ViolatedConstraint("CpuCostOptions::repetitions >= 3");
   for (const Cell& cell : o.cells) {
-    if (!Reads(cell.variant_info().input, cell.convention, cell.format)) {
+    if (!Reads(cell.variant_info(), cell.convention, cell.format)) {
       return InvalidArgument(fmt::format("{} does not read {} under the {} convention: no such pass to time",
                                          cell.variant_info().name, Info(cell.format).name, Info(cell.convention).name));
     }

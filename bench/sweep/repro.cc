@@ -109,7 +109,7 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
       for (int k = 0; k < 3; ++k) o.position[k] = outputs[b][c * 3 + k];  // one sample: components are adjacent
       o.nan = std::isnan(o.position[0]) || std::isnan(o.position[1]) || std::isnan(o.position[2]);
       o.inf = !o.nan && !(std::isfinite(o.position[0]) && std::isfinite(o.position[1]) && std::isfinite(o.position[2]));
-      const SampleErrors e = ErrorsOf(r, batch.Ray(0), frame.camera_position, o.position);
+      const SampleErrors e = ErrorsOf(r, batch.Ray(0), batch.Offset(0), frame.camera_position, o.position);
       o.total = std::sqrt(e.total_sq);
       o.arith = std::sqrt(e.arith_sq);
       o.absolute = std::sqrt(e.absolute_sq);

@@ -213,6 +213,9 @@ std::vector<Cell> CellsForDomain(std::span<const Cell> cells, const Domain& doma
     if (needs_finite && !domain.finite_far) continue;
     if (needs_infinite && !domain.infinite_far) continue;
     if (c.hardware && domain.depth_convention && *domain.depth_convention != c.id) continue;
+    // An orthographic domain runs the orthographic conventions' cells, a
+    // perspective one the others.
+    if (c.orthographic() != domain.orthographic.has_value()) continue;
     out.push_back(cell);
   }
   return out;
@@ -235,7 +238,7 @@ Expected<Results> RunSweep(const SweepOptions& requested, std::span<Backend* con
     return InvalidArgument(
         "none of the selected cells can run in this domain (finite-far conventions and linear formats need "
         "a finite far plane; infinite-far conventions need --ratio to allow inf; a projection matrix runs its own "
-        "convention only)");
+        "convention only; an orthographic domain runs the ortho-* conventions only)");
   }
   const RunLayout layout = MakeRunLayout(cells);
   for (Backend* backend : backends) {

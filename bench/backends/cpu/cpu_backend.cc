@@ -127,6 +127,7 @@ CellRunner RunnerFor(Variant v) {
     case Variant::kDivide: return RunCell<f32x8::divide_world_position>;
     case Variant::kReciprocal: return RunCell<f32x8::reciprocal_world_position>;
     case Variant::kPq: return RunCell<f32x8::pq_world_position>;
+    case Variant::kOrthoLerp: return RunCell<f32x8::ortho_lerp_world_position>;
     default: break;
   }
   return nullptr;
