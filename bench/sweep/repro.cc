@@ -70,11 +70,16 @@ Expected<Repro> ReproduceFrom(const SampleSource& sampler, std::uint64_t index, 
 
   Repro repro;
   repro.index = index;
+  const std::string lens =
+      frame.orthographic
+          ? fmt::format("orthographic, half extents {:.9g} x {:.9g}", frame.aspect * frame.tan_half_fov_y,
+                        frame.tan_half_fov_y)
+          : fmt::format("fov {:.9g} deg, aspect {:.9g}", frame.fov_y_degrees, frame.aspect);
   repro.frame = fmt::format(
-      "frame {}: fov {:.9g} deg, aspect {:.9g}, near {:.9g}, far {:.9g} (far/near {:.4g}), camera ({:.9g}, {:.9g}, "
-      "{:.9g}) at {:.4g} from the origin, render target {}x{}",
-      frame.index, frame.fov_y_degrees, frame.aspect, frame.near, frame.far, frame.ratio(), frame.camera_position.x,
-      frame.camera_position.y, frame.camera_position.z, frame.camera_distance(), frame.width, frame.height);
+      "frame {}: {}, near {:.9g}, far {:.9g} (far/near {:.4g}), camera ({:.9g}, {:.9g}, {:.9g}) at {:.4g} from the "
+      "origin, render target {}x{}",
+      frame.index, lens, frame.near, frame.far, frame.ratio(), frame.camera_position.x, frame.camera_position.y,
+      frame.camera_position.z, frame.camera_distance(), frame.width, frame.height);
   if (frame.centre_x != 0.0 || frame.centre_y != 0.0) {
     repro.frame += fmt::format(", lens centre ({:.9g}, {:.9g})", frame.centre_x, frame.centre_y);
   }
