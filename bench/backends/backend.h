@@ -42,6 +42,10 @@ inline PassKind PassKindOf(ProductionModel production) {
 struct RenderedDepths {
   std::span<const std::uint32_t> codes;
   std::span<const float> fetched;
+  // 1 where the rasterizer wrote the sample's texel, 0 where it left it as
+  // cleared (a sample with geometry whose triangle was clipped or failed
+  // the depth test), laid out as codes; empty when every texel was written.
+  std::span<const std::uint8_t> drawn;
 };
 
 class Backend {

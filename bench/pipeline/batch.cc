@@ -319,7 +319,7 @@ void BatchBuilder::ReferenceChunk(Batch& batch, std::size_t slot, std::size_t lo
 }
 
 void BatchBuilder::AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes, std::span<const float> fetched,
-                                     ThreadPool& pool) const {
+                                     std::span<const std::uint8_t> drawn, ThreadPool& pool) const {
   const std::size_t count = batch.count, slots = encodings_.size();
   for (std::size_t s = 0; s < slots; ++s) {
     for (std::size_t i = 0; i < count; ++i) {
@@ -332,7 +332,14 @@ void BatchBuilder::AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t
   pool.ParallelFor(slots * chunks, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t lo = (job % chunks) * kChunk;
-      ReferenceChunk(batch, job / chunks, lo, std::min<std::size_t>(count - lo, kChunk));
+      const std::size_t slot = job / chunks, n = std::min<std::size_t>(count - lo, kChunk);
+      ReferenceChunk(batch, slot, lo, n);
+      // A texel the rasterizer left as cleared holds no depth of the
+      // sample's: not judged, and counted apart.
+      if (drawn.empty()) continue;
+      for (std::size_t i = lo; i < lo + n; ++i) {
+        if (drawn[slot * count + i] == 0) batch.reference.status[slot * count + i] = ReferenceStatus::kUndrawn;
+      }
     }
   });
 }

@@ -96,9 +96,11 @@ class BatchBuilder {
   // fetched floats, [depth slot * count + sample]) and computes their
   // references again. The production part stays the host's model's, so the
   // storage part then holds the device's own rounding and interpolation.
-  // `batch` must be the last one Build filled.
+  // `batch` must be the last one Build filled. Where `drawn` (laid out as
+  // codes; empty: all) is 0 the rasterizer left the texel as cleared, and
+  // the sample is not judged in that slot (ReferenceStatus::kUndrawn).
   void AdoptStoredDepths(Batch& batch, std::span<const std::uint32_t> codes, std::span<const float> fetched,
-                         ThreadPool& pool) const;
+                         std::span<const std::uint8_t> drawn, ThreadPool& pool) const;
 
  private:
   static constexpr std::size_t kChunk = 1024;  // samples per job of the encode and reference loops

@@ -150,6 +150,8 @@ template <bool kDistances>
       const auto count = [&](CellAccumulator::Slot & slot) __attribute__((always_inline)) {
         if (in.status[i] == ReferenceStatus::kDegenerate) {
           ++slot.degenerate;
+        } else if (in.status[i] == ReferenceStatus::kUndrawn) {
+          ++slot.undrawn;
         } else if (in.status[i] == ReferenceStatus::kOutside) {
           // Outside the frustum or the range of depths asked for: not
           // judged, whatever the output (a texel beyond the far plane may

@@ -68,9 +68,9 @@ RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample)
 struct RasterAgreement {
   Encoding encoding{};
   std::uint64_t texels = 0;             // samples with geometry
-  std::uint64_t differing = 0;          // whose texel bits differ from the model's code
-  std::uint64_t uncovered = 0;          // that the device left uncovered (nothing written)
-  std::uint32_t max_code_distance = 0;  // the largest |device code - model code| (ulps for float formats)
+  std::uint64_t differing = 0;          // drawn, and whose texel bits differ from the model's code
+  std::uint64_t uncovered = 0;          // that the device left uncovered (nothing written): not judged
+  std::uint32_t max_code_distance = 0;  // the largest |device code - model code| over drawn texels (ulps for floats)
 
   // Adds the counts of another part of the same sweep (a shard).
   void Merge(const RasterAgreement& other);

@@ -37,6 +37,8 @@ enum class ReferenceStatus : std::uint8_t {
   kOutside,     // a finite point outside the frustum (nearer than near,
                 // beyond a finite far plane) or outside the domain's eye-depth
                 // range of interest: only NaN/Inf outputs count
+  kUndrawn,     // the raster form's rasterizer left the sample's texel
+                // unwritten: nothing of the sample's to judge
 };
 
 // The reference of one (encoding, sample).

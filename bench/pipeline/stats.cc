@@ -170,6 +170,7 @@ void BandStats::MergeCounts(const BandStats& other) {
   stored_nonfinite += other.stored_nonfinite;
   degenerate += other.degenerate;
   outside += other.outside;
+  undrawn += other.undrawn;
   first_nonfinite_index = std::min(first_nonfinite_index, other.first_nonfinite_index);
 }
 
@@ -281,6 +282,7 @@ void CellAccumulator::FlushInto(CellStats& out) {
     add.stored_nonfinite = slot.stored_nonfinite;
     add.degenerate = slot.degenerate;
     add.outside = slot.outside;
+    add.undrawn = slot.undrawn;
     add.first_nonfinite_index = slot.nan + slot.inf > 0 ? slot.first_nonfinite_index : kNone;
     for (int m = 0; m < kMetricCount; ++m) {
       MetricStats& ms = add.metrics[m];

@@ -154,6 +154,10 @@ struct BandStats {
   std::uint64_t stored_nonfinite = 0;
   std::uint64_t degenerate = 0;  // reference at the camera or at infinity: not judged
   std::uint64_t outside = 0;     // outside the frustum or the depths asked for: not judged
+  // The raster form's rasterizer left the sample's texel unwritten (its
+  // triangle was clipped or failed the depth test): what the texel holds is
+  // the clear value, not a depth of the sample's, so it is not judged.
+  std::uint64_t undrawn = 0;
   std::uint64_t first_nonfinite_index = std::numeric_limits<std::uint64_t>::max();
   std::array<MetricStats, kMetricCount> metrics;
 
@@ -223,7 +227,7 @@ class CellAccumulator {
     std::array<std::uint64_t, kMetricCount> worst_index;
     // (Finite samples are not counted here: every one lands in a bin of the
     // total error, and the flush counts them from there.)
-    std::uint64_t nan, inf, stored_nonfinite, degenerate, outside;
+    std::uint64_t nan, inf, stored_nonfinite, degenerate, outside, undrawn;
     std::uint64_t first_nonfinite_index;
 
     // One value (squared) of one metric, in dense bin `bin`. Samples come

@@ -171,6 +171,10 @@ const JsonFields<BandStats>& BandCountFields() {
       JsonMember("stored_nonfinite", &BandStats::stored_nonfinite),
       JsonMember("degenerate", &BandStats::degenerate),
       JsonMember("outside", &BandStats::outside),
+      // Only the raster form has undrawn samples: written where there are
+      // some, and 0 where a file has none.
+      JsonOnlyIf(JsonMemberOr("undrawn", &BandStats::undrawn, JsonDefaultCodec<std::uint64_t>::type{}, 0),
+                 [](const BandStats& band) { return band.undrawn != 0; }),
       JsonMember("first_nonfinite_index", &BandStats::first_nonfinite_index, JsonIndexOrNull()),
   }};
   return fields;
@@ -455,7 +459,8 @@ Status CheckHistograms(const Results& results, const std::string& source) {
                              band_name(key));
         };
         std::uint64_t counted = 0;
-        for (std::uint64_t n : {band.finite, band.nan, band.inf, band.stored_nonfinite, band.degenerate, band.outside}) {
+        for (std::uint64_t n :
+             {band.finite, band.nan, band.inf, band.stored_nonfinite, band.degenerate, band.outside, band.undrawn}) {
           if (__builtin_add_overflow(counted, n, &counted)) {
             return InvalidArgument(fmt::format("{}: its counts add up past 2^64", where()));
           }
@@ -494,7 +499,7 @@ bool AddsWithinRange(const CellStats& a, const CellStats& b) {
       const BandStats& held = it->second;
       if (!fits(held.finite, band.finite) || !fits(held.nan, band.nan) || !fits(held.inf, band.inf) ||
           !fits(held.stored_nonfinite, band.stored_nonfinite) || !fits(held.degenerate, band.degenerate) ||
-          !fits(held.outside, band.outside)) {
+          !fits(held.outside, band.outside) || !fits(held.undrawn, band.undrawn)) {
         return false;
       }
       for (int m = 0; m < kMetricCount; ++m) {

@@ -180,7 +180,8 @@ void PrintRasterAgreement(const Results& results, std::ostream& out) {
       out << fmt::format("  {}/{}: {} of {} differ ({:.3g}%), at most {}{}\n", Info(a.encoding.convention).name,
                          Info(a.encoding.format).name, a.differing, a.texels,
                          a.texels == 0 ? 0.0 : 100.0 * static_cast<double>(a.differing) / static_cast<double>(a.texels),
-                         a.max_code_distance, a.uncovered == 0 ? "" : fmt::format("; {} left uncovered", a.uncovered));
+                         a.max_code_distance,
+                         a.uncovered == 0 ? "" : fmt::format("; {} left uncovered, not judged", a.uncovered));
     }
   }
 }

@@ -20,6 +20,7 @@ const char* StatusName(ReferenceStatus s) {
     case ReferenceStatus::kJudged: return "judged";
     case ReferenceStatus::kDegenerate: return "degenerate (the point is the camera or at infinity)";
     case ReferenceStatus::kOutside: return "outside the frustum (only NaN/Inf count)";
+    case ReferenceStatus::kUndrawn: return "undrawn (the rasterizer left the texel as cleared; not judged)";
   }
   return "?";
 }

@@ -199,7 +199,7 @@ Backend* DepthRenderer(ProductionModel production, std::span<Backend* const> bac
 Status AdoptRenderedDepths(Backend& renderer, const BatchBuilder& builder, Batch& batch, ThreadPool& pool) {
   auto rendered = renderer.RenderDepths(batch);
   if (!rendered.ok()) return rendered.status().WithContext("rendering depths on the " + renderer.name() + " backend");
-  builder.AdoptStoredDepths(batch, rendered->codes, rendered->fetched, pool);
+  builder.AdoptStoredDepths(batch, rendered->codes, rendered->fetched, rendered->drawn, pool);
   return Status::Ok();
 }
 

@@ -558,7 +558,7 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
     }
   }
   rendered_ = RenderedBatch{batch.first_index, batch.count};
-  return RenderedDepths{texels_, fetched_};
+  return RenderedDepths{texels_, fetched_, texel_drawn_};
 }
 
 Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
@@ -727,6 +727,7 @@ void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std:
 void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn) {
   const std::size_t count = batch.count;
   texels_.assign(slots_.size() * count, 0);
+  texel_drawn_.assign(slots_.size() * count, 1);
   std::copy_n(batch.codes.begin(), std::min(texels_.size(), batch.codes.size()), texels_.begin());
   const auto* readback = static_cast<const std::byte*>(readback_.mapped());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
@@ -742,8 +743,14 @@ void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool
       const std::uint32_t device = CodeOf(format, texels + i * bytes);
       texels_[s * count + i] = device;
       ++agreement.texels;
+      // An uncovered texel holds the clear value: it is counted apart,
+      // neither judged nor compared with the model.
+      if (coverage[i] == std::byte{0}) {
+        ++agreement.uncovered;
+        texel_drawn_[s * count + i] = 0;
+        continue;
+      }
       agreement.differing += device != host ? 1 : 0;
-      agreement.uncovered += coverage[i] == std::byte{0} ? 1 : 0;
       agreement.max_code_distance = std::max(agreement.max_code_distance, CodeDistance(format, device, host));
     }
   }

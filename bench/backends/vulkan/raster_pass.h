@@ -142,6 +142,7 @@ class RasterPass {
   std::vector<RasterAgreement> agreement_;
   std::vector<std::uint32_t> texels_;
   std::vector<float> fetched_;
+  std::vector<std::uint8_t> texel_drawn_;  // RenderedDepths::drawn of the last Render
 };
 
 }  // namespace depthbench
