@@ -157,7 +157,7 @@ void CheckWholeNumbers(CLI::App& app) {
 // --variant-file, of every subcommand that runs variants: once the command
 // line is parsed, the files make the catalogue the command runs with.
 void AddVariantFileOption(CLI::App& app, std::vector<std::string>& files) {
-  for (const char* name : {"list", "run", "fit", "gate", "choose", "speed", "report"}) {
+  for (const char* name : {"list", "run", "fit", "gate", "choose", "speed", "report", "bound"}) {
     app.get_subcommand(name)
         ->add_option("--variant-file", files,
                      "a reconstruction function of your own, in GLSL (.glsl) or HLSL (.hlsl), run as one more "
@@ -223,6 +223,7 @@ std::unique_ptr<CLI::App> MakeDepthbenchApp(CommandLine& line) {
   AddChooseCommand(*app, line.action);
   AddReportCommand(*app, line.action);
   AddFuzzCommand(*app, line.action);
+  AddBoundCommand(*app, line.action);
   AddVariantFileOption(*app, line.variant_files);
   NameOptionTypes(*app);
   DescribeStandardOutput(*app);

@@ -35,5 +35,6 @@ void AddFitCommand(CLI::App& app, CommandAction& action);
 void AddChooseCommand(CLI::App& app, CommandAction& action);
 void AddFuzzCommand(CLI::App& app, CommandAction& action);
 void AddReportCommand(CLI::App& app, CommandAction& action);
+void AddBoundCommand(CLI::App& app, CommandAction& action);
 
 }  // namespace depthbench::cli

@@ -14,6 +14,9 @@
 //                    DoubleDouble lanes: the reference's decode of stored
 //                    depths, four samples at a time, and the exact shader
 //                    constants of four frames at once.
+//   depthbench::iv   the parameter blocks and the depth mapping in
+//                    interval arithmetic: enclosures of the exact shader
+//                    constants over a box of frames (bench/bound/).
 // The third compilation is GLSL (shaders/, through glslang at run time).
 #pragma once
 
@@ -23,6 +26,7 @@
 
 #include "bench/base/simd.h"
 #include "bench/numerics/double_double.h"
+#include "bench/numerics/enclosure.h"
 #include "shared/compat.h"
 
 // Formulas take parameters they do not all use (one signature for all
@@ -83,6 +87,19 @@ using mat4 = glm::mat<4, 4, DoubleDouble4>;
 #include "shared/depth_mapping.h"
 // clang-format on
 }  // namespace depthbench::hp4
+
+namespace depthbench::iv {
+using real = Enclosure;
+using uint = std::uint32_t;
+using vec2 = glm::vec<2, Enclosure>;
+using vec3 = glm::vec<3, Enclosure>;
+using vec4 = glm::vec<4, Enclosure>;
+using mat4 = glm::mat<4, 4, Enclosure>;
+// clang-format off
+#include "shared/params.h"
+#include "shared/depth_mapping.h"
+// clang-format on
+}  // namespace depthbench::iv
 
 #pragma GCC diagnostic pop
 

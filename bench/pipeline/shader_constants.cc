@@ -17,16 +17,6 @@ using DD4 = DoubleDouble4;
 template <class Params>
 using RealOf = typename decltype(Params::lens)::value_type;
 
-// The frame parameters the formulas read, converted to `Real`. The far
-// plane is 0 where a frame has none, as FrameParams.camera_position.w
-// reads.
-template <class Real>
-struct FrameValues {
-  Real tan_half_fov_y, aspect, centre_x, centre_y, near, far, volume_depth, width, height;
-  glm::vec<3, Real> camera_position;
-  glm::mat<3, 3, Real> rotation;
-};
-
 // The one list of those parameters: lift(get) is the Real that holds
 // get(frame) of the frame, or of each lane's frame.
 template <class Real, class Lift>
@@ -146,6 +136,9 @@ hp::vec2 NdcDepthCoefficients(DD near, DD far, std::uint32_t convention) {
 }
 hp4::vec2 NdcDepthCoefficients(DD4 near, DD4 far, std::uint32_t convention) {
   return hp4::ndc_depth_coefficients(near, far, convention);
+}
+iv::vec2 NdcDepthCoefficients(Enclosure near, Enclosure far, std::uint32_t convention) {
+  return iv::ndc_depth_coefficients(near, far, convention);
 }
 
 // DepthParams (hp:: or hp4::) of `convention` from the frame's near and far
@@ -319,6 +312,60 @@ void BuildExactConstants4(const std::array<const Frame*, 4>& frames, f32::FrameP
 }  // namespace
 
 hp::FrameParams BuildFrameParams(const Frame& frame) { return FrameParamsIn<hp::FrameParams>(ValuesOf<DD>(frame)); }
+
+namespace {
+
+// The far plane enters every constant monotonically, for fixed values of
+// the other parameters: linearly in FrameParams (the frustum rays, the
+// planes), through A, B, P and Q in DepthParams, each monotone in far
+// (depth_mapping.h), and the inverse view-projection is linear in P and
+// Q. So the enclosure over a range of far planes is the hull of the
+// enclosures at its two ends, where evaluating the formulas over the range
+// itself would not do: interval arithmetic takes the far in f / (f - n)
+// as two independent ranges, and A would straddle 1 for any useful range.
+template <class Params, class Each, class Make>
+Params HullAtFarEnds(const FrameValues<Enclosure>& box, Each each_member, Make make) {
+  FrameValues<Enclosure> at = box;
+  at.far = Enclosure(box.far.lo);
+  Params hull = make(at);
+  at.far = Enclosure(box.far.hi);
+  const Params high = make(at);
+  each_member([&](auto member) {
+    auto& h = member(hull);
+    const auto& other = member(const_cast<Params&>(high));
+    using Member = std::remove_cvref_t<decltype(h)>;
+    if constexpr (std::is_same_v<Member, iv::mat4>) {
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) h[c][r] = Enclosure::Hull(h[c][r], other[c][r]);
+      }
+    } else {
+      for (int k = 0; k < 4; ++k) h[k] = Enclosure::Hull(h[k], other[k]);
+    }
+  });
+  return hull;
+}
+
+}  // namespace
+
+iv::FrameParams EncloseFrameParams(const FrameValues<Enclosure>& box) {
+  return HullAtFarEnds<iv::FrameParams>(box, [](auto visit) { ForEachFrameParamsMember(visit); },
+                                        [](const FrameValues<Enclosure>& at) { return FrameParamsIn<iv::FrameParams>(at); });
+}
+
+iv::DepthParams EncloseDepthParams(const FrameValues<Enclosure>& box, Convention convention) {
+  const std::uint32_t bits = Info(convention).bits;
+  iv::DepthParams d = HullAtFarEnds<iv::DepthParams>(
+      box, [](auto visit) { ForEachDepthParamsMember(visit); },
+      [&](const FrameValues<Enclosure>& at) {
+        return DepthParamsIn<iv::DepthParams>(at.near, at.far, FrameParamsIn<iv::FrameParams>(at), bits);
+      });
+  // The view-projection's entries mix A and B with opposite signs, which
+  // need not be monotone in far: not enclosed (only the raster form reads it).
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) d.view_projection[c][r] = Enclosure::Whole();
+  }
+  return d;
+}
 
 hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& f, Convention convention) {
   return DepthParamsIn<hp::DepthParams>(DD(frame.near), frame.finite() ? DD(frame.far) : DD(0.0), f,

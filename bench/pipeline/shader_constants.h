@@ -22,10 +22,25 @@
 
 namespace depthbench {
 
+// The frame parameters the constant formulas read, in one arithmetic. The
+// far plane is 0 where a frame has none, as FrameParams.camera_position.w
+// reads.
+template <class Real>
+struct FrameValues {
+  Real tan_half_fov_y, aspect, centre_x, centre_y, near, far, volume_depth, width, height;
+  glm::vec<3, Real> camera_position;
+  glm::mat<3, 3, Real> rotation;
+};
+
 hp::FrameParams BuildFrameParams(const Frame& frame);
 // Only for the projective conventions (Info(c).hardware); `frame_params` is
 // BuildFrameParams(frame).
 hp::DepthParams BuildDepthParams(const Frame& frame, const hp::FrameParams& frame_params, Convention convention);
+
+// The same formulas over a box of frames: every field encloses the exact
+// constant of every frame whose parameters lie in `box` (bench/bound/).
+iv::FrameParams EncloseFrameParams(const FrameValues<Enclosure>& box);
+iv::DepthParams EncloseDepthParams(const FrameValues<Enclosure>& box, Convention convention);
 
 f32::FrameParams RoundToFloat(const hp::FrameParams& params);
 f32::DepthParams RoundToFloat(const hp::DepthParams& params);

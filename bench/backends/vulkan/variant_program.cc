@@ -45,7 +45,7 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
   if (user == nullptr) {
     text += include(dir / "common.glsl");
     text += include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
-    text += fmt::format("#define RECONSTRUCT {}\n", VariantFunctionName(variant));
+    text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   } else {
     text += fmt::format(
         "#define DB_USER_ENTRY {}\n#define DB_USER_UV_BOTTOM_LEFT {}\n#define DB_USER_VIEW_LEFT_HANDED {}\n",
@@ -53,7 +53,7 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
     text += include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
     text += include(dir / "user" / "contract.inc");
     text += include(user->path);
-    text += "#define RECONSTRUCT db_user_world_position\n";
+    text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   }
   switch (pass) {
     case VariantPass::kAccuracy: text += include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
@@ -71,6 +71,10 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
 
 std::string VariantFunctionName(const VariantInfo& variant) {
   return variant.user != nullptr ? variant.user->entry : std::string(variant.name) + "_world_position";
+}
+
+std::string ReconstructFunctionName(const VariantInfo& variant) {
+  return variant.user != nullptr ? "db_user_world_position" : VariantFunctionName(variant);
 }
 
 std::string VariantProgramName(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& shader_dir) {

@@ -35,6 +35,9 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
 // The function of the program that holds the variant's arithmetic (what a
 // static cost model counts): <name>_world_position, or the user's entry.
 std::string VariantFunctionName(const VariantInfo& variant);
+// What the passes call as RECONSTRUCT(frame, depth, uv, stored): the
+// variant's function, or for a user's the contract's wrapper around it.
+std::string ReconstructFunctionName(const VariantInfo& variant);
 
 // What compile messages call the program: its path, or for a generated
 // one "<NAME's accuracy program>" (speed, raster).

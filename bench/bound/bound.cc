@@ -1,0 +1,506 @@
+#include "bench/bound/bound.h"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <queue>
+
+#include <fmt/format.h>
+
+#include "bench/backends/vulkan/variant_program.h"
+#include "bench/bound/spirv_eval.h"
+#include "bench/pipeline/shader_constants.h"
+
+namespace depthbench::bound {
+
+double BoundBits(double relative_error) {
+  if (!(relative_error > 0.0)) return 0.0;
+  return std::max(0.0, std::log2(relative_error) + 24.0);
+}
+
+namespace {
+
+constexpr double kU = kUnitRoundoff;
+constexpr double kPi = std::numbers::pi;
+
+// The dimensions of a box. Lengths are in units of the near plane.
+enum Dim : int {
+  kLogRatio,   // log of far / near
+  kDepth,      // t: the true eye depth is ratio^t (so 1 to far)
+  kPixelX,     // pixel column, whole numbers
+  kPixelY,     // pixel row
+  kFov,        // vertical field of view, degrees
+  kLogAspect,  // log of width / height
+  kYaw,        // the camera's rotation as Z-Y-X Euler angles, radians
+  kPitch,
+  kRoll,
+  kDistance,     // the camera's distance from the world origin, in near planes
+  kVolumeDepth,  // t: the light volume's surface lies at eye depth ratio^t
+  kDims,
+};
+
+struct Box {
+  std::array<Enclosure, kDims> d;
+  std::uint32_t width = 0, height = 0;  // the render target
+  double shader = 0.0;                  // the box's figures (relative errors)
+  double depth = 0.0;
+  std::string why;             // why `shader` is infinite
+  int last_split = kDims - 1;  // the dimension split to make this box
+  double total() const { return shader + depth; }
+  // What the refinement lowers: the shader part's bound, or the whole's.
+  bool refine_total = false;
+  double figure() const { return refine_total ? total() : shader; }
+  friend bool operator<(const Box& a, const Box& b) { return a.figure() < b.figure(); }
+};
+
+Enclosure Exp(const Enclosure& x) { return Enclosure::Outward(std::exp(x.lo), std::exp(x.hi)); }
+
+// cos over an interval of angles: the endpoints' values, and 1 or -1 where
+// the interval holds a multiple of 2 pi or an odd multiple of pi.
+Enclosure Cos(const Enclosure& a) {
+  if (a.width() >= 2.0 * kPi) return {-1.0, 1.0};
+  const double c0 = std::cos(a.lo), c1 = std::cos(a.hi);
+  double lo = std::min(c0, c1), hi = std::max(c0, c1);
+  auto holds = [&](double phase) { return phase + 2.0 * kPi * std::ceil((a.lo - phase) / (2.0 * kPi)) <= a.hi; };
+  if (holds(0.0)) hi = 1.0;
+  if (holds(kPi)) lo = -1.0;
+  return {std::max(-1.0, lo - 1e-15), std::min(1.0, hi + 1e-15)};
+}
+Enclosure Sin(const Enclosure& a) { return Cos(a - Enclosure(kPi / 2.0)); }
+
+// The camera's rotation (columns: its axes in world space) over the box's angles.
+glm::mat<3, 3, Enclosure> Rotation(const Box& box) {
+  const Enclosure cy = Cos(box.d[kYaw]), sy = Sin(box.d[kYaw]);
+  const Enclosure cp = Cos(box.d[kPitch]), sp = Sin(box.d[kPitch]);
+  const Enclosure cr = Cos(box.d[kRoll]), sr = Sin(box.d[kRoll]);
+  auto clamp = [](const Enclosure& x) { return Enclosure(std::max(-1.0, x.lo), std::min(1.0, x.hi)); };
+  glm::mat<3, 3, Enclosure> r;
+  r[0][0] = clamp(cy * cp);
+  r[1][0] = clamp(cy * sp * sr - sy * cr);
+  r[2][0] = clamp(cy * sp * cr + sy * sr);
+  r[0][1] = clamp(sy * cp);
+  r[1][1] = clamp(sy * sp * sr + cy * cr);
+  r[2][1] = clamp(sy * sp * cr - cy * sr);
+  r[0][2] = clamp(-sp);
+  r[1][2] = clamp(cp * sr);
+  r[2][2] = clamp(cp * cr);
+  return r;
+}
+
+// An input lane: the exact constant lies in `x` widened by `widen` u of
+// its magnitude; the float32 value the shader receives is within `error` u
+// of it. A point that float32 holds exactly arrives exactly.
+Lane Input(const Enclosure& x, double widen, double error) {
+  if (x.lo == x.hi && static_cast<double>(static_cast<float>(x.lo)) == x.lo && widen == 0.0) return Lane::Exact(x);
+  const double w = widen * kU * x.mag();
+  return {Enclosure::Outward(x.lo - w, x.hi + w), error * kU * x.mag() + kUnderflow};
+}
+Value Inputs(const iv::vec4& v, double widen, double error, int exact_lanes = 0) {
+  std::vector<Value> parts;
+  for (int k = 0; k < 4; ++k)
+    parts.push_back(Value::Float(k < exact_lanes ? Lane::Exact(v[k]) : Input(v[k], widen, error)));
+  return Value::Composite(std::move(parts));
+}
+Value Inputs(const iv::mat4& m, double widen, double error) {
+  std::vector<Value> columns;
+  for (int c = 0; c < 4; ++c) columns.push_back(Inputs(m[c], widen, error));
+  return Value::Composite(std::move(columns));
+}
+
+// FrameParams as the shader receives them, members in declaration order
+// (shared/params.h). Every constant is the exact one rounded once to float32
+// (ConstantsModel::kExact), except where the reference itself reads a
+// float32 value: the camera position (the sampler's is float32) and the
+// far plane (the linear formats' reference decodes with the float far
+// plane, so the frustum rays, which scale with the exact far plane, are a
+// further ulp from what it denotes).
+Value FrameInputs(const iv::FrameParams& f) {
+  std::vector<Value> m;
+  Value camera_world = Inputs(f.camera_world, 0, 1);
+  camera_world.parts[3] = Inputs(f.camera_world[3], 0, 0, 4);
+  m.push_back(std::move(camera_world));
+  Value camera_position = Inputs(f.camera_position, 0, 0, 3);
+  camera_position.parts[3] = Value::Float(Input(f.camera_position.w, 1, 0));
+  m.push_back(std::move(camera_position));
+  m.push_back(Inputs(f.lens, 0, 1));
+  m.push_back(Inputs(f.resolution, 0, 1));
+  for (const iv::vec4* ray : {&f.frustum_ray_origin, &f.frustum_ray_du, &f.frustum_ray_dv})
+    m.push_back(Inputs(*ray, 1, 2));
+  for (const iv::vec4* v :
+       {&f.volume_position_origin, &f.volume_position_du, &f.volume_position_dv, &f.eye_ray_view_origin,
+        &f.eye_ray_view_du, &f.eye_ray_view_dv, &f.eye_ray_world_origin, &f.eye_ray_world_du, &f.eye_ray_world_dv}) {
+    m.push_back(Inputs(*v, 0, 1));
+  }
+  m.push_back(Inputs(f.world_view, 0, 1));
+  m.push_back(Inputs(f.lens_centre, 0, 1));
+  Value clip_planes = Inputs(f.clip_planes, 0, 1);
+  clip_planes.parts[1] = Value::Float(Input(f.clip_planes.y, 1, 0));
+  m.push_back(std::move(clip_planes));
+  return Value::Composite(std::move(m));
+}
+
+// DepthParams as the shader receives them. The reference decodes with the
+// float32 A and B (encode.h), so those arrive exactly; P = 1/B, Q = -A/B
+// and the matrices are rounded from the exact frame's, up to two ulps from
+// what the float A and B give, plus their own rounding.
+Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention) {
+  std::vector<Value> m;
+  if (d != nullptr) {
+    m.push_back(Inputs(d->inverse_view_projection, 2, 3));
+    m.push_back(Inputs(d->view_projection, 2, 3));
+    Value coefficients = Inputs(d->coefficients, 2, 3);
+    coefficients.parts[0] = Value::Float(Input(d->coefficients.x, 1, 0));
+    coefficients.parts[1] = Value::Float(Input(d->coefficients.y, 1, 0));
+    m.push_back(std::move(coefficients));
+  } else {
+    // Not a projective convention: nothing here is the cell's to read.
+    m.resize(3);
+  }
+  m.push_back(Value::Integer(convention));
+  for (int k = 0; k < 3; ++k) m.push_back(Value::Integer(0));
+  return Value::Composite(std::move(m));
+}
+
+// The stored values a box's true eye depths may produce, and the depth
+// part's relative error bound.
+struct Stored {
+  Enclosure value;
+  double depth = 0.0;
+  std::string why;
+};
+
+// Production as the host models it (encode.h, kFloat32: each operation
+// correctly rounded), then the format's rounding and the fetch.
+// `linear` encloses z / far, which the caller knows tighter than the two
+// ranges' quotient.
+Stored StoredValues(Encoding encoding, const Lane& a, const Lane& b, const Enclosure& far, const Enclosure& z,
+                    const Enclosure& linear) {
+  const FormatInfo& format = Info(encoding.format);
+  const Lane zf{z, kU * z.mag() + kUnderflow};
+  // The format's rounding of a produced value of magnitude `mag`.
+  auto storage = [&](double mag) {
+    switch (format.texel) {
+      case TexelKind::kUnorm: return 0.5 / (std::ldexp(1.0, format.bits) - 1.0) + kU;
+      case TexelKind::kFloat16: return 0x1p-11 * mag + 0x1p-25;
+      case TexelKind::kFloat32: return 0.0;
+    }
+    return 0.0;
+  };
+  Stored out;
+  switch (format.stores) {
+    case DepthInput::kHardware: {
+      const bool gl = (Info(encoding.convention).bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
+      const Lane ndc = Divide(Add(Multiply(a, zf), b), zf, kExactlyRounded);
+      Enclosure exact = a.exact + b.exact / z;
+      double produced = ndc.error;
+      if (gl) {
+        const Lane window = Add(Multiply(Lane{exact, produced}, Lane::Exact(0.5)), Lane::Exact(0.5));
+        exact = exact * Enclosure(0.5) + Enclosure(0.5);
+        produced = window.error;
+      }
+      const double delta = produced + storage(exact.mag());
+      out.value = Enclosure(std::max(0.0, exact.lo - delta), std::min(1.0, exact.hi + delta));
+      // The true value's NDC depth less A is B / z; the stored value's lies
+      // within delta (2 delta in NDC for GL-style clip depth) of it. Where
+      // that may reach 0, the stored value may denote an infinite depth:
+      // such samples are not judged (an infinite far plane's A is 0 or 1,
+      // the stored values next to it are a step of the format away), so
+      // the step is the least distance left.
+      // (A finite far plane's stored values, in [0, 1], stay as far from A
+      // as 0 or 1 does: the second term.)
+      const double ndc_delta = (gl ? 2.0 : 1.0) * delta;
+      const Enclosure ndc_stored = gl ? out.value * Enclosure(2.0) - Enclosure(1.0) : out.value;
+      double gap = std::max((b.exact / z).mig() - ndc_delta, (ndc_stored - a.exact).mig());
+      if (!(gap > 0.0) && (Info(encoding.convention).bits & 2u) != 0u) {  // DB_CONVENTION_INFINITE
+        const double step = format.texel == TexelKind::kUnorm ? 1.0 / (std::ldexp(1.0, format.bits) - 1.0) : 0x1p-24;
+        gap = (gl ? 2.0 : 1.0) * step;
+      }
+      if (!(gap > 0.0)) {
+        out.why = "stored values that may denote an infinite depth";
+        out.depth = INFINITY;
+        return out;
+      }
+      out.depth = ndc_delta / gap;
+      return out;
+    }
+    case DepthInput::kLinear: {
+      const Lane v = Divide(zf, Lane::Exact(far), kExactlyRounded);
+      const Enclosure exact = linear;
+      const double delta = v.error + storage(exact.mag());
+      out.value = Enclosure(std::max(0.0, exact.lo - delta), exact.hi + delta);
+      out.depth = delta / exact.mig();
+      return out;
+    }
+    case DepthInput::kViewZ: {
+      const double delta = zf.error;
+      out.value = Enclosure(-z.hi - delta, -z.lo + delta);
+      out.depth = delta / z.lo;
+      return out;
+    }
+  }
+  return out;
+}
+
+// What a cell needs to evaluate its boxes.
+struct CellProgram {
+  const SpirvProgram* program = nullptr;
+  std::uint32_t uv_function = 0;
+  std::uint32_t reconstruct = 0;
+};
+
+class CellAnalysis {
+ public:
+  CellAnalysis(const Domain& domain, const Cell& cell, const CellProgram& program)
+      : domain_(domain), cell_(cell), program_(program), convention_(Info(cell.convention)) {}
+
+  // The box's shader and depth figures under `machine`.
+  void Evaluate(Box& box, const Machine& machine) const {
+    box.why.clear();
+    const Enclosure ratio = Exp(box.d[kLogRatio]);
+    // z = ratio^t and z / far = ratio^(t - 1), each from one product.
+    const Enclosure z = Exp(box.d[kDepth] * box.d[kLogRatio]);
+    const Enclosure linear = Exp((box.d[kDepth] - Enclosure(1.0)) * box.d[kLogRatio]);
+    FrameValues<Enclosure> v;
+    LensOf(box, v);
+    v.near = Enclosure(1.0);
+    v.far = domain_.finite_far ? ratio : Enclosure(0.0);
+    v.volume_depth = Exp(box.d[kVolumeDepth] * box.d[kLogRatio]);
+    v.width = Enclosure(box.width);
+    v.height = Enclosure(box.height);
+    const double reach = box.d[kDistance].hi;
+    for (int k = 0; k < 3; ++k) v.camera_position[k] = Enclosure(-reach, reach);
+    v.rotation = Rotation(box);
+
+    const iv::FrameParams frame = EncloseFrameParams(v);
+    iv::DepthParams depth{};
+    const bool hardware = convention_.hardware;
+    if (hardware) depth = EncloseDepthParams(v, cell_.convention);
+    const Value frame_value = FrameInputs(frame);
+    const Value depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits);
+
+    const Lane a = Input(depth.coefficients.x, 1, 0), b = Input(depth.coefficients.y, 1, 0);
+    const Stored stored = StoredValues(cell_.encoding(), a, b, Input(frame.camera_position.w, 1, 0).exact, z, linear);
+    box.depth = stored.depth;
+    if (!stored.why.empty()) return Fail(box, stored.why);
+
+    const Value pixel[3] = {Value::Float(Lane::Exact(box.d[kPixelX])), Value::Float(Lane::Exact(box.d[kPixelY])),
+                            frame_value.parts[3]};
+    Expected<Value> uv = program_.program->Evaluate(program_.uv_function, pixel, machine);
+    if (!uv.ok()) return Fail(box, uv.status().message());
+    const Value arguments[4] = {frame_value, depth_value, *uv, Value::Float(Lane::Exact(stored.value))};
+    Expected<Value> p = program_.program->Evaluate(program_.reconstruct, arguments, machine);
+    if (!p.ok()) return Fail(box, p.status().message());
+    if (p->kind != Value::Kind::kComposite || p->parts.size() != 3) return Fail(box, "an output that is not a vec3");
+    double sum = 0.0;
+    for (const Value& lane : p->parts) {
+      if (lane.kind != Value::Kind::kFloat) return Fail(box, "an output lane with no known float value");
+      sum += lane.lane.error * lane.lane.error;
+    }
+    // |true point - camera| = true eye depth * |the pixel's ray per unit eye depth|.
+    const Enclosure ndc_x = (box.d[kPixelX] + Enclosure(0.5)) * Enclosure(2.0) / v.width - Enclosure(1.0);
+    const Enclosure ndc_y = Enclosure(1.0) - (box.d[kPixelY] + Enclosure(0.5)) * Enclosure(2.0) / v.height;
+    const Enclosure ray_sq = Enclosure(1.0) + Square(ndc_x * frame.lens.x + frame.lens_centre.x) +
+                             Square(ndc_y * frame.lens.y + frame.lens_centre.y);
+    box.shader = std::sqrt(sum) / (z.lo * std::sqrt(ray_sq.lo)) * (1.0 + 1e-12);
+  }
+
+  // The whole domain's boxes: one per render target.
+  std::vector<Box> Roots() const {
+    std::vector<Box> roots;
+    for (const Resolution& r : domain_.resolutions) {
+      Box box;
+      const double ratio_lo = domain_.finite_far ? domain_.ratio.min : Domain::kInfiniteDepthSpan;
+      const double ratio_hi = domain_.finite_far ? domain_.ratio.max : Domain::kInfiniteDepthSpan;
+      box.d[kLogRatio] = Enclosure(std::log(ratio_lo), std::log(ratio_hi));
+      box.d[kDepth] = Enclosure(0.0, 1.0);
+      box.d[kPixelX] = Enclosure(0.0, r.width - 1.0);
+      box.d[kPixelY] = Enclosure(0.0, r.height - 1.0);
+      box.d[kFov] = Enclosure(domain_.fov_degrees.min, domain_.fov_degrees.max);
+      box.d[kLogAspect] = Enclosure(std::log(domain_.aspect.min), std::log(domain_.aspect.max));
+      box.d[kYaw] = Enclosure(-kPi, kPi);
+      box.d[kPitch] = Enclosure(-kPi / 2.0, kPi / 2.0);
+      box.d[kRoll] = Enclosure(-kPi, kPi);
+      box.d[kDistance] = Enclosure(0.0, domain_.camera_distance.max / domain_.near.min);
+      box.d[kVolumeDepth] = Enclosure(0.0, 1.0);
+      box.width = r.width;
+      box.height = r.height;
+      roots.push_back(box);
+    }
+    return roots;
+  }
+
+ private:
+  static void Fail(Box& box, std::string why) {
+    box.shader = INFINITY;
+    box.why = std::move(why);
+  }
+
+  // tan(fov/2), aspect and the lens centre of the box's frames.
+  void LensOf(const Box& box, FrameValues<Enclosure>& v) const {
+    if (domain_.eye_fov) {
+      const EyeFov& e = *domain_.eye_fov;
+      v.tan_half_fov_y = Enclosure((e.TanUp() - e.TanDown()) / 2.0);
+      v.aspect = Enclosure((e.TanRight() - e.TanLeft()) / 2.0) / v.tan_half_fov_y;
+      v.centre_x = Enclosure((e.TanRight() + e.TanLeft()) / 2.0);
+      v.centre_y = Enclosure((e.TanUp() + e.TanDown()) / 2.0);
+    } else {
+      const double to_half_radians = kPi / 360.0;
+      v.tan_half_fov_y =
+          Enclosure::Outward(std::tan(box.d[kFov].lo * to_half_radians), std::tan(box.d[kFov].hi * to_half_radians));
+      v.aspect = Exp(box.d[kLogAspect]);
+      v.centre_x = v.centre_y = Enclosure(0.0);
+    }
+    if (domain_.jitter > 0.0) {
+      // Up to `jitter` pixels: 2 jitter / width of the half width tan_x.
+      const Enclosure j(-domain_.jitter, domain_.jitter);
+      v.centre_x = v.centre_x + j * Enclosure(2.0) / Enclosure(box.width) * (v.aspect * v.tan_half_fov_y);
+      v.centre_y = v.centre_y + j * Enclosure(2.0) / Enclosure(box.height) * v.tan_half_fov_y;
+    }
+  }
+
+  const Domain& domain_;
+  const Cell& cell_;
+  const CellProgram& program_;
+  const ConventionInfo& convention_;
+};
+
+// The two halves of `box` along `dim` (pixels split between whole numbers).
+std::optional<std::pair<Box, Box>> Halves(const Box& box, int dim) {
+  const Enclosure& x = box.d[dim];
+  double cut = x.mid();
+  std::pair<Box, Box> halves{box, box};
+  if (dim == kPixelX || dim == kPixelY) {
+    if (x.hi - x.lo < 1.0) return std::nullopt;
+    cut = std::floor(cut);
+    halves.first.d[dim] = Enclosure(x.lo, cut);
+    halves.second.d[dim] = Enclosure(cut + 1.0, x.hi);
+    return halves;
+  }
+  if (!(x.width() > 0.0)) return std::nullopt;
+  halves.first.d[dim] = Enclosure(x.lo, cut);
+  halves.second.d[dim] = Enclosure(cut, x.hi);
+  return halves;
+}
+
+struct Outcome {
+  double shader = 0.0, depth = 0.0, total = 0.0;
+  std::uint64_t boxes = 0;
+  std::string why;
+};
+
+// Branch and bound: split the worst box along the dimension whose halves'
+// worse figure is lowest, `splits` times; the figure is the shader part's
+// bound, or with `refine_total` the whole error's.
+Outcome Refine(const CellAnalysis& analysis, const Machine& machine, int splits, bool refine_total) {
+  std::priority_queue<Box> queue;
+  for (Box box : analysis.Roots()) {
+    box.refine_total = refine_total;
+    analysis.Evaluate(box, machine);
+    queue.push(std::move(box));
+  }
+  for (int s = 0; s < splits && !queue.empty(); ++s) {
+    const Box& worst = queue.top();
+    std::optional<std::pair<Box, Box>> best;
+    double best_figure = INFINITY;
+    // Dimensions in turn from the one after the box's last split, so that
+    // where every split leaves a half unbounded (a divisor range that
+    // holds 0 until the box is narrow in several dimensions), each
+    // dimension is split in turn.
+    for (int k = 0; k < kDims; ++k) {
+      const int dim = (worst.last_split + 1 + k) % kDims;
+      std::optional<std::pair<Box, Box>> halves = Halves(worst, dim);
+      if (!halves) continue;
+      analysis.Evaluate(halves->first, machine);
+      analysis.Evaluate(halves->second, machine);
+      const double figure = std::log(halves->first.figure()) + std::log(halves->second.figure());
+      if (!best || figure < best_figure) {
+        best_figure = figure;
+        halves->first.last_split = halves->second.last_split = dim;
+        best = std::move(halves);
+      }
+    }
+    if (!best) break;  // a point: nothing left to split
+    queue.pop();
+    queue.push(std::move(best->first));
+    queue.push(std::move(best->second));
+  }
+  // The boxes cover the domain, so the worst of each figure over them
+  // bounds it everywhere.
+  Outcome out;
+  out.boxes = queue.size();
+  for (; !queue.empty(); queue.pop()) {
+    const Box& box = queue.top();
+    if (box.shader > out.shader && !box.why.empty()) out.why = box.why;
+    out.shader = std::max(out.shader, box.shader);
+    out.depth = std::max(out.depth, box.depth);
+    out.total = std::max(out.total, box.total());
+  }
+  return out;
+}
+
+Status CheckCovered(const Domain& domain) {
+  if (domain.orthographic) return InvalidArgument("bounds cover perspective domains only (this one is orthographic)");
+  if (domain.capture) return InvalidArgument("bounds cover drawn domains only (this one is a captured frame)");
+  if (domain.eye_depth || domain.far) {
+    return InvalidArgument("bounds cover domains of far/near ratios only (this one names absolute depths)");
+  }
+  if (domain.constants != ConstantsModel::kExact) {
+    return InvalidArgument("bounds cover exact shader constants only (this domain computes them in float32)");
+  }
+  if (domain.production != ProductionModel::kFloat32) {
+    return InvalidArgument("bounds cover the float32 production model only");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<const Cell> cells,
+                                            const std::filesystem::path& shader_dir, const BoundOptions& options,
+                                            const std::function<void(std::size_t, std::size_t)>& progress) {
+  DB_RETURN_IF_ERROR(CheckCovered(domain));
+  std::vector<CellBound> bounds;
+  std::map<Variant, Expected<SpirvProgram>> programs;
+  for (const Cell& cell : cells) {
+    CellBound bound;
+    bound.cell = cell;
+    const VariantInfo& variant = cell.variant_info();
+    auto found = programs.find(cell.variant);
+    if (found == programs.end()) {
+      Expected<std::vector<std::uint32_t>> words = CompileVariant(variant, VariantPass::kAccuracy, shader_dir);
+      Expected<SpirvProgram> program =
+          words.ok() ? SpirvProgram::Parse(*words) : Expected<SpirvProgram>(words.status());
+      found = programs.emplace(cell.variant, std::move(program)).first;
+    }
+    if (!found->second.ok()) return found->second.status();
+    CellProgram program{&*found->second};
+    Expected<std::uint32_t> uv = program.program->Function("uv_from_pixel");
+    Expected<std::uint32_t> reconstruct = program.program->Function(ReconstructFunctionName(variant));
+    if (!uv.ok()) return uv.status();
+    if (!reconstruct.ok()) return reconstruct.status();
+    program.uv_function = *uv;
+    program.reconstruct = *reconstruct;
+    if (variant.assumes_symmetric_frustum && domain.OffCentre()) {
+      bound.device_shader = bound.exact_shader = bound.total = INFINITY;
+      bound.unbounded = "its formula assumes a symmetric frustum, and this domain's is off-centre";
+    } else {
+      const CellAnalysis analysis(domain, cell, program);
+      const Outcome device = Refine(analysis, kVulkanDevice, options.splits, false);
+      const Outcome exact = Refine(analysis, kExactlyRounded, options.splits, false);
+      const Outcome whole = Refine(analysis, kVulkanDevice, options.splits, true);
+      bound.device_shader = device.shader;
+      bound.exact_shader = exact.shader;
+      bound.depth = whole.depth;
+      bound.total = whole.total;
+      bound.boxes = device.boxes;
+      bound.unbounded = !device.why.empty() ? device.why : whole.why;
+    }
+    bounds.push_back(std::move(bound));
+    if (progress) progress(bounds.size(), cells.size());
+  }
+  return bounds;
+}
+
+}  // namespace depthbench::bound

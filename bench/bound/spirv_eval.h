@@ -1,0 +1,80 @@
+// Abstract evaluation of a compiled shader function: each float lane is a
+// bound::Lane (an enclosure of the exact value and a bound on the float32
+// error, rounding.h), integers and booleans are known values. It runs the
+// very SPIR-V module the Vulkan backend runs, so a shader edit changes the
+// bound, and a function from the user's file is bounded like a built-in one.
+//
+// It follows straight-line code through calls, local and private
+// variables, composites and branches whose condition is known (the depth
+// convention's bits). Whatever it cannot bound is named, never guessed: a
+// loop, a branch or a select on a computed float, an instruction it does
+// not know, a divisor that may be zero.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/base/status.h"
+#include "bench/bound/rounding.h"
+
+namespace depthbench::bound {
+
+struct Value {
+  enum class Kind : std::uint8_t { kUndefined, kFloat, kInteger, kComputedBool, kComposite, kPointer };
+  Kind kind = Kind::kUndefined;
+  Lane lane;                        // kFloat
+  std::uint64_t integer = 0;        // kInteger (booleans are 0 and 1)
+  std::vector<Value> parts;         // kComposite: members, components or columns
+  std::uint32_t variable = 0;       // kPointer: the variable
+  std::vector<std::uint32_t> path;  // kPointer: the indices into it
+
+  static Value Float(const Lane& lane) {
+    Value v;
+    v.kind = Kind::kFloat;
+    v.lane = lane;
+    return v;
+  }
+  static Value Integer(std::uint64_t x) {
+    Value v;
+    v.kind = Kind::kInteger;
+    v.integer = x;
+    return v;
+  }
+  static Value Composite(std::vector<Value> parts) {
+    Value v;
+    v.kind = Kind::kComposite;
+    v.parts = std::move(parts);
+    return v;
+  }
+};
+
+class Module;
+
+// A parsed SPIR-V module, ready to evaluate its functions.
+class SpirvProgram {
+ public:
+  // InvalidArgument when the words are not a SPIR-V module.
+  static Expected<SpirvProgram> Parse(std::span<const std::uint32_t> words);
+  SpirvProgram(SpirvProgram&&) noexcept;
+  SpirvProgram& operator=(SpirvProgram&&) noexcept;
+  ~SpirvProgram();
+
+  // The function whose debug name is `name` or starts with `name(` (glslang's
+  // mangled names); NotFound otherwise.
+  Expected<std::uint32_t> Function(std::string_view name) const;
+
+  // Evaluates `function` on `arguments` (values, not pointers: a parameter
+  // the compiler passes by pointer gets a variable holding its argument).
+  // The error says what could not be bounded, and where.
+  Expected<Value> Evaluate(std::uint32_t function, std::span<const Value> arguments, const Machine& machine) const;
+
+ private:
+  explicit SpirvProgram(std::unique_ptr<Module> module);
+  std::unique_ptr<Module> module_;
+};
+
+}  // namespace depthbench::bound

@@ -1,0 +1,249 @@
+// Guaranteed bounds: the abstract evaluation of compiled programs against
+// hand-worked cases, and the bounds of every cell against what sweeps on
+// the CPU and on lavapipe measure.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bench/backends/factory.h"
+#include "bench/backends/vulkan/shader_compiler.h"
+#include "bench/bound/bound.h"
+#include "bench/bound/spirv_eval.h"
+#include "bench/pipeline/stats.h"
+#include "bench/pipeline/user_variant.h"
+#include "bench/sweep/sweep.h"
+#include "tests/sanitized_stage.h"
+
+namespace depthbench {
+namespace {
+
+namespace fs = std::filesystem;
+using bound::Lane;
+using bound::Value;
+
+const fs::path kShaders = fs::path(DEPTHBENCH_SOURCE_DIR) / "shaders";
+
+constexpr char kProgram[] = R"(#version 450
+layout(local_size_x = 1) in;
+layout(std430, binding = 0) buffer Values { float v[]; };
+float quotient(float a, float b) { return a / b; }
+float dotted(vec3 a, vec3 b) { return dot(a, b); }
+float looped(float a) {
+  float s = 0.0;
+  for (int i = 0; i < 4; ++i) s += a;
+  return s;
+}
+float branched(float a) {
+  if (a > 1.0) return a;
+  return 2.0 * a;
+}
+void main() {
+  v[0] = quotient(v[1], v[2]) + dotted(vec3(v[3]), vec3(v[4])) + looped(v[5]) + branched(v[6]);
+}
+)";
+
+class SpirvEvalTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto words = CompileShaderSource(kProgram, "bound_test.comp", kShaders, ShaderLanguage::kGlsl,
+                                     ShaderStage::kCompute, nullptr, /*source_lines=*/true);
+    ASSERT_TRUE(words.ok()) << words.status().message();
+    auto program = bound::SpirvProgram::Parse(*words);
+    ASSERT_TRUE(program.ok()) << program.status().message();
+    program_ = std::make_unique<bound::SpirvProgram>(std::move(program).value());
+  }
+  Expected<Value> Run(const std::string& function, const std::vector<Value>& arguments,
+                      const bound::Machine& machine) const {
+    DB_ASSIGN_OR_RETURN(const std::uint32_t id, program_->Function(function));
+    return program_->Evaluate(id, arguments, machine);
+  }
+  std::unique_ptr<bound::SpirvProgram> program_;
+};
+
+// 3/7 rounds once: within half an ULP on an exactly rounded machine and
+// 2.5 ULP on a Vulkan device, an ULP being at most 2^-23 of the quotient's
+// magnitude (plus the underflow allowance). The float quotient lies within
+// both.
+TEST_F(SpirvEvalTest, DivisionIsBoundedByEachMachinesRule) {
+  const std::vector<Value> exact = {Value::Float(Lane::Exact(3.0)), Value::Float(Lane::Exact(7.0))};
+  auto device = Run("quotient", exact, bound::kVulkanDevice);
+  auto host = Run("quotient", exact, bound::kExactlyRounded);
+  ASSERT_TRUE(device.ok()) << device.status().message();
+  ASSERT_TRUE(host.ok()) << host.status().message();
+  const double q = 3.0 / 7.0;
+  EXPECT_NEAR(host->lane.error, 0.5 * 0x1p-23 * q + bound::kUnderflow, 1e-12 * host->lane.error);
+  EXPECT_NEAR(device->lane.error, 2.5 * 0x1p-23 * q + bound::kUnderflow, 1e-12 * device->lane.error);
+  EXPECT_LE(std::fabs(static_cast<double>(3.0f / 7.0f) - q), host->lane.error);
+  EXPECT_LE(host->lane.exact.lo, q);
+  EXPECT_GE(host->lane.exact.hi, q);
+
+  // Operands that arrive with errors: |x~/y~ - x/y| <= ex/|y~| + |x| ey/(|y| |y~|), then the rounding.
+  const std::vector<Value> rounded = {Value::Float({Enclosure(3.0), 1e-6}), Value::Float({Enclosure(7.0), 1e-6})};
+  auto propagated = Run("quotient", rounded, bound::kExactlyRounded);
+  ASSERT_TRUE(propagated.ok());
+  const double carried = 1e-6 / (7.0 - 1e-6) + 3.0 * 1e-6 / (7.0 * (7.0 - 1e-6));
+  EXPECT_NEAR(propagated->lane.error, carried + 0.5 * 0x1p-23 * (q + carried) + bound::kUnderflow,
+              1e-12 * propagated->lane.error);
+
+  // A divisor range that holds 0 has no bound.
+  auto zero = Run("quotient", {Value::Float(Lane::Exact(1.0)), Value::Float(Lane::Exact(Enclosure(-1.0, 1.0)))},
+                  bound::kExactlyRounded);
+  ASSERT_FALSE(zero.ok());
+  EXPECT_NE(zero.status().message().find("divisor"), std::string::npos) << zero.status().message();
+}
+
+// A dot product of three terms in any order, fused or not: gamma_3 times
+// the sum of the products' magnitudes (Higham 3.1).
+TEST_F(SpirvEvalTest, DotProductCoversAnyOrder) {
+  auto vec = [](double a, double b, double c) {
+    return Value::Composite({Value::Float(Lane::Exact(a)), Value::Float(Lane::Exact(b)), Value::Float(Lane::Exact(c))});
+  };
+  auto d = Run("dotted", {vec(1.0, 2.0, 3.0), vec(0.5, -0.25, 1.0 / 3.0)}, bound::kVulkanDevice);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  const double magnitude = 1.0 * 0.5 + 2.0 * 0.25 + 3.0 * (1.0 / 3.0);
+  const double gamma = 3 * 0x1p-24 / (1 - 3 * 0x1p-24);
+  EXPECT_NEAR(d->lane.error, gamma * magnitude + 3 * bound::kUnderflow, 1e-12 * gamma);
+}
+
+// What the analysis cannot bound is named, with its line.
+TEST_F(SpirvEvalTest, LoopsAndBranchesOnComputedFloatsAreNamed) {
+  auto loop = Run("looped", {Value::Float(Lane::Exact(1.0))}, bound::kVulkanDevice);
+  ASSERT_FALSE(loop.ok());
+  EXPECT_NE(loop.status().message().find("cannot bound a loop in looped (line 8 of"), std::string::npos)
+      << loop.status().message();
+  auto branch = Run("branched", {Value::Float(Lane::Exact(Enclosure(0.0, 2.0)))}, bound::kVulkanDevice);
+  ASSERT_FALSE(branch.ok());
+  EXPECT_NE(branch.status().message().find("computed float value in branched (line 12 of"), std::string::npos)
+      << branch.status().message();
+}
+
+// A domain narrow enough that thirty splits per cell bound every
+// built-in cell: one lens, one render target, far/near 1e3, the camera at
+// the origin.
+Domain NarrowDomain() {
+  Domain d;
+  d.fov_degrees = {60.0, 60.0};
+  d.aspect = {1.5, 1.5};
+  d.ratio = {1e3, 1e3};
+  d.infinite_far = false;
+  d.resolutions = {{1280, 720}};
+  return d;
+}
+
+struct Measured {
+  std::vector<bound::CellBound> bounds;
+  Results cpu, vulkan;
+};
+
+const Measured& Sweeps() {
+  static const Measured* measured = [] {
+    auto* m = new Measured;
+    const Domain domain = NarrowDomain();
+    const std::vector<Cell> cells = CellsForDomain(AllCells(), domain);
+    bound::BoundOptions options;
+    options.splits = 30;
+    auto bounds = bound::BoundCells(domain, cells, kShaders, options);
+    EXPECT_TRUE(bounds.ok()) << bounds.status().message();
+    if (bounds.ok()) m->bounds = *std::move(bounds);
+    SweepOptions sweep;
+    sweep.samples = testing::kSanitized ? 2000 : 20000;
+    sweep.seed = 42;
+    sweep.domain = domain;
+    sweep.cells = cells;
+    for (const std::string backend : {"cpu", "vulkan"}) {
+      auto made = MakeBackend(backend, BackendOptions{});
+      EXPECT_TRUE(made.ok()) << made.status().message();
+      if (!made.ok()) continue;
+      Backend* backends[] = {made->get()};
+      auto run = RunSweep(sweep, backends);
+      EXPECT_TRUE(run.ok()) << run.status().message();
+      if (run.ok()) (backend == "cpu" ? m->cpu : m->vulkan) = *std::move(run);
+    }
+    return m;
+  }();
+  return *measured;
+}
+
+double Worst(const Results& results, const Cell& cell, Metric metric) {
+  const CellResult* r = results.Find(cell, results.cells.empty() ? "" : results.cells[0].backend);
+  return r == nullptr ? NAN : r->stats.Everything()[metric].max();
+}
+
+// Every judged sample's shader part lies within its cell's bound: the
+// exactly rounded machine's on the CPU, any device's on lavapipe; and the
+// whole error within the whole's bound. Scaled down eightfold, the bounds
+// are exceeded somewhere: the comparison can fail.
+TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
+  const Measured& m = Sweeps();
+  ASSERT_EQ(m.bounds.size(), 58u);
+  int bounded = 0, exceeded_at_an_eighth = 0;
+  for (const bound::CellBound& b : m.bounds) {
+    SCOPED_TRACE(b.cell.Name());
+    if (!std::isfinite(b.device_shader)) continue;
+    ++bounded;
+    const double cpu = Worst(m.cpu, b.cell, Metric::kArith), gpu = Worst(m.vulkan, b.cell, Metric::kArith);
+    EXPECT_LE(cpu, b.exact_shader);
+    EXPECT_LE(gpu, b.device_shader);
+    EXPECT_LE(b.exact_shader, b.device_shader);  // the device's rules allow more
+    EXPECT_LE(Worst(m.cpu, b.cell, Metric::kTotal), b.total);
+    EXPECT_LE(Worst(m.vulkan, b.cell, Metric::kTotal), b.total);
+    exceeded_at_an_eighth += cpu > b.exact_shader / 8.0;
+  }
+  // volume_ray's three cells need narrower boxes than thirty splits make
+  // (its light volume's depth enters a divisor).
+  EXPECT_GE(bounded, 55);
+  EXPECT_GT(exceeded_at_an_eighth, 0);
+}
+
+// A user's edit of divide that adds about 1 to the NDC depth and takes it
+// away again: under reversed Z the depth is small, and the sum keeps few
+// of its bits. Its bound rises far above divide's, as what lavapipe
+// measures does. (The two ones are different values, tan times its
+// reciprocal in x and in y: lavapipe's compiler removes (x + c) - c.)
+TEST(BoundTest, AShaderEditMovesItsBound) {
+  DEPTHBENCH_FIGURES_ONLY("EveryMeasuredSampleLiesWithinItsCellsBound");
+  const fs::path path = fs::path(::testing::TempDir()) / "divide_round_trip.glsl";
+  std::ofstream(path) << "// depthbench: input=hardware entry=reconstruct\n"
+                         "vec3 reconstruct(vec2 uv, float depth) {\n"
+                         "  vec2 ndc = vec2(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0);\n"
+                         "  float ndc_z = (depth + db_Lens.x * db_Lens.z) - db_Lens.y * db_Lens.w;\n"
+                         "  float a = db_DepthCoefficients.x;\n"
+                         "  float b = db_DepthCoefficients.y;\n"
+                         "  vec3 view = vec3(ndc.x / db_Lens.z, ndc.y / db_Lens.w, -1.0) / (ndc_z / b - a / b);\n"
+                         "  return (db_ViewToWorld * vec4(view, 1.0)).xyz;\n"
+                         "}\n";
+  auto catalogue = MakeCatalogue({path.string()});
+  ASSERT_TRUE(catalogue.ok()) << catalogue.status().message();
+  const Variant edit = (*catalogue)->variants().back().id;
+  const std::vector<Cell> cells = {(*catalogue)->MakeCell(Variant::kDivide, Convention::kReversed, Format::kD32Sfloat),
+                                   (*catalogue)->MakeCell(edit, Convention::kReversed, Format::kD32Sfloat)};
+  bound::BoundOptions options;
+  options.splits = 30;
+  auto bounds = bound::BoundCells(NarrowDomain(), cells, kShaders, options);
+  ASSERT_TRUE(bounds.ok()) << bounds.status().message();
+  const double divide = bound::BoundBits((*bounds)[0].device_shader);
+  const double edited = bound::BoundBits((*bounds)[1].device_shader);
+  EXPECT_GT(edited, divide + 6.0) << divide << " -> " << edited;
+
+  SweepOptions sweep;
+  sweep.samples = 20000;
+  sweep.domain = NarrowDomain();
+  sweep.cells = cells;
+  auto vulkan = MakeBackend("vulkan", BackendOptions{});
+  ASSERT_TRUE(vulkan.ok());
+  Backend* backends[] = {vulkan->get()};
+  auto run = RunSweep(sweep, backends);
+  ASSERT_TRUE(run.ok()) << run.status().message();
+  const double measured_divide = BitsLost(Worst(*run, cells[0], Metric::kArith));
+  const double measured_edit = BitsLost(Worst(*run, cells[1], Metric::kArith));
+  EXPECT_GT(measured_edit, measured_divide + 6.0) << measured_divide << " -> " << measured_edit;
+  EXPECT_LE(measured_edit, edited);
+}
+
+}  // namespace
+}  // namespace depthbench
