@@ -9,11 +9,14 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <glm/gtc/quaternion.hpp>
 
 #include "bench/backends/factory.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/bound/bound.h"
 #include "bench/bound/spirv_eval.h"
+#include "bench/numerics/formulas.h"
+#include "bench/pipeline/shader_constants.h"
 #include "bench/pipeline/stats.h"
 #include "bench/pipeline/user_variant.h"
 #include "bench/sweep/sweep.h"
@@ -198,6 +201,67 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   // (its light volume's depth enters a divisor).
   EXPECT_GE(bounded, 55);
   EXPECT_GT(exceeded_at_an_eighth, 0);
+}
+
+// The second method: every float32 stored value of a binade, one frame of
+// the narrow domain (its camera turned and off the origin), one pixel,
+// each reconstructed by the CPU's float32 formula (exactly rounded, as
+// the bound's second machine) and compared with the point it denotes, in
+// double-double. The worst of the 2^23 must lie within the bound proven for
+// that frame, pixel and binade (ShaderBoundAt), and so within the domain's.
+TEST(BoundTest, EveryStoredValueOfABinadeLiesWithinTheBound) {
+  DEPTHBENCH_FIGURES_ONLY("EveryMeasuredSampleLiesWithinItsCellsBound");
+  Frame frame;
+  frame.tan_half_fov_y = std::tan(M_PI / 6.0);
+  frame.aspect = 1.5;
+  frame.near = 1.0;
+  frame.far = 1e3;
+  frame.width = 1280;
+  frame.height = 720;
+  frame.volume_depth = 10.0;
+  frame.camera_position = glm::dvec3(3.0, -2.0, 0.5);
+  frame.rotation = glm::dmat3(glm::mat3_cast(glm::normalize(glm::dquat(0.9, 0.2, -0.3, 0.1))));
+  f32::FrameParams fp;
+  std::array<f32::DepthParams, kHardwareConventionCount> dp;
+  BuildShaderConstants(frame, ConstantsModel::kExact, fp, dp);
+  const f32::DepthParams& depth = dp[DepthSlot(Convention::kReversed)];
+  const std::uint32_t px = 100, py = 200;
+  const f32::vec2 uv = f32::uv_from_pixel(static_cast<float>(px), static_cast<float>(py), fp.resolution);
+  const double ndc_x = 2.0 * (px + 0.5) / frame.width - 1.0, ndc_y = 1.0 - 2.0 * (py + 0.5) / frame.height;
+  const glm::dvec3 ray =
+      frame.rotation * glm::dvec3(ndc_x * frame.aspect * frame.tan_half_fov_y, ndc_y * frame.tan_half_fov_y, -1.0);
+  const glm::vec3 camera(frame.camera_position);
+  const float lo = 0.25f, hi = 0.5f;
+
+  const std::pair<Variant, f32::WorldPositionFn> variants[] = {{Variant::kDivide, f32::divide_world_position},
+                                                               {Variant::kReciprocal, f32::reciprocal_world_position},
+                                                               {Variant::kPq, f32::pq_world_position},
+                                                               {Variant::kInverseVp, f32::inverse_vp_world_position}};
+  for (const auto& [variant, reconstruct] : variants) {
+    const Cell cell{variant, Convention::kReversed, Format::kD32Sfloat};
+    SCOPED_TRACE(cell.Name());
+    auto proven = bound::ShaderBoundAt(cell, frame, px, py, Enclosure(lo, hi), bound::kExactlyRounded, kShaders);
+    ASSERT_TRUE(proven.ok()) << proven.status().message();
+    double worst = 0.0;
+    for (std::uint32_t bits = std::bit_cast<std::uint32_t>(lo); bits < std::bit_cast<std::uint32_t>(hi); ++bits) {
+      const float stored = std::bit_cast<float>(bits);
+      // The eye depth the stored value denotes under the float A and B.
+      const DoubleDouble z =
+          DoubleDouble(depth.coefficients.y) / (DoubleDouble(stored) - DoubleDouble(depth.coefficients.x));
+      const f32::vec3 p = reconstruct(fp, depth, uv, stored);
+      double sq = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        // p - camera is exact in double-double; the denoted point is camera + z ray.
+        const double e = (DoubleDouble(p[k]) - DoubleDouble(camera[k]) - z * DoubleDouble(ray[k])).hi();
+        sq += e * e;
+      }
+      worst = std::max(worst, std::sqrt(sq) / (z.hi() * glm::length(ray)));
+    }
+    std::printf("%s, stored values in [0.25, 0.5): worst %.2f bits, proven %.2f bits\n", cell.Name().c_str(),
+                BitsLost(worst), bound::BoundBits(*proven));
+    EXPECT_GT(worst, 0.0);
+    EXPECT_LE(worst, *proven);
+  }
 }
 
 // A user's edit of divide that adds about 1 to the NDC depth and takes it

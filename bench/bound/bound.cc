@@ -272,38 +272,66 @@ class CellAnalysis {
     const double reach = box.d[kDistance].hi;
     for (int k = 0; k < 3; ++k) v.camera_position[k] = Enclosure(-reach, reach);
     v.rotation = Rotation(box);
+    const Inputs in = InputsOf(v);
 
-    const iv::FrameParams frame = EncloseFrameParams(v);
+    const Stored stored = StoredValues(cell_.encoding(), in.a, in.b, in.far, z, linear);
+    box.depth = stored.depth;
+    if (!stored.why.empty()) return Fail(box, stored.why);
+    Expected<double> error = ShaderError(in, box.d[kPixelX], box.d[kPixelY], stored.value, machine);
+    if (!error.ok()) return Fail(box, error.status().message());
+    // |true point - camera| = true eye depth * |the pixel's ray per unit eye depth|.
+    box.shader = *error / (z.lo * RayLength(in, box.d[kPixelX], box.d[kPixelY]));
+  }
+
+  // What the shader receives for the frames of `v`.
+  struct Inputs {
+    FrameValues<Enclosure> values;
+    iv::FrameParams frame;
+    Value frame_value, depth_value;
+    Lane a, b;      // the depth mapping's A and B, as the reference reads them
+    Enclosure far;  // the far plane, as the linear formats' reference reads it
+  };
+  Inputs InputsOf(const FrameValues<Enclosure>& v) const {
+    Inputs in;
+    in.values = v;
+    in.frame = EncloseFrameParams(v);
     iv::DepthParams depth{};
     const bool hardware = convention_.hardware;
     if (hardware) depth = EncloseDepthParams(v, cell_.convention);
-    const Value frame_value = FrameInputs(frame);
-    const Value depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits);
+    in.frame_value = FrameInputs(in.frame);
+    in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits);
+    in.a = Input(depth.coefficients.x, 1, 0);
+    in.b = Input(depth.coefficients.y, 1, 0);
+    in.far = Input(in.frame.camera_position.w, 1, 0).exact;
+    return in;
+  }
 
-    const Lane a = Input(depth.coefficients.x, 1, 0), b = Input(depth.coefficients.y, 1, 0);
-    const Stored stored = StoredValues(cell_.encoding(), a, b, Input(frame.camera_position.w, 1, 0).exact, z, linear);
-    box.depth = stored.depth;
-    if (!stored.why.empty()) return Fail(box, stored.why);
-
-    const Value pixel[3] = {Value::Float(Lane::Exact(box.d[kPixelX])), Value::Float(Lane::Exact(box.d[kPixelY])),
-                            frame_value.parts[3]};
-    Expected<Value> uv = program_.program->Evaluate(program_.uv_function, pixel, machine);
-    if (!uv.ok()) return Fail(box, uv.status().message());
-    const Value arguments[4] = {frame_value, depth_value, *uv, Value::Float(Lane::Exact(stored.value))};
-    Expected<Value> p = program_.program->Evaluate(program_.reconstruct, arguments, machine);
-    if (!p.ok()) return Fail(box, p.status().message());
-    if (p->kind != Value::Kind::kComposite || p->parts.size() != 3) return Fail(box, "an output that is not a vec3");
+  // The bound on the output's distance from the point exact arithmetic
+  // gives, for the pixels and stored values given.
+  Expected<double> ShaderError(const Inputs& in, const Enclosure& pixel_x, const Enclosure& pixel_y,
+                               const Enclosure& stored, const Machine& machine) const {
+    const Value pixel[3] = {Value::Float(Lane::Exact(pixel_x)), Value::Float(Lane::Exact(pixel_y)),
+                            in.frame_value.parts[3]};
+    DB_ASSIGN_OR_RETURN(const Value uv, program_.program->Evaluate(program_.uv_function, pixel, machine));
+    const Value arguments[4] = {in.frame_value, in.depth_value, uv, Value::Float(Lane::Exact(stored))};
+    DB_ASSIGN_OR_RETURN(const Value p, program_.program->Evaluate(program_.reconstruct, arguments, machine));
+    if (p.kind != Value::Kind::kComposite || p.parts.size() != 3)
+      return InvalidArgument("an output that is not a vec3");
     double sum = 0.0;
-    for (const Value& lane : p->parts) {
-      if (lane.kind != Value::Kind::kFloat) return Fail(box, "an output lane with no known float value");
+    for (const Value& lane : p.parts) {
+      if (lane.kind != Value::Kind::kFloat) return InvalidArgument("an output lane with no known float value");
       sum += lane.lane.error * lane.lane.error;
     }
-    // |true point - camera| = true eye depth * |the pixel's ray per unit eye depth|.
-    const Enclosure ndc_x = (box.d[kPixelX] + Enclosure(0.5)) * Enclosure(2.0) / v.width - Enclosure(1.0);
-    const Enclosure ndc_y = Enclosure(1.0) - (box.d[kPixelY] + Enclosure(0.5)) * Enclosure(2.0) / v.height;
-    const Enclosure ray_sq = Enclosure(1.0) + Square(ndc_x * frame.lens.x + frame.lens_centre.x) +
-                             Square(ndc_y * frame.lens.y + frame.lens_centre.y);
-    box.shader = std::sqrt(sum) / (z.lo * std::sqrt(ray_sq.lo)) * (1.0 + 1e-12);
+    return std::sqrt(sum) * (1.0 + 1e-12);
+  }
+
+  // The least length of the pixels' rays per unit eye depth.
+  static double RayLength(const Inputs& in, const Enclosure& pixel_x, const Enclosure& pixel_y) {
+    const Enclosure ndc_x = (pixel_x + Enclosure(0.5)) * Enclosure(2.0) / in.values.width - Enclosure(1.0);
+    const Enclosure ndc_y = Enclosure(1.0) - (pixel_y + Enclosure(0.5)) * Enclosure(2.0) / in.values.height;
+    const Enclosure ray_sq = Enclosure(1.0) + Square(ndc_x * in.frame.lens.x + in.frame.lens_centre.x) +
+                             Square(ndc_y * in.frame.lens.y + in.frame.lens_centre.y);
+    return std::sqrt(ray_sq.lo) * (1.0 - 1e-12);
   }
 
   // The whole domain's boxes: one per render target.
@@ -440,6 +468,24 @@ Outcome Refine(const CellAnalysis& analysis, const Machine& machine, int splits,
   return out;
 }
 
+// Each variant's program, compiled and parsed once.
+using Programs = std::map<Variant, Expected<SpirvProgram>>;
+
+Expected<CellProgram> ProgramOf(const Cell& cell, const std::filesystem::path& shader_dir, Programs& programs) {
+  auto found = programs.find(cell.variant);
+  if (found == programs.end()) {
+    Expected<std::vector<std::uint32_t>> words =
+        CompileVariant(cell.variant_info(), VariantPass::kAccuracy, shader_dir);
+    Expected<SpirvProgram> program = words.ok() ? SpirvProgram::Parse(*words) : Expected<SpirvProgram>(words.status());
+    found = programs.emplace(cell.variant, std::move(program)).first;
+  }
+  if (!found->second.ok()) return found->second.status();
+  CellProgram program{&*found->second};
+  DB_ASSIGN_OR_RETURN(program.uv_function, program.program->Function("uv_from_pixel"));
+  DB_ASSIGN_OR_RETURN(program.reconstruct, program.program->Function(ReconstructFunctionName(cell.variant_info())));
+  return program;
+}
+
 Status CheckCovered(const Domain& domain) {
   if (domain.orthographic) return InvalidArgument("bounds cover perspective domains only (this one is orthographic)");
   if (domain.capture) return InvalidArgument("bounds cover drawn domains only (this one is a captured frame)");
@@ -462,26 +508,12 @@ Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<cons
                                             const std::function<void(std::size_t, std::size_t)>& progress) {
   DB_RETURN_IF_ERROR(CheckCovered(domain));
   std::vector<CellBound> bounds;
-  std::map<Variant, Expected<SpirvProgram>> programs;
+  Programs programs;
   for (const Cell& cell : cells) {
     CellBound bound;
     bound.cell = cell;
     const VariantInfo& variant = cell.variant_info();
-    auto found = programs.find(cell.variant);
-    if (found == programs.end()) {
-      Expected<std::vector<std::uint32_t>> words = CompileVariant(variant, VariantPass::kAccuracy, shader_dir);
-      Expected<SpirvProgram> program =
-          words.ok() ? SpirvProgram::Parse(*words) : Expected<SpirvProgram>(words.status());
-      found = programs.emplace(cell.variant, std::move(program)).first;
-    }
-    if (!found->second.ok()) return found->second.status();
-    CellProgram program{&*found->second};
-    Expected<std::uint32_t> uv = program.program->Function("uv_from_pixel");
-    Expected<std::uint32_t> reconstruct = program.program->Function(ReconstructFunctionName(variant));
-    if (!uv.ok()) return uv.status();
-    if (!reconstruct.ok()) return reconstruct.status();
-    program.uv_function = *uv;
-    program.reconstruct = *reconstruct;
+    DB_ASSIGN_OR_RETURN(const CellProgram program, ProgramOf(cell, shader_dir, programs));
     if (variant.assumes_symmetric_frustum && domain.OffCentre()) {
       bound.device_shader = bound.exact_shader = bound.total = INFINITY;
       bound.unbounded = "its formula assumes a symmetric frustum, and this domain's is off-centre";
@@ -501,6 +533,45 @@ Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<cons
     if (progress) progress(bounds.size(), cells.size());
   }
   return bounds;
+}
+
+Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                               const Enclosure& stored, const Machine& machine,
+                               const std::filesystem::path& shader_dir) {
+  Programs programs;
+  DB_ASSIGN_OR_RETURN(const CellProgram program, ProgramOf(cell, shader_dir, programs));
+  Domain domain;
+  const CellAnalysis analysis(domain, cell, program);
+  FrameValues<Enclosure> v;
+  v.tan_half_fov_y = Enclosure(frame.tan_half_fov_y);
+  v.aspect = Enclosure(frame.aspect);
+  v.centre_x = Enclosure(frame.centre_x);
+  v.centre_y = Enclosure(frame.centre_y);
+  v.near = Enclosure(frame.near);
+  v.far = Enclosure(frame.finite() ? frame.far : 0.0);
+  v.volume_depth = Enclosure(frame.volume_depth);
+  v.width = Enclosure(frame.width);
+  v.height = Enclosure(frame.height);
+  for (int k = 0; k < 3; ++k) v.camera_position[k] = Enclosure(frame.camera_position[k]);
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) v.rotation[c][r] = Enclosure(frame.rotation[c][r]);
+  }
+  const auto in = analysis.InputsOf(v);
+  const Enclosure px(pixel_x), py(pixel_y);
+  DB_ASSIGN_OR_RETURN(const double error, analysis.ShaderError(in, px, py, stored, machine));
+  // The eye depths the stored values denote, as the reference decodes them.
+  Enclosure depth;
+  switch (Info(cell.format).stores) {
+    case DepthInput::kHardware: {
+      const bool gl = (Info(cell.convention).bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
+      depth = in.b.exact / ((gl ? stored * Enclosure(2.0) - Enclosure(1.0) : stored) - in.a.exact);
+      break;
+    }
+    case DepthInput::kLinear: depth = stored * in.far; break;
+    case DepthInput::kViewZ: depth = -stored; break;
+  }
+  if (!(depth.lo > 0.0)) return InvalidArgument("stored values that denote no depth in front of the camera");
+  return error / (depth.lo * CellAnalysis::RayLength(in, px, py));
 }
 
 }  // namespace depthbench::bound

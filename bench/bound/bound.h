@@ -27,8 +27,10 @@
 #include <vector>
 
 #include "bench/base/status.h"
+#include "bench/bound/rounding.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
+#include "bench/pipeline/sampler.h"
 
 namespace depthbench::bound {
 
@@ -60,5 +62,14 @@ struct BoundOptions {
 Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<const Cell> cells,
                                             const std::filesystem::path& shader_dir, const BoundOptions& options,
                                             const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+// The shader part's bound for one frame (its camera's rotation and
+// position included), one pixel and a range of stored values, relative to
+// the nearest depth those values denote: what a second method can check
+// point by point (tests/bound_test.cc enumerates every float32 of a
+// binade). Projective conventions decode with the frame's A and B.
+Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                               const Enclosure& stored, const Machine& machine,
+                               const std::filesystem::path& shader_dir);
 
 }  // namespace depthbench::bound
