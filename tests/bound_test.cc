@@ -15,6 +15,7 @@
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/bound/bound.h"
 #include "bench/bound/spirv_eval.h"
+#include "bench/fuzz/campaign.h"
 #include "bench/numerics/formulas.h"
 #include "bench/pipeline/shader_constants.h"
 #include "bench/pipeline/stats.h"
@@ -201,6 +202,46 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   // (its light volume's depth enters a divisor).
   EXPECT_GE(bounded, 55);
   EXPECT_GT(exceeded_at_an_eighth, 0);
+}
+
+// The fuzzer holds every judged sample against its cell's proven bound.
+// With the bounds proven, it finds nothing beyond them; with bounds planted
+// an eighth as large, it finds a sample beyond one, a finding of its own
+// kind, shrunk and written like the others. (A bound one ULP too small for
+// division is not enough to plant: the bounds take every rounding at its
+// worst, some bits above what any input reaches; docs/bounds.md.)
+TEST(BoundTest, TheFuzzerFindsSamplesBeyondAPlantedBound) {
+  const Measured& m = Sweeps();
+  ASSERT_EQ(m.bounds.size(), 58u);
+  auto cpu = MakeBackend("cpu", BackendOptions{});
+  ASSERT_TRUE(cpu.ok());
+  Backend* backends[] = {cpu->get()};
+  auto campaign = [&](double scale, const fs::path& out) {
+    CampaignOptions options;
+    options.seconds = 0;
+    options.cases = testing::kSanitized ? 64 * 64 : 64 * 64 * 8;
+    options.domain = NarrowDomain();
+    options.cells = CellsForDomain(AllCells(), options.domain);
+    for (const bound::CellBound& b : m.bounds) options.proven.push_back(b.exact_shader * scale);
+    options.out = out;
+    return RunCampaign(options, backends);
+  };
+  auto kept = campaign(1.0, fs::path(::testing::TempDir()) / "proven_kept");
+  ASSERT_TRUE(kept.ok()) << kept.status().message();
+  for (const CampaignFinding& f : kept->findings) EXPECT_NE(f.kind, FindingKind::kBeyondProven) << f.signature;
+
+  auto planted = campaign(1.0 / 8.0, fs::path(::testing::TempDir()) / "proven_planted");
+  ASSERT_TRUE(planted.ok()) << planted.status().message();
+  int beyond = 0;
+  for (const CampaignFinding& f : planted->findings) {
+    if (f.kind != FindingKind::kBeyondProven) continue;
+    ++beyond;
+    SCOPED_TRACE(f.signature);
+    EXPECT_NE(f.signature.find("beyond_proven_bound"), std::string::npos);
+    EXPECT_TRUE(f.judgement.beyond_proven());  // the shrunk case still is
+    EXPECT_TRUE(fs::exists(f.file));
+  }
+  EXPECT_GT(beyond, 0);
 }
 
 // The second method: every float32 stored value of a binade, one frame of

@@ -8,6 +8,7 @@
 #include "bench/base/progress.h"
 #include "bench/base/resources.h"
 #include "bench/base/text_table.h"
+#include "bench/bound/bound.h"
 #include "bench/cli/cli_common.h"
 #include "bench/cli/commands.h"
 #include "bench/fuzz/campaign.h"
@@ -24,8 +25,9 @@ namespace {
 // by run, fit and choose, not fuzzed.
 Status CheckFuzzable(const Domain& domain) {
   if (!domain.orthographic) return Status::Ok();
-  return InvalidArgument("fuzz: orthographic domains are not fuzzed yet (its cases and bounds are perspective "
-                         "frames); measure one with run, fit or choose");
+  return InvalidArgument(
+      "fuzz: orthographic domains are not fuzzed yet (its cases and bounds are perspective "
+      "frames); measure one with run, fit or choose");
 }
 
 struct FuzzFlags {
@@ -36,6 +38,7 @@ struct FuzzFlags {
   std::string out = "fuzz-findings";
   std::string known;  // default: the data folder's fuzz/known_findings.json; "none": no file
   bool search = false;
+  int prove = 0;  // splits per cell of the proven bounds (0: none)
   std::string against_random;
   bool quiet = false;
   DomainFlags domain;
@@ -55,6 +58,46 @@ std::string DescribeCase(const FuzzCase& c) {
       "{}x{}, {}",
       f.fov_y_degrees, f.aspect, f.near, f.ratio(), f.camera_distance(), c.sample.x, c.sample.y, f.width, f.height,
       depth);
+}
+
+// The bounds `depthbench bound` proves for `cells` over `domain`, with
+// --prove's splits; the cells that have none are said.
+Expected<std::vector<bound::CellBound>> Prove(const FuzzFlags& f, const Domain& domain, const std::vector<Cell>& cells,
+                                              const TextOutput& out) {
+  std::filesystem::path shader_dir = f.backends.shaders;
+  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
+  bound::BoundOptions options;
+  options.splits = f.prove;
+  Progress progress("prove", StderrIsTerminal(), f.quiet);
+  DB_ASSIGN_OR_RETURN(std::vector<bound::CellBound> bounds,
+                      bound::BoundCells(domain, cells, shader_dir, options, [&](std::size_t done, std::size_t total) {
+                        progress.Update(static_cast<double>(done) / static_cast<double>(total),
+                                        fmt::format("{} of {} cells bounded", done, total));
+                      }));
+  progress.Finish(fmt::format("{} cells bounded", bounds.size()));
+  const auto unbounded =
+      std::count_if(bounds.begin(), bounds.end(), [](const bound::CellBound& b) { return !std::isfinite(b.total); });
+  if (unbounded > 0) {
+    out.text << fmt::format(
+        "--prove: {} of {} cells have no proven bound over this domain (depthbench bound says "
+        "why); they are held to the other checks only\n",
+        unbounded, bounds.size());
+  }
+  return bounds;
+}
+
+// The campaign's proven bound of each (cell, backend), cells major: the
+// shader part's under the Vulkan rules on a Vulkan backend, under exact
+// rounding on the CPU's.
+Expected<std::vector<double>> ProvenBounds(const FuzzFlags& f, const CampaignOptions& options,
+                                           std::span<Backend* const> backends, const TextOutput& out) {
+  DB_ASSIGN_OR_RETURN(const std::vector<bound::CellBound> bounds, Prove(f, options.domain, options.cells, out));
+  std::vector<double> proven;
+  for (const bound::CellBound& b : bounds) {
+    for (const Backend* backend : backends)
+      proven.push_back(backend->name() == "cpu" ? b.exact_shader : b.device_shader);
+  }
+  return proven;
 }
 
 Expected<std::vector<KnownFinding>> KnownFindings(const FuzzFlags& f) {
@@ -124,6 +167,7 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
         "production and exact constants");
   }
   options.cells = CellsForDomain(cells, options.domain);
+  if (f.prove > 0) DB_RETURN_IF_ERROR(StoreInto(ProvenBounds(f, options, backends, out), options.proven));
   Progress progress("fuzz", StderrIsTerminal(), f.quiet);
   options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
   DB_ASSIGN_OR_RETURN(const CampaignResult result, RunCampaign(options, backends));
@@ -138,8 +182,8 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
       result.cases / std::max(result.seconds, 1e-9));
   out.text << fmt::format(
       "invariants: finite output where the reference is finite; arithmetic error within "
-      "{}x2^-24 x (depth + ray + world condition numbers)\n",
-      kRoundings);
+      "{}x2^-24 x (depth + ray + world condition numbers){}\n",
+      kRoundings, options.proven.empty() ? "" : "; shader part of judged samples within the proven bound");
   if (result.findings.empty()) {
     out.text << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;
@@ -198,14 +242,18 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
     DB_ASSIGN_OR_RETURN(random_samples, ParseCount(f.against_random, "--against-random"));
   }
   Backend& backend = *backends.front();
-  TextTable table({{"cell", TextTable::Align::kLeft},
-                   {"search: worst bits lost"},
-                   {"evaluations"},
-                   {"seconds"},
-                   {"random: worst bits lost"},
-                   {"samples"},
-                   {"seconds"},
-                   {"search >= random"}});
+  std::vector<TextTable::Column> columns = {{"cell", TextTable::Align::kLeft},
+                                            {"search: worst bits lost"},
+                                            {"evaluations"},
+                                            {"seconds"},
+                                            {"random: worst bits lost"},
+                                            {"samples"},
+                                            {"seconds"},
+                                            {"search >= random"}};
+  if (f.prove > 0) columns.insert(columns.end(), {{"proven total bound"}, {"within"}});
+  TextTable table(columns);
+  std::vector<bound::CellBound> proven;
+  if (f.prove > 0) DB_RETURN_IF_ERROR(StoreInto(Prove(f, domain, CellsForDomain(cells, domain), out), proven));
   bool all_found = true;
   for (const Cell& cell : CellsForDomain(cells, domain)) {
     SearchOptions options;
@@ -238,6 +286,17 @@ Expected<int> Search(const FuzzFlags& f, const std::vector<Cell>& cells, std::sp
                   fmt::format("{:.1f}", results.run.seconds), ok ? "yes" : "NO"});
     } else {
       row.insert(row.end(), {"-", "-", "-", "-"});
+    }
+    if (!proven.empty()) {
+      // The search maximizes the whole error: its worst, and so every
+      // input it judged, lies within the whole's bound (the Vulkan rules
+      // allow more than the CPU's exact rounding).
+      const double total =
+          std::find_if(proven.begin(), proven.end(), [&](const auto& b) { return b.cell == cell; })->total;
+      const bool within = found.worst <= total;
+      all_found = all_found && within;
+      row.insert(row.end(), {std::isfinite(total) ? fmt::format("{:.3f}", bound::BoundBits(total)) : "none",
+                             within ? "yes" : "NO"});
     }
     table.AddRow(row);
     if (!f.quiet) std::cerr << "  worst input of " << cell.Name() << ": " << DescribeCase(found.worst_case) << "\n";
@@ -295,6 +354,10 @@ void AddFuzzCommand(CLI::App& app, CommandAction& action) {
                   "the known-findings file: findings it lists, each with its reason, are reported apart and do not "
                   "fail the run (default: fuzz/known_findings.json of the data folder; none: every finding fails)")
       ->type_name("FILE|none");
+  cmd->add_option("--prove", flags->prove,
+                  "hold every judged sample against the bound depthbench bound proves for its cell over the domain, "
+                  "proven with this many splits per cell (0, the default: not); a sample beyond it is a finding of "
+                  "its own kind, beyond_proven_bound: a wrong bound, or a device outside the Vulkan rounding rules");
   cmd->add_flag("--search", flags->search,
                 "search each cell's worst case (largest total error) in the default domain, narrowed by the domain "
                 "flags, on the CPU backend unless --backend says otherwise");

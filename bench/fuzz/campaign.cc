@@ -186,6 +186,10 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
   DB_ASSIGN_OR_RETURN(std::vector<FuzzPoint> corpus, ReadCorpus(options.corpus));
   std::vector<Backend*> backend_list(backends.begin(), backends.end());
   DB_ASSIGN_OR_RETURN(CaseChecker checker, CaseChecker::Make(options.cells, backend_list));
+  if (!options.proven.empty() && options.proven.size() != options.cells.size() * backend_list.size()) {
+    return Internal("proven bounds for a different number of cells and backends");
+  }
+  checker.SetProvenBounds(options.proven);
   if (!options.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(options.out, ec);
@@ -312,6 +316,13 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     Backend* backend = *std::find_if(backend_list.begin(), backend_list.end(),
                                      [&](Backend* b) { return b->name() == finding.backend; });
     DB_ASSIGN_OR_RETURN(CaseChecker one, CaseChecker::Make({finding.cell}, {backend}, 1));
+    if (!options.proven.empty()) {
+      const auto c = static_cast<std::size_t>(std::find(options.cells.begin(), options.cells.end(), finding.cell) -
+                                              options.cells.begin());
+      const auto b =
+          static_cast<std::size_t>(std::find(backend_list.begin(), backend_list.end(), backend) - backend_list.begin());
+      one.SetProvenBounds({options.proven[c * backend_list.size() + b]});
+    }
     DB_ASSIGN_OR_RETURN(finding.shrunk, Shrink(one, finding.first, finding.kind, options.domain));
     DB_ASSIGN_OR_RETURN(finding.judgement, CheckOne(one, finding.shrunk));
     if (!options.out.empty()) DB_RETURN_IF_ERROR(WriteFinding(finding));

@@ -37,6 +37,10 @@ struct CampaignOptions {
   // Units held at a value in every input (index into the 18 units of a
   // FuzzPoint, value): how a named extreme pins a depth pick or a pixel.
   std::vector<std::pair<int, double>> pinned;
+  // Proven bounds of the shader part, per (cell, backend) in that order
+  // (cells major), over `domain` (empty: none): a judged sample beyond its
+  // bound is a finding of its own kind (FindingKind::kBeyondProven).
+  std::vector<double> proven;
   std::function<void(double fraction, const std::string& line)> progress;
 };
 

@@ -13,6 +13,7 @@ const char* FindingKindName(FindingKind kind) {
     case FindingKind::kNaN: return "nan";
     case FindingKind::kInf: return "inf";
     case FindingKind::kBeyondBound: return "beyond_bound";
+    case FindingKind::kBeyondProven: return "beyond_proven_bound";
   }
   return "?";
 }
@@ -76,6 +77,7 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
             if (!CellRunsOn(plan.cell, frame) || r.status == ReferenceStatus::kDegenerate) continue;
             j.checked = true;
             j.judged = r.status == ReferenceStatus::kJudged;
+            if (!proven_.empty()) j.proven = proven_[c * backends_.size() + b];
             float p[3];
             for (int k = 0; k < 3; ++k) p[k] = out[(c * 3 + k) * count + i];
             j.nan = std::isnan(p[0]) || std::isnan(p[1]) || std::isnan(p[2]);

@@ -24,8 +24,12 @@
 
 namespace depthbench {
 
-enum class FindingKind : std::uint8_t { kNaN, kInf, kBeyondBound };
-const char* FindingKindName(FindingKind kind);  // "nan", "inf", "beyond_bound"
+// kBeyondProven: the shader part beyond the bound `depthbench bound`
+// proved for the cell and domain (bench/bound/): a wrong bound, or a device
+// outside the rules it was proven under.
+enum class FindingKind : std::uint8_t { kNaN, kInf, kBeyondBound, kBeyondProven };
+// "nan", "inf", "beyond_bound", "beyond_proven_bound"
+const char* FindingKindName(FindingKind kind);
 
 // The documented theoretical bound on the relative arithmetic error of one
 // reconstruction, until fitted models replace it. First-order rounding
@@ -54,14 +58,30 @@ struct Judgement {
   bool checked = false;  // the reference is finite and the cell runs on the frame
   bool judged = false;   // and the point lies inside the frustum (errors count, as in a sweep)
   bool nan = false, inf = false;
-  bool violates() const { return checked && (nan || inf || (std::isfinite(bound) && arith > bound)); }
-  FindingKind kind() const { return nan ? FindingKind::kNaN : inf ? FindingKind::kInf : FindingKind::kBeyondBound; }
+  // The cell's proven bound for this backend (CaseChecker::SetProvenBounds;
+  // infinite where none was given): it covers judged samples.
+  double proven = INFINITY;
+  bool beyond_proven() const { return judged && !nan && !inf && arith > proven; }
+  bool violates() const {
+    return checked && (nan || inf || (std::isfinite(bound) && arith > bound) || beyond_proven());
+  }
+  FindingKind kind() const {
+    return nan               ? FindingKind::kNaN
+           : inf             ? FindingKind::kInf
+           : beyond_proven() ? FindingKind::kBeyondProven
+                             : FindingKind::kBeyondBound;
+  }
 };
 
 class CaseChecker {
  public:
   // Prepares every backend for the cells (shaders compiled once).
   static Expected<CaseChecker> Make(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads = 0);
+
+  // The proven bound of cell c on backend b at [c * backends + b] (relative
+  // shader errors, bench/bound/), for the samples of the domain it was
+  // proven over; every judged sample is held against it.
+  void SetProvenBounds(std::vector<double> proven) { proven_ = std::move(proven); }
 
   // Runs samples [first, first + count) of `source` through every backend
   // and judges each output.
@@ -78,6 +98,7 @@ class CaseChecker {
   CaseChecker(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads);
 
   std::vector<Cell> cells_;
+  std::vector<double> proven_;  // per (cell, backend), or empty
   std::vector<Backend*> backends_;
   RunLayout layout_;
   std::unique_ptr<ThreadPool> pool_;

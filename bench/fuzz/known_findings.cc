@@ -9,10 +9,11 @@ namespace {
 
 Expected<FindingKind> KindFrom(const JsonReader& r) {
   DB_ASSIGN_OR_RETURN(const std::string name, r.String());
-  for (FindingKind kind : {FindingKind::kNaN, FindingKind::kInf, FindingKind::kBeyondBound}) {
+  for (FindingKind kind :
+       {FindingKind::kNaN, FindingKind::kInf, FindingKind::kBeyondBound, FindingKind::kBeyondProven}) {
     if (name == FindingKindName(kind)) return kind;
   }
-  return r.Error(fmt::format("'{}' is not one of nan, inf, beyond_bound", name));
+  return r.Error(fmt::format("'{}' is not one of nan, inf, beyond_bound, beyond_proven_bound", name));
 }
 
 // Reads the optional list `key` of names through `parse`.
