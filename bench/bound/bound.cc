@@ -11,6 +11,7 @@
 
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/bound/spirv_eval.h"
+#include "bench/pipeline/encode.h"
 #include "bench/pipeline/shader_constants.h"
 
 namespace depthbench::bound {
@@ -48,6 +49,9 @@ struct Box {
   double depth = 0.0;
   std::string why;             // why `shader` is infinite
   int last_split = kDims - 1;  // the dimension split to make this box
+  // A box of the sweep's stored-value picks (sampler.h DepthPick): the
+  // stored value is the format's edge, and the truth is what it denotes.
+  DepthPick pick = DepthPick::kEyeDepth;
   double total() const { return shader + depth; }
   // What the refinement lowers: the shader part's bound, or the whole's.
   bool refine_total = false;
@@ -89,11 +93,40 @@ glm::mat<3, 3, Enclosure> Rotation(const Box& box) {
   return r;
 }
 
+// Scale. The analysis runs with the near plane at 1, and a bound found
+// there must hold at every scale: rounding bounds relative to a value's
+// magnitude do, but a value a float holds exactly at this scale need not
+// be exact at another. So only values that do not scale are taken as
+// exact: the program's literals, zero, whole numbers of pixels, the
+// dimensionless A; a length (B, the far plane, near) never is, even where
+// its normalized value is 1.
+
+// The float32 values that round to nearest from the points of `x`, for a
+// dimensionless constant the shader and the reference both read rounded
+// (a point when x is one a float holds).
+Enclosure FloatHull(const Enclosure& x) {
+  auto down = [](double v) {
+    const auto f = static_cast<float>(v);
+    return static_cast<double>(f) <= v ? static_cast<double>(f) : static_cast<double>(std::nextafter(f, -INFINITY));
+  };
+  auto up = [](double v) {
+    const auto f = static_cast<float>(v);
+    return static_cast<double>(f) >= v ? static_cast<double>(f) : static_cast<double>(std::nextafter(f, INFINITY));
+  };
+  return {down(x.lo), up(x.hi)};
+}
+
+// The same for a length: at any scale its float lies within 2^-24 of it.
+Enclosure LengthFloat(const Enclosure& x) {
+  const double w = kU * x.mag();
+  return Enclosure::Outward(x.lo - w, x.hi + w);
+}
+
 // An input lane: the exact constant lies in `x` widened by `widen` u of
 // its magnitude; the float32 value the shader receives is within `error` u
-// of it. A point that float32 holds exactly arrives exactly.
+// of it (exactly 0 when it is 0, at any scale).
 Lane Input(const Enclosure& x, double widen, double error) {
-  if (x.lo == x.hi && static_cast<double>(static_cast<float>(x.lo)) == x.lo && widen == 0.0) return Lane::Exact(x);
+  if (x.lo == 0.0 && x.hi == 0.0) return Lane::Exact(x);
   const double w = widen * kU * x.mag();
   return {Enclosure::Outward(x.lo - w, x.hi + w), error * kU * x.mag() + kUnderflow};
 }
@@ -122,10 +155,11 @@ Value FrameInputs(const iv::FrameParams& f) {
   camera_world.parts[3] = Inputs(f.camera_world[3], 0, 0, 4);
   m.push_back(std::move(camera_world));
   Value camera_position = Inputs(f.camera_position, 0, 0, 3);
-  camera_position.parts[3] = Value::Float(Input(f.camera_position.w, 1, 0));
+  camera_position.parts[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w)));
   m.push_back(std::move(camera_position));
   m.push_back(Inputs(f.lens, 0, 1));
-  m.push_back(Inputs(f.resolution, 0, 1));
+  Value resolution = Inputs(f.resolution, 0, 1, 2);  // whole numbers of pixels, then their reciprocals
+  m.push_back(std::move(resolution));
   for (const iv::vec4* ray : {&f.frustum_ray_origin, &f.frustum_ray_du, &f.frustum_ray_dv})
     m.push_back(Inputs(*ray, 1, 2));
   for (const iv::vec4* v :
@@ -136,7 +170,7 @@ Value FrameInputs(const iv::FrameParams& f) {
   m.push_back(Inputs(f.world_view, 0, 1));
   m.push_back(Inputs(f.lens_centre, 0, 1));
   Value clip_planes = Inputs(f.clip_planes, 0, 1);
-  clip_planes.parts[1] = Value::Float(Input(f.clip_planes.y, 1, 0));
+  clip_planes.parts[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y)));
   m.push_back(std::move(clip_planes));
   return Value::Composite(std::move(m));
 }
@@ -151,8 +185,8 @@ Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention) {
     m.push_back(Inputs(d->inverse_view_projection, 2, 3));
     m.push_back(Inputs(d->view_projection, 2, 3));
     Value coefficients = Inputs(d->coefficients, 2, 3);
-    coefficients.parts[0] = Value::Float(Input(d->coefficients.x, 1, 0));
-    coefficients.parts[1] = Value::Float(Input(d->coefficients.y, 1, 0));
+    coefficients.parts[0] = Value::Float(Lane::Exact(FloatHull(d->coefficients.x)));
+    coefficients.parts[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y)));
     m.push_back(std::move(coefficients));
   } else {
     // Not a projective convention: nothing here is the cell's to read.
@@ -171,53 +205,74 @@ struct Stored {
   std::string why;
 };
 
-// Production as the host models it (encode.h, kFloat32: each operation
-// correctly rounded), then the format's rounding and the fetch.
-// `linear` encloses z / far, which the caller knows tighter than the two
-// ranges' quotient.
-Stored StoredValues(Encoding encoding, const Lane& a, const Lane& b, const Enclosure& far, const Enclosure& z,
+// (1 + u)^n - 1 and (1 + u)^n / (1 - u) - 1: the relative error of n
+// correctly rounded operations, without and with one in the denominator.
+constexpr double Gamma(int n) { return n == 0 ? 0.0 : (1.0 + kU) * (Gamma(n - 1) + 1.0) - 1.0; }
+constexpr double GammaOver(int n) { return (Gamma(n) + 1.0) / (1.0 - kU) - 1.0; }
+
+// The format's rounding of a produced value v, then the fetch back to
+// float32: within relative * |v| + absolute of it.
+struct StorageError {
+  double relative = 0.0, absolute = 0.0;
+};
+StorageError StorageOf(const FormatInfo& format) {
+  switch (format.texel) {
+    case TexelKind::kUnorm: return {kU, 0.5 / (std::ldexp(1.0, format.bits) - 1.0)};  // nearest code, fetched
+    case TexelKind::kFloat16: return {0x1p-11, 0x1p-25};                              // float16's unit roundoff
+    case TexelKind::kFloat32: return {};                                              // stored as produced
+  }
+  return {};
+}
+
+// Production as the host models it (encode.h, kFloat32), then the format's
+// rounding and the fetch. The production's few operations are bounded in
+// closed form, relative to each term, rather than by the lane rules:
+// those would take the largest eye depth of the box over the smallest.
+//   hardware: ndc = (A z~ (1 + d1) + B)(1 + d2) / z~ (1 + d3), z~ = z (1 + d0),
+//             so |ndc - (A + B / z)| <= |A| gamma_3 + |B / z| gamma'_3;
+//             GL-style clip depth then 0.5 ndc + 0.5, one rounding more;
+//   linear:   z~ / far (1 + d1): within gamma_2 of z / far, relatively;
+//   view z:   -z~: within u of it.
+// `a`, `b` and `far` are the float32 values the reference decodes with.
+// `linear` encloses z / far, tighter than the two ranges' quotient.
+Stored StoredValues(Encoding encoding, const Enclosure& a, const Enclosure& b, const Enclosure& far, const Enclosure& z,
                     const Enclosure& linear) {
   const FormatInfo& format = Info(encoding.format);
-  const Lane zf{z, kU * z.mag() + kUnderflow};
-  // The format's rounding of a produced value of magnitude `mag`.
-  auto storage = [&](double mag) {
-    switch (format.texel) {
-      case TexelKind::kUnorm: return 0.5 / (std::ldexp(1.0, format.bits) - 1.0) + kU;
-      case TexelKind::kFloat16: return 0x1p-11 * mag + 0x1p-25;
-      case TexelKind::kFloat32: return 0.0;
-    }
-    return 0.0;
-  };
+  const StorageError storage = StorageOf(format);
   Stored out;
   switch (format.stores) {
     case DepthInput::kHardware: {
-      const bool gl = (Info(encoding.convention).bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
-      const Lane ndc = Divide(Add(Multiply(a, zf), b), zf, kExactlyRounded);
-      Enclosure exact = a.exact + b.exact / z;
-      double produced = ndc.error;
+      const std::uint32_t bits = Info(encoding.convention).bits;
+      const bool gl = (bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
+      const Enclosure b_over_z = b / z;
+      Enclosure value = a + b_over_z;
+      double produced = a.mag() * Gamma(3) + b_over_z.mag() * GammaOver(3) + kUnderflow;
       if (gl) {
-        const Lane window = Add(Multiply(Lane{exact, produced}, Lane::Exact(0.5)), Lane::Exact(0.5));
-        exact = exact * Enclosure(0.5) + Enclosure(0.5);
-        produced = window.error;
+        value = value * Enclosure(0.5) + Enclosure(0.5);
+        produced = 0.5 * produced + kU * (value.mag() + 0.5 * produced) + kUnderflow;
       }
-      const double delta = produced + storage(exact.mag());
-      out.value = Enclosure(std::max(0.0, exact.lo - delta), std::min(1.0, exact.hi + delta));
+      const double delta = produced + storage.relative * value.mag() + storage.absolute;
+      out.value = Enclosure(std::max(0.0, value.lo - delta), std::min(1.0, value.hi + delta));
+      if ((bits & 2u) != 0u) {  // DB_CONVENTION_INFINITE
+        // The stored value that denotes an infinite depth (A, as a window
+        // depth 0 or 1) is not judged; the values next to it are a step of
+        // the format away.
+        const double step = format.texel == TexelKind::kUnorm ? 1.0 / (std::ldexp(1.0, format.bits) - 1.0)
+                            : a.mid() > 0.0                   ? 0x1p-24
+                                                              : 0x1p-149;
+        if (a.mid() > 0.0) {
+          out.value.hi = std::min(out.value.hi, 1.0 - step);
+        } else {
+          out.value.lo = std::max(out.value.lo, step);
+        }
+      }
       // The true value's NDC depth less A is B / z; the stored value's lies
-      // within delta (2 delta in NDC for GL-style clip depth) of it. Where
-      // that may reach 0, the stored value may denote an infinite depth:
-      // such samples are not judged (an infinite far plane's A is 0 or 1,
-      // the stored values next to it are a step of the format away), so
-      // the step is the least distance left.
-      // (A finite far plane's stored values, in [0, 1], stay as far from A
-      // as 0 or 1 does: the second term.)
+      // within delta (2 delta in NDC for GL-style clip depth) of it, and no
+      // nearer A than the stored values themselves.
       const double ndc_delta = (gl ? 2.0 : 1.0) * delta;
       const Enclosure ndc_stored = gl ? out.value * Enclosure(2.0) - Enclosure(1.0) : out.value;
-      double gap = std::max((b.exact / z).mig() - ndc_delta, (ndc_stored - a.exact).mig());
-      if (!(gap > 0.0) && (Info(encoding.convention).bits & 2u) != 0u) {  // DB_CONVENTION_INFINITE
-        const double step = format.texel == TexelKind::kUnorm ? 1.0 / (std::ldexp(1.0, format.bits) - 1.0) : 0x1p-24;
-        gap = (gl ? 2.0 : 1.0) * step;
-      }
-      if (!(gap > 0.0)) {
+      const double gap = std::max(b_over_z.mig() - ndc_delta, (ndc_stored - a).mig());
+      if (!(gap > 0.0) || out.value.lo > out.value.hi) {
         out.why = "stored values that may denote an infinite depth";
         out.depth = INFINITY;
         return out;
@@ -226,17 +281,17 @@ Stored StoredValues(Encoding encoding, const Lane& a, const Lane& b, const Enclo
       return out;
     }
     case DepthInput::kLinear: {
-      const Lane v = Divide(zf, Lane::Exact(far), kExactlyRounded);
-      const Enclosure exact = linear;
-      const double delta = v.error + storage(exact.mag());
-      out.value = Enclosure(std::max(0.0, exact.lo - delta), exact.hi + delta);
-      out.depth = delta / exact.mig();
+      const double relative = Gamma(2) + storage.relative * (1.0 + Gamma(2));
+      const double delta = relative * linear.mag() + storage.absolute;
+      out.value = Enclosure(std::max(0.0, linear.lo - delta), linear.hi + delta);
+      out.depth = relative + storage.absolute / linear.mig();
+      (void)far;
       return out;
     }
     case DepthInput::kViewZ: {
-      const double delta = zf.error;
+      const double delta = kU * z.mag() + kUnderflow;
       out.value = Enclosure(-z.hi - delta, -z.lo + delta);
-      out.depth = delta / z.lo;
+      out.depth = kU + kUnderflow / z.lo;
       return out;
     }
   }
@@ -274,13 +329,33 @@ class CellAnalysis {
     v.rotation = Rotation(box);
     const Inputs in = InputsOf(v);
 
-    const Stored stored = StoredValues(cell_.encoding(), in.a, in.b, in.far, z, linear);
+    Stored stored;
+    Enclosure truth = z;
+    if (box.pick == DepthPick::kEyeDepth) {
+      stored = StoredValues(cell_.encoding(), in.a, in.b, in.far, z, linear);
+    } else {
+      // A pick's truth is the depth it denotes, judged between the near
+      // plane and the far one (none for an infinite far plane, reference.cc).
+      // A denoted point float32 world coordinates cannot hold (infinity,
+      // or past 2^64 from the camera at the domain's smallest scale) is
+      // not judged either.
+      stored.value = PickedValue(box.pick, ratio);
+      truth = DenotedDepths(in, stored.value);
+      const double slack = 0x1p-20;
+      const bool infinite = (convention_.bits & 2u) != 0u;
+      const bool holdable = truth.lo > 0.0 && truth.finite() && truth.lo * domain_.near.min < 0x1p64;
+      if (!holdable || !(truth.hi >= 1.0 - slack) || (!infinite && !(truth.lo <= ratio.hi * (1.0 + slack)))) {
+        box.shader = box.depth = 0.0;  // never judged
+        return;
+      }
+      truth.lo = std::max(truth.lo, 1.0 - slack);
+    }
     box.depth = stored.depth;
     if (!stored.why.empty()) return Fail(box, stored.why);
     Expected<double> error = ShaderError(in, box.d[kPixelX], box.d[kPixelY], stored.value, machine);
     if (!error.ok()) return Fail(box, error.status().message());
     // |true point - camera| = true eye depth * |the pixel's ray per unit eye depth|.
-    box.shader = *error / (z.lo * RayLength(in, box.d[kPixelX], box.d[kPixelY]));
+    box.shader = *error / (truth.lo * RayLength(in, box.d[kPixelX], box.d[kPixelY]));
   }
 
   // What the shader receives for the frames of `v`.
@@ -288,8 +363,8 @@ class CellAnalysis {
     FrameValues<Enclosure> values;
     iv::FrameParams frame;
     Value frame_value, depth_value;
-    Lane a, b;      // the depth mapping's A and B, as the reference reads them
-    Enclosure far;  // the far plane, as the linear formats' reference reads it
+    Enclosure a, b;  // the depth mapping's A and B, as the reference reads them
+    Enclosure far;   // the far plane, as the linear formats' reference reads it
   };
   Inputs InputsOf(const FrameValues<Enclosure>& v) const {
     Inputs in;
@@ -300,9 +375,9 @@ class CellAnalysis {
     if (hardware) depth = EncloseDepthParams(v, cell_.convention);
     in.frame_value = FrameInputs(in.frame);
     in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits);
-    in.a = Input(depth.coefficients.x, 1, 0);
-    in.b = Input(depth.coefficients.y, 1, 0);
-    in.far = Input(in.frame.camera_position.w, 1, 0).exact;
+    in.a = FloatHull(depth.coefficients.x);
+    in.b = LengthFloat(depth.coefficients.y);
+    in.far = LengthFloat(in.frame.camera_position.w);
     return in;
   }
 
@@ -323,6 +398,33 @@ class CellAnalysis {
       sum += lane.lane.error * lane.lane.error;
     }
     return std::sqrt(sum) * (1.0 + 1e-12);
+  }
+
+  // The stored value a pick takes (the fetched float, encode.h EncodeEdge);
+  // a view-z format's far end follows the frame's far plane.
+  Enclosure PickedValue(DepthPick pick, const Enclosure& ratio) const {
+    if (Info(cell_.format).stores == DepthInput::kViewZ) {
+      switch (pick) {
+        case DepthPick::kStoredOne:
+        case DepthPick::kStoredBeforeOne: return -ratio * Enclosure(1.0 - 0x1p-23, 1.0);
+        case DepthPick::kStoredAfterZero: return Enclosure(-0x1p-149);
+        default: return Enclosure(0.0);
+      }
+    }
+    return Enclosure(EncodeEdge(cell_.encoding(), Frame{}, pick).fetched);
+  }
+
+  // The eye depths stored values denote, as the reference decodes them.
+  Enclosure DenotedDepths(const Inputs& in, const Enclosure& stored) const {
+    switch (Info(cell_.format).stores) {
+      case DepthInput::kHardware: {
+        const bool gl = (convention_.bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
+        return in.b / ((gl ? stored * Enclosure(2.0) - Enclosure(1.0) : stored) - in.a);
+      }
+      case DepthInput::kLinear: return stored * in.far;
+      case DepthInput::kViewZ: return -stored;
+    }
+    return Enclosure::Whole();
   }
 
   // The least length of the pixels' rays per unit eye depth.
@@ -355,6 +457,14 @@ class CellAnalysis {
       box.width = r.width;
       box.height = r.height;
       roots.push_back(box);
+      // The sweep's stored-value picks, over every frame and pixel.
+      for (DepthPick pick :
+           {DepthPick::kStoredZero, DepthPick::kStoredOne, DepthPick::kStoredAfterZero, DepthPick::kStoredBeforeOne}) {
+        Box edge = box;
+        edge.pick = pick;
+        edge.d[kDepth] = Enclosure(0.0);
+        roots.push_back(edge);
+      }
     }
     return roots;
   }
@@ -559,17 +669,7 @@ Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32
   const auto in = analysis.InputsOf(v);
   const Enclosure px(pixel_x), py(pixel_y);
   DB_ASSIGN_OR_RETURN(const double error, analysis.ShaderError(in, px, py, stored, machine));
-  // The eye depths the stored values denote, as the reference decodes them.
-  Enclosure depth;
-  switch (Info(cell.format).stores) {
-    case DepthInput::kHardware: {
-      const bool gl = (Info(cell.convention).bits & 4u) != 0u;  // DB_CONVENTION_CLIP_MINUS_ONE
-      depth = in.b.exact / ((gl ? stored * Enclosure(2.0) - Enclosure(1.0) : stored) - in.a.exact);
-      break;
-    }
-    case DepthInput::kLinear: depth = stored * in.far; break;
-    case DepthInput::kViewZ: depth = -stored; break;
-  }
+  const Enclosure depth = analysis.DenotedDepths(in, stored);
   if (!(depth.lo > 0.0)) return InvalidArgument("stored values that denote no depth in front of the camera");
   return error / (depth.lo * CellAnalysis::RayLength(in, px, py));
 }
