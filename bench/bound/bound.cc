@@ -152,10 +152,10 @@ Value Inputs(const iv::mat4& m, double widen, double error) {
 Value FrameInputs(const iv::FrameParams& f) {
   std::vector<Value> m;
   Value camera_world = Inputs(f.camera_world, 0, 1);
-  camera_world.parts[3] = Inputs(f.camera_world[3], 0, 0, 4);
+  camera_world.parts.Mutable()[3] = Inputs(f.camera_world[3], 0, 0, 4);
   m.push_back(std::move(camera_world));
   Value camera_position = Inputs(f.camera_position, 0, 0, 3);
-  camera_position.parts[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w)));
+  camera_position.parts.Mutable()[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w)));
   m.push_back(std::move(camera_position));
   m.push_back(Inputs(f.lens, 0, 1));
   Value resolution = Inputs(f.resolution, 0, 1, 2);  // whole numbers of pixels, then their reciprocals
@@ -170,7 +170,7 @@ Value FrameInputs(const iv::FrameParams& f) {
   m.push_back(Inputs(f.world_view, 0, 1));
   m.push_back(Inputs(f.lens_centre, 0, 1));
   Value clip_planes = Inputs(f.clip_planes, 0, 1);
-  clip_planes.parts[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y)));
+  clip_planes.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y)));
   m.push_back(std::move(clip_planes));
   return Value::Composite(std::move(m));
 }
@@ -185,8 +185,8 @@ Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention) {
     m.push_back(Inputs(d->inverse_view_projection, 2, 3));
     m.push_back(Inputs(d->view_projection, 2, 3));
     Value coefficients = Inputs(d->coefficients, 2, 3);
-    coefficients.parts[0] = Value::Float(Lane::Exact(FloatHull(d->coefficients.x)));
-    coefficients.parts[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y)));
+    coefficients.parts.Mutable()[0] = Value::Float(Lane::Exact(FloatHull(d->coefficients.x)));
+    coefficients.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y)));
     m.push_back(std::move(coefficients));
   } else {
     // Not a projective convention: nothing here is the cell's to read.

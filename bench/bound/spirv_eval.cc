@@ -34,6 +34,35 @@ struct FunctionInfo {
   std::unordered_map<std::uint32_t, std::size_t> labels;  // label id -> instruction index
 };
 
+// Values by id, for one evaluation at a time: a flat array (SPIR-V ids are
+// small and unique in a module), cleared in O(1) by moving to a new
+// generation, so that the many evaluations of one analysis reuse it.
+class IdMap {
+ public:
+  void Clear() { ++generation_; }
+  const Value* Find(std::uint32_t id) const {
+    return id < values_.size() && generations_[id] == generation_ ? &values_[id] : nullptr;
+  }
+  bool Contains(std::uint32_t id) const { return Find(id) != nullptr; }
+  // The value of `id`, empty if it had none in this evaluation.
+  Value& operator[](std::uint32_t id) {
+    if (id >= values_.size()) {
+      values_.resize(id + 1);
+      generations_.resize(id + 1, 0);
+    }
+    if (generations_[id] != generation_) {
+      values_[id] = Value{};
+      generations_[id] = generation_;
+    }
+    return values_[id];
+  }
+
+ private:
+  std::vector<Value> values_;
+  std::vector<std::uint32_t> generations_;
+  std::uint32_t generation_ = 1;
+};
+
 std::string Text(const std::uint32_t* words, std::size_t count) {
   std::string text(reinterpret_cast<const char*>(words), count * sizeof(std::uint32_t));
   return text.substr(0, text.find('\0'));
@@ -52,6 +81,9 @@ class Module {
   std::unordered_map<std::uint32_t, std::string> names, strings;
   std::unordered_map<std::uint32_t, std::size_t> globals;  // module-scope OpVariable -> its instruction
   std::uint32_t glsl_std_450 = 0;
+  std::uint32_t id_bound = 0;
+  // The evaluations' values and variables (one evaluation at a time).
+  mutable IdMap values, memory;
 
   // A value of `type` whose lanes are all undefined (or zero).
   Value Shape(std::uint32_t type_id, bool zero) const {
@@ -82,6 +114,7 @@ class Module {
 
   Status Parse() {
     if (words.size() < 5 || words[0] != spv::MagicNumber) return InvalidArgument("not a SPIR-V module");
+    id_bound = words[3];
     std::uint32_t file = 0, line = 0;
     std::uint32_t function = 0;
     for (std::size_t at = 5; at < words.size();) {
@@ -157,6 +190,7 @@ class Module {
       case spv::OpConstantNull: constants[w[2]] = Shape(w[1], true); break;
       case spv::OpUndef: constants[w[2]] = Shape(w[1], false); break;
       case spv::OpVariable:
+        type_of[w[2]] = w[1];
         if (function == 0) globals[w[2]] = index;
         break;
       case spv::OpFunction:
@@ -268,11 +302,22 @@ Expected<Value> MatrixTimesVector(const Value& m, const Value& v) {
   return EachPart(Transposed(m), [&](const Value& row) { return DotOf(row, v); });
 }
 
-Value* At(Value& root, std::span<const std::uint32_t> path) {
-  Value* v = &root;
+// The part of `root` at `path`, to read; null when there is none.
+const Value* At(const Value& root, std::span<const std::uint32_t> path) {
+  const Value* v = &root;
   for (std::uint32_t index : path) {
     if (v->kind != Value::Kind::kComposite || index >= v->parts.size()) return nullptr;
     v = &v->parts[index];
+  }
+  return v;
+}
+
+// The same, to change: the parts on the way become `root`'s own.
+Value* MutableAt(Value& root, std::span<const std::uint32_t> path) {
+  Value* v = &root;
+  for (std::uint32_t index : path) {
+    if (v->kind != Value::Kind::kComposite || index >= v->parts.size()) return nullptr;
+    v = &v->parts.Mutable()[index];
   }
   return v;
 }
@@ -293,7 +338,11 @@ bool IsFloat(const Value& v) {
 
 class Evaluator {
  public:
-  Evaluator(const Module& module, const Machine& machine) : m_(module), machine_(machine) {}
+  Evaluator(const Module& module, const Machine& machine)
+      : m_(module), machine_(machine), values_(module.values), memory_(module.memory), next_slot_(module.id_bound) {
+    values_.Clear();
+    memory_.Clear();
+  }
 
   Expected<Value> Call(std::uint32_t function_id, std::vector<Value> arguments) {
     const auto found = m_.functions.find(function_id);
@@ -301,10 +350,12 @@ class Evaluator {
       return InvalidArgument("a call to a function with no body");
     if (++depth_ > 64) return InvalidArgument("calls nested more than 64 deep (recursion?)");
     const FunctionInfo& f = found->second;
-    std::unordered_map<std::uint32_t, Value> values;
-    for (std::size_t k = 0; k < f.parameters.size() && k < arguments.size(); ++k)
-      values[f.parameters[k]] = arguments[k];
-    Expected<Value> result = Run(f, values, Name(function_id));
+    // Ids are unique in a module and calls do not recurse, so one map of
+    // values serves every call.
+    for (std::size_t k = 0; k < f.parameters.size() && k < arguments.size(); ++k) {
+      values_[f.parameters[k]] = arguments[k];
+    }
+    Expected<Value> result = Run(f, values_, Name(function_id));
     --depth_;
     return result;
   }
@@ -333,11 +384,11 @@ class Evaluator {
     return InvalidArgument(fmt::format("cannot bound {} in {}{}", what, function, m_.Where(in)));
   }
 
-  Expected<Value> Get(std::unordered_map<std::uint32_t, Value>& values, std::uint32_t id) {
-    if (const auto v = values.find(id); v != values.end()) return v->second;
+  Expected<Value> Get(IdMap& values, std::uint32_t id) {
+    if (const Value* v = values.Find(id)) return *v;
     if (const auto c = m_.constants.find(id); c != m_.constants.end()) return c->second;
     if (const auto g = m_.globals.find(id); g != m_.globals.end()) {
-      if (!memory_.contains(id)) {
+      if (!memory_.Contains(id)) {
         const Instruction& var = m_.code[g->second];
         const std::uint32_t pointee = m_.types.at(var.w[1]).element;
         memory_[id] =
@@ -351,14 +402,14 @@ class Evaluator {
     return InvalidArgument(fmt::format("a value (%{}) it has no bound for", id));
   }
 
-  Expected<std::uint64_t> Known(std::unordered_map<std::uint32_t, Value>& values, std::uint32_t id) {
+  Expected<std::uint64_t> Known(IdMap& values, std::uint32_t id) {
     DB_ASSIGN_OR_RETURN(Value v, Get(values, id));
     if (v.kind != Value::Kind::kInteger)
       return InvalidArgument("an integer or condition that depends on computed floats");
     return v.integer;
   }
 
-  Expected<Value> Float(const Instruction& in, std::unordered_map<std::uint32_t, Value>& values) {
+  Expected<Value> Float(const Instruction& in, IdMap& values) {
     const std::uint32_t* w = in.w;
     DB_ASSIGN_OR_RETURN(Value a, Get(values, w[3]));
     if (in.op == Op::OpFNegate) {
@@ -382,7 +433,7 @@ class Evaluator {
     }
   }
 
-  Expected<Value> Extended(const Instruction& in, std::unordered_map<std::uint32_t, Value>& values) {
+  Expected<Value> Extended(const Instruction& in, IdMap& values) {
     const std::uint32_t* w = in.w;
     if (w[3] != m_.glsl_std_450) return InvalidArgument("an extended instruction outside GLSL.std.450");
     auto operand = [&](int k) { return Get(values, w[k]); };
@@ -422,7 +473,7 @@ class Evaluator {
     }
   }
 
-  Expected<Value> Integer(const Instruction& in, std::unordered_map<std::uint32_t, Value>& values) {
+  Expected<Value> Integer(const Instruction& in, IdMap& values) {
     const std::uint32_t* w = in.w;
     DB_ASSIGN_OR_RETURN(std::uint64_t a, Known(values, w[3]));
     if (in.op == Op::OpNot) return Value::Integer(~a & 0xFFFFFFFFu);
@@ -511,8 +562,7 @@ class Evaluator {
   }
   static bool IsFloatComparison(Op op) { return op >= Op::OpFOrdEqual && op <= Op::OpFUnordGreaterThanEqual; }
 
-  Expected<Value> Run(const FunctionInfo& f, std::unordered_map<std::uint32_t, Value>& values,
-                      const std::string& name) {
+  Expected<Value> Run(const FunctionInfo& f, IdMap& values, const std::string& name) {
     std::size_t pc = f.first;
     std::uint32_t block = 0, previous = 0;
     for (int steps = 0; steps < 1000000; ++steps) {
@@ -580,8 +630,9 @@ class Evaluator {
           return v;
         }
         case Op::OpVariable: {
-          Value initial = in.count > 4 ? Get(values, w[4]).value() : m_.Shape(m_.types.at(w[1]).element, false);
-          memory_[w[2]] = std::move(initial);
+          // Without an initializer it is undefined; its shape is made only
+          // when a part of it is stored first (most are stored whole).
+          memory_[w[2]] = in.count > 4 ? Get(values, w[4]).value() : Value{};
           Value pointer;
           pointer.kind = Value::Kind::kPointer;
           pointer.variable = w[2];
@@ -605,7 +656,7 @@ class Evaluator {
           Expected<Value> pointer = Get(values, w[3]);
           if (!pointer.ok() || pointer->kind != Value::Kind::kPointer)
             return refuse("a load through an unknown pointer");
-          Value* v = At(memory_[pointer->variable], pointer->path);
+          const Value* v = At(memory_[pointer->variable], pointer->path);
           if (v == nullptr) return refuse("a load from outside its variable");
           values[w[2]] = *v;
           break;
@@ -615,7 +666,12 @@ class Evaluator {
           Expected<Value> v = Get(values, w[2]);
           if (!pointer.ok() || pointer->kind != Value::Kind::kPointer || !v.ok())
             return refuse("a store it cannot follow");
-          Value* target = At(memory_[pointer->variable], pointer->path);
+          Value& root = memory_[pointer->variable];
+          if (root.kind == Value::Kind::kUndefined && !pointer->path.empty()) {
+            const auto type = m_.type_of.find(pointer->variable);
+            if (type != m_.type_of.end()) root = m_.Shape(m_.types.at(type->second).element, false);
+          }
+          Value* target = MutableAt(root, pointer->path);
           if (target == nullptr) return refuse("a store outside its variable");
           *target = std::move(v).value();
           break;
@@ -661,7 +717,7 @@ class Evaluator {
           Expected<Value> whole = Get(values, w[4]);
           if (!part.ok() || !whole.ok()) return refuse("an insert of an unknown value");
           Value out = std::move(whole).value();
-          Value* v = At(out, std::span<const std::uint32_t>(w + 5, in.count - 5));
+          Value* v = MutableAt(out, std::span<const std::uint32_t>(w + 5, in.count - 5));
           if (v == nullptr) return refuse("an insert outside its composite");
           *v = std::move(part).value();
           values[w[2]] = std::move(out);
@@ -731,8 +787,9 @@ class Evaluator {
 
   const Module& m_;
   const Machine& machine_;
-  std::unordered_map<std::uint32_t, Value> memory_;
-  std::uint32_t next_slot_ = 0xF0000000u;
+  IdMap& values_;
+  IdMap& memory_;            // variables by id, then the slots of pointer arguments
+  std::uint32_t next_slot_;  // past the module's ids
   int depth_ = 0;
 };
 

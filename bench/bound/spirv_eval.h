@@ -23,12 +23,33 @@
 
 namespace depthbench::bound {
 
+struct Value;
+
+// A composite's parts, shared between copies until one is changed: the
+// programs pass whole parameter blocks by value, and copying them lane by
+// lane was most of the analysis's time.
+class Parts {
+ public:
+  Parts() = default;
+  explicit Parts(std::vector<Value> parts);
+  std::size_t size() const { return parts_ ? parts_->size() : 0; }
+  bool empty() const { return size() == 0; }
+  const Value& operator[](std::size_t k) const { return (*parts_)[k]; }
+  const Value* begin() const;
+  const Value* end() const;
+  // The parts, this value's own (copied first when shared).
+  std::vector<Value>& Mutable();
+
+ private:
+  std::shared_ptr<std::vector<Value>> parts_;
+};
+
 struct Value {
   enum class Kind : std::uint8_t { kUndefined, kFloat, kInteger, kComputedBool, kComposite, kPointer };
   Kind kind = Kind::kUndefined;
   Lane lane;                        // kFloat
   std::uint64_t integer = 0;        // kInteger (booleans are 0 and 1)
-  std::vector<Value> parts;         // kComposite: members, components or columns
+  Parts parts;                      // kComposite: members, components or columns
   std::uint32_t variable = 0;       // kPointer: the variable
   std::vector<std::uint32_t> path;  // kPointer: the indices into it
 
@@ -47,10 +68,22 @@ struct Value {
   static Value Composite(std::vector<Value> parts) {
     Value v;
     v.kind = Kind::kComposite;
-    v.parts = std::move(parts);
+    v.parts = Parts(std::move(parts));
     return v;
   }
 };
+
+inline Parts::Parts(std::vector<Value> parts) : parts_(std::make_shared<std::vector<Value>>(std::move(parts))) {}
+inline const Value* Parts::begin() const { return parts_ ? parts_->data() : nullptr; }
+inline const Value* Parts::end() const { return parts_ ? parts_->data() + parts_->size() : nullptr; }
+inline std::vector<Value>& Parts::Mutable() {
+  if (!parts_) {
+    parts_ = std::make_shared<std::vector<Value>>();
+  } else if (parts_.use_count() > 1) {
+    parts_ = std::make_shared<std::vector<Value>>(*parts_);
+  }
+  return *parts_;
+}
 
 class Module;
 
