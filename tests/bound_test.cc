@@ -305,6 +305,27 @@ TEST(BoundTest, EveryStoredValueOfABinadeLiesWithinTheBound) {
   }
 }
 
+// The HLSL example restates inverse_vp; glslang's HLSL front end holds its
+// matrices transposed (rows as SPIR-V columns, read row-major), and the
+// bound must read them so: its bound is inverse_vp's, to a fraction of a
+// bit (the two programs order a few operations differently).
+TEST(BoundTest, AnHlslFunctionIsBoundedAsItsGlslTwin) {
+  DEPTHBENCH_FIGURES_ONLY("AShaderEditMovesItsBound");
+  auto catalogue =
+      MakeCatalogue({(fs::path(DEPTHBENCH_SOURCE_DIR) / "bench/examples/unity_world_position.hlsl").string()});
+  ASSERT_TRUE(catalogue.ok()) << catalogue.status().message();
+  const Variant hlsl = (*catalogue)->variants().back().id;
+  const std::vector<Cell> cells = {
+      (*catalogue)->MakeCell(Variant::kInverseVp, Convention::kReversed, Format::kD32Sfloat),
+      (*catalogue)->MakeCell(hlsl, Convention::kReversed, Format::kD32Sfloat)};
+  bound::BoundOptions options;
+  options.splits = 30;
+  auto bounds = bound::BoundCells(NarrowDomain(), cells, kShaders, options);
+  ASSERT_TRUE(bounds.ok()) << bounds.status().message();
+  ASSERT_TRUE(std::isfinite((*bounds)[1].device_shader)) << (*bounds)[1].unbounded;
+  EXPECT_NEAR(bound::BoundBits((*bounds)[1].device_shader), bound::BoundBits((*bounds)[0].device_shader), 0.5);
+}
+
 // A user's edit of divide that adds about 1 to the NDC depth and takes it
 // away again: under reversed Z the depth is small, and the sum keeps few
 // of its bits. Its bound rises far above divide's, as what lavapipe

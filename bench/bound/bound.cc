@@ -136,9 +136,15 @@ Value Inputs(const iv::vec4& v, double widen, double error, int exact_lanes = 0)
     parts.push_back(Value::Float(k < exact_lanes ? Lane::Exact(v[k]) : Input(v[k], widen, error)));
   return Value::Composite(std::move(parts));
 }
-Value Inputs(const iv::mat4& m, double widen, double error) {
+// A matrix's columns; `transposed`: its rows, as a program that reads its
+// buffers row-major holds it (SpirvProgram::RowMajorMatrices).
+Value Inputs(const iv::mat4& m, double widen, double error, bool transposed) {
   std::vector<Value> columns;
-  for (int c = 0; c < 4; ++c) columns.push_back(Inputs(m[c], widen, error));
+  for (int c = 0; c < 4; ++c) {
+    iv::vec4 column = m[c];
+    if (transposed) column = iv::vec4(m[0][c], m[1][c], m[2][c], m[3][c]);
+    columns.push_back(Inputs(column, widen, error));
+  }
   return Value::Composite(std::move(columns));
 }
 
@@ -149,10 +155,15 @@ Value Inputs(const iv::mat4& m, double widen, double error) {
 // far plane (the linear formats' reference decodes with the float far
 // plane, so the frustum rays, which scale with the exact far plane, are a
 // further ulp from what it denotes).
-Value FrameInputs(const iv::FrameParams& f) {
+Value FrameInputs(const iv::FrameParams& f, bool transposed) {
   std::vector<Value> m;
-  Value camera_world = Inputs(f.camera_world, 0, 1);
-  camera_world.parts.Mutable()[3] = Inputs(f.camera_world[3], 0, 0, 4);
+  Value camera_world = Inputs(f.camera_world, 0, 1, transposed);
+  if (transposed) {
+    for (int r = 0; r < 3; ++r)
+      camera_world.parts.Mutable()[r].parts.Mutable()[3] = Value::Float(Lane::Exact(f.camera_world[3][r]));
+  } else {
+    camera_world.parts.Mutable()[3] = Inputs(f.camera_world[3], 0, 0, 4);
+  }
   m.push_back(std::move(camera_world));
   Value camera_position = Inputs(f.camera_position, 0, 0, 3);
   camera_position.parts.Mutable()[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w)));
@@ -167,7 +178,7 @@ Value FrameInputs(const iv::FrameParams& f) {
         &f.eye_ray_view_du, &f.eye_ray_view_dv, &f.eye_ray_world_origin, &f.eye_ray_world_du, &f.eye_ray_world_dv}) {
     m.push_back(Inputs(*v, 0, 1));
   }
-  m.push_back(Inputs(f.world_view, 0, 1));
+  m.push_back(Inputs(f.world_view, 0, 1, transposed));
   m.push_back(Inputs(f.lens_centre, 0, 1));
   Value clip_planes = Inputs(f.clip_planes, 0, 1);
   clip_planes.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y)));
@@ -179,11 +190,11 @@ Value FrameInputs(const iv::FrameParams& f) {
 // float32 A and B (encode.h), so those arrive exactly; P = 1/B, Q = -A/B
 // and the matrices are rounded from the exact frame's, up to two ulps from
 // what the float A and B give, plus their own rounding.
-Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention) {
+Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention, bool transposed) {
   std::vector<Value> m;
   if (d != nullptr) {
-    m.push_back(Inputs(d->inverse_view_projection, 2, 3));
-    m.push_back(Inputs(d->view_projection, 2, 3));
+    m.push_back(Inputs(d->inverse_view_projection, 2, 3, transposed));
+    m.push_back(Inputs(d->view_projection, 2, 3, transposed));
     Value coefficients = Inputs(d->coefficients, 2, 3);
     coefficients.parts.Mutable()[0] = Value::Float(Lane::Exact(FloatHull(d->coefficients.x)));
     coefficients.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y)));
@@ -373,8 +384,9 @@ class CellAnalysis {
     iv::DepthParams depth{};
     const bool hardware = convention_.hardware;
     if (hardware) depth = EncloseDepthParams(v, cell_.convention);
-    in.frame_value = FrameInputs(in.frame);
-    in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits);
+    const bool transposed = program_.program->RowMajorMatrices();
+    in.frame_value = FrameInputs(in.frame, transposed);
+    in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits, transposed);
     in.a = FloatHull(depth.coefficients.x);
     in.b = LengthFloat(depth.coefficients.y);
     in.far = LengthFloat(in.frame.camera_position.w);

@@ -82,6 +82,7 @@ class Module {
   std::unordered_map<std::uint32_t, std::size_t> globals;  // module-scope OpVariable -> its instruction
   std::uint32_t glsl_std_450 = 0;
   std::uint32_t id_bound = 0;
+  bool row_major = false;  // some member is decorated RowMajor
   // The evaluations' values and variables (one evaluation at a time).
   mutable IdMap values, memory;
 
@@ -142,6 +143,9 @@ class Module {
     switch (in.op) {
       case spv::OpName: names[w[1]] = Text(w + 2, in.count - 2); break;
       case spv::OpString: strings[w[1]] = Text(w + 2, in.count - 2); break;
+      case spv::OpMemberDecorate:
+        if (in.count > 3 && w[3] == spv::DecorationRowMajor) row_major = true;
+        break;
       case spv::OpExtInstImport:
         if (Text(w + 2, in.count - 2) == "GLSL.std.450") glsl_std_450 = w[1];
         break;
@@ -806,6 +810,8 @@ Expected<SpirvProgram> SpirvProgram::Parse(std::span<const std::uint32_t> words)
   DB_RETURN_IF_ERROR(module->Parse());
   return SpirvProgram(std::move(module));
 }
+
+bool SpirvProgram::RowMajorMatrices() const { return module_->row_major; }
 
 Expected<std::uint32_t> SpirvProgram::Function(std::string_view name) const {
   const std::string prefix = std::string(name) + "(";

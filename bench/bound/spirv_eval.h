@@ -100,6 +100,12 @@ class SpirvProgram {
   // mangled names); NotFound otherwise.
   Expected<std::uint32_t> Function(std::string_view name) const;
 
+  // Whether the module's buffer blocks hold matrices row-major: what
+  // glslang's HLSL front end makes of HLSL's column_major default (its
+  // matrices' rows are SPIR-V's columns). A parameter block read from such
+  // a buffer holds each matrix transposed.
+  bool RowMajorMatrices() const;
+
   // Evaluates `function` on `arguments` (values, not pointers: a parameter
   // the compiler passes by pointer gets a variable holding its argument).
   // The error says what could not be bounded, and where.
