@@ -618,7 +618,10 @@ Status CheckCovered(const Domain& domain) {
     return InvalidArgument("bounds cover exact shader constants only (this domain computes them in float32)");
   }
   if (domain.production != ProductionModel::kFloat32) {
-    return InvalidArgument("bounds cover the float32 production model only");
+    return InvalidArgument(
+        "bounds cover the compute form's float32 production only (--production float32): the raster form's depths "
+        "come from the device's rasterizer, which the specification gives no tolerance for, and exact production "
+        "decodes with the exact frame");
   }
   return Status::Ok();
 }
