@@ -30,8 +30,12 @@ struct BoundFlags {
   BackendFlags backends;
 };
 
+// A bound in bits lost; "24+" where it allows an error as large as the
+// distance (nothing is guaranteed, as "none" where no bound holds).
 std::string Bits(double relative) {
-  return std::isfinite(relative) ? fmt::format("{:.1f}", bound::BoundBits(relative)) : "none";
+  if (!std::isfinite(relative)) return "none";
+  const double bits = bound::BoundBits(relative);
+  return bits >= kAllBitsLost ? "24+" : fmt::format("{:.1f}", bits);
 }
 
 // The measured worst of one metric of a cell over every judged sample.
@@ -103,8 +107,10 @@ Expected<int> Bound(const BoundFlags& f, const CommandContext& context) {
     if (!std::isfinite(b.device_shader) || !std::isfinite(b.total)) json["unbounded"] = b.unbounded;
     rows.push_back(std::move(json));
   }
-  out.text << fmt::format("Proven bounds over {} (bits lost; measured: the worst of {} samples)\n", domain.Describe(),
-                          samples);
+  out.text << fmt::format(
+      "Proven bounds over {} (bits lost; 24+: an error as large as the distance is not excluded; measured: the "
+      "worst of {} samples)\n",
+      domain.Describe(), samples);
   table.Print(out);
   for (const bound::CellBound& b : bounds) {
     if (!b.unbounded.empty()) out.text << fmt::format("{}: no bound: {}\n", b.cell.Name(), b.unbounded);
