@@ -335,11 +335,6 @@ void Flatten(const Value& v, std::vector<Value>& out) {
   }
 }
 
-bool IsFloat(const Value& v) {
-  if (v.kind == Value::Kind::kFloat) return true;
-  return v.kind == Value::Kind::kComposite && !v.parts.empty() && IsFloat(v.parts[0]);
-}
-
 class Evaluator {
  public:
   Evaluator(const Module& module, const Machine& machine)

@@ -32,9 +32,10 @@ class Parts {
  public:
   Parts() = default;
   explicit Parts(std::vector<Value> parts);
-  std::size_t size() const { return parts_ ? parts_->size() : 0; }
+  // (Defined after Value: a vector's element must be complete to index it.)
+  std::size_t size() const;
   bool empty() const { return size() == 0; }
-  const Value& operator[](std::size_t k) const { return (*parts_)[k]; }
+  const Value& operator[](std::size_t k) const;
   const Value* begin() const;
   const Value* end() const;
   // The parts, this value's own (copied first when shared).
@@ -74,6 +75,8 @@ struct Value {
 };
 
 inline Parts::Parts(std::vector<Value> parts) : parts_(std::make_shared<std::vector<Value>>(std::move(parts))) {}
+inline std::size_t Parts::size() const { return parts_ ? parts_->size() : 0; }
+inline const Value& Parts::operator[](std::size_t k) const { return (*parts_)[k]; }
 inline const Value* Parts::begin() const { return parts_ ? parts_->data() : nullptr; }
 inline const Value* Parts::end() const { return parts_ ? parts_->data() + parts_->size() : nullptr; }
 inline std::vector<Value>& Parts::Mutable() {
