@@ -179,6 +179,30 @@ Expected<std::vector<FuzzPoint>> ReadCorpus(const std::vector<std::filesystem::p
   return points;
 }
 
+// Shrinks each finding on its own cell and backend, then rewrites its file
+// with the shrunk case and the final hit count. A signal stops this after
+// the file in hand; the findings not reached keep the case as found.
+Status ShrinkFindings(const CampaignOptions& options, const std::vector<Backend*>& backend_list,
+                      CampaignResult& result) {
+  for (CampaignFinding& finding : result.findings) {
+    if (Interrupted()) break;
+    Backend* backend = *std::find_if(backend_list.begin(), backend_list.end(),
+                                     [&](Backend* b) { return b->name() == finding.backend; });
+    DB_ASSIGN_OR_RETURN(CaseChecker one, CaseChecker::Make({finding.cell}, {backend}, 1));
+    if (!options.proven.empty()) {
+      const auto c = static_cast<std::size_t>(std::find(options.cells.begin(), options.cells.end(), finding.cell) -
+                                              options.cells.begin());
+      const auto b =
+          static_cast<std::size_t>(std::find(backend_list.begin(), backend_list.end(), backend) - backend_list.begin());
+      one.SetProvenBounds({options.proven[c * backend_list.size() + b]});
+    }
+    DB_ASSIGN_OR_RETURN(finding.shrunk, Shrink(one, finding.first, finding.kind, options.domain));
+    DB_ASSIGN_OR_RETURN(finding.judgement, CheckOne(one, finding.shrunk));
+    if (!options.out.empty()) DB_RETURN_IF_ERROR(WriteFinding(finding));
+  }
+  return Status::Ok();
+}
+
 Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (options.seconds <= 0 && options.cases == 0)
@@ -308,25 +332,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
   }
   result.seconds = elapsed();
 
-  // Shrink each finding on its own cell and backend, then rewrite its file
-  // with the shrunk case and the final hit count. A signal stops this after
-  // the file in hand; the findings not reached keep the case as found.
-  for (CampaignFinding& finding : result.findings) {
-    if (Interrupted()) break;
-    Backend* backend = *std::find_if(backend_list.begin(), backend_list.end(),
-                                     [&](Backend* b) { return b->name() == finding.backend; });
-    DB_ASSIGN_OR_RETURN(CaseChecker one, CaseChecker::Make({finding.cell}, {backend}, 1));
-    if (!options.proven.empty()) {
-      const auto c = static_cast<std::size_t>(std::find(options.cells.begin(), options.cells.end(), finding.cell) -
-                                              options.cells.begin());
-      const auto b =
-          static_cast<std::size_t>(std::find(backend_list.begin(), backend_list.end(), backend) - backend_list.begin());
-      one.SetProvenBounds({options.proven[c * backend_list.size() + b]});
-    }
-    DB_ASSIGN_OR_RETURN(finding.shrunk, Shrink(one, finding.first, finding.kind, options.domain));
-    DB_ASSIGN_OR_RETURN(finding.judgement, CheckOne(one, finding.shrunk));
-    if (!options.out.empty()) DB_RETURN_IF_ERROR(WriteFinding(finding));
-  }
+  DB_RETURN_IF_ERROR(ShrinkFindings(options, backend_list, result));
   return result;
 }
 
