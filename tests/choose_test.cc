@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "bench/backends/factory.h"
@@ -238,6 +239,46 @@ TEST(ChooseTest, SpeedFileCostsAllCandidatesOrNone) {
 
 // choose gates a scene in CI: exit 1 when nothing meets the requirement,
 // with the decision in --json.
+// requirement.level = "bound": the proven bound decides. It is held
+// against the limit (a limit just below the choice's bound turns it down),
+// and it is a bound: no candidate's measured maximum exceeds it, and
+// bounds in world units at a depth follow from the relative one.
+TEST(ChooseTest, ProvenRequirementIsDecidedByTheBound) {
+  const std::string dir = testing::MakeTempDir("proven_scene");
+  const auto scene_with = [&](const std::string& name, double limit) {
+    return WriteScene(dir, name, "0.5", "500",
+                      fmt::format("resolution = [1280, 720]\n[engine]\nvariants = [\"divide\", \"frustum_ray\"]\n"
+                                  "formats = [\"d32_sfloat\", \"r32_sfloat\"]\n[requirement]\nabsolute_error = {}\n"
+                                  "at_depth = 400\nlevel = \"bound\"\n",
+                                  limit));
+  };
+  const ChooseResult loose = ChooseFor(scene_with("loose", 0.05), "", 20000);
+  ASSERT_TRUE(loose.proven);
+  ASSERT_TRUE(loose.Met()) << loose.ranked.front().reason;
+  for (const CandidateVerdict& v : loose.ranked) {
+    ASSERT_FALSE(std::isnan(v.proven)) << v.cell.Name();
+    if (!std::isfinite(v.proven)) {
+      EXPECT_FALSE(v.unproven.empty()) << v.cell.Name();
+      continue;
+    }
+    // A bound over every input of the population holds every sample of it.
+    EXPECT_LE(v.measured_max, v.proven) << v.cell.Name();
+    EXPECT_EQ(v.meets, v.proven <= 0.05) << v.cell.Name();
+  }
+  const CandidateVerdict& choice = loose.ranked.front();
+  EXPECT_NE(choice.reason.find("on any conformant Vulkan device"), std::string::npos) << choice.reason;
+  // Just below the choice's bound, the choice no longer meets the limit.
+  const ChooseResult tight = ChooseFor(scene_with("tight", choice.proven * 0.99), "", 20000);
+  bool seen = false;
+  for (const CandidateVerdict& v : tight.ranked) {
+    if (!(v.cell == choice.cell)) continue;
+    seen = true;
+    EXPECT_FALSE(v.meets) << v.reason;
+  }
+  EXPECT_TRUE(seen);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ChooseTest, NothingMeetsExitsWithOne) {
   const std::string dir = testing::MakeTempDir("impossible_scene");
   const std::string impossible =

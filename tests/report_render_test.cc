@@ -120,7 +120,7 @@ TEST(ReportRenderTest, FirstScreenSaysDoNotUseWhereNothingIsKept) {
   const std::string lost_line = "| " + lost.convention + " | " + lost.format + " | **do not use**: keeps nothing |";
   EXPECT_NE(summary.find(lost_line), std::string::npos) << summary;
   const std::string kept_line = "| " + kept.convention + " | " + kept.format + " | `inverse_vp` (= pq, reciprocal, "
-                                "divide) | 1e4 | 20.2 [20.1, 20.3] | 3.1 mm | 31 m | 8 |";
+                                "divide) | 1e4 | 20.2 [20.1, 20.3] | none | 3.1 mm | 31 m | 8 |";
   EXPECT_NE(summary.find(kept_line), std::string::npos) << summary;
 }
 

@@ -182,10 +182,20 @@ TEST(ReportFirstScreenTest, EveryIntervalHoldsItsPoint) {
                                 "--backend", "cpu", "--no-speed", "--no-history", "--out", out});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json doc = json::parse(ReadText(out + "/results.json"));
-  std::size_t infinite = 0, with_interval = 0;
+  std::size_t infinite = 0, with_interval = 0, proven = 0;
   for (const json& row : doc["recommendations"]) {
     const std::string name = row["convention"].get<std::string>() + "/" + row["format"].get<std::string>();
     if (row["ratio"] == "inf") ++infinite;
+    // The proven bound is at or above every sample of the row's population,
+    // so at or above the lower end of its far-plane p99.9. Not where the
+    // row keeps nothing: there the far plane's figure is the model's, past
+    // the last stored value before the one that denotes infinity, and no
+    // judged sample reaches it (reversed-inf/d16_unorm: the model says 24,
+    // every sample 23.0 at most, the bound 23.0).
+    if (!row["proven_bits"].is_null() && !row["bits_low"].is_null() && !row["keeps_nothing"].get<bool>()) {
+      ++proven;
+      EXPECT_LE(row["bits_low"].get<double>(), row["proven_bits"].get<double>()) << name;
+    }
     // null: every bit lost, or no interval (a fit without a covariance).
     if (row["bits"].is_null() || row["bits_low"].is_null() || row["bits_high"].is_null()) continue;
     ++with_interval;
@@ -195,6 +205,7 @@ TEST(ReportFirstScreenTest, EveryIntervalHoldsItsPoint) {
   }
   EXPECT_EQ(infinite, 4u) << "two infinite-far conventions, two formats";
   EXPECT_EQ(with_interval, doc["recommendations"].size());
+  EXPECT_EQ(proven, 3u) << "standard (d16, d32f) and reversed-inf/d32f keep bits, and each is bounded";
   fs::remove_all(out);
 }
 

@@ -152,7 +152,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"[camera]", "[cameras]", "bad.toml:8:1: cameras: unknown field; allowed here: name, projection"},
         BadScene{"resolution = [1920, 1080]", "resolution = [1920]",
                  "projection.resolution: expected [width, height] in pixels"},
-        BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\""},
+        BadScene{"[requirement]", "[requirement]\nlevel = \"p42\"", "requirement.level: allowed: \"p99.9\", \"max\", \"bound\""},
         BadScene{"name = \"test\"", "name = \"test\"\nbroken = = 1", "bad.toml:2:"},
         BadScene{"aspect = 1.78", "aspect = 1.78\neye_fov = [-40, 40, 30, -30]",
                  "eye_fov sets the lens; give one or the other"},

@@ -342,8 +342,15 @@ class CellAnalysis {
 
     Stored stored;
     Enclosure truth = z;
+    const Enclosure interest = Interest();
     if (box.pick == DepthPick::kEyeDepth) {
-      stored = StoredValues(cell_.encoding(), in.a, in.b, in.far, z, linear);
+      // Only the eye depths of interest are drawn.
+      if (!(z.hi >= interest.lo && z.lo <= interest.hi)) return NeverJudged(box);
+      const Enclosure drawn(std::max(z.lo, interest.lo), std::min(z.hi, interest.hi));
+      const Enclosure drawn_linear(std::max(linear.lo, (Enclosure(drawn.lo) / ratio).lo),
+                                   std::min(linear.hi, (Enclosure(drawn.hi) / ratio).hi));
+      truth = drawn;
+      stored = StoredValues(cell_.encoding(), in.a, in.b, in.far, drawn, drawn_linear);
     } else {
       // A pick's truth is the depth it denotes, judged between the near
       // plane and the far one (none for an infinite far plane, reference.cc).
@@ -355,11 +362,10 @@ class CellAnalysis {
       const double slack = 0x1p-20;
       const bool infinite = (convention_.bits & 2u) != 0u;
       const bool holdable = truth.lo > 0.0 && truth.finite() && truth.lo * domain_.near.min < 0x1p64;
-      if (!holdable || !(truth.hi >= 1.0 - slack) || (!infinite && !(truth.lo <= ratio.hi * (1.0 + slack)))) {
-        box.shader = box.depth = 0.0;  // never judged
-        return;
-      }
-      truth.lo = std::max(truth.lo, 1.0 - slack);
+      const double nearest = std::max(1.0, interest.lo) * (1.0 - slack);
+      const double farthest = std::min(infinite ? INFINITY : ratio.hi, interest.hi) * (1.0 + slack);
+      if (!holdable || !(truth.hi >= nearest) || !(truth.lo <= farthest)) return NeverJudged(box);
+      truth.lo = std::max(truth.lo, nearest);
     }
     box.depth = stored.depth;
     if (!stored.why.empty()) return Fail(box, stored.why);
@@ -453,9 +459,8 @@ class CellAnalysis {
     std::vector<Box> roots;
     for (const Resolution& r : domain_.resolutions) {
       Box box;
-      const double ratio_lo = domain_.finite_far ? domain_.ratio.min : Domain::kInfiniteDepthSpan;
-      const double ratio_hi = domain_.finite_far ? domain_.ratio.max : Domain::kInfiniteDepthSpan;
-      box.d[kLogRatio] = Enclosure(std::log(ratio_lo), std::log(ratio_hi));
+      const Range ratio = Ratios();
+      box.d[kLogRatio] = Enclosure(std::log(ratio.min), std::log(ratio.max));
       box.d[kDepth] = Enclosure(0.0, 1.0);
       box.d[kPixelX] = Enclosure(0.0, r.width - 1.0);
       box.d[kPixelY] = Enclosure(0.0, r.height - 1.0);
@@ -482,6 +487,21 @@ class CellAnalysis {
   }
 
  private:
+  // The far/near ratios of the domain's frames: an absolute far plane's
+  // over every near plane it may meet. Infinite-far frames reach
+  // kInfiniteDepthSpan.
+  Range Ratios() const {
+    if (!domain_.finite_far) return {Domain::kInfiniteDepthSpan, Domain::kInfiniteDepthSpan};
+    if (!domain_.far) return domain_.ratio;
+    return {domain_.far->min / domain_.near.max, domain_.far->max / domain_.near.min};
+  }
+  // The eye depths of interest in near planes (reference.cc judges only
+  // those): an absolute range over every near plane it may meet.
+  Enclosure Interest() const {
+    if (!domain_.eye_depth) return {0.0, INFINITY};
+    return Enclosure::Outward(domain_.eye_depth->min / domain_.near.max, domain_.eye_depth->max / domain_.near.min);
+  }
+  static void NeverJudged(Box& box) { box.shader = box.depth = 0.0; }
   static void Fail(Box& box, std::string why) {
     box.shader = INFINITY;
     box.why = std::move(why);
@@ -611,9 +631,6 @@ Expected<CellProgram> ProgramOf(const Cell& cell, const std::filesystem::path& s
 Status CheckCovered(const Domain& domain) {
   if (domain.orthographic) return InvalidArgument("bounds cover perspective domains only (this one is orthographic)");
   if (domain.capture) return InvalidArgument("bounds cover drawn domains only (this one is a captured frame)");
-  if (domain.eye_depth || domain.far) {
-    return InvalidArgument("bounds cover domains of far/near ratios only (this one names absolute depths)");
-  }
   if (domain.constants != ConstantsModel::kExact) {
     return InvalidArgument("bounds cover exact shader constants only (this domain computes them in float32)");
   }
@@ -658,6 +675,30 @@ Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<cons
     if (progress) progress(bounds.size(), cells.size());
   }
   return bounds;
+}
+
+double LongestRay(const Domain& domain) {
+  double tan_x = 0.0, tan_y = 0.0;
+  if (domain.eye_fov) {
+    const EyeFov& e = *domain.eye_fov;
+    tan_x = std::max(std::fabs(e.TanLeft()), std::fabs(e.TanRight()));
+    tan_y = std::max(std::fabs(e.TanUp()), std::fabs(e.TanDown()));
+  } else {
+    tan_y = std::tan(domain.fov_degrees.max * kPi / 360.0);
+    tan_x = tan_y * domain.aspect.max;
+  }
+  if (domain.jitter > 0.0) {
+    // A shift of `jitter` pixels moves the lens by 2 jitter / size of its
+    // half extent, at most (CellAnalysis::LensOf).
+    std::uint32_t width = UINT32_MAX, height = UINT32_MAX;
+    for (const Resolution& r : domain.resolutions) {
+      width = std::min(width, r.width);
+      height = std::min(height, r.height);
+    }
+    tan_x *= 1.0 + 2.0 * domain.jitter / width;
+    tan_y *= 1.0 + 2.0 * domain.jitter / height;
+  }
+  return std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y) * (1.0 + 1e-12);
 }
 
 Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,

@@ -56,12 +56,18 @@ struct BoundOptions {
 
 // Bounds for `cells` over `domain`, from the programs of `shader_dir`.
 // InvalidArgument when the domain is one the analysis does not cover
-// (orthographic, a captured frame, an absolute depth range, constants in
-// float32); a cell whose program cannot be bounded gets its reason.
+// (orthographic, a captured frame, constants in float32); an absolute far
+// plane or eye-depth range is taken over every near plane it may meet. A
+// cell whose program cannot be bounded gets its reason.
 // `progress(done, total)` is called after each cell.
 Expected<std::vector<CellBound>> BoundCells(const Domain& domain, std::span<const Cell> cells,
                                             const std::filesystem::path& shader_dir, const BoundOptions& options,
                                             const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+// The longest distance from the camera per unit of eye depth that any
+// pixel of the domain's frames has (its lens, off-centre or jittered):
+// what turns a relative bound into world units at a given eye depth.
+double LongestRay(const Domain& domain);
 
 // The shader part's bound for one frame (its camera's rotation and
 // position included), one pixel and a range of stored values, relative to

@@ -14,6 +14,7 @@
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/resources.h"
 #include "bench/base/text_table.h"
+#include "bench/bound/bound.h"
 #include "bench/pipeline/captured.h"
 #include "bench/speed/instruction_mix.h"
 #include "bench/speed/speed_results.h"
@@ -199,6 +200,7 @@ namespace {
 // never leaves the origin) or the requirement's depth (at the far end).
 struct Populations {
   Results scene, origin, depth, far;
+  Domain judged_domain;  // the requirement's population (judged()'s)
   bool own_origin = false, own_depth = false, own_far = false;
   const Results& at_origin() const { return own_origin ? origin : scene; }
   const Results& judged() const { return own_depth ? depth : scene; }
@@ -235,8 +237,11 @@ Expected<Populations> Measure(const Scene& scene, Backend& backend, const std::v
     DB_ASSIGN_OR_RETURN(p.origin, RunSweep(origin, backends));
     p.own_origin = true;
   }
+  p.judged_domain = whole.domain;
   if (req.at_depth) {
-    DB_ASSIGN_OR_RETURN(p.depth, RunSweep(Before(whole, *req.at_depth), backends));
+    const SweepOptions before = Before(whole, *req.at_depth);
+    p.judged_domain = before.domain;
+    DB_ASSIGN_OR_RETURN(p.depth, RunSweep(before, backends));
     p.own_depth = true;
   }
   // The far end, directly: what a far-end prediction is checked against.
@@ -285,9 +290,37 @@ std::vector<DepthFigure> ByDepth(const Scene& scene, const CellResult& in_scene)
   return figures;
 }
 
+// A proven relative bound (bound.h CellBound::total) in the requirement's
+// unit: an absolute error at the requirement's depth is at most that
+// depth times the longest ray per unit of eye depth times the bound.
+double ProvenInUnit(const Requirement& req, const Domain& domain, double total) {
+  switch (req.kind) {
+    case Requirement::Kind::kAbsolute: return total * req.at_depth.value_or(DepthLimit(domain)) * bound::LongestRay(domain);
+    case Requirement::Kind::kRelative: return total;
+    case Requirement::Kind::kBitsLost: return bound::BoundBits(total);
+  }
+  return INFINITY;
+}
+
+// The proven bounds of `cells` over the requirement's population, in the
+// order of `cells`; empty for a measured requirement.
+Expected<std::vector<bound::CellBound>> ProveCandidates(const Scene& scene, const Populations& p,
+                                                        const std::vector<Cell>& cells, const ChooseOptions& options) {
+  if (!scene.requirement.proven) return std::vector<bound::CellBound>{};
+  std::filesystem::path dir = options.shader_dir;
+  if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
+  bound::BoundOptions bound_options;
+  bound_options.splits = options.bound_splits;
+  Expected<std::vector<bound::CellBound>> bounds =
+      bound::BoundCells(p.judged_domain, cells, dir, bound_options, options.bound_progress);
+  if (!bounds.ok()) return bounds.status().WithContext("requirement.level = \"bound\"");
+  return bounds;
+}
+
 // One candidate's verdict; nullopt when a population lacks it.
 std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, const Populations& p,
-                                      const std::string& backend, const CostLookup& cost_of) {
+                                      const std::string& backend, const CostLookup& cost_of,
+                                      const bound::CellBound* proven) {
   const Requirement& req = scene.requirement;
   const CellResult* at_depth = p.judged().Find(cell, backend);
   const CellResult* in_scene = p.scene.Find(cell, backend);
@@ -325,6 +358,14 @@ std::optional<CandidateVerdict> Judge(const Scene& scene, const Cell& cell, cons
   // only if the sampling error cannot be what makes it pass.
   v.meets = v.supported && v.interval.high <= req.value && v.nonfinite == 0;
   v.too_close = v.supported && v.nonfinite == 0 && v.measured <= req.value && !v.meets;
+  if (req.proven) {
+    // The bound decides: it holds for every input of the population, so
+    // no sampling interval or sample count enters.
+    v.proven = proven != nullptr ? ProvenInUnit(req, p.judged_domain, proven->total) : INFINITY;
+    if (!std::isfinite(v.proven)) v.unproven = proven != nullptr ? proven->unbounded : "not bounded";
+    v.meets = v.nonfinite == 0 && v.proven <= req.value;
+    v.too_close = false;
+  }
   v.cost = cost_of ? cost_of(cell) : std::nullopt;
   v.over_budget = scene.max_cost && v.cost && v.cost->value > *scene.max_cost;
   return v;
@@ -351,10 +392,10 @@ Status CheckSupported(const ChooseResult& result, const Requirement& req, const 
 }
 
 // The ranking (ranking.h), on the upper end of each interval.
-void RankVerdicts(ChooseResult& result) {
+void RankVerdicts(ChooseResult& result, bool req_proven) {
   std::vector<RankInput> inputs;
   for (const CandidateVerdict& v : result.ranked) {
-    inputs.push_back({v.meets, v.over_budget, v.nonfinite, v.supported, v.interval.high, v.cost});
+    inputs.push_back({v.meets, v.over_budget, v.nonfinite, v.supported || req_proven, v.Figure(), v.cost});
   }
   std::vector<CandidateVerdict> ranked;
   for (const RankPlace& place : Rank(inputs)) {
@@ -396,18 +437,26 @@ void Explain(const Scene& scene, ChooseResult& result) {
   const std::uint64_t needed = MinimumSamples(req.level);
   const double limit = req.value;
   for (CandidateVerdict& v : result.ranked) {
-    const std::string measured = InUnitText(req, v.interval.high);
+    const std::string measured =
+        req.proven ? fmt::format("proven {} (measured max {})", InUnitText(req, v.proven), InUnitText(req, v.measured))
+                   : InUnitText(req, v.interval.high);
+    const std::string at_most =
+        req.proven ? fmt::format("at most {} on any conformant Vulkan device (measured max {})",
+                                 InUnitText(req, v.proven), InUnitText(req, v.measured))
+                   : fmt::format("{} at most (95% interval)", measured);
     const std::string cost =
         v.cost ? fmt::format("{:.3g} {}", v.cost->value, v.cost->unit) : std::string("unknown cost");
     if (v.meets && v.rank == 1) {
-      v.reason = fmt::format("{}: {} at most (95% interval) against {} ({:.1f}x margin), {}",
-                             v.tied ? "tied for the cheapest that meets it" : "the cheapest that meets it", measured,
-                             InUnitText(req, limit), limit / std::max(v.interval.high, 1e-300), cost);
+      v.reason = fmt::format("{}: {} against {} ({:.1f}x margin), {}",
+                             v.tied ? "tied for the cheapest that meets it" : "the cheapest that meets it", at_most,
+                             InUnitText(req, limit), limit / std::max(v.Figure(), 1e-300), cost);
     } else if (v.meets && v.over_budget) {
       v.reason = fmt::format("meets it ({}), but {} is over the budget of {:g}", measured, cost, *scene.max_cost);
     } else if (v.meets) {
       v.reason = fmt::format("meets it ({}), but costs more: {}", measured, cost);
-    } else if (!v.supported) {
+    } else if (req.proven && !std::isfinite(v.proven)) {
+      v.reason = fmt::format("fails: no bound is proven ({}); measured max {}", v.unproven, InUnitText(req, v.measured));
+    } else if (!v.supported && !req.proven) {
       v.reason = fmt::format("unsupported: {} samples at the requirement's depth, a {} needs {} (raise --samples)",
                              v.samples, LevelName(req.level), needed);
     } else if (v.nonfinite > 0) {
@@ -416,7 +465,7 @@ void Explain(const Scene& scene, ChooseResult& result) {
       v.reason = fmt::format("fails: {} measured, but the interval reaches {}: too close to call",
                              InUnitText(req, v.measured), measured);
     } else {
-      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.interval.high / limit,
+      v.reason = fmt::format("fails: {}, {:.3g}x the limit; {}", measured, v.Figure() / limit,
                              v.wrong_lens ? "its formula assumes a symmetric frustum, and this scene's is off-centre "
                                             "(it puts NDC (0, 0) on the view axis)"
                                           : CauseText(v.dominant));
@@ -432,8 +481,8 @@ void Suggest(const Scene& scene, ChooseResult& result) {
   if (!result.Met() && !result.ranked.empty()) {
     const CandidateVerdict& closest = result.ranked.front();
     result.suggestions.push_back(fmt::format("nothing meets {}; the closest is {} at {} ({:.3g}x the limit)",
-                                             req.Describe(), closest.cell.Name(), InUnitText(req, closest.measured),
-                                             closest.measured / limit));
+                                             req.Describe(), closest.cell.Name(), InUnitText(req, closest.Figure()),
+                                             closest.Figure() / limit));
     const bool depth = closest.dominant != Metric::kArith;  // production or storage: the depth buffer's own
     const bool reversed_float =
         closest.cell.format == Format::kD32Sfloat && (Info(closest.cell.convention).bits & 1u) != 0u;
@@ -561,6 +610,7 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   ChooseResult result;
   result.scene = scene.name;
   result.requirement = scene.requirement.Describe();
+  result.proven = scene.requirement.proven;
   result.limit = scene.requirement.value;
   result.at_depth = scene.requirement.at_depth;
   result.unit = scene.requirement.kind == Requirement::Kind::kAbsolute ? "world units"
@@ -572,15 +622,19 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   // One cost unit for the whole ranking.
   const CostChoice chosen_costs = ChooseCosts(costs, cells);
   result.cost_note = chosen_costs.note;
-  for (const Cell& cell : cells) {
-    if (auto v = Judge(scene, cell, populations, backend.name(), chosen_costs.lookup)) result.ranked.push_back(*v);
+  DB_ASSIGN_OR_RETURN(const std::vector<bound::CellBound> bounds,
+                      ProveCandidates(scene, populations, cells, options));
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const bound::CellBound* proven = k < bounds.size() ? &bounds[k] : nullptr;
+    if (auto v = Judge(scene, cells[k], populations, backend.name(), chosen_costs.lookup, proven))
+      result.ranked.push_back(*v);
   }
   DB_RETURN_IF_ERROR(CheckSupported(result, scene.requirement, options));
   if (!result.ranked.empty() && result.ranked.front().cost) {
     result.cost_unit = result.ranked.front().cost->unit;
     result.cost_source = result.ranked.front().cost->source;
   }
-  RankVerdicts(result);
+  RankVerdicts(result, scene.requirement.proven);
   result.projection_facts = scene.projection_facts;
   result.lens = LensText(scene.domain);
   if (const auto& capture = scene.domain.capture) {
@@ -590,7 +644,9 @@ Expected<ChooseResult> Choose(const Scene& scene, Backend& backend, const CostSo
   if (result.Met()) result.api_recipe = ApiRecipe(result.ranked.front().cell.convention);
   Explain(scene, result);
   Suggest(scene, result);
-  if (!result.Met() && !result.ranked.empty()) {
+  // What-ifs are measured; a proven requirement's would need their own
+  // bounds, so it has none.
+  if (!result.Met() && !result.ranked.empty() && !scene.requirement.proven) {
     DB_RETURN_IF_ERROR(AddWhatIfs(scene, backend, options, result));
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -602,7 +658,8 @@ namespace {
 // What holds a candidate back, in a word.
 std::string Limit(const CandidateVerdict& v) {
   if (v.meets) return "";
-  if (!v.supported) return "samples";
+  if (!std::isnan(v.proven) && !std::isfinite(v.proven)) return "no bound";
+  if (!v.supported && std::isnan(v.proven)) return "samples";
   if (v.wrong_lens) return "symmetric lens";
   if (v.nonfinite > 0) return "NaN/Inf";
   if (v.too_close) return "interval";
@@ -635,25 +692,29 @@ std::string ModelText(const CandidateVerdict& v) {
 // The ranked candidates, best first; at most `rows` of them.
 TextTable CandidateTable(const ChooseResult& r, std::size_t rows) {
   using Align = TextTable::Align;
-  TextTable table({{"rank"},
-                   {"candidate", Align::kLeft},
-                   {"measured (upper)"},
-                   {"far end"},
-                   {"model", Align::kLeft, true},
-                   {"NaN/Inf"},
-                   {"meets", Align::kLeft},
-                   {"held back by", Align::kLeft, true},
-                   {"B/px"},
-                   {"cost"}});
+  std::vector<TextTable::Column> columns{{"rank"}, {"candidate", Align::kLeft}, {"measured (upper)"}};
+  if (r.proven) columns.push_back({"proven"});
+  columns.insert(columns.end(), {{"far end"},
+                                 {"model", Align::kLeft, true},
+                                 {"NaN/Inf"},
+                                 {"meets", Align::kLeft},
+                                 {"held back by", Align::kLeft, true},
+                                 {"B/px"},
+                                 {"cost"}});
+  TextTable table(std::move(columns));
   for (std::size_t k = 0; k < r.ranked.size() && k < rows; ++k) {
     const CandidateVerdict& v = r.ranked[k];
-    table.AddRow(
-        {fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
-         v.interval.high > v.measured ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
-                                      : fmt::format("{:.3g}", v.measured),
-         fmt::format("{:.3g}", v.far_end_measured), ModelText(v), std::to_string(v.nonfinite), v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
-         v.cost && v.cost->bytes_per_pixel > 0 ? std::to_string(v.cost->bytes_per_pixel) : "-",
-         v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
+    std::vector<std::string> row{fmt::format("{}{}", v.rank, v.tied ? "=" : ""), v.cell.Name(),
+                                 v.interval.high > v.measured
+                                     ? fmt::format("{:.3g} (<={:.3g})", v.measured, v.interval.high)
+                                     : fmt::format("{:.3g}", v.measured)};
+    if (r.proven) row.push_back(std::isfinite(v.proven) ? fmt::format("{:.3g}", v.proven) : "none");
+    row.insert(row.end(),
+               {fmt::format("{:.3g}", v.far_end_measured), ModelText(v), std::to_string(v.nonfinite),
+                v.meets ? (v.over_budget ? "over budget" : "yes") : "no", Limit(v),
+                v.cost && v.cost->bytes_per_pixel > 0 ? std::to_string(v.cost->bytes_per_pixel) : "-",
+                v.cost ? fmt::format("{:.3g}", v.cost->value) : "-"});
+    table.AddRow(std::move(row));
   }
   return table;
 }
@@ -764,6 +825,8 @@ nlohmann::json ChoiceToJson(const ChooseResult& r) {
                       {"meets", v.meets},
                       {"wrong_lens", v.wrong_lens},
                       {"too_close", v.too_close},
+                      {"proven", JsonNumber(v.proven)},
+                      {"unproven", v.unproven},
                       {"over_budget", v.over_budget},
                       {"cost", v.cost ? nlohmann::json{{"value", v.cost->value},
                                                        {"spread", v.cost->spread},

@@ -6,6 +6,9 @@
 // cheapest candidate that meets the requirement first.
 #pragma once
 
+#include <cmath>
+#include <filesystem>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -85,6 +88,14 @@ struct CandidateVerdict {
   // not: more samples could tell.
   bool too_close = false;
   bool over_budget = false;
+  // With a proven requirement (level = "bound"): the candidate's proven
+  // bound over the requirement's population, in its unit; +infinity where
+  // none holds (`unproven` says why); NaN for a measured requirement.
+  double proven = std::nan("");
+  std::string unproven;
+  // What the verdict and the ranking hold against the limit: the proven
+  // bound, or the upper end of the measured level's interval.
+  double Figure() const { return std::isnan(proven) ? interval.high : proven; }
   std::optional<CandidateCost> cost;
   int rank = 0;        // 1 = the choice; candidates that tie share a rank
   bool tied = false;   // shares its rank with another candidate
@@ -99,6 +110,12 @@ inline constexpr double kPublishedPredictionBits = 0.3;
 struct ChooseOptions {
   std::uint64_t samples = 100000;
   std::uint64_t seed = 11;
+  // For a proven requirement: the programs bounded (empty: the installed
+  // shaders), the splits per cell (bound.h BoundOptions), and a progress
+  // callback per cell bounded.
+  std::filesystem::path shader_dir;
+  int bound_splits = 200;
+  std::function<void(std::size_t, std::size_t)> bound_progress;
 };
 
 // What one change to the scene would give, measured as the scene is (at
@@ -120,6 +137,7 @@ struct ChooseResult {
   std::string backend, device;
   std::string cost_unit, cost_source;
   std::string cost_note;                 // why the static model ranks, when a speed file was given
+  bool proven = false;                   // the requirement is proven (level = "bound")
   std::vector<CandidateVerdict> ranked;  // best first
   std::vector<std::string> suggestions;  // when nothing meets the requirement
   std::vector<std::string> unusable_formats;  // listed but never a candidate (Scene::UnusableFormats)

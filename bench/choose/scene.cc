@@ -131,7 +131,7 @@ std::string Requirement::Describe() const {
     case Kind::kBitsLost: what = fmt::format("bits lost <= {:g}", value); break;
   }
   if (at_depth) what += fmt::format(" at eye depth {:g}", *at_depth);
-  return what + fmt::format(" ({})", LevelName(level));
+  return what + (proven ? std::string(" (proven, on any conformant Vulkan device)") : fmt::format(" ({})", LevelName(level)));
 }
 
 std::vector<Cell> Scene::CellsWith(std::vector<Convention> conventions, std::vector<Format> formats) const {
@@ -474,9 +474,13 @@ Status ReadRequirement(SceneReader& r, const toml::table& root, const Domain& d,
   }
   if (const toml::node* node = requirement->get("level")) {
     auto name = node->value<std::string>();
-    auto level = name ? ParseLevel(*name) : Expected<Level>(InvalidArgument("expected a string"));
+    // "bound": the proven bound decides; the measured maximum is shown beside it.
+    req.proven = name && *name == "bound";
+    auto level = req.proven ? Expected<Level>(Level::kMax)
+                 : name     ? ParseLevel(*name)
+                            : Expected<Level>(InvalidArgument("expected a string"));
     if (!level.ok() || (*level != Level::kP999 && *level != Level::kMax)) {
-      return r.Error(node, "requirement.level", "allowed: \"p99.9\", \"max\"");
+      return r.Error(node, "requirement.level", "allowed: \"p99.9\", \"max\", \"bound\"");
     }
     req.level = *level;
   }

@@ -27,7 +27,8 @@
 //   [requirement]             # exactly one of absolute_error, relative_error, bits_lost
 //   absolute_error = 0.01     # world units ...
 //   at_depth = 50000          # ... at this eye depth ("1 cm at 50 km")
-//   level = "p99.9"           # or "max"
+//   level = "p99.9"           # or "max", or "bound": proven for any
+//                             # conformant Vulkan device (bench/bound)
 //   [cost]
 //   max_cost = 60             # in the cost unit choose uses
 #pragma once
@@ -52,6 +53,10 @@ struct Requirement {
   double value = 0.0;
   std::optional<double> at_depth;  // eye depth the requirement applies at
   Level level = Level::kP999;
+  // level = "bound": the candidate's proven bound over the requirement's
+  // population (bound.h) decides, not a measurement; `level` is then kMax,
+  // the measured figure shown beside it.
+  bool proven = false;
 
   // The largest relative error that meets it at eye depth z (bits lost
   // and relative errors ignore z).

@@ -15,6 +15,7 @@
 #include "bench/base/environment.h"
 #include "bench/base/files.h"
 #include "bench/base/interrupt.h"
+#include "bench/base/resources.h"
 #include "bench/choose/scene.h"
 #include "bench/pipeline/projection_matrix.h"
 
@@ -371,6 +372,27 @@ Status CheckWritable(const std::string& path, const std::string& what) {
   std::error_code ec;
   fs::remove(probe, ec);
   return Status::Ok();
+}
+
+std::function<void(std::size_t, std::size_t)> CellsBoundProgress(Progress& progress) {
+  return [&progress](std::size_t done, std::size_t total) {
+    progress.Update(static_cast<double>(done) / static_cast<double>(total),
+                    fmt::format("{} of {} cells bounded", done, total));
+  };
+}
+
+Expected<std::vector<bound::CellBound>> ProveCells(const Domain& domain, const std::vector<Cell>& cells,
+                                                   const std::string& shaders, int splits, bool quiet,
+                                                   const char* label) {
+  std::filesystem::path shader_dir = shaders;
+  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
+  bound::BoundOptions options;
+  options.splits = splits;
+  Progress progress(label, StderrIsTerminal(), quiet);
+  DB_ASSIGN_OR_RETURN(std::vector<bound::CellBound> bounds,
+                      bound::BoundCells(domain, cells, shader_dir, options, CellsBoundProgress(progress)));
+  progress.Finish(fmt::format("{} cells bounded", bounds.size()));
+  return bounds;
 }
 
 bool StderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }

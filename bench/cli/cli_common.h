@@ -2,6 +2,7 @@
 // conversion of their strings into the bench's types with clear messages.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -10,7 +11,9 @@
 #include <CLI/CLI.hpp>
 
 #include "bench/backends/backend.h"
+#include "bench/base/progress.h"
 #include "bench/base/status.h"
+#include "bench/bound/bound.h"
 #include "bench/pipeline/cells.h"
 #include "bench/pipeline/domain.h"
 
@@ -124,6 +127,16 @@ Status WriteSummary(const std::string& path, const std::string& markdown);
 
 // True when stderr is a terminal (progress lines are shown only then).
 bool StderrIsTerminal();
+
+// What bound::BoundCells reports after each cell, as a progress line.
+std::function<void(std::size_t, std::size_t)> CellsBoundProgress(Progress& progress);
+
+// The proven bounds of `cells` over `domain` (bound::BoundCells) from the
+// programs of `shaders` (empty: the installed ones), with a progress line
+// named `label`.
+Expected<std::vector<bound::CellBound>> ProveCells(const Domain& domain, const std::vector<Cell>& cells,
+                                                   const std::string& shaders, int splits, bool quiet,
+                                                   const char* label);
 
 // Prints a Status as "depthbench: error: ..." and returns its exit code.
 // Commands return their Status; app.cc alone reports it with this.

@@ -54,17 +54,8 @@ Expected<int> Bound(const BoundFlags& f, const CommandContext& context) {
   DB_ASSIGN_OR_RETURN(const BackendSet made, f.backends.Make(context.catalogue));
   const std::span<Backend* const> backends = made.view();
 
-  std::filesystem::path shader_dir = f.backends.shaders;
-  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
-  Progress progress("bound", StderrIsTerminal(), f.quiet);
-  bound::BoundOptions options;
-  options.splits = f.splits;
   DB_ASSIGN_OR_RETURN(const std::vector<bound::CellBound> bounds,
-                      bound::BoundCells(domain, cells, shader_dir, options, [&](std::size_t done, std::size_t total) {
-                        progress.Update(static_cast<double>(done) / static_cast<double>(total),
-                                        fmt::format("{} of {} cells bounded", done, total));
-                      }));
-  progress.Finish(fmt::format("{} cells bounded", bounds.size()));
+                      ProveCells(domain, cells, f.backends.shaders, f.splits, f.quiet, "bound"));
 
   SweepOptions sweep;
   sweep.samples = samples;

@@ -25,6 +25,7 @@ struct ChooseFlags {
   std::string json, summary;
   std::string backend = "vulkan";
   std::string device, shaders;
+  int splits = ChooseOptions{}.bound_splits;
 };
 
 // The frame costs of the speed file for the device the scene runs on
@@ -76,6 +77,11 @@ Expected<int> RunChoose(const ChooseFlags& f, const CommandContext& context) {
   CostSources costs;
   DB_ASSIGN_OR_RETURN(costs.static_model, StaticCostLookup(f.shaders, context.catalogue));
   DB_RETURN_IF_ERROR(AddFrameCosts(f, scene, *backend, context.catalogue, costs));
+  options.shader_dir = f.shaders;
+  if (f.splits < 0) return InvalidArgument(fmt::format("--splits: {} is negative", f.splits));
+  options.bound_splits = f.splits;
+  Progress proving("bound", StderrIsTerminal());
+  options.bound_progress = CellsBoundProgress(proving);
   Progress progress("choose", StderrIsTerminal());
   DB_ASSIGN_OR_RETURN(const ChooseResult choice, Choose(scene, *backend, costs, options));
   progress.Finish(fmt::format("{} candidates", choice.ranked.size()));
@@ -99,7 +105,10 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
       "the requirement's depth), models its error over eye depth to predict the scene's far end, costs it, and "
       "ranks: the cheapest candidate that meets the requirement first. A candidate meets it when the upper end of "
       "the 95% interval of its measured level is within the limit, it has enough samples for that level, and it "
-      "has no NaN or Inf findings inside the scene's ranges. When nothing does, it says so, shows the closest, and "
+      "has no NaN or Inf findings inside the scene's ranges. With requirement.level = \"bound\" the proven bound "
+      "decides instead (depthbench bound: the most the candidate can lose on any conformant Vulkan device, over "
+      "the requirement's population), so a scene is decided for devices nobody has tested; the measured maximum "
+      "is shown beside it, and no what-ifs are measured. When nothing does, it says so, shows the closest, and "
       "what would have to change. Example scenes: bench/scenes/*.toml.\n\n"
       "Costs come in one unit per ranking. With a speed file of the device the command runs on (committed under "
       "reports/speed/, or named with --speed, whatever device it was measured on) a candidate costs what it makes "
@@ -129,6 +138,9 @@ void AddChooseCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--backend", flags->backend, "the backend the scene's engine runs: vulkan (default) or cpu");
   cmd->add_option("--device", flags->device, "Vulkan device (part of its name); default lavapipe");
   cmd->add_option("--shaders", flags->shaders, "shader directory (default: the source tree's shaders/)");
+  cmd->add_option("--splits", flags->splits,
+                  "with requirement.level = \"bound\": how many times the worst box of a candidate's domain is "
+                  "split (depthbench bound --splits; default 200)");
   cmd->callback(
       [flags, &action] { action = [flags](const CommandContext& context) { return RunChoose(*flags, context); }; });
 }

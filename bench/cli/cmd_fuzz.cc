@@ -64,17 +64,8 @@ std::string DescribeCase(const FuzzCase& c) {
 // --prove's splits; the cells that have none are said.
 Expected<std::vector<bound::CellBound>> Prove(const FuzzFlags& f, const Domain& domain, const std::vector<Cell>& cells,
                                               const TextOutput& out) {
-  std::filesystem::path shader_dir = f.backends.shaders;
-  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
-  bound::BoundOptions options;
-  options.splits = f.prove;
-  Progress progress("prove", StderrIsTerminal(), f.quiet);
   DB_ASSIGN_OR_RETURN(std::vector<bound::CellBound> bounds,
-                      bound::BoundCells(domain, cells, shader_dir, options, [&](std::size_t done, std::size_t total) {
-                        progress.Update(static_cast<double>(done) / static_cast<double>(total),
-                                        fmt::format("{} of {} cells bounded", done, total));
-                      }));
-  progress.Finish(fmt::format("{} cells bounded", bounds.size()));
+                      ProveCells(domain, cells, f.backends.shaders, f.prove, f.quiet, "prove"));
   const auto unbounded =
       std::count_if(bounds.begin(), bounds.end(), [](const bound::CellBound& b) { return !std::isfinite(b.total); });
   if (unbounded > 0) {

@@ -10,6 +10,7 @@
 
 #include "bench/base/environment.h"
 #include "bench/base/interrupt.h"
+#include "bench/base/resources.h"
 #include "bench/capture/depth_capture.h"
 #include "bench/choose/choose.h"
 #include "bench/choose/frame_cost.h"
@@ -473,7 +474,11 @@ std::vector<RecommendationRow> Recommendations(const ReportMeasurements& m) {
       if (inputs[place.candidate].meets) row.variants.emplace_back(group[place.candidate]->cell.variant_info().name);
     }
     const PrecisionFit& chosen = *group[ranked.front().candidate];
+    row.cell = chosen.cell.Name();
     row.bits = Shown(bits_of(&chosen));
+    for (const bound::CellBound& b : m.recommended_bounds) {
+      if (b.cell.Name() == row.cell && std::isfinite(b.total)) row.proven_bits = Shown(bound::BoundBits(b.total));
+    }
     // The interval of that very prediction (the fit's model at the far
     // plane of the ratio), not of a band's point: a band can sit elsewhere
     // (the infinite sweep's deepest band ends short of the span predicted).
@@ -553,8 +558,9 @@ SceneSection SceneScreen(const ChooseResult& choice) {
     row.variant = std::string(v.cell.variant_info().name);
     row.measured = Shown(v.interval.high);
     row.far_end = Shown(v.far_end_measured);
+    if (std::isfinite(v.proven)) row.proven = Shown(v.proven);
     row.meets = v.meets;
-    row.times_limit = choice.limit > 0.0 ? v.interval.high / choice.limit : 0.0;
+    row.times_limit = choice.limit > 0.0 ? v.Figure() / choice.limit : 0.0;
     if (v.cost) {
       row.bytes_per_pixel = v.cost->bytes_per_pixel;
       row.cost = Shown(v.cost->value);
@@ -568,6 +574,7 @@ SceneSection SceneScreen(const ChooseResult& choice) {
                                                                  w.figure, w.meets ? "meets it" : "still fails"));
   }
   section.not_candidates = choice.unusable_formats;
+  section.proven = choice.proven;
   return section;
 }
 
@@ -593,6 +600,33 @@ ReportEnvironment Environment(const ReportPlan& plan, const ReportMeasurements& 
   env.default_sweep = {m.main.run.seed, m.main.run.samples, m.main.run.reconstructions, m.main.run.domain.Describe()};
   for (const auto& [path, speed] : m.speed) env.speed_files.push_back(path.string());
   return env;
+}
+
+// The proven bounds of the first screen's recommended cells, over the
+// population its figures describe: the fit sweeps' domain at the row's
+// far/near (1e4, or an infinite far plane), the camera at the origin.
+Expected<std::vector<bound::CellBound>> ProveRecommended(const ReportPlan& plan, const Domain& fit_domain,
+                                                        const ReportMeasurements& m) {
+  std::filesystem::path dir = plan.shader_dir;
+  if (dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), dir));
+  bound::BoundOptions options;
+  options.splits = plan.bound_splits;
+  std::vector<bound::CellBound> bounds;
+  for (const RecommendationRow& row : Recommendations(m)) {
+    const auto fit = std::find_if(m.fits.begin(), m.fits.end(),
+                                  [&](const PrecisionFit& f) { return f.cell.Name() == row.cell; });
+    if (fit == m.fits.end()) continue;
+    Domain domain = fit_domain;
+    domain.far.reset();
+    domain.camera_distance = Range{0.0, 0.0};
+    domain.finite_far = row.ratio != "inf";
+    domain.infinite_far = !domain.finite_far;
+    domain.ratio = Range{1e4, 1e4};
+    const Cell cells[] = {fit->cell};
+    DB_ASSIGN_OR_RETURN(std::vector<bound::CellBound> one, bound::BoundCells(domain, cells, dir, options));
+    bounds.insert(bounds.end(), one.begin(), one.end());
+  }
+  return bounds;
 }
 
 }  // namespace
@@ -661,6 +695,7 @@ ReportPlan ReportPlan::Quick() {
   // Enough for a p99.9 in most depth decades (MinimumSamples: 4000 a band).
   plan.fit.samples_per_ratio = 40000;
   plan.main_samples = 100000;
+  plan.bound_splits = 50;
   return plan;
 }
 
@@ -734,6 +769,13 @@ Expected<ReportMeasurements> MeasureReport(const ReportPlan& plan, std::span<Bac
   const Metric metrics[] = {Metric::kTotal};
   m.fits = FitPrecision(m.sweeps, fit_plan, metrics, kAllLevels, progress.fits);
   end("error models", fmt::format("{} fits", m.fits.size()));
+
+  begin("proven bounds");
+  // A domain the analysis does not cover leaves the first screen without
+  // its bounds, not the report without its other parts.
+  m.bounds_status = StoreInto(ProveRecommended(plan, fit_plan.domain, m), m.recommended_bounds);
+  end("proven bounds", m.bounds_status.ok() ? fmt::format("{} cells bounded", m.recommended_bounds.size())
+                                            : std::string(m.bounds_status.message()));
 
   return m;
 }

@@ -25,6 +25,7 @@
 
 #include "bench/backends/backend.h"
 #include "bench/base/status.h"
+#include "bench/bound/bound.h"
 #include "bench/choose/choose.h"
 #include "bench/fit/precision_fit.h"
 #include "bench/gate/baseline.h"
@@ -56,6 +57,8 @@ struct ReportPlan {
   int trend_runs = 60;               // runs of the history the trend shows
   // A scene (--scene): its choice (choose.h) leads the first screen.
   std::optional<Scene> scene;
+  // Splits per cell for the first screen's proven bounds (bound.h).
+  int bound_splits = 200;
 
   // The nightly plan, and the quick one (same sweeps, fewer samples).
   static ReportPlan Nightly();
@@ -94,6 +97,10 @@ struct ReportMeasurements {
     std::vector<float> bits;  // row by row from the top; NaN: background or outside the frustum
   };
   std::optional<CaptureBits> capture_bits;
+  // The proven bounds of the first screen's recommended cells
+  // (ProveRecommended), or why there are none.
+  std::vector<bound::CellBound> recommended_bounds;
+  Status bounds_status;
 };
 
 

@@ -182,11 +182,13 @@ json SceneJson(const std::optional<SceneSection>& scene) {
           {"unit", scene->unit},
           {"limit", scene->limit},
           {"at_depth", scene->at_depth ? json(*scene->at_depth) : json(nullptr)},
+          {"proven", scene->proven},
           {"rows", Rows(scene->rows,
                         [](const SceneRow& r) {
                           return json{{"convention", r.convention},     {"format", r.format},
                                       {"variant", r.variant},           {"measured", Value(r.measured)},
                                       {"far_end", Value(r.far_end)},    {"meets", r.meets},
+                                      {"proven", Value(r.proven)},
                                       {"times_limit", r.times_limit},   {"bytes_per_pixel", r.bytes_per_pixel},
                                       {"cost", Value(r.cost)},
                                       {"by_depth", Rows(r.by_depth, [](const SceneRow::DepthPoint& p) {
@@ -224,6 +226,7 @@ nlohmann::json ReportToJson(const Report& report) {
                                                             {"bits", Value(r.bits)},
                                                             {"bits_low", Value(r.bits_low)},
                                                             {"bits_high", Value(r.bits_high)},
+                                                            {"proven_bits", Value(r.proven_bits)},
                                                             {"cost", Value(r.cost)},
                                                             {"cost_kind", CostKindName(r.cost_kind)},
                                                             {"cost_unit", r.cost_unit},

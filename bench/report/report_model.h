@@ -228,7 +228,13 @@ struct RecommendationRow {
   std::string convention, format, backend;
   std::string ratio;                  // the far/near the bits are predicted at: "1e4", or "inf"
   std::vector<std::string> variants;  // the recommended first, then those tied with it
+  std::string cell;                   // the recommended variant's cell, by name
   Figure bits, bits_low, bits_high;   // p99.9 bits lost at the far plane, the model's 95% interval
+  // Proven (bench/bound): the most bits the cell can lose anywhere at this
+  // far/near (every depth, pixel and lens of the fit sweeps' domain, the
+  // camera at the origin) on any conformant Vulkan device; none where no
+  // bound holds. A bound, not a p99.9: it is at or above the measured worst.
+  Figure proven_bits;
   Figure cost;                        // none: no cost known
   CostKind cost_kind = CostKind::kStaticModel;
   std::string cost_unit;  // "µs per 1920x1080 frame on llvmpipe (...)", "FMA-equivalent slots"
@@ -252,6 +258,9 @@ struct SceneRow {
   std::string convention, format, variant;
   Figure measured;  // the upper end of the 95% interval, at the requirement's level and depth
   Figure far_end;   // measured at the scene's far end
+  // With a proven requirement (level = "bound"): the candidate's bound,
+  // which decides `meets`; none otherwise, or where no bound holds.
+  Figure proven;
   bool meets = false;
   double times_limit = 0.0;  // measured / the requirement's limit
   std::uint32_t bytes_per_pixel = 0;
@@ -279,6 +288,7 @@ struct SceneSection {
     double median_bits = 0.0, p999_bits = 0.0, worst_bits = 0.0;
   };
   std::optional<CapturePicture> capture;
+  bool proven = false;  // the requirement is proven (level = "bound")
 };
 
 // The PNG of a capture's bits lost per pixel, beside report.html.

@@ -153,19 +153,22 @@ void WhatToUse(const Report& report, std::string& out) {
         r->bits_low && r->bits_high ? fmt::format(" [{:.1f}, {:.1f}]", *r->bits_low, *r->bits_high) : "";
     return Bits(r->bits) + interval;
   };
+  const auto proven = [](const RecommendationRow* r) {
+    return r == nullptr ? std::string("-") : r->proven_bits ? Bits(r->proven_bits) : std::string("none");
+  };
   out += fmt::format("## What to use: the convention and format first ({} backend; cost in {})\n\n", first.backend,
                      first.cost_unit);
   out +=
-      "| convention | format | use | f/n | bits lost [95%] | far plane at 100 m | at 10 km | B/px | cost | f/n for "
-      "1e-3 | f/n for 1e-6 | infinite far: use | bits lost [95%] |\n";
-  out += "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
+      "| convention | format | use | f/n | bits lost [95%] | proven, any device | far plane at 100 m | at 10 km | B/px "
+      "| cost | f/n for 1e-3 | f/n for 1e-6 | infinite far: use | bits lost [95%] | proven, any device |\n";
+  out += "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
   for (const Line& l : lines) {
     const RecommendationRow* f = l.finite;
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", l.convention, l.format,
-                       use(f), f ? f->ratio : "-", bits(f), f ? Metres(f->error_far_100m) : "-",
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", l.convention,
+                       l.format, use(f), f ? f->ratio : "-", bits(f), proven(f), f ? Metres(f->error_far_100m) : "-",
                        f ? Metres(f->error_far_10km) : "-", f ? std::to_string(f->bytes_per_pixel) : "-",
                        f ? Number(f->cost) : "-", f ? Budget(f->ratio_for_1e3) : "-",
-                       f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite));
+                       f ? Budget(f->ratio_for_1e6) : "-", use(l.infinite), bits(l.infinite), proven(l.infinite));
   }
   // The lever in one sentence, from the rows themselves.
   const auto find = [&](const char* convention) -> const RecommendationRow* {
@@ -183,7 +186,9 @@ void WhatToUse(const Report& report, std::string& out) {
       "\nThe combinations that keep the most bits first: the convention and format are the lever{}; the variant "
       "moves it by a bit or less. Use: the cheapest variant within {} bit of the most precise (= tied ones); 'do not use' where even the "
       "interval's lower end keeps less than one bit. Bits lost at p99.9 at the far plane at that far/near, with the "
-      "model's 95% interval, and that error in world units with the far plane at 100 m (near 1 cm) and 10 km (near "
+      "model's 95% interval; proven, any device: the most bits the variant can lose anywhere at that far/near (every "
+      "depth, pixel and lens, the camera at the origin) on any conformant Vulkan device (`depthbench bound`; none: "
+      "no bound holds), a guarantee for devices nobody measured, at or above the worst any sample shows; that error in world units with the far plane at 100 m (near 1 cm) and 10 km (near "
       "1 m); B/px: the depth bytes a frame moves per pixel (no stencil); f/n for 1e-3 and 1e-6: the far/near up to "
       "which the upper end of the far plane's interval keeps that relative error; infinite far: the convention's "
       "-inf form, at its far end.\n\n",
@@ -197,12 +202,14 @@ void YourScene(const Report& report, std::string& out) {
   const SceneSection& s = *report.scene;
   out += fmt::format("## Your scene: {} ({}; {} backend; cost in {})\n\n", s.name, s.requirement, s.backend,
                      s.cost_unit);
-  out += "| convention | format | measured (upper) | far end | B/px | cost | use |\n";
-  out += "|---|---|---:|---:|---:|---:|---|\n";
+  out += fmt::format("| convention | format | measured (upper) |{} far end | B/px | cost | use |\n",
+                     s.proven ? " proven, any device |" : "");
+  out += fmt::format("|---|---|---:|{}---:|---:|---:|---|\n", s.proven ? "---:|" : "");
   for (const SceneRow& r : s.rows) {
     const std::string use =
         r.meets ? "`" + r.variant + "`" : fmt::format("**do not use**: {:.3g}x the limit", r.times_limit);
-    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", r.convention, r.format, Number(r.measured),
+    const std::string proven = s.proven ? fmt::format(" {} |", r.proven ? Number(r.proven) : "none") : "";
+    out += fmt::format("| {} | {} | {} |{} {} | {} | {} | {} |\n", r.convention, r.format, Number(r.measured), proven,
                        Number(r.far_end), r.bytes_per_pixel > 0 ? std::to_string(r.bytes_per_pixel) : "-",
                        Number(r.cost), use);
   }
@@ -217,7 +224,12 @@ void YourScene(const Report& report, std::string& out) {
   for (const std::string& n : s.not_candidates) out += "- not a candidate: " + n + "\n";
   out += "\nMeasured: the upper end of the 95% interval at the requirement's level and depth, in its unit; far end: "
          "measured at the scene's far end; each convention and format by its best variant as `depthbench choose` "
-         "ranks them.\n\n";
+         "ranks them.";
+  if (s.proven) {
+    out += " Proven: the most the candidate can lose at the requirement's depth on any conformant Vulkan device "
+           "(`depthbench bound`), which decides whether it meets the requirement.";
+  }
+  out += "\n\n";
 }
 
 // The worst cells over the default domain and the NaN/Inf findings by
