@@ -69,7 +69,7 @@ TEST(ArithmeticProbeTest, EveryVariantStaysValidAndLosesItsFreedoms) {
     const Counts before = CountModule(*compiled);
     ASSERT_GT(before.fdiv32, 0) << variant.name << ": every variant divides (at least by w or by the resolution)";
     EXPECT_EQ(before.no_contraction, 0);
-    for (std::uint32_t probes : {1u, 2u, 3u}) {
+    for (std::uint32_t probes : {1u, 2u, 3u, 4u, 5u}) {
       auto probed = ApplyArithmeticProbes(*compiled, probes);
       ASSERT_TRUE(probed.ok()) << probed.status().message();
       EXPECT_EQ(Validate(*probed), "") << variant.name << " " << ArithmeticProbesName(probes);
@@ -77,7 +77,7 @@ TEST(ArithmeticProbeTest, EveryVariantStaysValidAndLosesItsFreedoms) {
       if ((probes & kNoContraction) != 0) {
         EXPECT_EQ(after.no_contraction, before.contractible) << variant.name;
       }
-      if ((probes & kExactDivision) != 0) {
+      if ((probes & (kExactDivision | kWorstDivision)) != 0) {
         EXPECT_EQ(after.fdiv32, 0) << variant.name;
         EXPECT_EQ(after.fdiv64, before.fdiv32) << variant.name;
       }
@@ -88,6 +88,8 @@ TEST(ArithmeticProbeTest, EveryVariantStaysValidAndLosesItsFreedoms) {
 TEST(ArithmeticProbeTest, NamesParseBothWays) {
   EXPECT_EQ(*ParseArithmeticProbes("no-contraction+exact-division"), kNoContraction | kExactDivision);
   EXPECT_EQ(ArithmeticProbesName(kNoContraction | kExactDivision), "no-contraction+exact-division");
+  EXPECT_EQ(*ParseArithmeticProbes("worst-division+no-contraction"), kWorstDivision | kNoContraction);
+  EXPECT_EQ(ArithmeticProbesName(kWorstDivision), "worst-division");
   EXPECT_FALSE(ParseArithmeticProbes("no-fma").ok());
   EXPECT_FALSE(ApplyArithmeticProbes(std::vector<std::uint32_t>{1, 2, 3}, kNoContraction).ok());
 }

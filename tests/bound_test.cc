@@ -141,7 +141,9 @@ Domain NarrowDomain() {
 
 struct Measured {
   std::vector<bound::CellBound> bounds;
-  Results cpu, vulkan;
+  // lavapipe as it is, and as a device that takes every division 2 to 2.5
+  // ulp off (arithmetic_probe.h worst-division): still within Vulkan's rules.
+  Results cpu, vulkan, worst_division;
 };
 
 const Measured& Sweeps() {
@@ -159,14 +161,14 @@ const Measured& Sweeps() {
     sweep.seed = 42;
     sweep.domain = domain;
     sweep.cells = cells;
-    for (const std::string backend : {"cpu", "vulkan"}) {
+    for (const std::string backend : {"cpu", "vulkan", "vulkan:worst-division"}) {
       auto made = MakeBackend(backend, BackendOptions{});
       EXPECT_TRUE(made.ok()) << made.status().message();
       if (!made.ok()) continue;
       Backend* backends[] = {made->get()};
       auto run = RunSweep(sweep, backends);
       EXPECT_TRUE(run.ok()) << run.status().message();
-      if (run.ok()) (backend == "cpu" ? m->cpu : m->vulkan) = *std::move(run);
+      if (run.ok()) (backend == "cpu" ? m->cpu : backend == "vulkan" ? m->vulkan : m->worst_division) = *std::move(run);
     }
     return m;
   }();
@@ -179,13 +181,15 @@ double Worst(const Results& results, const Cell& cell, Metric metric) {
 }
 
 // Every judged sample's shader part lies within its cell's bound: the
-// exactly rounded machine's on the CPU, any device's on lavapipe; and the
-// whole error within the whole's bound. Scaled down eightfold, the bounds
-// are exceeded somewhere: the comparison can fail.
+// exactly rounded machine's on the CPU, any device's on lavapipe, as it is
+// and with every division as far off as Vulkan allows; and the whole
+// error within the whole's bound. Scaled down eightfold, the bounds are
+// exceeded somewhere: the comparison can fail. The worst divisions cost
+// something: they raise the worst shader error of most cells.
 TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   const Measured& m = Sweeps();
   ASSERT_EQ(m.bounds.size(), 58u);
-  int bounded = 0, exceeded_at_an_eighth = 0;
+  int bounded = 0, exceeded_at_an_eighth = 0, raised_by_worst_division = 0;
   for (const bound::CellBound& b : m.bounds) {
     SCOPED_TRACE(b.cell.Name());
     if (!std::isfinite(b.device_shader)) continue;
@@ -193,6 +197,10 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
     const double cpu = Worst(m.cpu, b.cell, Metric::kArith), gpu = Worst(m.vulkan, b.cell, Metric::kArith);
     EXPECT_LE(cpu, b.exact_shader);
     EXPECT_LE(gpu, b.device_shader);
+    const double worst = Worst(m.worst_division, b.cell, Metric::kArith);
+    EXPECT_LE(worst, b.device_shader);
+    EXPECT_LE(Worst(m.worst_division, b.cell, Metric::kTotal), b.total);
+    raised_by_worst_division += worst > gpu * 1.5;
     EXPECT_LE(b.exact_shader, b.device_shader);  // the device's rules allow more
     EXPECT_LE(Worst(m.cpu, b.cell, Metric::kTotal), b.total);
     EXPECT_LE(Worst(m.vulkan, b.cell, Metric::kTotal), b.total);
@@ -202,14 +210,16 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   // (its light volume's depth enters a divisor).
   EXPECT_GE(bounded, 55);
   EXPECT_GT(exceeded_at_an_eighth, 0);
+  EXPECT_GT(raised_by_worst_division, bounded / 2);
 }
 
 // The fuzzer holds every judged sample against its cell's proven bound.
 // With the bounds proven, it finds nothing beyond them; with bounds planted
 // an eighth as large, it finds a sample beyond one, a finding of its own
 // kind, shrunk and written like the others. (A bound one ULP too small for
-// division is not enough to plant: the bounds take every rounding at its
-// worst, some bits above what any input reaches; docs/bounds.md.)
+// division is not enough to plant: no cell's bound lies within the 0.4 bit
+// of what even vulkan:worst-division reaches that it would take; the boxes
+// of camera rotation alone cost more, docs/bounds.md.)
 TEST(BoundTest, TheFuzzerFindsSamplesBeyondAPlantedBound) {
   const Measured& m = Sweeps();
   ASSERT_EQ(m.bounds.size(), 58u);

@@ -19,7 +19,7 @@ Expected<std::unique_ptr<Backend>> MakeBackend(const std::string& name, const Ba
   }
   return InvalidArgument("unknown backend '" + name +
                          "'; available: cpu, vulkan, and vulkan:PROBES to measure the GPU's arithmetic "
-                         "(PROBES: no-contraction, exact-division, or both joined by '+')");
+                         "(PROBES: no-contraction, exact-division, worst-division, or several joined by '+')");
 }
 
 }  // namespace depthbench

@@ -236,7 +236,9 @@ void BackendFlags::Add(CLI::App& app, bool allow_several) {
       "--backend", backends,
       allow_several ? "backends to run: cpu, vulkan (default both); vulkan:no-contraction, vulkan:exact-division "
                       "or vulkan:no-contraction+exact-division run the Vulkan backend with fused "
-                      "multiply-adds forbidden or divisions correctly rounded (reports/gpu-probes)"
+                      "multiply-adds forbidden or divisions correctly rounded (reports/gpu-probes); "
+                      "vulkan:worst-division with every division 2 to 2.5 ulp off, as far as Vulkan allows "
+                      "(docs/bounds.md)"
                     : "backend to run: cpu or vulkan");
   option->delimiter(',')->group("Backends");
   if (!allow_several) option->expected(1);

@@ -17,7 +17,8 @@ struct Probe {
   std::uint32_t bit;
   std::string_view name;
 };
-constexpr Probe kProbes[] = {{kNoContraction, "no-contraction"}, {kExactDivision, "exact-division"}};
+constexpr Probe kProbes[] = {
+    {kNoContraction, "no-contraction"}, {kExactDivision, "exact-division"}, {kWorstDivision, "worst-division"}};
 
 // The arithmetic a compiler may contract: SPIR-V's NoContraction applies to
 // these.
@@ -115,8 +116,8 @@ Expected<std::uint32_t> ParseArithmeticProbes(std::string_view text) {
     }
     if (!known) {
       return InvalidArgument(
-          fmt::format("unknown arithmetic probe '{}'; allowed: no-contraction, exact-division "
-                      "(or both, joined by '+')",
+          fmt::format("unknown arithmetic probe '{}'; allowed: no-contraction, exact-division, worst-division "
+                      "(or several, joined by '+')",
                       name));
     }
     text = plus == std::string_view::npos ? std::string_view() : text.substr(plus + 1);
@@ -138,18 +139,21 @@ Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::
   DB_ASSIGN_OR_RETURN(const std::vector<Instruction> instructions, Instructions(spirv));
   if (probes == 0) return std::vector<std::uint32_t>(spirv.begin(), spirv.end());
   const bool no_contraction = (probes & kNoContraction) != 0;
-  const bool exact_division = (probes & kExactDivision) != 0;
+  const bool worst_division = (probes & kWorstDivision) != 0;
+  const bool exact_division = (probes & kExactDivision) != 0 || worst_division;
 
   // First pass: the float types, the results to decorate, the divisions.
   std::map<std::uint32_t, std::uint32_t> float_width;                        // type id -> width
   std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> vectors;  // id -> (component, count)
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> vector_of;
   std::vector<std::uint32_t> contractible;
+  std::uint32_t uint_type = 0;
   bool float64_capability = false;
   for (const Instruction& inst : instructions) {
     const std::uint32_t* w = spirv.data() + inst.at;
     if (inst.op == spv::OpCapability && w[1] == spv::CapabilityFloat64) float64_capability = true;
     if (inst.op == spv::OpTypeFloat) float_width[w[1]] = w[2];
+    if (inst.op == spv::OpTypeInt && w[2] == 32 && w[3] == 0) uint_type = w[1];
     if (inst.op == spv::OpTypeVector) {
       vectors[w[1]] = {w[2], w[3]};
       vector_of[{w[2], w[3]}] = w[1];
@@ -183,6 +187,36 @@ Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::
     }
     widened[type] = wide;
     return wide;
+  };
+  // worst-division: the unsigned integer type of a float32 type's bits, and
+  // the constant 2 of that type, made where missing.
+  std::uint32_t two = 0;
+  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> bits_of;
+  auto bits = [&](std::uint32_t type) -> std::pair<std::uint32_t, std::uint32_t> {
+    if (auto found = bits_of.find(type); found != bits_of.end()) return found->second;
+    if (uint_type == 0) {
+      uint_type = bound++;
+      new_types.insert(new_types.end(), {Word(spv::OpTypeInt, 4), uint_type, 32, 0});
+    }
+    if (two == 0) {
+      two = bound++;
+      new_types.insert(new_types.end(), {Word(spv::OpConstant, 4), uint_type, two, 2});
+    }
+    std::pair<std::uint32_t, std::uint32_t> made{uint_type, two};
+    if (auto v = vectors.find(type); v != vectors.end()) {
+      const std::uint32_t count = v->second.second;
+      const std::pair<std::uint32_t, std::uint32_t> key{uint_type, count};
+      auto existing = vector_of.find(key);
+      if (existing == vector_of.end()) {
+        existing = vector_of.emplace(key, bound++).first;
+        new_types.insert(new_types.end(), {Word(spv::OpTypeVector, 4), existing->second, uint_type, count});
+      }
+      made = {existing->second, bound++};
+      new_types.insert(new_types.end(), {Word(spv::OpConstantComposite, 3 + count), made.first, made.second});
+      new_types.insert(new_types.end(), count, two);
+    }
+    bits_of[type] = made;
+    return made;
   };
   auto is_float32 = [&](std::uint32_t type) {
     if (auto v = vectors.find(type); v != vectors.end()) type = v->second.first;
@@ -218,9 +252,18 @@ Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::
       const std::uint32_t type = w[1], result = w[2], a = w[3], b = w[4];
       const std::uint32_t wide = widen(type);
       const std::uint32_t wide_a = bound++, wide_b = bound++, quotient = bound++;
+      const std::uint32_t rounded = worst_division ? bound++ : result;
       to.insert(to.end(), {Word(spv::OpFConvert, 4), wide, wide_a, a, Word(spv::OpFConvert, 4), wide, wide_b, b,
-                           Word(spv::OpFDiv, 5), wide, quotient, wide_a, wide_b, Word(spv::OpFConvert, 4), type, result,
+                           Word(spv::OpFDiv, 5), wide, quotient, wide_a, wide_b, Word(spv::OpFConvert, 4), type, rounded,
                            quotient});
+      if (worst_division) {
+        // Two steps of the float's bits away from zero: the correctly
+        // rounded quotient moved by 2 ulp, within 2.5 ulp of the exact one.
+        const auto [uint_of, two_of] = bits(type);
+        const std::uint32_t raw = bound++, pushed = bound++;
+        to.insert(to.end(), {Word(spv::OpBitcast, 4), uint_of, raw, rounded, Word(spv::OpIAdd, 5), uint_of, pushed, raw,
+                             two_of, Word(spv::OpBitcast, 4), type, result, pushed});
+      }
       continue;
     }
     to.insert(to.end(), w, w + inst.words);

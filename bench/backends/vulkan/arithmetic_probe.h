@@ -9,10 +9,16 @@
 //     the widened operands, rounded once to float32: the correctly rounded
 //     quotient (Vulkan lets a float32 division be off by 2.5 ulp; a float64
 //     quotient rounded to float32 is wrong only when the exact quotient lies
-//     within about 2^-29 ulp of a rounding midpoint).
+//     within about 2^-29 ulp of a rounding midpoint);
+//   worst-division: that correctly rounded quotient then moved two steps
+//     of its bits away from zero: 2 to 2.5 ulp from the exact quotient,
+//     every time, the same way. A device that uses the whole tolerance
+//     Vulkan allows a division (an infinite quotient becomes NaN), which is
+//     what a bound's division rule must cover (bench/bound).
 //
 // The Vulkan backend applies them when its name says so
-// ("vulkan:no-contraction", "vulkan:exact-division", or both joined by '+').
+// ("vulkan:no-contraction", "vulkan:exact-division", "vulkan:worst-division",
+// or several joined by '+').
 #pragma once
 
 #include <cstdint>
@@ -28,6 +34,7 @@ namespace depthbench {
 enum ArithmeticProbe : std::uint32_t {
   kNoContraction = 1u << 0,
   kExactDivision = 1u << 1,
+  kWorstDivision = 1u << 2,
 };
 
 // "no-contraction+exact-division" <-> bits; "" for none.
