@@ -80,9 +80,20 @@ inline bool PowerOfTwo(const Lane& x) {
   return std::fabs(std::frexp(x.exact.lo, &exponent)) == 0.5;
 }
 
+// Whether every x + y of the two ranges is a float when x and y are
+// floats: one of them is 0, or they have opposite signs and within a factor
+// of two of each other in magnitude (Sterbenz's lemma), as -1 + 2 d is for a
+// stored depth d in [0.25, 1].
+inline bool SumIsExact(const Enclosure& x, const Enclosure& y) {
+  if (x == Enclosure(0.0) || y == Enclosure(0.0)) return true;
+  const bool opposite = (x.lo > 0.0 && y.hi < 0.0) || (x.hi < 0.0 && y.lo > 0.0);
+  return opposite && 2.0 * x.mig() >= y.mag() && 2.0 * y.mig() >= x.mag();
+}
+
 inline Lane Add(const Lane& x, const Lane& y) {
   const Enclosure exact = x.exact + y.exact;
-  if (x.error == 0.0 && y.error == 0.0 && (x.exact == Enclosure(0.0) || y.exact == Enclosure(0.0))) return {exact, 0.0};
+  // Lanes without error hold floats (inputs, literals, exact results).
+  if (x.error == 0.0 && y.error == 0.0 && SumIsExact(x.exact, y.exact)) return {exact, 0.0};
   return {exact, Rounded(exact, x.error + y.error, 0.5)};
 }
 inline Lane Negate(const Lane& x) { return {-x.exact, x.error}; }
