@@ -203,6 +203,47 @@ Status ShrinkFindings(const CampaignOptions& options, const std::vector<Backend*
   return Status::Ok();
 }
 
+namespace {
+
+// One batch: each frame's point comes from one source (the corpus first,
+// then mutations of the inputs closest to their bound, points near the
+// domain's extremes, random points); its 64 samples vary the point's sample
+// units (the first keeps them). Pinned units keep their values throughout.
+PointBatch NextBatch(const CampaignOptions& options, std::uint32_t frames, const std::vector<FuzzPoint>& corpus,
+                     std::size_t& corpus_next, const std::vector<std::pair<double, FuzzPoint>>& elite,
+                     std::mt19937_64& rng, CampaignResult& result) {
+  PointBatch batch(options.domain);
+  for (std::uint32_t f = 0; f < frames; ++f) {
+    FuzzPoint base;
+    if (corpus_next < corpus.size()) {
+      base = corpus[corpus_next++];
+      ++result.from_corpus;
+    } else {
+      const double r = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      if (!elite.empty() && r < 0.5) {
+        base = Mutate(elite[std::uniform_int_distribution<std::size_t>(0, elite.size() - 1)(rng)].second, rng);
+        ++result.from_mutation;
+      } else if (r < 0.75) {
+        base = RandomPoint(rng, 0.5);
+        ++result.from_extremes;
+      } else {
+        base = RandomPoint(rng, 0.0);
+        ++result.from_random;
+      }
+    }
+    for (const auto& [unit, value] : options.pinned) UnitOf(base, unit) = value;
+    batch.AddFrame(base, [&](std::uint32_t s) {
+      FuzzPoint p = base;
+      if (s > 0) p.sample = (s % 2 ? Mutate(base, rng) : RandomPoint(rng, 0.3)).sample;
+      for (const auto& [unit, value] : options.pinned) UnitOf(p, unit) = value;
+      return p;
+    });
+  }
+  return batch;
+}
+
+}  // namespace
+
 Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<Backend* const> backends) {
   DB_RETURN_IF_ERROR(options.domain.Validate());
   if (options.seconds <= 0 && options.cases == 0)
@@ -235,35 +276,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     const double t = elapsed();
     if (options.seconds > 0 && t >= options.seconds) break;
     if (options.cases > 0 && result.cases >= options.cases) break;
-    // One batch: each frame's point comes from one source; its 64 samples
-    // vary the point's sample units (the first keeps them).
-    PointBatch batch(options.domain);
-    for (std::uint32_t f = 0; f < frames; ++f) {
-      FuzzPoint base;
-      if (corpus_next < corpus.size()) {
-        base = corpus[corpus_next++];
-        ++result.from_corpus;
-      } else {
-        const double r = std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-        if (!elite.empty() && r < 0.5) {
-          base = Mutate(elite[std::uniform_int_distribution<std::size_t>(0, elite.size() - 1)(rng)].second, rng);
-          ++result.from_mutation;
-        } else if (r < 0.75) {
-          base = RandomPoint(rng, 0.5);
-          ++result.from_extremes;
-        } else {
-          base = RandomPoint(rng, 0.0);
-          ++result.from_random;
-        }
-      }
-      for (const auto& [unit, value] : options.pinned) UnitOf(base, unit) = value;
-      batch.AddFrame(base, [&](std::uint32_t s) {
-        FuzzPoint p = base;
-        if (s > 0) p.sample = (s % 2 ? Mutate(base, rng) : RandomPoint(rng, 0.3)).sample;
-        for (const auto& [unit, value] : options.pinned) UnitOf(p, unit) = value;
-        return p;
-      });
-    }
+    const PointBatch batch = NextBatch(options, frames, corpus, corpus_next, elite, rng, result);
     const CaseSource source = batch.Source();
     const std::uint32_t count = batch.count();
     DB_RETURN_IF_ERROR(checker.Evaluate(source, 0, count));
