@@ -347,9 +347,44 @@ Params HullAtFarEnds(const FrameValues<Enclosure>& box, Each each_member, Make m
 
 }  // namespace
 
+namespace {
+
+// `into` narrowed to what `also` encloses too (both enclose the same value).
+void Narrow(Enclosure& into, const Enclosure& also) {
+  const Enclosure both(std::max(into.lo, also.lo), std::min(into.hi, also.hi));
+  if (both.lo <= both.hi) into = both;
+}
+
+// The world-space screen attributes are rotated view-space ones. Over a box
+// of rotations, the steps FrameParamsIn takes as the difference of two
+// rotated corners are enclosed far more loosely than the rotated
+// view-space step (rotation is linear, so the two are equal), and a rotated
+// component is never longer than the vector: both tighten each member.
+void NarrowRotated(const FrameValues<Enclosure>& box, iv::FrameParams& p) {
+  const iv::vec4* view[] = {&p.eye_ray_view_origin, &p.eye_ray_view_du, &p.eye_ray_view_dv};
+  iv::vec4* eye_world[] = {&p.eye_ray_world_origin, &p.eye_ray_world_du, &p.eye_ray_world_dv};
+  iv::vec4* frustum[] = {&p.frustum_ray_origin, &p.frustum_ray_du, &p.frustum_ray_dv};
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec<3, Enclosure> v(view[k]->x, view[k]->y, view[k]->z);
+    const glm::vec<3, Enclosure> world = Rotate(box.rotation, v);
+    const double length = std::sqrt(Square(v.x).hi + Square(v.y).hi + Square(v.z).hi) * (1.0 + 0x1p-50);
+    for (int c = 0; c < 3; ++c) {
+      const Enclosure at_unit_depth(std::max(world[c].lo, -length), std::min(world[c].hi, length));
+      Narrow((*eye_world[k])[c], at_unit_depth);
+      // Pettineo's rays reach the far plane: the same at eye depth `far`.
+      if (box.far.lo > 0.0) Narrow((*frustum[k])[c], at_unit_depth * box.far);
+    }
+  }
+}
+
+}  // namespace
+
 iv::FrameParams EncloseFrameParams(const FrameValues<Enclosure>& box) {
-  return HullAtFarEnds<iv::FrameParams>(box, [](auto visit) { ForEachFrameParamsMember(visit); },
-                                        [](const FrameValues<Enclosure>& at) { return FrameParamsIn<iv::FrameParams>(at); });
+  iv::FrameParams p = HullAtFarEnds<iv::FrameParams>(
+      box, [](auto visit) { ForEachFrameParamsMember(visit); },
+      [](const FrameValues<Enclosure>& at) { return FrameParamsIn<iv::FrameParams>(at); });
+  NarrowRotated(box, p);
+  return p;
 }
 
 iv::DepthParams EncloseDepthParams(const FrameValues<Enclosure>& box, Convention convention) {
