@@ -204,11 +204,11 @@ double Worst(const Results& results, const Cell& cell, Metric metric) {
 // and with every division as far off as Vulkan allows; and the whole
 // error within the whole's bound. Scaled down eightfold, the bounds are
 // exceeded somewhere: the comparison can fail. The worst divisions cost
-// something: they raise the worst shader error of most cells.
+// something: they raise the worst shader error wherever rounding sets it.
 TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   const Measured& m = Sweeps();
   ASSERT_EQ(m.bounds.size(), 58u);
-  int bounded = 0, exceeded_at_an_eighth = 0, raised_by_worst_division = 0;
+  int bounded = 0, exceeded_at_an_eighth = 0, rounding_bound = 0;
   for (const bound::CellBound& b : m.bounds) {
     SCOPED_TRACE(b.cell.Name());
     if (!std::isfinite(b.device_shader)) continue;
@@ -219,7 +219,13 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
     const double worst = Worst(m.worst_division, b.cell, Metric::kArith);
     EXPECT_LE(worst, b.device_shader);
     EXPECT_LE(Worst(m.worst_division, b.cell, Metric::kTotal), b.total);
-    raised_by_worst_division += worst > gpu * 1.5;
+    // Where rounding, not a cancellation, sets the worst (under 4 bits
+    // lost), the worst divisions raise it by more than half a bit (0.7 to
+    // 1.8 bits measured; the others are set by ndc - A, 7 bits and more).
+    if (BitsLost(gpu) < 4.0) {
+      ++rounding_bound;
+      EXPECT_GT(worst, gpu * 1.5) << BitsLost(gpu) << " -> " << BitsLost(worst);
+    }
     EXPECT_LE(b.exact_shader, b.device_shader);  // the device's rules allow more
     EXPECT_LE(Worst(m.cpu, b.cell, Metric::kTotal), b.total);
     EXPECT_LE(Worst(m.vulkan, b.cell, Metric::kTotal), b.total);
@@ -229,7 +235,7 @@ TEST(BoundTest, EveryMeasuredSampleLiesWithinItsCellsBound) {
   // (its light volume's depth enters a divisor).
   EXPECT_GE(bounded, 55);
   EXPECT_GT(exceeded_at_an_eighth, 0);
-  EXPECT_GT(raised_by_worst_division, bounded / 2);
+  EXPECT_GE(rounding_bound, 20);
 }
 
 // The fuzzer holds every judged sample against its cell's proven bound.
