@@ -100,6 +100,100 @@ Expected<std::vector<Instruction>> Instructions(std::span<const std::uint32_t> s
   return out;
 }
 
+// The module's types, and those the division probes add: made where
+// missing, with fresh ids from the module's bound, to close its global
+// section (`made`).
+class TypeTable {
+ public:
+  TypeTable(std::span<const std::uint32_t> spirv, const std::vector<Instruction>& instructions)
+      : bound_(spirv[kBoundWord]) {
+    for (const Instruction& inst : instructions) {
+      const std::uint32_t* w = spirv.data() + inst.at;
+      if (inst.op == spv::OpTypeFloat) float_width_[w[1]] = w[2];
+      if (inst.op == spv::OpTypeFloat && w[2] == 64) double_ = w[1];
+      if (inst.op == spv::OpTypeInt && w[2] == 32 && w[3] == 0) uint_ = w[1];
+      if (inst.op == spv::OpTypeVector) {
+        vectors_[w[1]] = {w[2], w[3]};
+        vector_of_[{w[2], w[3]}] = w[1];
+      }
+    }
+  }
+
+  std::uint32_t Fresh() { return bound_++; }
+  std::uint32_t bound() const { return bound_; }
+  const std::vector<std::uint32_t>& made() const { return made_; }
+
+  bool IsFloat32(std::uint32_t type) const {
+    if (auto v = vectors_.find(type); v != vectors_.end()) type = v->second.first;
+    auto f = float_width_.find(type);
+    return f != float_width_.end() && f->second == 32;
+  }
+
+  // The float64 counterpart of a float32 scalar or vector type.
+  std::uint32_t Widened(std::uint32_t type) {
+    if (double_ == 0) Make({Word(spv::OpTypeFloat, 3), double_ = Fresh(), 64});
+    return SameShape(type, double_);
+  }
+
+  // The unsigned integer type of a float32 type's bits, and the constant 2
+  // of that type.
+  std::pair<std::uint32_t, std::uint32_t> Bits(std::uint32_t type) {
+    if (auto found = bits_of_.find(type); found != bits_of_.end()) return found->second;
+    if (uint_ == 0) Make({Word(spv::OpTypeInt, 4), uint_ = Fresh(), 32, 0});
+    if (two_ == 0) Make({Word(spv::OpConstant, 4), uint_, two_ = Fresh(), 2});
+    std::pair<std::uint32_t, std::uint32_t> bits{uint_, two_};
+    if (auto v = vectors_.find(type); v != vectors_.end()) {
+      const std::uint32_t count = v->second.second;
+      bits = {SameShape(type, uint_), Fresh()};
+      Make({Word(spv::OpConstantComposite, 3 + count), bits.first, bits.second});
+      made_.insert(made_.end(), count, two_);
+    }
+    return bits_of_[type] = bits;
+  }
+
+ private:
+  void Make(std::initializer_list<std::uint32_t> words) { made_.insert(made_.end(), words); }
+
+  // `component`, or a vector of it as long as `type` is one.
+  std::uint32_t SameShape(std::uint32_t type, std::uint32_t component) {
+    auto v = vectors_.find(type);
+    if (v == vectors_.end()) return component;
+    const std::pair<std::uint32_t, std::uint32_t> key{component, v->second.second};
+    auto existing = vector_of_.find(key);
+    if (existing == vector_of_.end()) {
+      existing = vector_of_.emplace(key, Fresh()).first;
+      Make({Word(spv::OpTypeVector, 4), existing->second, component, key.second});
+    }
+    return existing->second;
+  }
+
+  std::uint32_t bound_;
+  std::map<std::uint32_t, std::uint32_t> float_width_;                        // type id -> width
+  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> vectors_;  // id -> (component, count)
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> vector_of_;
+  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> bits_of_;
+  std::uint32_t double_ = 0, uint_ = 0, two_ = 0;
+  std::vector<std::uint32_t> made_;
+};
+
+// A float32 OpFDiv (w) as a float64 division rounded once to float32; with
+// `worst`, that quotient then moved two steps of its bits away from zero:
+// 2 ulp off the correctly rounded one, within Vulkan's 2.5 ulp of the exact.
+void RewriteDivision(const std::uint32_t* w, bool worst, TypeTable& types, std::vector<std::uint32_t>& to) {
+  const std::uint32_t type = w[1], result = w[2], a = w[3], b = w[4];
+  const std::uint32_t wide = types.Widened(type);
+  const std::uint32_t wide_a = types.Fresh(), wide_b = types.Fresh(), quotient = types.Fresh();
+  const std::uint32_t rounded = worst ? types.Fresh() : result;
+  to.insert(to.end(), {Word(spv::OpFConvert, 4), wide, wide_a, a, Word(spv::OpFConvert, 4), wide, wide_b, b,
+                       Word(spv::OpFDiv, 5), wide, quotient, wide_a, wide_b, Word(spv::OpFConvert, 4), type, rounded,
+                       quotient});
+  if (!worst) return;
+  const auto [uint_of, two_of] = types.Bits(type);
+  const std::uint32_t raw = types.Fresh(), pushed = types.Fresh();
+  to.insert(to.end(), {Word(spv::OpBitcast, 4), uint_of, raw, rounded, Word(spv::OpIAdd, 5), uint_of, pushed, raw,
+                       two_of, Word(spv::OpBitcast, 4), type, result, pushed});
+}
+
 }  // namespace
 
 Expected<std::uint32_t> ParseArithmeticProbes(std::string_view text) {
@@ -142,98 +236,21 @@ Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::
   const bool worst_division = (probes & kWorstDivision) != 0;
   const bool exact_division = (probes & kExactDivision) != 0 || worst_division;
 
-  // First pass: the float types, the results to decorate, the divisions.
-  std::map<std::uint32_t, std::uint32_t> float_width;                        // type id -> width
-  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> vectors;  // id -> (component, count)
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> vector_of;
+  // First pass: the types, the results to decorate, where functions begin.
+  TypeTable types(spirv, instructions);
   std::vector<std::uint32_t> contractible;
-  std::uint32_t uint_type = 0;
   bool float64_capability = false;
+  std::size_t first_function = spirv.size();
   for (const Instruction& inst : instructions) {
     const std::uint32_t* w = spirv.data() + inst.at;
     if (inst.op == spv::OpCapability && w[1] == spv::CapabilityFloat64) float64_capability = true;
-    if (inst.op == spv::OpTypeFloat) float_width[w[1]] = w[2];
-    if (inst.op == spv::OpTypeInt && w[2] == 32 && w[3] == 0) uint_type = w[1];
-    if (inst.op == spv::OpTypeVector) {
-      vectors[w[1]] = {w[2], w[3]};
-      vector_of[{w[2], w[3]}] = w[1];
-    }
     if (Contractible(inst.op)) contractible.push_back(w[2]);
+    if (inst.op == spv::OpFunction && first_function == spirv.size()) first_function = inst.at;
   }
-  std::uint32_t bound = spirv[kBoundWord];
-  // The float64 types the divisions need, made where missing.
-  std::vector<std::uint32_t> new_types;
-  std::uint32_t double_type = 0;
-  for (const auto& [id, width] : float_width) {
-    if (width == 64) double_type = id;
-  }
-  std::map<std::uint32_t, std::uint32_t> widened;  // float32 type -> its float64 counterpart
-  auto widen = [&](std::uint32_t type) -> std::uint32_t {
-    if (auto found = widened.find(type); found != widened.end()) return found->second;
-    if (double_type == 0) {
-      double_type = bound++;
-      new_types.insert(new_types.end(), {Word(spv::OpTypeFloat, 3), double_type, 64});
-    }
-    std::uint32_t wide = double_type;
-    if (auto v = vectors.find(type); v != vectors.end()) {
-      const std::pair<std::uint32_t, std::uint32_t> key{double_type, v->second.second};
-      if (auto existing = vector_of.find(key); existing != vector_of.end()) {
-        wide = existing->second;
-      } else {
-        wide = bound++;
-        vector_of[key] = wide;
-        new_types.insert(new_types.end(), {Word(spv::OpTypeVector, 4), wide, double_type, v->second.second});
-      }
-    }
-    widened[type] = wide;
-    return wide;
-  };
-  // worst-division: the unsigned integer type of a float32 type's bits, and
-  // the constant 2 of that type, made where missing.
-  std::uint32_t two = 0;
-  std::map<std::uint32_t, std::pair<std::uint32_t, std::uint32_t>> bits_of;
-  auto bits = [&](std::uint32_t type) -> std::pair<std::uint32_t, std::uint32_t> {
-    if (auto found = bits_of.find(type); found != bits_of.end()) return found->second;
-    if (uint_type == 0) {
-      uint_type = bound++;
-      new_types.insert(new_types.end(), {Word(spv::OpTypeInt, 4), uint_type, 32, 0});
-    }
-    if (two == 0) {
-      two = bound++;
-      new_types.insert(new_types.end(), {Word(spv::OpConstant, 4), uint_type, two, 2});
-    }
-    std::pair<std::uint32_t, std::uint32_t> made{uint_type, two};
-    if (auto v = vectors.find(type); v != vectors.end()) {
-      const std::uint32_t count = v->second.second;
-      const std::pair<std::uint32_t, std::uint32_t> key{uint_type, count};
-      auto existing = vector_of.find(key);
-      if (existing == vector_of.end()) {
-        existing = vector_of.emplace(key, bound++).first;
-        new_types.insert(new_types.end(), {Word(spv::OpTypeVector, 4), existing->second, uint_type, count});
-      }
-      made = {existing->second, bound++};
-      new_types.insert(new_types.end(), {Word(spv::OpConstantComposite, 3 + count), made.first, made.second});
-      new_types.insert(new_types.end(), count, two);
-    }
-    bits_of[type] = made;
-    return made;
-  };
-  auto is_float32 = [&](std::uint32_t type) {
-    if (auto v = vectors.find(type); v != vectors.end()) type = v->second.first;
-    auto f = float_width.find(type);
-    return f != float_width.end() && f->second == 32;
-  };
 
   // Second pass: copy, inserting and rewriting.
   std::vector<std::uint32_t> out(spirv.begin(), spirv.begin() + kHeaderWords);
   bool decorated = false, capability_added = false;
-  std::size_t first_function = spirv.size();
-  for (const Instruction& inst : instructions) {
-    if (inst.op == spv::OpFunction) {
-      first_function = inst.at;
-      break;
-    }
-  }
   std::vector<std::uint32_t> tail;  // the functions, rewritten
   for (const Instruction& inst : instructions) {
     const std::uint32_t* w = spirv.data() + inst.at;
@@ -248,30 +265,16 @@ Expected<std::vector<std::uint32_t>> ApplyArithmeticProbes(std::span<const std::
       }
       decorated = true;
     }
-    if (exact_division && inst.op == spv::OpFDiv && is_float32(w[1])) {
-      const std::uint32_t type = w[1], result = w[2], a = w[3], b = w[4];
-      const std::uint32_t wide = widen(type);
-      const std::uint32_t wide_a = bound++, wide_b = bound++, quotient = bound++;
-      const std::uint32_t rounded = worst_division ? bound++ : result;
-      to.insert(to.end(), {Word(spv::OpFConvert, 4), wide, wide_a, a, Word(spv::OpFConvert, 4), wide, wide_b, b,
-                           Word(spv::OpFDiv, 5), wide, quotient, wide_a, wide_b, Word(spv::OpFConvert, 4), type, rounded,
-                           quotient});
-      if (worst_division) {
-        // Two steps of the float's bits away from zero: the correctly
-        // rounded quotient moved by 2 ulp, within 2.5 ulp of the exact one.
-        const auto [uint_of, two_of] = bits(type);
-        const std::uint32_t raw = bound++, pushed = bound++;
-        to.insert(to.end(), {Word(spv::OpBitcast, 4), uint_of, raw, rounded, Word(spv::OpIAdd, 5), uint_of, pushed, raw,
-                             two_of, Word(spv::OpBitcast, 4), type, result, pushed});
-      }
+    if (exact_division && inst.op == spv::OpFDiv && types.IsFloat32(w[1])) {
+      RewriteDivision(w, worst_division, types, to);
       continue;
     }
     to.insert(to.end(), w, w + inst.words);
   }
   // The new types close the global section, before the first function.
-  out.insert(out.end(), new_types.begin(), new_types.end());
+  out.insert(out.end(), types.made().begin(), types.made().end());
   out.insert(out.end(), tail.begin(), tail.end());
-  out[kBoundWord] = bound;
+  out[kBoundWord] = types.bound();
   return out;
 }
 
