@@ -99,51 +99,48 @@ glm::mat<3, 3, Enclosure> Rotation(const Box& box) {
 // be exact at another. So only values that do not scale are taken as
 // exact: the program's literals, zero, whole numbers of pixels, the
 // dimensionless A; a length (B, the far plane, near) never is, even where
-// its normalized value is 1.
+// its normalized value is 1. A single sample's frame is analysed at its own
+// scale (`at_scale`, ShaderBoundAt): there every float is known.
 
-// The float32 values that round to nearest from the points of `x`, for a
-// dimensionless constant the shader and the reference both read rounded
-// (a point when x is one a float holds).
-Enclosure FloatHull(const Enclosure& x) {
-  auto down = [](double v) {
-    const auto f = static_cast<float>(v);
-    return static_cast<double>(f) <= v ? static_cast<double>(f) : static_cast<double>(std::nextafter(f, -INFINITY));
-  };
-  auto up = [](double v) {
-    const auto f = static_cast<float>(v);
-    return static_cast<double>(f) >= v ? static_cast<double>(f) : static_cast<double>(std::nextafter(f, INFINITY));
-  };
-  return {down(x.lo), up(x.hi)};
+// The float32 values the points of `x` round to nearest: what the shader
+// and the reference read of a constant computed exactly and rounded once
+// (encode.h FrameMapping; a point when x is one a float holds).
+Enclosure NearestFloats(const Enclosure& x) {
+  return {NearestFloat32(x.lo), NearestFloat32(x.hi)};
 }
 
-// The same for a length: at any scale its float lies within 2^-24 of it.
-Enclosure LengthFloat(const Enclosure& x) {
+// The same for a length: at a normalized scale, only that its float lies
+// within 2^-24 of it.
+Enclosure LengthFloat(const Enclosure& x, bool at_scale) {
+  if (at_scale) return NearestFloats(x);
   const double w = kU * x.mag();
   return Enclosure::Outward(x.lo - w, x.hi + w);
 }
 
 // An input lane: the exact constant lies in `x` widened by `widen` u of
 // its magnitude; the float32 value the shader receives is within `error` u
-// of it (exactly 0 when it is 0, at any scale).
-Lane Input(const Enclosure& x, double widen, double error) {
+// of it (exactly 0 when it is 0, at any scale), and at the frame's own
+// scale is x rounded.
+Lane Input(const Enclosure& x, double widen, double error, bool at_scale) {
   if (x.lo == 0.0 && x.hi == 0.0) return Lane::Exact(x);
   const double w = widen * kU * x.mag();
-  return {Enclosure::Outward(x.lo - w, x.hi + w), error * kU * x.mag() + kUnderflow};
+  return {Enclosure::Outward(x.lo - w, x.hi + w), error * kU * x.mag() + kUnderflow,
+          at_scale ? NearestFloats(x) : Enclosure::Whole()};
 }
-Value Inputs(const iv::vec4& v, double widen, double error, int exact_lanes = 0) {
+Value Inputs(const iv::vec4& v, double widen, double error, bool at_scale, int exact_lanes = 0) {
   std::vector<Value> parts;
   for (int k = 0; k < 4; ++k)
-    parts.push_back(Value::Float(k < exact_lanes ? Lane::Exact(v[k]) : Input(v[k], widen, error)));
+    parts.push_back(Value::Float(k < exact_lanes ? Lane::Exact(v[k]) : Input(v[k], widen, error, at_scale)));
   return Value::Composite(std::move(parts));
 }
 // A matrix's columns; `transposed`: its rows, as a program that reads its
 // buffers row-major holds it (SpirvProgram::RowMajorMatrices).
-Value Inputs(const iv::mat4& m, double widen, double error, bool transposed) {
+Value Inputs(const iv::mat4& m, double widen, double error, bool at_scale, bool transposed) {
   std::vector<Value> columns;
   for (int c = 0; c < 4; ++c) {
     iv::vec4 column = m[c];
     if (transposed) column = iv::vec4(m[0][c], m[1][c], m[2][c], m[3][c]);
-    columns.push_back(Inputs(column, widen, error));
+    columns.push_back(Inputs(column, widen, error, at_scale));
   }
   return Value::Composite(std::move(columns));
 }
@@ -155,33 +152,33 @@ Value Inputs(const iv::mat4& m, double widen, double error, bool transposed) {
 // far plane (the linear formats' reference decodes with the float far
 // plane, so the frustum rays, which scale with the exact far plane, are a
 // further ulp from what it denotes).
-Value FrameInputs(const iv::FrameParams& f, bool transposed) {
+Value FrameInputs(const iv::FrameParams& f, bool at_scale, bool transposed) {
   std::vector<Value> m;
-  Value camera_world = Inputs(f.camera_world, 0, 1, transposed);
+  Value camera_world = Inputs(f.camera_world, 0, 1, at_scale, transposed);
   if (transposed) {
     for (int r = 0; r < 3; ++r)
       camera_world.parts.Mutable()[r].parts.Mutable()[3] = Value::Float(Lane::Exact(f.camera_world[3][r]));
   } else {
-    camera_world.parts.Mutable()[3] = Inputs(f.camera_world[3], 0, 0, 4);
+    camera_world.parts.Mutable()[3] = Inputs(f.camera_world[3], 0, 0, at_scale, 4);
   }
   m.push_back(std::move(camera_world));
-  Value camera_position = Inputs(f.camera_position, 0, 0, 3);
-  camera_position.parts.Mutable()[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w)));
+  Value camera_position = Inputs(f.camera_position, 0, 0, at_scale, 3);
+  camera_position.parts.Mutable()[3] = Value::Float(Lane::Exact(LengthFloat(f.camera_position.w, at_scale)));
   m.push_back(std::move(camera_position));
-  m.push_back(Inputs(f.lens, 0, 1));
-  Value resolution = Inputs(f.resolution, 0, 1, 2);  // whole numbers of pixels, then their reciprocals
+  m.push_back(Inputs(f.lens, 0, 1, at_scale));
+  Value resolution = Inputs(f.resolution, 0, 1, at_scale, 2);  // whole numbers of pixels, then their reciprocals
   m.push_back(std::move(resolution));
   for (const iv::vec4* ray : {&f.frustum_ray_origin, &f.frustum_ray_du, &f.frustum_ray_dv})
-    m.push_back(Inputs(*ray, 1, 2));
+    m.push_back(Inputs(*ray, 1, 2, at_scale));
   for (const iv::vec4* v :
        {&f.volume_position_origin, &f.volume_position_du, &f.volume_position_dv, &f.eye_ray_view_origin,
         &f.eye_ray_view_du, &f.eye_ray_view_dv, &f.eye_ray_world_origin, &f.eye_ray_world_du, &f.eye_ray_world_dv}) {
-    m.push_back(Inputs(*v, 0, 1));
+    m.push_back(Inputs(*v, 0, 1, at_scale));
   }
-  m.push_back(Inputs(f.world_view, 0, 1, transposed));
-  m.push_back(Inputs(f.lens_centre, 0, 1));
-  Value clip_planes = Inputs(f.clip_planes, 0, 1);
-  clip_planes.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y)));
+  m.push_back(Inputs(f.world_view, 0, 1, at_scale, transposed));
+  m.push_back(Inputs(f.lens_centre, 0, 1, at_scale));
+  Value clip_planes = Inputs(f.clip_planes, 0, 1, at_scale);
+  clip_planes.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(f.clip_planes.y, at_scale)));
   m.push_back(std::move(clip_planes));
   return Value::Composite(std::move(m));
 }
@@ -190,14 +187,14 @@ Value FrameInputs(const iv::FrameParams& f, bool transposed) {
 // float32 A and B (encode.h), so those arrive exactly; P = 1/B, Q = -A/B
 // and the matrices are rounded from the exact frame's, up to two ulps from
 // what the float A and B give, plus their own rounding.
-Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention, bool transposed) {
+Value DepthInputs(const iv::DepthParams* d, std::uint32_t convention, bool at_scale, bool transposed) {
   std::vector<Value> m;
   if (d != nullptr) {
-    m.push_back(Inputs(d->inverse_view_projection, 2, 3, transposed));
-    m.push_back(Inputs(d->view_projection, 2, 3, transposed));
-    Value coefficients = Inputs(d->coefficients, 2, 3);
-    coefficients.parts.Mutable()[0] = Value::Float(Lane::Exact(FloatHull(d->coefficients.x)));
-    coefficients.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y)));
+    m.push_back(Inputs(d->inverse_view_projection, 2, 3, at_scale, transposed));
+    m.push_back(Inputs(d->view_projection, 2, 3, at_scale, transposed));
+    Value coefficients = Inputs(d->coefficients, 2, 3, at_scale);
+    coefficients.parts.Mutable()[0] = Value::Float(Lane::Exact(NearestFloats(d->coefficients.x)));
+    coefficients.parts.Mutable()[1] = Value::Float(Lane::Exact(LengthFloat(d->coefficients.y, at_scale)));
     m.push_back(std::move(coefficients));
   } else {
     // Not a projective convention: nothing here is the cell's to read.
@@ -318,8 +315,9 @@ struct CellProgram {
 
 class CellAnalysis {
  public:
-  CellAnalysis(const Domain& domain, const Cell& cell, const CellProgram& program)
-      : domain_(domain), cell_(cell), program_(program), convention_(Info(cell.convention)) {}
+  // `at_scale`: the frames given are samples' own, not normalized boxes.
+  CellAnalysis(const Domain& domain, const Cell& cell, const CellProgram& program, bool at_scale = false)
+      : domain_(domain), cell_(cell), program_(program), convention_(Info(cell.convention)), at_scale_(at_scale) {}
 
   // The box's shader and depth figures under `machine`.
   void Evaluate(Box& box, const Machine& machine) const {
@@ -391,11 +389,11 @@ class CellAnalysis {
     const bool hardware = convention_.hardware;
     if (hardware) depth = EncloseDepthParams(v, cell_.convention);
     const bool transposed = program_.program->RowMajorMatrices();
-    in.frame_value = FrameInputs(in.frame, transposed);
-    in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits, transposed);
-    in.a = FloatHull(depth.coefficients.x);
-    in.b = LengthFloat(depth.coefficients.y);
-    in.far = LengthFloat(in.frame.camera_position.w);
+    in.frame_value = FrameInputs(in.frame, at_scale_, transposed);
+    in.depth_value = DepthInputs(hardware ? &depth : nullptr, convention_.bits, at_scale_, transposed);
+    in.a = NearestFloats(depth.coefficients.x);
+    in.b = LengthFloat(depth.coefficients.y, at_scale_);
+    in.far = LengthFloat(in.frame.camera_position.w, at_scale_);
     return in;
   }
 
@@ -534,6 +532,7 @@ class CellAnalysis {
   const Cell& cell_;
   const CellProgram& program_;
   const ConventionInfo& convention_;
+  bool at_scale_;
 };
 
 // The two halves of `box` along `dim` (pixels split between whole numbers).
@@ -703,13 +702,32 @@ double LongestRay(const Domain& domain) {
   return std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y) * (1.0 + 1e-12);
 }
 
-Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
-                               const Enclosure& stored, const Machine& machine,
-                               const std::filesystem::path& shader_dir) {
+struct SampleBounds::State {
   Programs programs;
-  DB_ASSIGN_OR_RETURN(const CellProgram program, ProgramOf(cell, shader_dir, programs));
-  Domain domain;
-  const CellAnalysis analysis(domain, cell, program);
+  std::vector<Cell> cells;
+  std::vector<Expected<CellProgram>> cell_programs;
+};
+
+Expected<SampleBounds> SampleBounds::Make(std::span<const Cell> cells, const std::filesystem::path& shader_dir) {
+  SampleBounds bounds;
+  bounds.state_ = std::make_shared<State>();
+  State& state = *bounds.state_;
+  state.cells.assign(cells.begin(), cells.end());
+  for (const Cell& cell : state.cells) state.cell_programs.push_back(ProgramOf(cell, shader_dir, state.programs));
+  return bounds;
+}
+
+Expected<double> SampleBounds::At(const Cell& cell, const Frame& frame, std::uint32_t pixel_x,
+                                  std::uint32_t pixel_y, const Enclosure& stored, const Machine& machine) const {
+  const auto found = std::find(state_->cells.begin(), state_->cells.end(), cell);
+  if (found == state_->cells.end()) return InvalidArgument(fmt::format("{} was not given to bound", cell.Name()));
+  const Expected<CellProgram>& program = state_->cell_programs[found - state_->cells.begin()];
+  if (!program.ok()) return program.status();
+  // A formula that is wrong in exact arithmetic here has no bound.
+  if (cell.variant_info().assumes_symmetric_frustum && (frame.centre_x != 0.0 || frame.centre_y != 0.0))
+    return INFINITY;
+  const Domain domain;
+  const CellAnalysis analysis(domain, cell, *program, true);
   FrameValues<Enclosure> v;
   v.tan_half_fov_y = Enclosure(frame.tan_half_fov_y);
   v.aspect = Enclosure(frame.aspect);
@@ -721,15 +739,22 @@ Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32
   v.width = Enclosure(frame.width);
   v.height = Enclosure(frame.height);
   for (int k = 0; k < 3; ++k) v.camera_position[k] = Enclosure(frame.camera_position[k]);
-  for (int c = 0; c < 3; ++c) {
-    for (int r = 0; r < 3; ++r) v.rotation[c][r] = Enclosure(frame.rotation[c][r]);
+  for (int col = 0; col < 3; ++col) {
+    for (int r = 0; r < 3; ++r) v.rotation[col][r] = Enclosure(frame.rotation[col][r]);
   }
   const auto in = analysis.InputsOf(v);
   const Enclosure px(pixel_x), py(pixel_y);
-  DB_ASSIGN_OR_RETURN(const double error, analysis.ShaderError(in, px, py, stored, machine));
+  DB_ASSIGN_OR_RETURN(const double error, analysis.ShaderError(in, px, py, stored, AtScale(machine)));
   const Enclosure depth = analysis.DenotedDepths(in, stored);
   if (!(depth.lo > 0.0)) return InvalidArgument("stored values that denote no depth in front of the camera");
   return error / (depth.lo * CellAnalysis::RayLength(in, px, py));
+}
+
+Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                               const Enclosure& stored, const Machine& machine,
+                               const std::filesystem::path& shader_dir) {
+  DB_ASSIGN_OR_RETURN(const SampleBounds bounds, SampleBounds::Make(std::span<const Cell>(&cell, 1), shader_dir));
+  return bounds.At(cell, frame, pixel_x, pixel_y, stored, machine);
 }
 
 }  // namespace depthbench::bound

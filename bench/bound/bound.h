@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -71,9 +72,27 @@ double LongestRay(const Domain& domain);
 
 // The shader part's bound for one frame (its camera's rotation and
 // position included), one pixel and a range of stored values, relative to
-// the nearest depth those values denote: what a second method can check
-// point by point (tests/bound_test.cc enumerates every float32 of a
-// binade). Projective conventions decode with the frame's A and B.
+// the nearest depth those values denote. The frame is analysed at its own
+// scale, where the floats each operation can give are known (rounding.h):
+// at a single stored value the bound follows them rather than assuming
+// every rounding at its worst. Projective conventions decode with the
+// frame's A and B. Each cell's program is compiled once; not for use from
+// several threads at once (the programs' evaluations share state).
+class SampleBounds {
+ public:
+  static Expected<SampleBounds> Make(std::span<const Cell> cells, const std::filesystem::path& shader_dir);
+  // One of the cells given to Make; +infinity where the cell's formula
+  // assumes a symmetric frustum and the frame's is off-centre.
+  Expected<double> At(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                      const Enclosure& stored, const Machine& machine) const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+// The same for one cell: what a second method can check point by point
+// (tests/bound_test.cc enumerates every float32 of a binade).
 Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,
                                const Enclosure& stored, const Machine& machine,
                                const std::filesystem::path& shader_dir);

@@ -29,12 +29,27 @@
 // not 2^-126, because the analysis runs at a normalized scale (the near
 // plane at 1, bench/bound/bound.h) and a frame may be 2^-26 times as
 // small.
+//
+// Where the lanes hold one frame's own values rather than a normalized box
+// of them (Machine::at_scale: a single sample's inputs), a lane also
+// carries the set of float32 values the machine may compute, operation by
+// operation: the rounded results of every operand value, the unrounded
+// product beside the rounded one where a multiply may be fused into the
+// next add, every order of a dot product's additions, a division's whole
+// tolerance, zero for a denormal that may be flushed. At a point that set
+// is a handful of floats, and its distance from the exact enclosure bounds
+// the error without assuming every rounding at its worst at once; the
+// smaller of the two bounds is kept. At a normalized scale the floats are
+// not the frame's, and the set is the whole line.
 #pragma once
 
+#include <array>
+#include <cfloat>
 #include <cmath>
 #include <string_view>
 
 #include "bench/numerics/enclosure.h"
+#include "bench/numerics/float32.h"
 
 namespace depthbench::bound {
 
@@ -50,21 +65,59 @@ struct Machine {
   std::string_view name;
   double division_ulps;  // a division's error in ULP of its result
   bool divisor_range;    // whether the division rule holds only for divisors in [2^-126, 2^126]
+  bool fuses;            // whether a multiply may be fused into the add that reads it
+  bool flushes;          // whether a denormal operand or result may be flushed to zero
+  bool at_scale = false;  // whether the lanes hold a frame's own values, so that its floats are known
 };
-inline constexpr Machine kVulkanDevice{"vulkan", 2.5, true};
-inline constexpr Machine kExactlyRounded{"exactly rounded", 0.5, false};
+inline constexpr Machine kVulkanDevice{"vulkan", 2.5, true, true, true};
+inline constexpr Machine kExactlyRounded{"exactly rounded", 0.5, false, false, false};
+
+// The same machine over lanes that hold one frame's own values.
+constexpr Machine AtScale(Machine machine) {
+  machine.at_scale = true;
+  return machine;
+}
 
 // One float32 lane: the exact value lies in `exact`; the computed one is
-// within `error` of it.
+// within `error` of it, and in `computed` (the whole line where the floats
+// are not known).
 struct Lane {
   Enclosure exact;
   double error = 0.0;
+  Enclosure computed = Enclosure::Whole();
 
   // The largest magnitude the computed value can have.
   double computed_mag() const { return exact.mag() + error; }
   // An exact input: a float32 value the reference uses as is.
-  static Lane Exact(const Enclosure& x) { return {x, 0.0}; }
+  static Lane Exact(const Enclosure& x) { return {x, 0.0, x}; }
 };
+
+// The float32 nearest to each point of x (ties to even), or the whole
+// line past the float range; then zero too where `machine` may flush.
+inline Enclosure Flushed(const Enclosure& x, const Machine& machine) {
+  if (!machine.flushes || x.mig() >= FLT_MIN || x.contains_zero()) return x;
+  return Enclosure::Hull(x, Enclosure(0.0));
+}
+inline Enclosure RoundedSet(const Enclosure& x, const Machine& machine) {
+  if (!(x.mag() <= FLT_MAX)) return Enclosure::Whole();
+  return Flushed({NearestFloat32(x.lo), NearestFloat32(x.hi)}, machine);
+}
+
+// The spacing of float32 values at magnitude x and just above it: the ULP
+// a tolerance is counted in (at most 2^-23 x; the larger spacing at a power
+// of two).
+inline double Ulp(double x) {
+  if (!(x < FLT_MAX)) return INFINITY;
+  int exponent = 0;
+  std::frexp(x, &exponent);  // x = f 2^exponent, f in [0.5, 1)
+  return std::ldexp(1.0, std::max(exponent, -125) - 24);
+}
+
+// The lane with its error bound tightened by its sets' distance.
+inline Lane Settled(Lane lane) {
+  if (lane.computed.finite() && lane.error >= 0.0) lane.error = std::min(lane.error, (lane.computed - lane.exact).mag());
+  return lane;
+}
 
 // The error after rounding a result whose exact-on-computed-operands value
 // is within `propagated` of `exact`, to within `ulps` ULP.
@@ -90,20 +143,32 @@ inline bool SumIsExact(const Enclosure& x, const Enclosure& y) {
   return opposite && 2.0 * x.mig() >= y.mag() && 2.0 * y.mig() >= x.mag();
 }
 
-inline Lane Add(const Lane& x, const Lane& y) {
+inline Lane Add(const Lane& x, const Lane& y, const Machine& machine) {
   const Enclosure exact = x.exact + y.exact;
+  const Enclosure computed = machine.at_scale
+                                 ? RoundedSet(Flushed(x.computed, machine) + Flushed(y.computed, machine), machine)
+                                 : Enclosure::Whole();
   // Lanes without error hold floats (inputs, literals, exact results).
-  if (x.error == 0.0 && y.error == 0.0 && SumIsExact(x.exact, y.exact)) return {exact, 0.0};
-  return {exact, Rounded(exact, x.error + y.error, 0.5)};
+  if (x.error == 0.0 && y.error == 0.0 && SumIsExact(x.exact, y.exact)) return {exact, 0.0, computed};
+  return Settled({exact, Rounded(exact, x.error + y.error, 0.5), computed});
 }
-inline Lane Negate(const Lane& x) { return {-x.exact, x.error}; }
-inline Lane Subtract(const Lane& x, const Lane& y) { return Add(x, Negate(y)); }
+inline Lane Negate(const Lane& x) { return {-x.exact, x.error, -x.computed}; }
+inline Lane Subtract(const Lane& x, const Lane& y, const Machine& machine) { return Add(x, Negate(y), machine); }
 
-inline Lane Multiply(const Lane& x, const Lane& y) {
+// What a product may compute: rounded, or left unrounded for a fused add.
+inline Enclosure ProductSet(const Enclosure& x, const Enclosure& y, const Machine& machine) {
+  if (!machine.at_scale) return Enclosure::Whole();
+  const Enclosure product = Flushed(x, machine) * Flushed(y, machine);
+  const Enclosure rounded = RoundedSet(product, machine);
+  return machine.fuses ? Enclosure::Hull(rounded, product) : rounded;
+}
+
+inline Lane Multiply(const Lane& x, const Lane& y, const Machine& machine) {
   const Enclosure exact = x.exact * y.exact;
+  const Enclosure computed = ProductSet(x.computed, y.computed, machine);
   const double propagated = x.exact.mag() * y.error + y.exact.mag() * x.error + x.error * y.error;
-  if (PowerOfTwo(x) || PowerOfTwo(y)) return {exact, propagated};
-  return {exact, Rounded(exact, propagated, 0.5)};
+  if (PowerOfTwo(x) || PowerOfTwo(y)) return Settled({exact, propagated, computed});
+  return Settled({exact, Rounded(exact, propagated, 0.5), computed});
 }
 
 // Division: the error, or a negative error when the divisor may be zero
@@ -116,12 +181,40 @@ inline Lane Divide(const Lane& x, const Lane& y, const Machine& machine) {
   }
   const Enclosure exact = x.exact / y.exact;
   const double propagated = x.error / least + x.exact.mag() * y.error / (y.exact.mig() * least);
-  return {exact, Rounded(exact, propagated, machine.division_ulps)};
+  Enclosure computed = Enclosure::Whole();
+  if (machine.at_scale) {
+    // Correctly rounded, or within the tolerance, from every quotient of
+    // the operands' floats.
+    const Enclosure q = Flushed(x.computed, machine) / Flushed(y.computed, machine);
+    const double slack = machine.division_ulps * Ulp(q.mag());
+    computed = machine.division_ulps == 0.5 ? RoundedSet(q, machine)
+                                            : RoundedSet(Enclosure::Outward(q.lo - slack, q.hi + slack), machine);
+  }
+  return Settled({exact, Rounded(exact, propagated, machine.division_ulps), computed});
+}
+
+// Every float a sum of the n sets may round to, in any order of additions:
+// each pair may be added first.
+inline Enclosure AnyOrderSum(std::array<Enclosure, 4> terms, int n, const Machine& machine) {
+  if (n == 1) return terms[0];
+  Enclosure all = Enclosure::Whole();
+  bool first = true;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      std::array<Enclosure, 4> next = terms;
+      next[i] = RoundedSet(terms[i] + terms[j], machine);
+      next[j] = terms[n - 1];
+      const Enclosure sum = AnyOrderSum(next, n - 1, machine);
+      all = first ? sum : Enclosure::Hull(all, sum);
+      first = false;
+    }
+  }
+  return all;
 }
 
 // sum over i of x[i] * y[i], n terms, in any order, fused or not.
 template <class Lanes>
-Lane Dot(const Lanes& x, const Lanes& y, int n) {
+Lane Dot(const Lanes& x, const Lanes& y, int n, const Machine& machine) {
   Enclosure exact(0.0);
   double propagated = 0.0, magnitude = 0.0;
   for (int i = 0; i < n; ++i) {
@@ -130,7 +223,13 @@ Lane Dot(const Lanes& x, const Lanes& y, int n) {
     magnitude += x[i].computed_mag() * y[i].computed_mag();
   }
   const double gamma = n * kUnitRoundoff / (1.0 - n * kUnitRoundoff);
-  return {exact, propagated + gamma * magnitude + n * kUnderflow};
+  Enclosure computed = Enclosure::Whole();
+  if (machine.at_scale && n <= 4) {
+    std::array<Enclosure, 4> products{};
+    for (int i = 0; i < n; ++i) products[i] = ProductSet(x[i].computed, y[i].computed, machine);
+    computed = AnyOrderSum(products, n, machine);
+  }
+  return Settled({exact, propagated + gamma * magnitude + n * kUnderflow, computed});
 }
 
 }  // namespace depthbench::bound

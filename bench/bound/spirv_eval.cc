@@ -271,11 +271,11 @@ Expected<std::vector<Lane>> Lanes(const Value& v) {
   return lanes;
 }
 
-Expected<Value> DotOf(const Value& a, const Value& b) {
+Expected<Value> DotOf(const Value& a, const Value& b, const Machine& machine) {
   DB_ASSIGN_OR_RETURN(std::vector<Lane> x, Lanes(a));
   DB_ASSIGN_OR_RETURN(std::vector<Lane> y, Lanes(b));
   if (x.size() != y.size()) return InvalidArgument("a dot product of vectors of different lengths");
-  return Value::Float(Dot(x, y, static_cast<int>(x.size())));
+  return Value::Float(Dot(x, y, static_cast<int>(x.size()), machine));
 }
 
 // Rows of a matrix (its parts are columns) as vectors.
@@ -302,8 +302,8 @@ Expected<Value> EachPart(const Value& whole, F f) {
 }
 
 // matrix * vector: the dot product of each row with the vector.
-Expected<Value> MatrixTimesVector(const Value& m, const Value& v) {
-  return EachPart(Transposed(m), [&](const Value& row) { return DotOf(row, v); });
+Expected<Value> MatrixTimesVector(const Value& m, const Value& v, const Machine& machine) {
+  return EachPart(Transposed(m), [&](const Value& row) { return DotOf(row, v, machine); });
 }
 
 // The part of `root` at `path`, to read; null when there is none.
@@ -416,18 +416,19 @@ class Evaluator {
     }
     DB_ASSIGN_OR_RETURN(Value b, Get(values, w[4]));
     const Machine& machine = machine_;
+    const auto multiply = [&](const Lane& x, const Lane& y) { return Multiply(x, y, machine); };
     switch (in.op) {
-      case Op::OpFAdd: return Lanewise(a, b, [](const Lane& x, const Lane& y) { return Add(x, y); });
-      case Op::OpFSub: return Lanewise(a, b, [](const Lane& x, const Lane& y) { return Subtract(x, y); });
-      case Op::OpFMul: return Lanewise(a, b, [](const Lane& x, const Lane& y) { return Multiply(x, y); });
+      case Op::OpFAdd: return Lanewise(a, b, [&](const Lane& x, const Lane& y) { return Add(x, y, machine); });
+      case Op::OpFSub: return Lanewise(a, b, [&](const Lane& x, const Lane& y) { return Subtract(x, y, machine); });
+      case Op::OpFMul: return Lanewise(a, b, multiply);
       case Op::OpFDiv: return Lanewise(a, b, [&](const Lane& x, const Lane& y) { return Divide(x, y, machine); });
       case Op::OpVectorTimesScalar:
-      case Op::OpMatrixTimesScalar: return ByScalar(a, b, [](const Lane& x, const Lane& y) { return Multiply(x, y); });
-      case Op::OpDot: return DotOf(a, b);
-      case Op::OpMatrixTimesVector: return MatrixTimesVector(a, b);
-      case Op::OpVectorTimesMatrix: return EachPart(b, [&](const Value& column) { return DotOf(a, column); });
+      case Op::OpMatrixTimesScalar: return ByScalar(a, b, multiply);
+      case Op::OpDot: return DotOf(a, b, machine);
+      case Op::OpMatrixTimesVector: return MatrixTimesVector(a, b, machine);
+      case Op::OpVectorTimesMatrix: return EachPart(b, [&](const Value& column) { return DotOf(a, column, machine); });
       case Op::OpMatrixTimesMatrix:
-        return EachPart(b, [&](const Value& column) { return MatrixTimesVector(a, column); });
+        return EachPart(b, [&](const Value& column) { return MatrixTimesVector(a, column, machine); });
       default: return InvalidArgument("not a float operation");
     }
   }
@@ -440,9 +441,10 @@ class Evaluator {
       case GLSLstd450FAbs: {
         DB_ASSIGN_OR_RETURN(Value a, operand(5));
         return ByScalar(a, Value::Float(Lane::Exact(1.0)), [](const Lane& x, const Lane&) {
-          const Enclosure abs =
-              x.exact.contains_zero() ? Enclosure(0.0, x.exact.mag()) : Enclosure(x.exact.mig(), x.exact.mag());
-          return Lane{abs, x.error};
+          auto abs = [](const Enclosure& e) {
+            return e.contains_zero() ? Enclosure(0.0, e.mag()) : Enclosure(e.mig(), e.mag());
+          };
+          return Lane{abs(x.exact), x.error, abs(x.computed)};
         });
       }
       case GLSLstd450FMin:
@@ -454,9 +456,11 @@ class Evaluator {
         DB_ASSIGN_OR_RETURN(Value a, operand(5));
         DB_ASSIGN_OR_RETURN(Value b, operand(6));
         return Lanewise(a, b, [min](const Lane& x, const Lane& y) {
-          const Enclosure exact = min ? Enclosure(std::min(x.exact.lo, y.exact.lo), std::min(x.exact.hi, y.exact.hi))
-                                      : Enclosure(std::max(x.exact.lo, y.exact.lo), std::max(x.exact.hi, y.exact.hi));
-          return Lane{exact, std::max(x.error, y.error)};
+          auto pick = [min](const Enclosure& p, const Enclosure& q) {
+            return min ? Enclosure(std::min(p.lo, q.lo), std::min(p.hi, q.hi))
+                       : Enclosure(std::max(p.lo, q.lo), std::max(p.hi, q.hi));
+          };
+          return Lane{pick(x.exact, y.exact), std::max(x.error, y.error), pick(x.computed, y.computed)};
         });
       }
       case GLSLstd450Fma: {
@@ -465,8 +469,10 @@ class Evaluator {
         DB_ASSIGN_OR_RETURN(Value a, operand(5));
         DB_ASSIGN_OR_RETURN(Value b, operand(6));
         DB_ASSIGN_OR_RETURN(Value c, operand(7));
-        DB_ASSIGN_OR_RETURN(Value product, Lanewise(a, b, [](const Lane& x, const Lane& y) { return Multiply(x, y); }));
-        return Lanewise(product, c, [](const Lane& x, const Lane& y) { return Add(x, y); });
+        const Machine& machine = machine_;
+        DB_ASSIGN_OR_RETURN(Value product,
+                            Lanewise(a, b, [&](const Lane& x, const Lane& y) { return Multiply(x, y, machine); }));
+        return Lanewise(product, c, [&](const Lane& x, const Lane& y) { return Add(x, y, machine); });
       }
       default: return InvalidArgument(fmt::format("the GLSL.std.450 instruction #{}", w[4]));
     }
@@ -762,8 +768,8 @@ class Evaluator {
           if (!x.ok()) return refuse("a conversion of an unknown integer");
           const double exact =
               in.op == Op::OpConvertSToF ? static_cast<double>(static_cast<std::int32_t>(*x)) : static_cast<double>(*x);
-          const auto rounded = static_cast<double>(static_cast<float>(exact));
-          values[w[2]] = Value::Float({Enclosure(exact), std::fabs(rounded - exact)});
+          const double rounded = NearestFloat32(exact);
+          values[w[2]] = Value::Float({Enclosure(exact), std::fabs(rounded - exact), Enclosure(rounded)});
           break;
         }
         case Op::OpExtInst: DB_RETURN_IF_ERROR(set(Extended(in, values))); break;

@@ -91,6 +91,19 @@ Expected<std::vector<double>> ProvenBounds(const FuzzFlags& f, const CampaignOpt
   return proven;
 }
 
+// The same machines' bounds at single samples, for each batch's worst.
+Expected<SampleBound> SampleBoundsOf(const FuzzFlags& f, const std::vector<Cell>& cells) {
+  std::filesystem::path shader_dir = f.backends.shaders;
+  if (shader_dir.empty()) DB_RETURN_IF_ERROR(StoreInto(DataPath("shaders"), shader_dir));
+  DB_ASSIGN_OR_RETURN(const bound::SampleBounds bounds, bound::SampleBounds::Make(cells, shader_dir));
+  return SampleBound([bounds](const Cell& cell, std::string_view backend, const Frame& frame, std::uint32_t x,
+                              std::uint32_t y, float stored) {
+    const Expected<double> b = bounds.At(cell, frame, x, y, Enclosure(stored),
+                                         backend == "cpu" ? bound::kExactlyRounded : bound::kVulkanDevice);
+    return b.ok() ? *b : INFINITY;
+  });
+}
+
 Expected<std::vector<KnownFinding>> KnownFindings(const FuzzFlags& f) {
   if (f.known == "none") return std::vector<KnownFinding>{};
   std::filesystem::path path = f.known;
@@ -158,7 +171,10 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
         "production and exact constants");
   }
   options.cells = CellsForDomain(cells, options.domain);
-  if (f.prove > 0) DB_RETURN_IF_ERROR(StoreInto(ProvenBounds(f, options, backends, out), options.proven));
+  if (f.prove > 0) {
+    DB_RETURN_IF_ERROR(StoreInto(ProvenBounds(f, options, backends, out), options.proven));
+    DB_RETURN_IF_ERROR(StoreInto(SampleBoundsOf(f, options.cells), options.sample_bound));
+  }
   Progress progress("fuzz", StderrIsTerminal(), f.quiet);
   options.progress = [&](double fraction, const std::string& line) { progress.Update(fraction, line); };
   DB_ASSIGN_OR_RETURN(const CampaignResult result, RunCampaign(options, backends));
@@ -347,8 +363,9 @@ void AddFuzzCommand(CLI::App& app, CommandAction& action) {
       ->type_name("FILE|none");
   cmd->add_option("--prove", flags->prove,
                   "hold every judged sample against the bound depthbench bound proves for its cell over the domain, "
-                  "proven with this many splits per cell (0, the default: not); a sample beyond it is a finding of "
-                  "its own kind, beyond_proven_bound: a wrong bound, or a device outside the Vulkan rounding rules");
+                  "proven with this many splits per cell (0, the default: not), and each batch's worst samples "
+                  "against the bound proven at their own inputs; a sample beyond either is a finding of its own "
+                  "kind, beyond_proven_bound: a wrong bound, or a device outside the Vulkan rounding rules");
   cmd->add_flag("--search", flags->search,
                 "search each cell's worst case (largest total error) in the default domain, narrowed by the domain "
                 "flags, on the CPU backend unless --backend says otherwise");

@@ -196,6 +196,7 @@ Status ShrinkFindings(const CampaignOptions& options, const std::vector<Backend*
           static_cast<std::size_t>(std::find(backend_list.begin(), backend_list.end(), backend) - backend_list.begin());
       one.SetProvenBounds({options.proven[c * backend_list.size() + b]});
     }
+    one.SetSampleBound(options.sample_bound);
     DB_ASSIGN_OR_RETURN(finding.shrunk, Shrink(one, finding.first, finding.kind, options.domain));
     DB_ASSIGN_OR_RETURN(finding.judgement, CheckOne(one, finding.shrunk));
     if (!options.out.empty()) DB_RETURN_IF_ERROR(WriteFinding(finding));
@@ -255,6 +256,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     return Internal("proven bounds for a different number of cells and backends");
   }
   checker.SetProvenBounds(options.proven);
+  checker.SetSampleBound(options.sample_bound);
   if (!options.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(options.out, ec);

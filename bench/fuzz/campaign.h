@@ -41,6 +41,9 @@ struct CampaignOptions {
   // (cells major), over `domain` (empty: none): a judged sample beyond its
   // bound is a finding of its own kind (FindingKind::kBeyondProven).
   std::vector<double> proven;
+  // The proven bound at single samples (CaseChecker::SetSampleBound), or
+  // empty: each batch's worst samples are held against it too.
+  SampleBound sample_bound;
   std::function<void(double fraction, const std::string& line)> progress;
 };
 

@@ -110,8 +110,35 @@ Status CaseChecker::Evaluate(const SampleSource& source, std::uint64_t first, st
           }
         },
         256);
+    if (sample_bound_) HoldWorstAgainstSampleBounds(b, count);
   }
   return Status::Ok();
+}
+
+void CaseChecker::HoldWorstAgainstSampleBounds(std::size_t b, std::uint32_t count) {
+  for (std::size_t c = 0; c < cells_.size(); ++c) {
+    const CellPlan& plan = layout_.cells[c];
+    Judgement* judged = &judgements_[(c * backends_.size() + b) * count];
+    // The worst by error, and by error over the condition-based bound
+    // (the sample whose inputs make it worst for its conditioning).
+    std::uint32_t worst[2] = {count, count};
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const Judgement& j = judged[i];
+      if (!j.judged || j.nan || j.inf) continue;
+      if (worst[0] == count || j.arith > judged[worst[0]].arith) worst[0] = i;
+      if (worst[1] == count || j.arith * judged[worst[1]].bound > judged[worst[1]].arith * j.bound) worst[1] = i;
+    }
+    for (std::uint32_t i : worst) {
+      if (i == count) continue;
+      const std::size_t at = static_cast<std::size_t>(plan.depth_slot) * count + i;
+      const ReferenceSample r = batch_.reference.Get(at);
+      const std::uint32_t pixel = batch_.pixels[i];
+      const double bound = sample_bound_(cells_[c], backends_[b]->name(), batch_.frames[batch_.FrameOf(i)],
+                                         pixel & 0xFFFFu, pixel >> 16, batch_.depths[at]);
+      // The judge measures against the true point's distance.
+      judged[i].proven = std::min(judged[i].proven, bound * (r.denoted_depth / r.true_depth));
+    }
+  }
 }
 
 }  // namespace depthbench

@@ -11,8 +11,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench/backends/backend.h"
@@ -73,6 +75,13 @@ struct Judgement {
   }
 };
 
+// The shader part's proven bound at one judged sample: the cell, the
+// backend's name, the sample's exact frame, pixel and fetched stored value;
+// relative to the distance of the point that value denotes, +infinity where
+// none is proven.
+using SampleBound = std::function<double(const Cell& cell, std::string_view backend, const Frame& frame,
+                                         std::uint32_t pixel_x, std::uint32_t pixel_y, float stored)>;
+
 class CaseChecker {
  public:
   // Prepares every backend for the cells (shaders compiled once).
@@ -82,6 +91,11 @@ class CaseChecker {
   // shader errors, bench/bound/), for the samples of the domain it was
   // proven over; every judged sample is held against it.
   void SetProvenBounds(std::vector<double> proven) { proven_ = std::move(proven); }
+  // The proven bound at single samples' own inputs (bound::SampleBounds),
+  // which is tighter than a domain's: each batch's worst judged sample of
+  // every cell and backend, by its error and by its error over
+  // ArithmeticBound, is held against it too.
+  void SetSampleBound(SampleBound bound) { sample_bound_ = std::move(bound); }
 
   // Runs samples [first, first + count) of `source` through every backend
   // and judges each output.
@@ -96,9 +110,13 @@ class CaseChecker {
 
  private:
   CaseChecker(std::vector<Cell> cells, std::vector<Backend*> backends, unsigned threads);
+  // Lowers the proven bound of backend b's worst judged samples to their
+  // sample bounds.
+  void HoldWorstAgainstSampleBounds(std::size_t b, std::uint32_t count);
 
   std::vector<Cell> cells_;
   std::vector<double> proven_;  // per (cell, backend), or empty
+  SampleBound sample_bound_;    // or empty
   std::vector<Backend*> backends_;
   RunLayout layout_;
   std::unique_ptr<ThreadPool> pool_;

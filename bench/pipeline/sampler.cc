@@ -6,6 +6,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "bench/numerics/float32.h"
 #include "bench/numerics/formulas.h"
 
 namespace depthbench {
@@ -33,15 +34,6 @@ double LogUniform(double u, const Range& range) {
 }
 
 double LogUniform(double u, double lo, double hi) { return LogUniform(u, Range{lo, hi}); }
-
-// x rounded to the nearest float32. Out of line on purpose: GCC 12 at -O3
-// vectorised the camera loop below and dropped the float round trip for two
-// of its three components, so cameras were not float32 values (found by the
-// fuzzer's reproducer files, which check it).
-[[gnu::noinline]] double RoundToFloat32(double x) {
-  volatile float rounded = static_cast<float>(x);
-  return rounded;
-}
 
 }  // namespace
 
@@ -166,7 +158,7 @@ Frame FrameFromUnits(const Domain& d, const FrameUnits& u, std::uint64_t frame_i
   double rxy = std::sqrt(std::max(0.0, 1.0 - cz * cz));
   glm::dvec3 direction(rxy * std::cos(phi), rxy * std::sin(phi), cz);
   for (int k = 0; k < 3; ++k) {
-    f.camera_position[k] = RoundToFloat32(direction[k] * distance);
+    f.camera_position[k] = NearestFloat32(direction[k] * distance);
   }
 
   const std::size_t pick =
