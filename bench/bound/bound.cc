@@ -124,8 +124,12 @@ Enclosure LengthFloat(const Enclosure& x, bool at_scale) {
 Lane Input(const Enclosure& x, double widen, double error, bool at_scale) {
   if (x.lo == 0.0 && x.hi == 0.0) return Lane::Exact(x);
   const double w = widen * kU * x.mag();
-  return {Enclosure::Outward(x.lo - w, x.hi + w), error * kU * x.mag() + kUnderflow,
-          at_scale ? NearestFloats(x) : Enclosure::Whole()};
+  const Enclosure exact = Enclosure::Outward(x.lo - w, x.hi + w);
+  // Point by point the float is within error u of x, which is within
+  // widen u of the exact value: relative to the exact value where no
+  // point is small enough to round as a denormal.
+  const double relative = exact.mig() >= kLeastRelative ? Up(error * kU / (1.0 - widen * kU)) : INFINITY;
+  return {exact, error * kU * x.mag() + kUnderflow, at_scale ? NearestFloats(x) : Enclosure::Whole(), relative};
 }
 Value Inputs(const iv::vec4& v, double widen, double error, bool at_scale, int exact_lanes = 0) {
   std::vector<Value> parts;
@@ -155,6 +159,7 @@ Value Inputs(const iv::mat4& m, double widen, double error, bool at_scale, bool 
 Value FrameInputs(const iv::FrameParams& f, bool at_scale, bool transposed) {
   std::vector<Value> m;
   Value camera_world = Inputs(f.camera_world, 0, 1, at_scale, transposed);
+  camera_world.camera_to_world = !transposed;
   if (transposed) {
     for (int r = 0; r < 3; ++r)
       camera_world.parts.Mutable()[r].parts.Mutable()[3] = Value::Float(Lane::Exact(f.camera_world[3][r]));
@@ -367,10 +372,13 @@ class CellAnalysis {
     }
     box.depth = stored.depth;
     if (!stored.why.empty()) return Fail(box, stored.why);
-    Expected<double> error = ShaderError(in, box.d[kPixelX], box.d[kPixelY], stored.value, machine);
+    Expected<OutputError> error = ShaderError(in, box.d[kPixelX], box.d[kPixelY], stored.value, machine);
     if (!error.ok()) return Fail(box, error.status().message());
     // |true point - camera| = true eye depth * |the pixel's ray per unit eye depth|.
-    box.shader = *error / (truth.lo * RayLength(in, box.d[kPixelX], box.d[kPixelY]));
+    box.shader = error->absolute / (truth.lo * RayLength(in, box.d[kPixelX], box.d[kPixelY]));
+    // The point the stored value denotes is within the depth part of the
+    // true one, relative to the true eye depth: 1 / (1 - depth) as far.
+    if (stored.depth < 1.0) box.shader = std::min(box.shader, error->distance_relative / (1.0 - stored.depth));
   }
 
   // What the shader receives for the frames of `v`.
@@ -399,8 +407,15 @@ class CellAnalysis {
 
   // The bound on the output's distance from the point exact arithmetic
   // gives, for the pixels and stored values given.
-  Expected<double> ShaderError(const Inputs& in, const Enclosure& pixel_x, const Enclosure& pixel_y,
-                               const Enclosure& stored, const Machine& machine) const {
+  struct OutputError {
+    double absolute = 0.0;  // the error vector's length
+    // Its length over the exact output's distance from the camera, point
+    // by point (a camera-to-world product's, Lane::distance_relative), or
+    // infinity.
+    double distance_relative = INFINITY;
+  };
+  Expected<OutputError> ShaderError(const Inputs& in, const Enclosure& pixel_x, const Enclosure& pixel_y,
+                                    const Enclosure& stored, const Machine& machine) const {
     const Value pixel[3] = {Value::Float(Lane::Exact(pixel_x)), Value::Float(Lane::Exact(pixel_y)),
                             in.frame_value.parts[3]};
     DB_ASSIGN_OR_RETURN(const Value uv, program_.program->Evaluate(program_.uv_function, pixel, machine));
@@ -413,7 +428,13 @@ class CellAnalysis {
       if (lane.kind != Value::Kind::kFloat) return InvalidArgument("an output lane with no known float value");
       sum += lane.lane.error * lane.lane.error;
     }
-    return std::sqrt(sum) * (1.0 + 1e-12);
+    OutputError out{std::sqrt(sum) * (1.0 + 1e-12)};
+    const Lane& first = p.parts[0].lane;
+    bool product = first.vector != 0;
+    for (int k = 0; k < 3; ++k)
+      product = product && p.parts[k].lane.vector == first.vector && p.parts[k].lane.component == k;
+    if (product) out.distance_relative = first.distance_relative;
+    return out;
   }
 
   // The stored value a pick takes (the fetched float, encode.h EncodeEdge);
@@ -744,10 +765,10 @@ Expected<double> SampleBounds::At(const Cell& cell, const Frame& frame, std::uin
   }
   const auto in = analysis.InputsOf(v);
   const Enclosure px(pixel_x), py(pixel_y);
-  DB_ASSIGN_OR_RETURN(const double error, analysis.ShaderError(in, px, py, stored, AtScale(machine)));
+  DB_ASSIGN_OR_RETURN(const auto error, analysis.ShaderError(in, px, py, stored, AtScale(machine)));
   const Enclosure depth = analysis.DenotedDepths(in, stored);
   if (!(depth.lo > 0.0)) return InvalidArgument("stored values that denote no depth in front of the camera");
-  return error / (depth.lo * CellAnalysis::RayLength(in, px, py));
+  return std::min(error.absolute / (depth.lo * CellAnalysis::RayLength(in, px, py)), error.distance_relative);
 }
 
 Expected<double> ShaderBoundAt(const Cell& cell, const Frame& frame, std::uint32_t pixel_x, std::uint32_t pixel_y,

@@ -46,6 +46,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <string_view>
 
 #include "bench/numerics/enclosure.h"
@@ -80,17 +81,37 @@ constexpr Machine AtScale(Machine machine) {
 
 // One float32 lane: the exact value lies in `exact`; the computed one is
 // within `error` of it, and in `computed` (the whole line where the floats
-// are not known).
+// are not known). `relative` bounds the same distance point by point,
+// relative to the exact value there: |computed - exact| <= relative
+// |exact| (infinite where unknown). A box's absolute bound takes its
+// largest magnitudes and least divisors together; the relative one holds
+// at each point, so a chain of products and quotients keeps it as tight
+// over a wide box as at a point.
 struct Lane {
   Enclosure exact;
   double error = 0.0;
   Enclosure computed = Enclosure::Whole();
+  double relative = INFINITY;
+  // Set on the first three lanes of a camera-to-world product (its
+  // `vector` an id of its own, `component` 0 to 2): the error vector of the
+  // three is at most `distance_relative` times the exact point's distance
+  // from the camera, at every point (spirv_eval.cc CameraToWorld).
+  std::uint32_t vector = 0;
+  int component = -1;
+  double distance_relative = INFINITY;
 
   // The largest magnitude the computed value can have.
   double computed_mag() const { return exact.mag() + error; }
   // An exact input: a float32 value the reference uses as is.
-  static Lane Exact(const Enclosure& x) { return {x, 0.0, x}; }
+  static Lane Exact(const Enclosure& x) { return {x, 0.0, x, 0.0}; }
 };
+
+// Relative rounding bounds hold for results of at least this magnitude:
+// normal floats at any scale a frame may have (kUnderflow's 2^-26 below
+// the normalized one), with margin.
+inline constexpr double kLeastRelative = 0x1p-90;
+// A relative bound computed in double, moved up past its own rounding.
+inline double Up(double relative) { return relative * (1.0 + 0x1p-50); }
 
 // The float32 nearest to each point of x (ties to even), or the whole
 // line past the float range; then zero too where `machine` may flush.
@@ -113,11 +134,18 @@ inline double Ulp(double x) {
   return std::ldexp(1.0, std::max(exponent, -125) - 24);
 }
 
-// The lane with its error bound tightened by its sets' distance.
+// The lane with its error bound tightened by its sets' distance and its
+// relative bound, and its relative bound by its error bound.
 inline Lane Settled(Lane lane) {
-  if (lane.computed.finite() && lane.error >= 0.0) lane.error = std::min(lane.error, (lane.computed - lane.exact).mag());
+  if (lane.error < 0.0) return lane;
+  if (lane.computed.finite()) lane.error = std::min(lane.error, (lane.computed - lane.exact).mag());
+  if (lane.relative < INFINITY) lane.error = std::min(lane.error, Up(lane.relative * lane.exact.mag()));
+  const double least = lane.exact.mig();
+  if (least >= kLeastRelative) lane.relative = std::min(lane.relative, Up(lane.error / least));
   return lane;
 }
+// (1 + r)(1 + s) - 1 and its like: relative bounds composed, rounded up.
+inline double Compose(double r, double s) { return r < INFINITY && s < INFINITY ? Up(r + s + r * s) : INFINITY; }
 
 // The error after rounding a result whose exact-on-computed-operands value
 // is within `propagated` of `exact`, to within `ulps` ULP.
@@ -149,10 +177,15 @@ inline Lane Add(const Lane& x, const Lane& y, const Machine& machine) {
                                  ? RoundedSet(Flushed(x.computed, machine) + Flushed(y.computed, machine), machine)
                                  : Enclosure::Whole();
   // Lanes without error hold floats (inputs, literals, exact results).
-  if (x.error == 0.0 && y.error == 0.0 && SumIsExact(x.exact, y.exact)) return {exact, 0.0, computed};
-  return Settled({exact, Rounded(exact, x.error + y.error, 0.5), computed});
+  if (x.error == 0.0 && y.error == 0.0 && SumIsExact(x.exact, y.exact)) return {exact, 0.0, computed, 0.0};
+  // Terms of one sign: their errors relative to each add up to at most the
+  // larger relative bound of the sum.
+  const bool one_sign = (x.exact.lo >= 0.0 && y.exact.lo >= 0.0) || (x.exact.hi <= 0.0 && y.exact.hi <= 0.0);
+  const double relative =
+      one_sign && exact.mig() >= kLeastRelative ? Compose(std::max(x.relative, y.relative), kUnitRoundoff) : INFINITY;
+  return Settled({exact, Rounded(exact, x.error + y.error, 0.5), computed, relative});
 }
-inline Lane Negate(const Lane& x) { return {-x.exact, x.error, -x.computed}; }
+inline Lane Negate(const Lane& x) { return {-x.exact, x.error, -x.computed, x.relative}; }
 inline Lane Subtract(const Lane& x, const Lane& y, const Machine& machine) { return Add(x, Negate(y), machine); }
 
 // What a product may compute: rounded, or left unrounded for a fused add.
@@ -167,8 +200,10 @@ inline Lane Multiply(const Lane& x, const Lane& y, const Machine& machine) {
   const Enclosure exact = x.exact * y.exact;
   const Enclosure computed = ProductSet(x.computed, y.computed, machine);
   const double propagated = x.exact.mag() * y.error + y.exact.mag() * x.error + x.error * y.error;
-  if (PowerOfTwo(x) || PowerOfTwo(y)) return Settled({exact, propagated, computed});
-  return Settled({exact, Rounded(exact, propagated, 0.5), computed});
+  const bool normal = exact.mig() >= kLeastRelative;
+  const double operands = normal ? Compose(x.relative, y.relative) : INFINITY;
+  if (PowerOfTwo(x) || PowerOfTwo(y)) return Settled({exact, propagated, computed, operands});
+  return Settled({exact, Rounded(exact, propagated, 0.5), computed, Compose(operands, kUnitRoundoff)});
 }
 
 // Division: the error, or a negative error when the divisor may be zero
@@ -190,7 +225,12 @@ inline Lane Divide(const Lane& x, const Lane& y, const Machine& machine) {
     computed = machine.division_ulps == 0.5 ? RoundedSet(q, machine)
                                             : RoundedSet(Enclosure::Outward(q.lo - slack, q.hi + slack), machine);
   }
-  return Settled({exact, Rounded(exact, propagated, machine.division_ulps), computed});
+  // x~ / y~ = (x / y)(1 + dx) / (1 + dy), then the tolerance.
+  double relative = INFINITY;
+  if (exact.mig() >= kLeastRelative && y.relative < 1.0) {
+    relative = Compose(Up((1.0 + x.relative) / (1.0 - y.relative)) - 1.0, machine.division_ulps * kUlpOfValue);
+  }
+  return Settled({exact, Rounded(exact, propagated, machine.division_ulps), computed, relative});
 }
 
 // Every float a sum of the n sets may round to, in any order of additions:

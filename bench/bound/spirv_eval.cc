@@ -1,6 +1,7 @@
 #include "bench/bound/spirv_eval.h"
 
 #include <algorithm>
+#include <atomic>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -301,9 +302,88 @@ Expected<Value> EachPart(const Value& whole, F f) {
   return Value::Composite(std::move(out));
 }
 
-// matrix * vector: the dot product of each row with the vector.
+// The bound on a camera-to-world product's error relative to the exact
+// point's distance from the camera, or infinity where `m` and `v` are not
+// one: m = [R~ t; 0 1] with R~ a rotation R rounded entry by entry and t
+// exact, v = (v~, 1). A rotation keeps lengths, which lane by lane
+// bounds cannot see: with |R v| = |v| the distance,
+//   |fl(R~ v~ + t) - (R v + t)| <= |v~ - v| + |R~ - R|_F |v~|
+//                                  + gamma_n (|(|R~| |v~|)| + |t|),
+// the last the dot products' roundings in any order (n terms),
+// |(|R~| |v~|)| <= (sqrt(3) + |R~ - R|_F) |v~| and |v~| <= (1 + r_v)|v|.
+// Each lane's error enters by its relative bound where it has one, so the
+// figure holds point by point, with the box's least |v| only where a lane
+// has none (and for the translation's rounding).
+double CameraToWorldRelative(const Value& m, const Value& v) {
+  if (!m.camera_to_world || m.parts.size() != 4 || v.parts.size() != 4) return INFINITY;
+  for (const Value& column : m.parts) {
+    if (column.parts.size() != 4) return INFINITY;
+    for (const Value& lane : column.parts)
+      if (lane.kind != Value::Kind::kFloat) return INFINITY;
+  }
+  for (const Value& lane : v.parts)
+    if (lane.kind != Value::Kind::kFloat) return INFINITY;
+  const Lane& w = v.parts[3].lane;
+  if (w.error != 0.0 || w.exact != Enclosure(1.0)) return INFINITY;
+  // The view vector's error: relative lanes, and the rest over its least length.
+  double least_sq = 0.0, relative = 0.0, absolute_sq = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    const Lane& x = v.parts[j].lane;
+    least_sq += x.exact.mig() * x.exact.mig();
+    if (x.relative < INFINITY) {
+      relative = std::max(relative, x.relative);
+    } else {
+      absolute_sq += x.error * x.error;
+    }
+  }
+  const double least = std::sqrt(least_sq) * (1.0 - 0x1p-50);
+  if (absolute_sq > 0.0 && !(least > 0.0)) return INFINITY;
+  const double r_v = Up(std::sqrt(relative * relative + (absolute_sq > 0.0 ? absolute_sq / (least * least) : 0.0)));
+  // |R~ - R|_F: each entry within its relative bound of |R_ij| <= 1, or its error.
+  double entries_sq = 0.0, translation_sq = 0.0;
+  bool translated = false;
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) {
+      const Lane& e = m.parts[c].parts[r].lane;
+      const double bound = std::min(e.error, e.relative);
+      entries_sq += bound * bound;
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    const Lane& t = m.parts[3].parts[r].lane;
+    if (t.error != 0.0) return INFINITY;
+    translation_sq += t.exact.mag() * t.exact.mag();
+    translated = translated || t.exact != Enclosure(0.0);
+  }
+  const double frobenius = Up(std::sqrt(entries_sq));
+  const int n = translated ? 4 : 3;
+  const double gamma = n * kUnitRoundoff / (1.0 - n * kUnitRoundoff);
+  const double translation = translated ? gamma * std::sqrt(translation_sq) / least : 0.0;
+  if (translated && !(least > 0.0)) return INFINITY;
+  // A rotation's exact entries are orthonormal to the double rounding of
+  // the angles' sines and cosines: 2^-40 covers it.
+  const double total = r_v * (1.0 + 0x1p-40) + frobenius * (1.0 + r_v) +
+                       gamma * (std::sqrt(3.0) + frobenius) * (1.0 + r_v) + translation + n * kUnderflow / least;
+  return std::isfinite(total) ? Up(total) : INFINITY;
+}
+
+std::atomic<std::uint32_t> next_vector{1};
+
+// matrix * vector: the dot product of each row with the vector; a
+// camera-to-world product's first three lanes carry its distance bound.
 Expected<Value> MatrixTimesVector(const Value& m, const Value& v, const Machine& machine) {
-  return EachPart(Transposed(m), [&](const Value& row) { return DotOf(row, v, machine); });
+  DB_ASSIGN_OR_RETURN(Value out, EachPart(Transposed(m), [&](const Value& row) { return DotOf(row, v, machine); }));
+  const double relative = CameraToWorldRelative(m, v);
+  if (relative < INFINITY && out.parts.size() == 4) {
+    const std::uint32_t id = next_vector.fetch_add(1, std::memory_order_relaxed);
+    for (int k = 0; k < 3; ++k) {
+      Lane& lane = out.parts.Mutable()[k].lane;
+      lane.vector = id;
+      lane.component = k;
+      lane.distance_relative = relative;
+    }
+  }
+  return out;
 }
 
 // The part of `root` at `path`, to read; null when there is none.
@@ -444,7 +524,7 @@ class Evaluator {
           auto abs = [](const Enclosure& e) {
             return e.contains_zero() ? Enclosure(0.0, e.mag()) : Enclosure(e.mig(), e.mag());
           };
-          return Lane{abs(x.exact), x.error, abs(x.computed)};
+          return Lane{abs(x.exact), x.error, abs(x.computed), x.relative};
         });
       }
       case GLSLstd450FMin:
@@ -769,7 +849,9 @@ class Evaluator {
           const double exact =
               in.op == Op::OpConvertSToF ? static_cast<double>(static_cast<std::int32_t>(*x)) : static_cast<double>(*x);
           const double rounded = NearestFloat32(exact);
-          values[w[2]] = Value::Float({Enclosure(exact), std::fabs(rounded - exact), Enclosure(rounded)});
+          const double error = std::fabs(rounded - exact);
+          values[w[2]] = Value::Float(
+              {Enclosure(exact), error, Enclosure(rounded), exact != 0.0 ? Up(error / std::fabs(exact)) : 0.0});
           break;
         }
         case Op::OpExtInst: DB_RETURN_IF_ERROR(set(Extended(in, values))); break;

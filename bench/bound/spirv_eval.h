@@ -53,6 +53,9 @@ struct Value {
   Parts parts;                      // kComposite: members, components or columns
   std::uint32_t variable = 0;       // kPointer: the variable
   std::vector<std::uint32_t> path;  // kPointer: the indices into it
+  // kComposite: a camera-to-world matrix, its upper 3x3 a rounded rotation
+  // and its last column the camera's exact position (bound.cc FrameInputs).
+  bool camera_to_world = false;
 
   static Value Float(const Lane& lane) {
     Value v;
