@@ -95,7 +95,7 @@ struct Lane {
   // Set on the first three lanes of a camera-to-world product (its
   // `vector` an id of its own, `component` 0 to 2): the error vector of the
   // three is at most `distance_relative` times the exact point's distance
-  // from the camera, at every point (spirv_eval.cc CameraToWorld).
+  // from the camera, at every point (spirv_eval.cc CameraToWorldRelative).
   std::uint32_t vector = 0;
   int component = -1;
   double distance_relative = INFINITY;
@@ -113,12 +113,13 @@ inline constexpr double kLeastRelative = 0x1p-90;
 // A relative bound computed in double, moved up past its own rounding.
 inline double Up(double relative) { return relative * (1.0 + 0x1p-50); }
 
-// The float32 nearest to each point of x (ties to even), or the whole
-// line past the float range; then zero too where `machine` may flush.
+// x with zero too where `machine` may flush a denormal in it.
 inline Enclosure Flushed(const Enclosure& x, const Machine& machine) {
   if (!machine.flushes || x.mig() >= FLT_MIN || x.contains_zero()) return x;
   return Enclosure::Hull(x, Enclosure(0.0));
 }
+// The float32 nearest to each point of x (ties to even), flushed as the
+// machine may; the whole line past the float range.
 inline Enclosure RoundedSet(const Enclosure& x, const Machine& machine) {
   if (!(x.mag() <= FLT_MAX)) return Enclosure::Whole();
   return Flushed({NearestFloat32(x.lo), NearestFloat32(x.hi)}, machine);
