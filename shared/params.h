@@ -104,8 +104,9 @@ struct RasterSample {
 
 // Push constants of the raster form's draws (shaders/raster/): how the
 // batch's samples lie in the atlas, where sample i is texel
-// (i % atlas_width, i / atlas_width), and what the draw renders: a depth
-// slot (pass 1) or a cell (pass 2).
+// (i % atlas_width, i / atlas_width), the one viewport every draw uses
+// (shaders/raster/atlas_placement.glsl), and what the draw renders: a
+// depth slot (pass 1) or a cell (pass 2).
 struct RasterConstants {
   uint sample_count;       // samples in the batch: the length of a position slice
   uint atlas_width;        // texels per atlas row
@@ -114,7 +115,7 @@ struct RasterConstants {
   uint conventions_per_frame;
   uint convention_slot;  // the slot's or cell's convention within a frame's DepthParams
   uint output_offset;    // pass 2: first float of the cell's positions: slices of x, then y, then z
-  uint reserved0;
+  uint viewport_height;  // the atlas viewport's height in texels: a power of two
 };
 
 // Where one cell's inputs and outputs lie in the batch's buffers.

@@ -141,7 +141,7 @@ TEST_F(LayoutTest, RasterConstantsMatchesStd430) {
   EXPECT_MEMBER_AT(draw, RasterConstants, conventions_per_frame);
   EXPECT_MEMBER_AT(draw, RasterConstants, convention_slot);
   EXPECT_MEMBER_AT(draw, RasterConstants, output_offset);
-  EXPECT_MEMBER_AT(draw, RasterConstants, reserved0);
+  EXPECT_MEMBER_AT(draw, RasterConstants, viewport_height);
   EXPECT_EQ(MembersOf("draw"), 8) << "a RasterConstants member is not listed above";
   EXPECT_EQ(Offset("draw_end"), static_cast<int>(sizeof(f32::RasterConstants)));
 }

@@ -298,7 +298,7 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   in.close();
   const std::string call = "vec3 p = RECONSTRUCT(frame, depth, uv, stored);";
   ASSERT_NE(text.find(call), std::string::npos);
-  text.replace(text.find(call), call.size(), "vec3 p = volume_position;");
+  text.replace(text.find(call), call.size(), "vec3 p = volume_position.xyz;");
   std::ofstream(pass) << text;
 
   BackendOptions options;

@@ -7,6 +7,12 @@
 #include "raster_common.glsl"
 
 layout(location = 0) in float view_z;  // what the G-buffer form reads; unused here
+layout(location = 1) flat in uint drawing_sample;
 layout(location = 0) out uint coverage;
 
-void main() { coverage = 1u; }
+void main() {
+  if (!on_own_texel(gl_FragCoord, drawing_sample)) {
+    discard;
+  }
+  coverage = 1u;
+}

@@ -1,8 +1,9 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_ARB_shader_viewport_layer_array : require
-// Pass 2 of the raster form for every variant but volume_ray: the frame's
-// full-screen triangle, per sample (the scissor keeps the sample's texel).
+// Pass 2a of the raster form: the frame's full-screen triangle, per sample,
+// through the sample's own viewport (its scissor keeps the sample's texel;
+// raster_common.glsl).
 // Each vertex emits the screen attributes at its own uv, computed from the
 // frame's constants in float32 as the engines' vertex stages do (Pettineo
 // 2009's frustum ray; the eye-ray post's view- and world-space rays); the

@@ -10,10 +10,14 @@
 layout(constant_id = 0) const bool VIEW_Z = false;
 
 layout(location = 0) in float view_z;
+layout(location = 1) flat in uint drawing_sample;
 layout(location = 0) out uint coverage;
 layout(location = 1) out float stored;
 
 void main() {
+  if (!on_own_texel(gl_FragCoord, drawing_sample)) {
+    discard;
+  }
   coverage = 1u;
   if (VIEW_Z) {
     stored = view_z;

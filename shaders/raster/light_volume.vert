@@ -1,7 +1,7 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_ARB_shader_viewport_layer_array : require
-// Pass 2 of the raster form for volume_ray (Pettineo 2009, light-volume
+// Pass 2a of the raster form for volume_ray cells (Pettineo 2009, light-volume
 // geometry): the sample's cube, twelve triangles, of which the pipeline
 // draws the back faces (the camera may be inside a light's volume; its
 // back faces are always in view). Each vertex emits its view-space

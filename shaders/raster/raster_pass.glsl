@@ -9,15 +9,13 @@
 // The atlas of the cell's depth slot (the host binds the slot's set).
 layout(set = 0, binding = 4) uniform sampler2D depth_texture;
 layout(std430, set = 0, binding = 5) writeonly buffer Positions { float positions[]; };
+layout(std430, set = 0, binding = 6) readonly buffer Attributes { vec4 attributes[]; };
 
-layout(location = 0) in vec3 frustum_ray;
-layout(location = 1) in vec3 eye_ray_view;
-layout(location = 2) in vec3 eye_ray_world;
-layout(location = 3) in vec3 volume_position;
+layout(constant_id = 0) const bool LIGHT_VOLUME = false;
 
 #include "reconstruct.inc"
 
 void main() {
   float stored = texelFetch(depth_texture, ivec2(gl_FragCoord.xy), 0).r;
-  reconstruct_fragment(gl_FragCoord, stored, frustum_ray, eye_ray_view, eye_ray_world, volume_position);
+  reconstruct_fragment(gl_FragCoord, stored);
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -26,8 +27,13 @@ struct RasterPass::Slot {
 
 namespace {
 
-// shaders/raster/raster_common.glsl's VIEWPORTS_PER_DRAW. Every device with
-// multiViewport has at least 16 viewports (the minimum of maxViewports).
+// shaders/raster/atlas_placement.glsl's ATLAS_GUARD: the texels the atlas
+// viewport reaches beyond the atlas on every side, so that a small
+// triangle at the atlas's edge is not clipped.
+constexpr std::uint32_t kAtlasGuard = 128;
+// shaders/raster/raster_common.glsl's VIEWPORTS_PER_DRAW: pass 2a's
+// samples a draw. Every device with multiViewport has at least 16
+// viewports (the minimum of maxViewports).
 constexpr std::uint32_t kViewportsPerDraw = 16;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
 constexpr std::uint32_t kTriangleVertices = 3;
@@ -35,7 +41,18 @@ constexpr std::uint32_t kCubeVertices = 36;  // shaders/raster/light_volume.vert
 
 // The descriptor set both passes draw with (shaders/raster/): the batch's
 // inputs first.
-enum Binding : std::uint32_t { kFrames, kDepthParams, kPixels, kGeometry, kAtlases, kPositions, kBindingCount };
+enum Binding : std::uint32_t {
+  kFrames,
+  kDepthParams,
+  kPixels,
+  kGeometry,
+  kAtlases,
+  kPositions,
+  kAttributes,  // what pass 2a captures for pass 2b: kAttributesPerSample vec4s a sample
+  kBindingCount
+};
+// shaders/raster/atlas.inc's ATTRIBUTES_PER_SAMPLE.
+constexpr VkDeviceSize kAttributesPerSample = 4;
 constexpr std::size_t kInputBindings = kGeometry + 1;
 
 // The bytes of the batch's inputs, binding by binding.
@@ -49,8 +66,10 @@ constexpr VkShaderStageFlags kDrawStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADE
 constexpr VkShaderStageFlags kSetStages = kDrawStages | VK_SHADER_STAGE_COMPUTE_BIT;
 constexpr std::uint32_t kFetchWorkgroup = 64;  // fetch.comp's local size
 
-// gbuffer.frag's specialization constant VIEW_Z.
+// gbuffer.frag's specialization constant VIEW_Z; capture.frag's and the
+// reconstruction's LIGHT_VOLUME.
 constexpr std::uint32_t kViewZConstant = 0;
+constexpr std::uint32_t kLightVolumeConstant = 0;
 
 bool ClipMinusOne(Convention convention) { return (Info(convention).bits & catalog::kGl) != 0; }
 bool ReversedDepth(Convention convention) { return (Info(convention).bits & catalog::kRev) != 0; }
@@ -85,6 +104,7 @@ struct DrawState {
   VkFormat depth = VK_FORMAT_UNDEFINED;  // a depth attachment, tested ALWAYS and written
   bool clip_minus_one = false;           // GL-style clip depth (VK_EXT_depth_clip_control)
   bool light_volume = false;             // back faces only, depth clamped rather than clipped
+  bool per_sample_viewports = false;     // pass 2a: kViewportsPerDraw viewports, one a sample
 };
 
 Expected<DeviceObject<VkPipeline>> CreateGraphicsPipeline(VkDevice device, VkPipelineLayout layout,
@@ -112,8 +132,8 @@ Expected<DeviceObject<VkPipeline>> CreateGraphicsPipeline(VkDevice device, VkPip
   VkPipelineViewportStateCreateInfo viewport{};
   viewport.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
   viewport.pNext = state.clip_minus_one ? &clip_control : nullptr;
-  viewport.viewportCount = kViewportsPerDraw;
-  viewport.scissorCount = kViewportsPerDraw;
+  viewport.viewportCount = state.per_sample_viewports ? kViewportsPerDraw : 1;
+  viewport.scissorCount = viewport.viewportCount;
 
   VkPipelineRasterizationStateCreateInfo rasterization{};
   rasterization.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
@@ -146,7 +166,8 @@ Expected<DeviceObject<VkPipeline>> CreateGraphicsPipeline(VkDevice device, VkPip
   blend.attachmentCount = static_cast<std::uint32_t>(attachments.size());
   blend.pAttachments = attachments.data();
 
-  // Every draw places its samples' viewports and scissors.
+  // The atlas viewport's height follows the batch's size; pass 2a's
+  // viewports are the samples'.
   const std::array<VkDynamicState, 2> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
   VkPipelineDynamicStateCreateInfo dynamic{};
   dynamic.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
@@ -188,6 +209,16 @@ VkRenderingAttachmentInfo ClearedAttachment(const VulkanImage& image, VkImageLay
   attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
   attachment.clearValue = clear;
   return attachment;
+}
+
+// The one viewport of a batch's draws, `rows` atlas rows: powers of two
+// wide and high, the atlas and kAtlasGuard texels around it, y up
+// (shaders/raster/atlas_placement.glsl).
+std::uint32_t ViewportHeight(std::uint32_t rows) { return std::bit_ceil(rows + 2 * kAtlasGuard); }
+VkViewport AtlasViewport(std::uint32_t rows) {
+  const auto height = static_cast<float>(ViewportHeight(rows));
+  const auto guard = static_cast<float>(kAtlasGuard);
+  return {-guard, height - guard, 2.0f * RasterPass::kAtlasWidth, -height, 0.0f, 1.0f};
 }
 
 // Ok when the device can use `format` for everything `needed` says.
@@ -306,6 +337,8 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> full_screen, stage("full_screen.vert", ShaderStage::kVertex));
   DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> light_volume,
                       stage("light_volume.vert", ShaderStage::kVertex));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> capture, stage("capture.frag", ShaderStage::kFragment));
+  DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> cover, stage("atlas_cover.vert", ShaderStage::kVertex));
   const VkPipelineLayout layout = pass_->pipeline_layout();
   {
     const std::filesystem::path path = shader_dir / "raster" / "fetch.comp";
@@ -337,6 +370,27 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
                                                            Info(slot.encoding.convention).name, Info(format).name)));
   }
 
+  // Pass 2a: the full-screen triangle's rays, and the light volume's
+  // position where a volume_ray cell reads it.
+  const VkSpecializationMapEntry light_volume_entry{kLightVolumeConstant, 0, sizeof(VkBool32)};
+  const std::array<VkBool32, 2> light_volume_values = {VK_FALSE, VK_TRUE};
+  std::array<VkSpecializationInfo, 2> light_volume_constants{};
+  for (std::size_t k = 0; k < light_volume_constants.size(); ++k) {
+    light_volume_constants[k] = {1, &light_volume_entry, sizeof(VkBool32), &light_volume_values[k]};
+  }
+  for (std::size_t k = 0; k < capture_.size(); ++k) {
+    DrawState state;
+    state.light_volume = k == 1;
+    state.per_sample_viewports = true;
+    state.vertex = state.light_volume ? light_volume.get() : full_screen.get();
+    state.fragment = capture.get();
+    state.fragment_constants = &light_volume_constants[k];
+    DB_ASSIGN_OR_RETURN(capture_[k], CreateGraphicsPipeline(device(), layout, state,
+                                                            state.light_volume ? "the raster form's light volumes"
+                                                                               : "the raster form's full-screen rays"));
+  }
+
+  // Pass 2b: one program per variant over the whole atlas.
   reconstruction_.clear();
   reconstruction_.resize(kMostVariants);
   for (const CellPlan& plan : cells) {
@@ -348,9 +402,9 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
         const DeviceObject<VkShaderModule> fragment,
         module(CompileVariant(plan.cell.variant_info(), VariantPass::kRaster, shader_dir, &sources), name));
     DrawState state;
-    state.light_volume = variant == Variant::kVolumeRay;
-    state.vertex = state.light_volume ? light_volume.get() : full_screen.get();
+    state.vertex = cover.get();
     state.fragment = fragment.get();
+    state.fragment_constants = &light_volume_constants[variant == Variant::kVolumeRay ? 1 : 0];
     DB_ASSIGN_OR_RETURN(pipeline, CreateGraphicsPipeline(device(), layout, state, name));
   }
   return Status::Ok();
@@ -358,7 +412,9 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
 
 std::uint64_t RasterPass::MaxBatchSamples() const {
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
-  const std::uint32_t rows = std::min(limits.maxImageDimension2D, limits.maxFramebufferHeight);
+  // The atlas viewport is a power of two high, the rows and their guard.
+  const std::uint32_t viewport_rows = std::bit_floor(limits.maxViewportDimensions[1]) - 2 * kAtlasGuard;
+  const std::uint32_t rows = std::min({limits.maxImageDimension2D, limits.maxFramebufferHeight, viewport_rows});
   return std::uint64_t{kAtlasWidth} * rows;
 }
 
@@ -380,22 +436,6 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
   if (std::uint64_t{batch.count} > MaxBatchSamples()) {
     return InvalidArgument(fmt::format("a batch of {} samples needs an atlas of {} rows; the device renders at most {}",
                                        batch.count, rows, MaxBatchSamples() / kAtlasWidth));
-  }
-  // A sample's viewport lies up to a frame's size beyond the atlas.
-  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
-  for (const f32::FrameParams& frame : batch.frame_params) {
-    const float width = frame.resolution.x;
-    const float height = frame.resolution.y;
-    if (width > static_cast<float>(limits.maxViewportDimensions[0]) ||
-        height > static_cast<float>(limits.maxViewportDimensions[1]) ||
-        -width < limits.viewportBoundsRange[0] ||
-        static_cast<float>(rows) + height > limits.viewportBoundsRange[1]) {
-      return InvalidArgument(fmt::format(
-          "a {}x{} frame's viewports reach beyond what the device allows (at most {}x{}, within [{}, {}]) with an "
-          "atlas of {} rows; run fewer samples at once",
-          width, height, limits.maxViewportDimensions[0], limits.maxViewportDimensions[1],
-          limits.viewportBoundsRange[0], limits.viewportBoundsRange[1], rows));
-    }
   }
   return Status::Ok();
 }
@@ -490,6 +530,10 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(
       positions_, position_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
       HostAccess::kReadback));
+  const VkDeviceSize attribute_bytes = kAttributesPerSample * count * sizeof(glm::vec4);
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(attributes_, attribute_bytes,
+                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                              HostAccess::kNone));
 
   // Points the sets at this run's buffers (they may have been reallocated)
   // and each at its atlas.
@@ -501,6 +545,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
       {geometry_.handle(), 0, input_bytes[kGeometry]},
       {},
       {positions_.handle(), 0, position_bytes},
+      {attributes_.handle(), 0, attribute_bytes},
   }};
   for (std::uint32_t set = 0; set < atlases_.size(); ++set) {
     const VkDescriptorImageInfo image{sampler_.get(), atlases_[set].value.view.get(),
@@ -517,9 +562,9 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
     pass_->WriteDescriptors(writes, set);
   }
 
-  // Sample i's viewport puts its frame's pixel on texel i; the scissor
-  // keeps that texel alone. Whole draws: the last one's unused viewports
-  // repeat its last sample's.
+  // Pass 2a: sample i's viewport puts its frame's pixel on texel i; the
+  // scissor keeps that texel alone. Whole draws: the last one's unused
+  // viewports repeat its last sample's.
   const std::uint32_t padded = (count + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
   viewports_.resize(padded);
   scissors_.resize(padded);
@@ -616,30 +661,48 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
     return;
   }
   vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
+  vkCmdFillBuffer(commands, attributes_.handle(), 0, VK_WHOLE_SIZE, 0);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
 
-  // Pass 2 has no attachments: its fragments write the positions.
+  // Pass 2 has no attachments: its fragments write the attributes (2a),
+  // then the positions (2b).
   VkRenderingInfo rendering{};
   rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
   rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
   rendering.layerCount = 1;
+  f32::RasterConstants constants = {.sample_count = batch.count,
+                                    .atlas_width = kAtlasWidth,
+                                    .samples_per_frame = kSamplesPerFrame,
+                                    .first_in_frame = batch.first_offset,
+                                    .conventions_per_frame = kHardwareConventionCount,
+                                    .convention_slot = 0,
+                                    .output_offset = 0,
+                                    .viewport_height = ViewportHeight(rows)};
+  const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
+  const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
+                                        std::any_of(which.begin(), which.end(), reads_volume)};
+  vkCmdBeginRendering(commands, &rendering);
+  for (std::size_t k = 0; k < capture_.size(); ++k) {
+    if (!captured[k]) continue;
+    pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
+    pass_->PushConstants(commands, &constants, sizeof(constants));
+    RecordSampleDraws(commands, batch.count, k == 1 ? kCubeVertices : kTriangleVertices);
+  }
+  vkCmdEndRendering(commands);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+
   vkCmdBeginRendering(commands, &rendering);
   for (std::size_t k = 0; k < which.size(); ++k) {
     const CellPlan& plan = cells_[which[k]];
     const Variant variant = plan.cell.variant;
     pass_->Bind(commands, reconstruction_[static_cast<std::size_t>(variant)].get(), VK_PIPELINE_BIND_POINT_GRAPHICS,
                 *slots_[plan.depth_slot].atlas);
-    const f32::RasterConstants constants = {.sample_count = batch.count,
-                                            .atlas_width = kAtlasWidth,
-                                            .samples_per_frame = kSamplesPerFrame,
-                                            .first_in_frame = batch.first_offset,
-                                            .conventions_per_frame = kHardwareConventionCount,
-                                            .convention_slot = plan.convention_slot,
-                                            .output_offset = static_cast<std::uint32_t>(k * 3 * batch.count),
-                                            .reserved0 = 0};
+    constants.convention_slot = plan.convention_slot;
+    constants.output_offset = static_cast<std::uint32_t>(k * 3 * batch.count);
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordDraws(commands, batch.count, variant == Variant::kVolumeRay ? kCubeVertices : kTriangleVertices);
+    RecordDraws(commands, 1, rows, kTriangleVertices);  // atlas_cover.vert: the whole atlas
   }
   vkCmdEndRendering(commands);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
@@ -691,8 +754,9 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& 
   constants.first_in_frame = batch.first_offset;
   constants.conventions_per_frame = kHardwareConventionCount;
   constants.convention_slot = slot.convention_slot;
+  constants.viewport_height = ViewportHeight(rows);
   pass_->PushConstants(commands, &constants, sizeof(constants));
-  RecordDraws(commands, batch.count, kTriangleVertices);
+  RecordDraws(commands, batch.count, rows, kTriangleVertices);
   vkCmdEndRendering(commands);
 
   // The texels and the coverage go to the host; the texels then to pass 2.
@@ -714,9 +778,21 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& 
                      VK_ACCESS_SHADER_READ_BIT);
 }
 
-// Instances are samples, kViewportsPerDraw to a draw: instance i takes
-// viewport i % kViewportsPerDraw, which the draw has just set.
-void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const {
+// Pass 1 and 2b: one draw for the whole batch through the atlas viewport
+// (pass 1: instance i is sample i, which the vertex stage places on its
+// texel; 2b: one instance over the atlas).
+void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows,
+                             std::uint32_t vertices) const {
+  const VkViewport viewport = AtlasViewport(rows);
+  const VkRect2D scissor = {{0, 0}, {kAtlasWidth, rows}};
+  vkCmdSetViewport(commands, 0, 1, &viewport);
+  vkCmdSetScissor(commands, 0, 1, &scissor);
+  vkCmdDraw(commands, vertices, count, 0, 0);
+}
+
+// Pass 2a: kViewportsPerDraw samples a draw, instance i taking viewport
+// i % kViewportsPerDraw, which the draw has just set.
+void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const {
   for (std::uint32_t first = 0; first < count; first += kViewportsPerDraw) {
     vkCmdSetViewport(commands, 0, kViewportsPerDraw, viewports_.data() + first);
     vkCmdSetScissor(commands, 0, kViewportsPerDraw, scissors_.data() + first);

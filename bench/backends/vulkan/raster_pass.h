@@ -9,19 +9,26 @@
 //      the linear and view-z ones, with an R8_UINT coverage attachment
 //      beside it. The texels are copied back and compared with the batch's
 //      codes (agreement());
-//   2. reconstruction, per cell: the variant's fragment program
-//      (shaders/raster/raster_pass.glsl around its function) reads the
-//      slot's atlas by texel, its rays interpolated from the vertex stage:
-//      a full-screen triangle per sample, or for volume_ray the back faces
-//      of the sample's light volume.
+//   2. reconstruction: (a) once per run, what the rasterizer interpolates
+//      at each sample's pixel, from the frame's full-screen triangle (the
+//      rays) and, where a volume_ray cell runs, the back faces of the
+//      sample's light volume (its view-space position), captured as
+//      float32 (shaders/raster/capture.frag); (b) per cell, one triangle
+//      over the atlas whose fragments run the variant's program
+//      (shaders/raster/raster_pass.glsl around its function) on the slot's
+//      texel and the captured attributes. Every cell's per-sample cost is
+//      then a fragment, as in the compute form's dispatch, and the
+//      geometry is drawn once per encoding (1) and once per run (2a).
 //
 // Sample i is texel (i % kAtlasWidth, i / kAtlasWidth) of every atlas, and
-// is drawn through a viewport of its own, offset by whole pixels so that
-// its frame's pixel lands on that texel: its geometry rasterizes as at its
-// real pixel. Instances are samples, 16 to a draw, each picking its
-// viewport (gl_ViewportIndex).
+// is instance i of one draw per pass and slot or cell, its geometry moved
+// by whole pixels so that its frame's pixel lands on that texel
+// (shaders/raster/atlas_placement.glsl): it rasterizes as at its real
+// pixel. Pass 1's fragments off their own texel are discarded; pass 2's
+// primitives are clipped to it.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -113,7 +120,8 @@ class RasterPass {
               const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const;
   void RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot,
                         std::uint32_t rows) const;
-  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const;
+  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows, std::uint32_t vertices) const;
+  void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const;
   void CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
@@ -123,14 +131,16 @@ class RasterPass {
   // the atlas (sampled by pass 2) and the positions.
   std::unique_ptr<ComputePass> pass_;
   DeviceObject<VkSampler> sampler_;
-  std::vector<DeviceObject<VkPipeline>> reconstruction_;
-  DeviceObject<VkPipeline> fetch_;  // shaders/raster/fetch.comp  // indexed by Variant; null where no cell uses it
+  std::array<DeviceObject<VkPipeline>, 2> capture_;  // pass 2a: the full-screen triangle, the light volume
+  std::vector<DeviceObject<VkPipeline>> reconstruction_;  // pass 2b, indexed by Variant; null where no cell uses it
+  DeviceObject<VkPipeline> fetch_;  // shaders/raster/fetch.comp
 
   std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), atlas_rows_ rows each
   std::uint32_t atlas_rows_ = 0;
-  std::vector<VkViewport> viewports_;  // per sample of the run, padded to whole draws
-  std::vector<VkRect2D> scissors_;
   VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
+  VulkanBuffer attributes_;  // pass 2a's output: shaders/raster/capture.frag
+  std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
+  std::vector<VkRect2D> scissors_;
   std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
 
   // The batch whose every depth slot the atlases hold (Render), if any.

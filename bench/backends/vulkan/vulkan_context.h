@@ -181,7 +181,7 @@ struct VulkanImage {
 struct RasterFeatures {
   bool graphics_queue = false;          // the chosen queue can draw
   bool dynamic_rendering = false;       // Vulkan 1.3: drawing without render pass objects
-  bool multi_viewport = false;          // every sample its own viewport
+  bool multi_viewport = false;          // pass 2a: every sample its own viewport
   bool viewport_index = false;          // shaderOutputViewportIndex: the vertex stage picks it
   bool depth_clamp = false;             // light volumes drawn without near and far clipping
   bool fragment_stores = false;         // fragmentStoresAndAtomics: positions written from the fragment stage
