@@ -17,11 +17,9 @@ layout(location = 1) out vec3 eye_ray_view;
 layout(location = 2) out vec3 eye_ray_world;
 layout(location = 3) out vec3 volume_position;
 
-// Corner c of the cube is the centre plus (c & 1, c & 2, c & 4 ? +half :
-// -half) along x, y, z. Two triangles a face, counter-clockwise seen from
-// outside: with the host's y-flipping viewport that is the front face.
-const uint kCubeCorners[36] = uint[](4u, 6u, 2u, 4u, 2u, 0u, 1u, 3u, 7u, 1u, 7u, 5u, 0u, 1u, 5u, 0u, 5u, 4u, 6u, 7u, 3u,
-                                     6u, 3u, 2u, 2u, 3u, 1u, 2u, 1u, 0u, 4u, 5u, 7u, 4u, 7u, 6u);
+// Vertex c is corner c of the cube: the centre plus (c & 1, c & 2, c & 4 ?
+// +half : -half) along x, y, z. The draw is indexed (vulkan/raster_pass.cc's
+// kCubeIndices), so the eight corners are shaded once a cube.
 
 float corner_coordinate(float centre, float half_edge, uint corner, uint bit) {
   return (corner & bit) != 0u ? centre + half_edge : centre - half_edge;
@@ -30,7 +28,7 @@ float corner_coordinate(float centre, float half_edge, uint corner, uint bit) {
 void main() {
   uint frame_index = frame_of(uint(gl_InstanceIndex));
   vec4 volume = raster[gl_InstanceIndex].volume;
-  uint corner = kCubeCorners[gl_VertexIndex];
+  uint corner = uint(gl_VertexIndex);
   vec4 world = vec4(corner_coordinate(volume.x, volume.w, corner, 1u), corner_coordinate(volume.y, volume.w, corner, 2u),
                     corner_coordinate(volume.z, volume.w, corner, 4u), 1.0f);
   gl_Position = depth_of(frame_index, 0u).view_projection * world;

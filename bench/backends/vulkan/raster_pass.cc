@@ -37,7 +37,11 @@ constexpr std::uint32_t kAtlasGuard = 128;
 constexpr std::uint32_t kViewportsPerDraw = 16;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
 constexpr std::uint32_t kTriangleVertices = 3;
-constexpr std::uint32_t kCubeVertices = 36;  // shaders/raster/light_volume.vert's kCubeCorners
+// The light volume's twelve triangles as corners of its cube
+// (shaders/raster/light_volume.vert), two a face, counter-clockwise seen
+// from outside: with the y-flipping viewport that is the front face.
+constexpr std::array<std::uint16_t, 36> kCubeIndices = {4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                                                        6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6};
 
 // The descriptor set both passes draw with (shaders/raster/): the batch's
 // inputs first.
@@ -315,6 +319,10 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
   DB_ASSIGN_OR_RETURN(pass->pass_, ComputePass::Create(pass->context_, bindings, sizeof(f32::RasterConstants),
                                                        kSetStages, std::max(atlases, 1u)));
   DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
+  DB_RETURN_IF_ERROR(pass->context_->GrowHostBuffer(pass->cube_indices_, sizeof(kCubeIndices),
+                                                    VK_BUFFER_USAGE_INDEX_BUFFER_BIT, HostAccess::kUpload));
+  std::memcpy(pass->cube_indices_.mapped(), kCubeIndices.data(), sizeof(kCubeIndices));
+  DB_RETURN_IF_ERROR(pass->cube_indices_.FlushHostWrites());
   DB_RETURN_IF_ERROR(pass->BuildPipelines(cells, shader_dir, arithmetic_probes, sources));
   return pass;
 }
@@ -687,7 +695,7 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
     if (!captured[k]) continue;
     pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordSampleDraws(commands, batch.count, k == 1 ? kCubeVertices : kTriangleVertices);
+    RecordSampleDraws(commands, batch.count, k == 1);
   }
   vkCmdEndRendering(commands);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -791,12 +799,19 @@ void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std:
 }
 
 // Pass 2a: kViewportsPerDraw samples a draw, instance i taking viewport
-// i % kViewportsPerDraw, which the draw has just set.
-void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const {
+// i % kViewportsPerDraw, which the draw has just set; a full-screen
+// triangle each, or a light volume (`cubes`).
+void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const {
+  if (cubes) vkCmdBindIndexBuffer(commands, cube_indices_.handle(), 0, VK_INDEX_TYPE_UINT16);
   for (std::uint32_t first = 0; first < count; first += kViewportsPerDraw) {
     vkCmdSetViewport(commands, 0, kViewportsPerDraw, viewports_.data() + first);
     vkCmdSetScissor(commands, 0, kViewportsPerDraw, scissors_.data() + first);
-    vkCmdDraw(commands, vertices, std::min(kViewportsPerDraw, count - first), 0, first);
+    const std::uint32_t instances = std::min(kViewportsPerDraw, count - first);
+    if (cubes) {
+      vkCmdDrawIndexed(commands, static_cast<std::uint32_t>(kCubeIndices.size()), instances, 0, 0, first);
+    } else {
+      vkCmdDraw(commands, kTriangleVertices, instances, 0, first);
+    }
   }
 }
 

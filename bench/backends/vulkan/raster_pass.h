@@ -121,7 +121,7 @@ class RasterPass {
   void RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot,
                         std::uint32_t rows) const;
   void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows, std::uint32_t vertices) const;
-  void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t vertices) const;
+  void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
   void CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
@@ -139,6 +139,7 @@ class RasterPass {
   std::uint32_t atlas_rows_ = 0;
   VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
   VulkanBuffer attributes_;  // pass 2a's output: shaders/raster/capture.frag
+  VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
   std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
   std::vector<VkRect2D> scissors_;
   std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
