@@ -124,11 +124,19 @@ TEST_F(RasterPassTest, LavapipeHasEverythingTheRasterFormNeeds) {
 
 // The compute form's positions on the texels the raster form stored must
 // be the raster form's, up to what the two forms do differently: nothing
-// but where the rays come from.
-TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
+// but where the rays come from. With the compute-attributes probe the rays
+// come from the compute form's formula too, and every bit agrees.
+class AgreementTest : public RasterPassTest, public ::testing::WithParamInterface<std::uint32_t> {};
+
+TEST_P(AgreementTest, AgreesWithTheComputeFormOnTheSameTexels) {
+  const std::uint32_t probes = GetParam();
+  BackendOptions options;
+  options.arithmetic_probes = probes;
+  auto probed = MakeVulkanBackend(context_, options);
+  ASSERT_TRUE(probed.ok()) << probed.status().message();
   const RunLayout layout = RepresentativeLayout();
   const std::vector<std::uint32_t> which = AllIndices(layout);
-  Status status = raster_->Prepare(layout.cells, PassKind::kRaster);
+  Status status = (*probed)->Prepare(layout.cells, PassKind::kRaster);
   ASSERT_TRUE(status.ok()) << status.message();
   status = compute_->Prepare(layout.cells, PassKind::kCompute);
   ASSERT_TRUE(status.ok()) << status.message();
@@ -136,7 +144,7 @@ TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
   // Starts and ends inside a frame, and inside an atlas row.
   Batch batch = BuildBatch(layout, 4101, 1000);
   std::vector<float> scratch;
-  auto drawn = raster_->Run(batch, which, scratch);
+  auto drawn = (*probed)->Run(batch, which, scratch);
   ASSERT_TRUE(drawn.ok()) << drawn.status().message();
   const std::vector<float> raster(drawn->begin(), drawn->end());
 
@@ -147,7 +155,7 @@ TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
   // also runs on the neighbours of that value, up to kDecodeUlps away; a
   // raster position is compared with the nearest of them.
   constexpr int kDecodeUlps = 2;
-  const std::vector<std::uint32_t> texels = raster_->raster_texels();
+  const std::vector<std::uint32_t> texels = (*probed)->raster_texels();
   ASSERT_EQ(texels.size(), batch.codes.size());
   std::vector<std::vector<float>> computed;
   for (int shift = -kDecodeUlps; shift <= kDecodeUlps; ++shift) {
@@ -183,7 +191,9 @@ TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
     // whose values are up to 3 times the ray at the pixel), then scaled by
     // the depth; volume_ray also divides by the interpolated surface z.
     // 64 units of 2^-24 |p| allows 16 such roundings of a term 4 times |p|.
-    const double units = RayVariant(cell.variant) ? 64.0 : 0.0;
+    // With compute-attributes the rays are the compute form's: no units.
+    const bool interpolated = RayVariant(cell.variant) && (probes & kComputeAttributes) == 0;
+    const double units = interpolated ? 64.0 : 0.0;
     double worst = 0.0;
     std::size_t finite = 0, compared = 0;
     for (std::uint32_t i = 0; i < batch.count; ++i) {
@@ -226,6 +236,26 @@ TEST_F(RasterPassTest, AgreesWithTheComputeFormOnTheSameTexels) {
     EXPECT_GT(compared, 0u) << cell.Name();
   }
   EXPECT_TRUE(context_->TakeValidationMessages().empty());
+  probed->reset();
+}
+
+INSTANTIATE_TEST_SUITE_P(Probes, AgreementTest, ::testing::Values(0u, std::uint32_t{kComputeAttributes}),
+                         [](const ::testing::TestParamInfo<std::uint32_t>& info) {
+                           return info.param == 0 ? std::string("Interpolated") : std::string("ComputeAttributes");
+                         });
+
+// The compute-attributes probe changes only the raster form; the compute
+// form is refused it, with what to run instead.
+TEST_F(RasterPassTest, TheComputeFormRefusesTheComputeAttributesProbe) {
+  BackendOptions options;
+  options.arithmetic_probes = kComputeAttributes;
+  auto probed = MakeVulkanBackend(context_, options);
+  ASSERT_TRUE(probed.ok()) << probed.status().message();
+  EXPECT_EQ((*probed)->name(), "vulkan:compute-attributes");
+  const Status status = (*probed)->Prepare(RepresentativeLayout().cells, PassKind::kCompute);
+  EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("--pipeline raster"), std::string::npos) << status.message();
+  probed->reset();
 }
 
 // The texels the device stored, against the batch's codes (the host's model

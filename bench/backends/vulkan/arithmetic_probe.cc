@@ -18,7 +18,10 @@ struct Probe {
   std::string_view name;
 };
 constexpr Probe kProbes[] = {
-    {kNoContraction, "no-contraction"}, {kExactDivision, "exact-division"}, {kWorstDivision, "worst-division"}};
+    {kNoContraction, "no-contraction"},
+    {kExactDivision, "exact-division"},
+    {kWorstDivision, "worst-division"},
+    {kComputeAttributes, "compute-attributes"}};
 
 // The arithmetic a compiler may contract: SPIR-V's NoContraction applies to
 // these.

@@ -16,9 +16,17 @@
 //     Vulkan allows a division (an infinite quotient becomes NaN), which is
 //     what a bound's division rule must cover (bench/bound).
 //
+// And one probe of the raster form's inputs, which rewrites nothing:
+//
+//   compute-attributes: the reconstruction's fragment gets the screen
+//     attributes (the rays, the light volume's position) as the compute
+//     form computes them at the pixel from the frame's constants, in place
+//     of what the rasterizer interpolated (vulkan/raster_pass.h), so that
+//     a run with and without it measures what the interpolation costs.
+//
 // The Vulkan backend applies them when its name says so
 // ("vulkan:no-contraction", "vulkan:exact-division", "vulkan:worst-division",
-// or several joined by '+').
+// "vulkan:compute-attributes", or several joined by '+').
 #pragma once
 
 #include <cstdint>
@@ -35,6 +43,7 @@ enum ArithmeticProbe : std::uint32_t {
   kNoContraction = 1u << 0,
   kExactDivision = 1u << 1,
   kWorstDivision = 1u << 2,
+  kComputeAttributes = 1u << 3,  // the raster form's; ApplyArithmeticProbes leaves it alone
 };
 
 // "no-contraction+exact-division" <-> bits; "" for none.

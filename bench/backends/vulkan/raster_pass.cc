@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -71,9 +72,16 @@ constexpr VkShaderStageFlags kSetStages = kDrawStages | VK_SHADER_STAGE_COMPUTE_
 constexpr std::uint32_t kFetchWorkgroup = 64;  // fetch.comp's local size
 
 // gbuffer.frag's specialization constant VIEW_Z; capture.frag's and the
-// reconstruction's LIGHT_VOLUME.
+// reconstruction's LIGHT_VOLUME; capture.frag's COMPUTE_ATTRIBUTES.
 constexpr std::uint32_t kViewZConstant = 0;
 constexpr std::uint32_t kLightVolumeConstant = 0;
+constexpr std::uint32_t kComputeAttributesConstant = 1;
+
+// A light volume or not, and capture.frag's probe.
+struct CaptureConstants {
+  VkBool32 light_volume;
+  VkBool32 compute_attributes;
+};
 
 bool ClipMinusOne(Convention convention) { return (Info(convention).bits & catalog::kGl) != 0; }
 bool ReversedDepth(Convention convention) { return (Info(convention).bits & catalog::kRev) != 0; }
@@ -379,12 +387,19 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   }
 
   // Pass 2a: the full-screen triangle's rays, and the light volume's
-  // position where a volume_ray cell reads it.
-  const VkSpecializationMapEntry light_volume_entry{kLightVolumeConstant, 0, sizeof(VkBool32)};
-  const std::array<VkBool32, 2> light_volume_values = {VK_FALSE, VK_TRUE};
-  std::array<VkSpecializationInfo, 2> light_volume_constants{};
-  for (std::size_t k = 0; k < light_volume_constants.size(); ++k) {
-    light_volume_constants[k] = {1, &light_volume_entry, sizeof(VkBool32), &light_volume_values[k]};
+  // position where a volume_ray cell reads it. Pass 2b's programs take the
+  // first constant alone.
+  const std::array<VkSpecializationMapEntry, 2> capture_entries = {{
+      {kLightVolumeConstant, offsetof(CaptureConstants, light_volume), sizeof(VkBool32)},
+      {kComputeAttributesConstant, offsetof(CaptureConstants, compute_attributes), sizeof(VkBool32)},
+  }};
+  const VkBool32 compute_attributes = (arithmetic_probes & kComputeAttributes) != 0 ? VK_TRUE : VK_FALSE;
+  const std::array<CaptureConstants, 2> capture_values = {{{VK_FALSE, compute_attributes},
+                                                           {VK_TRUE, compute_attributes}}};
+  std::array<VkSpecializationInfo, 2> capture_constants{}, light_volume_constants{};
+  for (std::size_t k = 0; k < capture_constants.size(); ++k) {
+    capture_constants[k] = {2, capture_entries.data(), sizeof(CaptureConstants), &capture_values[k]};
+    light_volume_constants[k] = {1, capture_entries.data(), sizeof(CaptureConstants), &capture_values[k]};
   }
   for (std::size_t k = 0; k < capture_.size(); ++k) {
     DrawState state;
@@ -392,7 +407,7 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
     state.per_sample_viewports = true;
     state.vertex = state.light_volume ? light_volume.get() : full_screen.get();
     state.fragment = capture.get();
-    state.fragment_constants = &light_volume_constants[k];
+    state.fragment_constants = &capture_constants[k];
     DB_ASSIGN_OR_RETURN(capture_[k], CreateGraphicsPipeline(device(), layout, state,
                                                             state.light_volume ? "the raster form's light volumes"
                                                                                : "the raster form's full-screen rays"));

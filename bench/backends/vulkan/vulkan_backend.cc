@@ -339,6 +339,10 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
   std::unique_ptr<RasterPass> raster;
   if (pass == PassKind::kRaster) {
     DB_ASSIGN_OR_RETURN(raster, RasterPass::Create(context_, cells, shader_dir_, options_.arithmetic_probes, sources));
+  } else if ((options_.arithmetic_probes & kComputeAttributes) != 0) {
+    return InvalidArgument(
+        "the compute-attributes probe replaces what the raster form's rasterizer interpolates; the compute form "
+        "computes those attributes already (run it with --pipeline raster)");
   } else {
     for (const CellPlan& plan : cells) {
       DeviceObject<VkPipeline>& pipeline = pipelines[VariantIndex(plan.cell.variant)];
