@@ -314,6 +314,15 @@ TEST(BoundTest, TheFuzzerCatchesADivisionRuleOneUlpTooSmall) {
   auto rules = campaign(2.5, fs::path(::testing::TempDir()) / "division_rules");
   ASSERT_TRUE(rules.ok()) << rules.status().message();
   EXPECT_EQ(beyond(*rules), 0);
+  // What the summary reports of the check's reach: two samples of each
+  // cell a batch, most of them bounded under 24 bits, and the nearest
+  // within the bound but close to it (the rules' bound is what the probe
+  // uses up, so some sample must come within a quarter of it).
+  const CaseChecker::SampleBoundReach& reach = rules->sample_bound_reach;
+  EXPECT_GT(reach.held, 0u);
+  EXPECT_GT(reach.below_24_bits, reach.held / 2);
+  EXPECT_LE(reach.closest, 1.0);
+  EXPECT_GT(reach.closest, 0.75);
   auto planted = campaign(1.5, fs::path(::testing::TempDir()) / "division_planted");
   ASSERT_TRUE(planted.ok()) << planted.status().message();
   std::printf("division rule 2.5 ULP: %d findings beyond; 1.5 ULP: %d\n", beyond(*rules), beyond(*planted));

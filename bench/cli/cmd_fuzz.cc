@@ -191,6 +191,14 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
       "invariants: finite output where the reference is finite; arithmetic error within "
       "{}x2^-24 x (depth + ray + world condition numbers){}\n",
       kRoundings, options.proven.empty() ? "" : "; shader part of judged samples within the proven bound");
+  if (options.sample_bound) {
+    const CaseChecker::SampleBoundReach& reach = result.sample_bound_reach;
+    out.text << fmt::format(
+        "bounds at single samples: {} samples (each batch's worst of every cell and backend) held against the bound "
+        "proven at their own inputs, {} of them under 24 bits; of those, the closest came to {:.3f} of it{}\n",
+        reach.held, reach.below_24_bits, reach.closest,
+        reach.closest_cell.empty() ? "" : " (" + reach.closest_cell + ")");
+  }
   if (result.findings.empty()) {
     out.text << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;

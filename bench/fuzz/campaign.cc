@@ -346,6 +346,7 @@ Expected<CampaignResult> RunCampaign(const CampaignOptions& options, std::span<B
     }
   }
   result.seconds = elapsed();
+  result.sample_bound_reach = checker.sample_bound_reach();
 
   DB_RETURN_IF_ERROR(ShrinkFindings(options, backend_list, result));
   return result;

@@ -66,6 +66,8 @@ struct CampaignResult {
   double seconds = 0.0;
   double closest = 0.0;  // the largest arithmetic error / bound seen that was no finding
   std::string closest_cell;
+  // Where CampaignOptions::sample_bound was given (CaseChecker's).
+  CaseChecker::SampleBoundReach sample_bound_reach;
   std::vector<CampaignFinding> findings;
 };
 

@@ -136,7 +136,17 @@ void CaseChecker::HoldWorstAgainstSampleBounds(std::size_t b, std::uint32_t coun
       const double bound = sample_bound_(cells_[c], backends_[b]->name(), batch_.frames[batch_.FrameOf(i)],
                                          pixel & 0xFFFFu, pixel >> 16, batch_.depths[at]);
       // The judge measures against the true point's distance.
-      judged[i].proven = std::min(judged[i].proven, bound * (r.denoted_depth / r.true_depth));
+      const double held = bound * (r.denoted_depth / r.true_depth);
+      judged[i].proven = std::min(judged[i].proven, held);
+      ++reach_.held;
+      // A bound of the whole distance or more (24 bits) says nothing a
+      // sample could come close to in a telling way.
+      if (!(held < 1.0)) continue;
+      ++reach_.below_24_bits;
+      if (judged[i].arith / held > reach_.closest) {
+        reach_.closest = judged[i].arith / held;
+        reach_.closest_cell = cells_[c].Name() + " on " + backends_[b]->name();
+      }
     }
   }
 }

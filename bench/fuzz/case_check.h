@@ -96,6 +96,17 @@ class CaseChecker {
   // every cell and backend, by its error and by its error over
   // ArithmeticBound, is held against it too.
   void SetSampleBound(SampleBound bound) { sample_bound_ = std::move(bound); }
+  // How far the sample bounds reached, since Make: the samples held
+  // against them, those of them whose bound is under 24 bits (less than
+  // the distance), and the largest shader error over its sample bound
+  // among the latter (with its cell's name).
+  struct SampleBoundReach {
+    std::uint64_t held = 0;
+    std::uint64_t below_24_bits = 0;
+    double closest = 0.0;
+    std::string closest_cell;
+  };
+  const SampleBoundReach& sample_bound_reach() const { return reach_; }
 
   // Runs samples [first, first + count) of `source` through every backend
   // and judges each output.
@@ -117,6 +128,7 @@ class CaseChecker {
   std::vector<Cell> cells_;
   std::vector<double> proven_;  // per (cell, backend), or empty
   SampleBound sample_bound_;    // or empty
+  SampleBoundReach reach_;
   std::vector<Backend*> backends_;
   RunLayout layout_;
   std::unique_ptr<ThreadPool> pool_;
