@@ -10,7 +10,9 @@
 # the host's cores; --judge device: binned where they are). With DEVICE (a
 # part of a Vulkan device's name, as --device takes it, "nvidia"): that
 # device with either judge at 10^7 and 10^8 samples, and with its own
-# judge at 10^9, each in its default batches. DEPTHBENCH names another program to run (a packed copy's
+# judge at 10^9, each in its default batches. Each ends with the raster
+# form (--pipeline raster, judged on the host) beside the compute form
+# with the same judge and samples, so that the two rates compare. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
@@ -37,6 +39,8 @@ if [[ -z $device ]]; then
     "lavapipe, host judge, 1e6 samples"
     "lavapipe, host judge, 1e7 samples"
     "lavapipe, device judge, 1e6 samples"
+    "lavapipe, compute form, host judge, 1e5"
+    "lavapipe, raster form, host judge, 1e5"
   )
   arguments=(
     "--backend cpu --samples 1e6"
@@ -45,6 +49,8 @@ if [[ -z $device ]]; then
     "--backend vulkan --judge host --samples 1e6"
     "--backend vulkan --judge host --samples 1e7"
     "--backend vulkan --judge device --samples 1e6"
+    "--backend vulkan --judge host --pipeline compute --samples 1e5"
+    "--backend vulkan --judge host --pipeline raster --samples 1e5"
   )
 else
   labels=() arguments=()
@@ -58,6 +64,10 @@ else
   # costs (its set-up, its first and last batches) fade.
   labels+=("$device, device judge, 1e9 samples")
   arguments+=("--backend vulkan --device $device --judge device --samples 1e9")
+  for form in compute raster; do
+    labels+=("$device, $form form, host judge, 1e7")
+    arguments+=("--backend vulkan --device $device --judge host --pipeline $form --samples 1e7")
+  done
 fi
 declare -a rates peaks  # per configuration: space-separated figures of its runs
 
