@@ -13,6 +13,7 @@
 #include "bench/fuzz/campaign.h"
 #include "bench/fuzz/case_check.h"
 #include "bench/fuzz/fuzz_case.h"
+#include "bench/fuzz/known_findings.h"
 #include "bench/fuzz/worst_case.h"
 #include "bench/pipeline/stats.h"
 #include "bench/sweep/sweep.h"
@@ -75,6 +76,37 @@ TEST(ReproFileTest, RoundTripsTheCaseExactly) {
   EXPECT_EQ(back->fuzz_case.sample.eye_depth, file.fuzz_case.sample.eye_depth);
   EXPECT_EQ(back->fuzz_case.sample.x, file.fuzz_case.sample.x);
   EXPECT_EQ(back->cells.front(), file.cells.front());
+}
+
+// A known finding may name the backends it is accepted on: "vulkan"
+// covers the device and its probes, not the CPU, so the same NaN on the
+// CPU stays new. A name that is no backend is refused with its field.
+TEST(KnownFindingsTest, BackendsScopeAnEntry) {
+  const auto parse = [](const std::string& backends) {
+    return KnownFindingsFromJson(nlohmann::json::parse(R"({"schema": "depthbench.known_findings", "schema_version": 1,
+        "findings": [{"variant": "divide", "conventions": ["reversed-inf"], "formats": ["d32_sfloat"],
+                      "backends": )" + backends + R"(, "kind": "nan", "reason": "a device's own"}]})"),
+                                 "known.json");
+  };
+  auto known = parse(R"(["vulkan"])");
+  ASSERT_TRUE(known.ok()) << known.status().message();
+  const Cell cell{Variant::kDivide, Convention::kReversedInf, Format::kD32Sfloat};
+  EXPECT_NE(FindKnown(*known, cell, FindingKind::kNaN, "vulkan"), nullptr);
+  EXPECT_NE(FindKnown(*known, cell, FindingKind::kNaN, "vulkan:worst-division"), nullptr);
+  EXPECT_EQ(FindKnown(*known, cell, FindingKind::kNaN, "cpu"), nullptr);
+  EXPECT_EQ(FindKnown(*known, cell, FindingKind::kInf, "vulkan"), nullptr);
+  const Cell other{Variant::kDivide, Convention::kReversed, Format::kD32Sfloat};
+  EXPECT_EQ(FindKnown(*known, other, FindingKind::kNaN, "vulkan"), nullptr);
+  // Without the field, any backend.
+  auto any = KnownFindingsFromJson(nlohmann::json::parse(R"({"schema": "depthbench.known_findings",
+      "schema_version": 1, "findings": [{"variant": "divide", "kind": "nan", "reason": "r"}]})"),
+                                   "known.json");
+  ASSERT_TRUE(any.ok()) << any.status().message();
+  EXPECT_NE(FindKnown(*any, cell, FindingKind::kNaN, "cpu"), nullptr);
+  auto bad = parse(R"(["gpu"])");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("backends"), std::string::npos) << bad.status().message();
+  EXPECT_NE(bad.status().message().find("'gpu' is not a backend"), std::string::npos) << bad.status().message();
 }
 
 TEST(ReproFileTest, BadFilesNameTheField) {

@@ -203,15 +203,16 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
     out.text << fmt::format("no findings; closest: {} at {:.2f} of its bound\n", result.closest_cell, result.closest);
     return kExitOk;
   }
-  // Grouped by cell and kind (backends that agree merged), new ones first,
-  // then the known ones under their reason.
+  // Grouped by cell, kind and known reason (backends that agree merged),
+  // new ones first, then the known ones under their reason.
   std::vector<FindingGroup> groups;
   for (const CampaignFinding& finding : result.findings) {
+    const KnownFinding* reason = FindKnown(known, finding.cell, finding.kind, finding.backend);
     auto same = std::find_if(groups.begin(), groups.end(), [&](const FindingGroup& g) {
-      return g.first->cell == finding.cell && g.first->kind == finding.kind;
+      return g.first->cell == finding.cell && g.first->kind == finding.kind && g.known == reason;
     });
     if (same == groups.end()) {
-      groups.push_back({&finding, {}, 0, FindKnown(known, finding.cell, finding.kind)});
+      groups.push_back({&finding, {}, 0, reason});
       same = groups.end() - 1;
     }
     same->backends.push_back(finding.backend);

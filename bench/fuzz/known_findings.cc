@@ -16,6 +16,13 @@ Expected<FindingKind> KindFrom(const JsonReader& r) {
   return r.Error(fmt::format("'{}' is not one of nan, inf, beyond_bound, beyond_proven_bound", name));
 }
 
+// A backend's name as --backend takes it: "cpu", "vulkan", or "vulkan:"
+// and its probes.
+Expected<std::string> ParseBackendName(const std::string& name) {
+  if (name == "cpu" || name == "vulkan" || name.starts_with("vulkan:")) return name;
+  return InvalidArgument(fmt::format("'{}' is not a backend (cpu, vulkan, or vulkan:PROBES)", name));
+}
+
 // Reads the optional list `key` of names through `parse`.
 template <class T, class Parse>
 Status NamesInto(const JsonReader& entry, const char* key, Parse parse, std::vector<T>& out) {
@@ -31,12 +38,17 @@ Status NamesInto(const JsonReader& entry, const char* key, Parse parse, std::vec
 
 }  // namespace
 
-bool KnownFinding::Matches(const Cell& cell, FindingKind found) const {
+bool KnownFinding::Matches(const Cell& cell, FindingKind found, std::string_view backend) const {
   const auto listed = [](const auto& list, auto value) {
     return list.empty() || std::find(list.begin(), list.end(), value) != list.end();
   };
+  // A backend's name before its probes: "vulkan" of "vulkan:worst-division".
+  const std::string_view base = backend.substr(0, backend.find(':'));
+  const bool on_backend = backends.empty() || std::any_of(backends.begin(), backends.end(), [&](const std::string& b) {
+                            return b == backend || b == base;
+                          });
   return cell.variant == variant && found == kind && listed(conventions, cell.convention) &&
-         listed(formats, cell.format);
+         listed(formats, cell.format) && on_backend;
 }
 
 Expected<std::vector<KnownFinding>> KnownFindingsFromJson(const nlohmann::json& json, const std::string& source) {
@@ -51,6 +63,7 @@ Expected<std::vector<KnownFinding>> KnownFindingsFromJson(const nlohmann::json& 
     k.variant = *parsed;
     DB_RETURN_IF_ERROR(NamesInto(entry, "conventions", ParseConvention, k.conventions));
     DB_RETURN_IF_ERROR(NamesInto(entry, "formats", ParseFormat, k.formats));
+    DB_RETURN_IF_ERROR(NamesInto(entry, "backends", ParseBackendName, k.backends));
     DB_ASSIGN_OR_RETURN(const JsonReader kind, entry.Field("kind"));
     DB_ASSIGN_OR_RETURN(k.kind, KindFrom(kind));
     DB_ASSIGN_OR_RETURN(k.reason, entry.String("reason"));
@@ -66,9 +79,10 @@ Expected<std::vector<KnownFinding>> ReadKnownFindings(const std::filesystem::pat
   return KnownFindingsFromJson(json, path.string());
 }
 
-const KnownFinding* FindKnown(const std::vector<KnownFinding>& known, const Cell& cell, FindingKind kind) {
+const KnownFinding* FindKnown(const std::vector<KnownFinding>& known, const Cell& cell, FindingKind kind,
+                              std::string_view backend) {
   for (const KnownFinding& k : known) {
-    if (k.Matches(cell, kind)) return &k;
+    if (k.Matches(cell, kind, backend)) return &k;
   }
   return nullptr;
 }

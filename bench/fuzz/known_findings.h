@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bench/base/json_reader.h"
@@ -24,16 +25,20 @@ struct KnownFinding {
   Variant variant;
   std::vector<Convention> conventions;  // empty: any
   std::vector<Format> formats;          // empty: any
+  // Backends it is accepted on (empty: any); "vulkan" also covers its
+  // probes ("vulkan:worst-division"), as the device's own behaviour does.
+  std::vector<std::string> backends;
   FindingKind kind = FindingKind::kNaN;
   std::string reason;
 
-  bool Matches(const Cell& cell, FindingKind found) const;
+  bool Matches(const Cell& cell, FindingKind found, std::string_view backend) const;
 };
 
 Expected<std::vector<KnownFinding>> KnownFindingsFromJson(const nlohmann::json& json, const std::string& source);
 Expected<std::vector<KnownFinding>> ReadKnownFindings(const std::filesystem::path& path);
 
 // The first entry that matches, or nullptr.
-const KnownFinding* FindKnown(const std::vector<KnownFinding>& known, const Cell& cell, FindingKind kind);
+const KnownFinding* FindKnown(const std::vector<KnownFinding>& known, const Cell& cell, FindingKind kind,
+                              std::string_view backend);
 
 }  // namespace depthbench
