@@ -460,6 +460,22 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
     return InvalidArgument(fmt::format("a batch of {} samples needs an atlas of {} rows; the device renders at most {}",
                                        batch.count, rows, MaxBatchSamples() / kAtlasWidth));
   }
+  // Pass 2a's viewport of a sample lies up to a frame's size beyond the atlas.
+  const VkPhysicalDeviceLimits& limits = context_->properties().limits;
+  for (const f32::FrameParams& frame : batch.frame_params) {
+    const float width = frame.resolution.x;
+    const float height = frame.resolution.y;
+    if (width > static_cast<float>(limits.maxViewportDimensions[0]) ||
+        height > static_cast<float>(limits.maxViewportDimensions[1]) ||
+        -width < limits.viewportBoundsRange[0] ||
+        static_cast<float>(rows) + height > limits.viewportBoundsRange[1]) {
+      return InvalidArgument(fmt::format(
+          "a {}x{} frame's viewports reach beyond what the device allows (at most {}x{}, within [{}, {}]) with an "
+          "atlas of {} rows; run fewer samples at once",
+          width, height, limits.maxViewportDimensions[0], limits.maxViewportDimensions[1],
+          limits.viewportBoundsRange[0], limits.viewportBoundsRange[1], rows));
+    }
+  }
   return Status::Ok();
 }
 
