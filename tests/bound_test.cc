@@ -323,6 +323,13 @@ TEST(BoundTest, TheFuzzerCatchesADivisionRuleOneUlpTooSmall) {
   EXPECT_GT(reach.below_24_bits, reach.held / 2);
   EXPECT_LE(reach.closest, 1.0);
   EXPECT_GT(reach.closest, 0.75);
+  // Tight at their own inputs: a good part lies within a bit of its bound
+  // (the closest alone can sit at 1 where the bound follows the floats).
+  EXPECT_GT(reach.within_one_bit, reach.below_24_bits / 4);
+  EXPECT_LE(reach.within_one_bit, reach.below_24_bits);
+  std::printf("sample bounds: %llu held, %llu under 24 bits, %llu within a bit, closest %.3f\n",
+              static_cast<unsigned long long>(reach.held), static_cast<unsigned long long>(reach.below_24_bits),
+              static_cast<unsigned long long>(reach.within_one_bit), reach.closest);
   auto planted = campaign(1.5, fs::path(::testing::TempDir()) / "division_planted");
   ASSERT_TRUE(planted.ok()) << planted.status().message();
   std::printf("division rule 2.5 ULP: %d findings beyond; 1.5 ULP: %d\n", beyond(*rules), beyond(*planted));

@@ -195,8 +195,9 @@ Expected<int> Campaign(const FuzzFlags& f, const std::vector<Cell>& cells, std::
     const CaseChecker::SampleBoundReach& reach = result.sample_bound_reach;
     out.text << fmt::format(
         "bounds at single samples: {} samples (each batch's worst of every cell and backend) held against the bound "
-        "proven at their own inputs, {} of them under 24 bits; of those, the closest came to {:.3f} of it{}\n",
-        reach.held, reach.below_24_bits, reach.closest,
+        "proven at their own inputs, {} of them under 24 bits; of those, {} within one bit of it, the closest at {:.3f} "
+        "of it{}\n",
+        reach.held, reach.below_24_bits, reach.within_one_bit, reach.closest,
         reach.closest_cell.empty() ? "" : " (" + reach.closest_cell + ")");
   }
   if (result.findings.empty()) {

@@ -143,6 +143,7 @@ void CaseChecker::HoldWorstAgainstSampleBounds(std::size_t b, std::uint32_t coun
       // sample could come close to in a telling way.
       if (!(held < 1.0)) continue;
       ++reach_.below_24_bits;
+      if (judged[i].arith >= 0.5 * held) ++reach_.within_one_bit;
       if (judged[i].arith / held > reach_.closest) {
         reach_.closest = judged[i].arith / held;
         reach_.closest_cell = cells_[c].Name() + " on " + backends_[b]->name();

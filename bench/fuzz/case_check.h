@@ -98,11 +98,15 @@ class CaseChecker {
   void SetSampleBound(SampleBound bound) { sample_bound_ = std::move(bound); }
   // How far the sample bounds reached, since Make: the samples held
   // against them, those of them whose bound is under 24 bits (less than
-  // the distance), and the largest shader error over its sample bound
-  // among the latter (with its cell's name).
+  // the distance), how many of the latter lie within one bit of their
+  // bound (an error at least half of it), and the largest shader error
+  // over its sample bound among them (with its cell's name). At a single
+  // sample the bound follows the floats the machine may compute, so the
+  // largest is often 1; the count within a bit says how many come close.
   struct SampleBoundReach {
     std::uint64_t held = 0;
     std::uint64_t below_24_bits = 0;
+    std::uint64_t within_one_bit = 0;
     double closest = 0.0;
     std::string closest_cell;
   };
