@@ -47,11 +47,7 @@ layout(std430, set = 0, binding = 5) writeonly buffer Positions { float position
 layout(std430, set = 0, binding = 5) writeonly buffer PositionQuads { vec4 position_quads[]; };
 layout(push_constant) uniform Pass { PassConstants pass; };
 
-// One sample, from its pixel and its stored depth.
-vec3 reconstruct_sample(FrameParams frame, DepthParams depth, uint pixel, float stored) {
-  vec2 uv = uv_from_pixel(float(pixel & 0xffffu), float(pixel >> 16u), frame.resolution);
-  return RECONSTRUCT(frame, depth, uv, stored);
-}
+#include "reconstruct_sample.glsl"
 
 // The slice element of the sample at `in_frame` within frame `frame_index`;
 // negative or >= slice_length when the batch starts or ends inside the frame.

@@ -125,4 +125,7 @@ struct JudgePass {
   uint seed_lo;           // the sampler's seed (the sample pass's)
   uint seed_hi;
   uint row_order;  // where the judge's order of accumulators starts in the run's layout
+  // Where each cell's convention slot within a frame's DepthParams lies in
+  // the run's layout (the fused pass's: shaders/judge/fused.comp).
+  uint cell_conventions;
 };

@@ -136,15 +136,25 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
     EXPECT_GE(seconds, 0.0) << pass;
     device_total += seconds;
   }
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"idle", "sample", "store", "reconstruction", "reference", "judge", "maxima"}));
+  // Fused (by request, or by default on a GPU), the reconstruction runs in
+  // the judge's phase 0, and the interval before the judge's submission is
+  // a wait.
+  const bool fused = tuning.fusion == JudgeFusion::kFused ||
+                     (tuning.fusion == JudgeFusion::kAuto &&
+                      DeviceJudgeTest::Context()->properties().type != VK_PHYSICAL_DEVICE_TYPE_CPU);
+  const std::string reconstruction = fused ? "reconstruction+judge" : "reconstruction";
+  const std::string judge = fused ? "reconstruction+judge" : "judge";
+  const std::vector<std::string> expected =
+      fused ? std::vector<std::string>{"idle", "sample", "store", "wait", "reference", "reconstruction+judge", "maxima"}
+            : std::vector<std::string>{"idle", "sample", "store", "reconstruction", "reference", "judge", "maxima"};
+  EXPECT_EQ(names, expected);
   EXPECT_LE(device_total, device->run.seconds);
   const auto seconds_of = [&](const std::string& pass) {
     return std::find_if(t.device_passes.begin(), t.device_passes.end(), [&](const auto& p) { return p.first == pass; })
         ->second;
   };
-  EXPECT_GT(seconds_of("judge"), 0.0);
-  EXPECT_GT(seconds_of("reconstruction"), 0.0);
+  EXPECT_GT(seconds_of(judge), 0.0);
+  EXPECT_GT(seconds_of(reconstruction), 0.0);
   if (device_draws) {
     EXPECT_GT(seconds_of("sample"), 0.0);
   }
@@ -175,18 +185,27 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
 // the index of each maximum: from the candidates phase 0 lists, or, with
 // no room for one, by judging every accumulator again. And either way of
 // drawing the samples: on the device (the default) or on the host
-// (`run --draw host`).
+// (`run --draw host`). And either way of reconstructing: the backend's
+// pass apart (lavapipe's default), or fused into the judge's program (a
+// GPU's), where phase 1 with no candidates reconstructs again, and where
+// the host uploads the pixels the next batch's upload would overwrite.
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
   ExpectSameStatistics(WideDomain(), "wide, device counters, drawn on the host",
                        {.bins = JudgeBinMerge::kDeviceCounters}, /*device_draws=*/false);
   ExpectSameStatistics(WideDomain(), "wide, workgroup table, no candidates",
                        {.bins = JudgeBinMerge::kWorkgroupTable, .candidates_per_row = 0});
+  ExpectSameStatistics(
+      WideDomain(), "wide, fused, workgroup table, no candidates, drawn on the host",
+      {.bins = JudgeBinMerge::kWorkgroupTable, .fusion = JudgeFusion::kFused, .candidates_per_row = 0},
+      /*device_draws=*/false);
 }
 
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
   ExpectSameStatistics(ExtremesDomain(), "extremes, device counters, no candidates",
                        {.bins = JudgeBinMerge::kDeviceCounters, .candidates_per_row = 0});
   ExpectSameStatistics(ExtremesDomain(), "extremes, workgroup table", {.bins = JudgeBinMerge::kWorkgroupTable});
+  ExpectSameStatistics(ExtremesDomain(), "extremes, fused, device counters",
+                       {.bins = JudgeBinMerge::kDeviceCounters, .fusion = JudgeFusion::kFused});
 }
 
 // An off-centre lens (a VR eye, with TAA jitter on top): the device draws

@@ -31,6 +31,7 @@ struct RunFlags {
   unsigned threads = 0;
   std::uint32_t batch = 0;  // by the judge (SweepOptions::batch_size)
   std::string judge = "auto";
+  std::string judge_fusion = "auto";
   std::string draw = "auto";
   bool quiet = false;
   DomainFlags domain;
@@ -80,6 +81,9 @@ Expected<int> Run(const RunFlags& f, const CommandContext& context) {
   options.batch_size = f.batch;
   options.judge = f.judge == "host" ? JudgeSite::kHost : f.judge == "device" ? JudgeSite::kDevice : JudgeSite::kAuto;
   options.device_draws = f.draw == "auto";
+  options.device_tuning.fusion = f.judge_fusion == "separate" ? JudgeFusion::kSeparate
+                                 : f.judge_fusion == "fused"  ? JudgeFusion::kFused
+                                                              : JudgeFusion::kAuto;
   if (!f.shard.empty()) {
     DB_ASSIGN_OR_RETURN(options.shard, ParseShard(f.shard));
   }
@@ -179,6 +183,14 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
       ->check(CLI::IsMember({"auto", "host", "device"}))
       ->type_name("WHERE")
+      ->group("Backends");
+  cmd->add_option("--judge-fusion", flags->judge_fusion,
+                  "how the device judges: 'fused': each variant's reconstruction inside the judge's program, so "
+                  "that no position goes through device memory (GLSL variants only); 'separate': the backend's "
+                  "pass writes the positions and the judge reads them; 'auto' (default): fused on a GPU where "
+                  "every variant is GLSL, separate on lavapipe (faster there). Same results either way")
+      ->check(CLI::IsMember({"auto", "fused", "separate"}))
+      ->type_name("HOW")
       ->group("Backends");
   cmd->add_option("--draw", flags->draw,
                   "where the samples are drawn when every backend judges on its device: 'auto' (default): on the "

@@ -39,7 +39,7 @@ static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus
               L::DB_JUDGE_STATUS_DEGENERATE == static_cast<unsigned>(ReferenceStatus::kDegenerate) &&
               L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
-static_assert(sizeof(L::JudgePass) == 60);
+static_assert(sizeof(L::JudgePass) == 64);
 static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9 + 2);  // shared/draw.h's DrawFrame, its rotation's nine
 static_assert(L::DB_JUDGE_TEXEL_UNORM == static_cast<unsigned>(TexelKind::kUnorm) &&
               L::DB_JUDGE_TEXEL_FLOAT32 == static_cast<unsigned>(TexelKind::kFloat32) &&
@@ -89,6 +89,10 @@ enum Binding : std::uint32_t {
   kPixels,  // the backend's
   kCandidates,
   kCandidateCounts,
+  // The fused pass's copies of the backend's frame constants and pixels.
+  kFrameParams,
+  kDepthParams,
+  kFusedPixels,
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
@@ -96,9 +100,11 @@ enum Binding : std::uint32_t {
 // into host-readable buffers: each batch's maxima and the unwritten counts
 // after the batch, the histograms and counts at a flush.
 bool DeviceOnly(Binding b) { return (b >= kReference && b <= kUnwritten) || b >= kCandidates; }
+// The bindings whose buffers the backend owns (DeviceRunBuffers).
+bool Backends(Binding b) { return b == kPositions || b == kTexels || b == kPixels; }
 // What the host writes for every batch: one buffer per lane (below), so
 // that it writes the next batch's while the device reads the last's.
-bool PerBatch(Binding b) { return b != kLayout && b != kPositions && b != kTexels && b != kPixels && !DeviceOnly(b); }
+bool PerBatch(Binding b) { return b != kLayout && !Backends(b) && !DeviceOnly(b); }
 
 // Two batches in flight: while the device runs one lane's passes, the host
 // writes the other's inputs. Each lane has its own uploads, descriptor
@@ -186,9 +192,15 @@ namespace {
 // backend's pass, queued between the two submissions, with any time the
 // device waits for the judge's submission; "idle" is the time from the
 // batch before's end to this one's start.
+// Where the judge is fused, the reconstruction runs in the judge's phase
+// 0, and the interval between the submissions is the wait alone.
 enum Mark : std::uint32_t { kStoreStart, kSampled, kStored, kJudgeStart, kReferenced, kJudged, kMaximaFound, kMarks };
 constexpr std::array<const char*, kMarks> kPassNames = {"idle",      "sample", "store", "reconstruction",
                                                         "reference", "judge",  "maxima"};
+constexpr std::array<const char*, kMarks> kFusedPassNames = {"idle",      "sample",
+                                                             "store",     "wait",
+                                                             "reference", "reconstruction+judge",
+                                                             "maxima"};
 
 }  // namespace
 
@@ -200,6 +212,14 @@ struct DeviceJudge::State {
   DeviceObject<VkPipeline> store_pipeline;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
+  // Where the judge is fused (JudgeFusion): per variant of the run, its
+  // program, and its rows: `rows` cells from `first_row` of the fused row
+  // order. Empty where it is not.
+  struct FusedVariant {
+    DeviceObject<VkPipeline> pipeline;
+    std::uint32_t first_row = 0, rows = 0;
+  };
+  std::vector<FusedVariant> fused;
   // [lane][binding]: lane 0 holds the bindings every lane shares (kPositions
   // and kTexels unused: the backend owns them); PerBatch ones are per lane.
   std::array<std::array<VulkanBuffer, kBindingCount>, kLanes> lane_buffers;
@@ -242,7 +262,11 @@ struct DeviceJudge::State {
   std::size_t accumulators() const { return cell_count() + depth_slots; }
   std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
   std::size_t row_order_at() const { return cell_count() + 2 * depth_slots + pipelines; }
-  std::size_t layout_words() const { return row_order_at() + accumulators(); }
+  // The fused passes' rows: the cells grouped by variant.
+  std::size_t fused_rows_at() const { return row_order_at() + accumulators(); }
+  // Per cell, its convention slot within a frame's DepthParams.
+  std::size_t cell_conventions_at() const { return fused_rows_at() + cell_count(); }
+  std::size_t layout_words() const { return cell_conventions_at() + cell_count(); }
   // Whether the storage pass produces the pipelines' floats (float32
   // production) or the host uploads them (exact production, which rounds
   // with MPFR where a tie needs it).
@@ -294,7 +318,17 @@ struct DeviceJudge::State {
   void Bind(const DeviceRunBuffers& run, const Batch& batch);
   L::JudgePass PassConstants(const Batch& batch, const DeviceJudgeInputs& device, const DeviceRunBuffers& run) const;
   // The sample pass where the device draws (`draws`), and the storage pass.
-  void RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws) const;
+  // The fused pass's copies of the backend's frame constants and pixels,
+  // by binding, and their bytes (none where the judge is not fused).
+  std::array<std::pair<Binding, VkDeviceSize>, 3> FusedCopies(const DeviceRunBuffers& run) const {
+    const bool copies = !fused.empty();
+    return {{{kFrameParams, copies ? run.frame_param_bytes : 0},
+             {kDepthParams, copies ? run.depth_param_bytes : 0},
+             {kFusedPixels, copies ? run.pixel_bytes : 0}}};
+  }
+  // Fused, then the copies of the backend's frame constants and pixels
+  // the fused pass reads.
+  void RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws, const DeviceRunBuffers& run) const;
   // The reference and judge passes, and the copy of the maxima.
   void Record(VkCommandBuffer commands, L::JudgePass constants, bool encodings) const;
   Status MergeMaxima(std::uint32_t lane, std::span<CellAccumulator> cells, std::span<CellAccumulator> encodings) const;
@@ -391,6 +425,42 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
     DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, specialization, "the device judge"), *pipeline));
   }
+  // The fused programs: one per variant of the run, whose rows are its
+  // cells (grouped by variant in the fused row order, each group's by
+  // depth slot as below).
+  std::vector<std::uint32_t> fused_rows(layout.cells.size());
+  std::iota(fused_rows.begin(), fused_rows.end(), 0u);
+  const auto variant_of = [&](std::uint32_t k) { return static_cast<int>(layout.cells[k].cell.variant); };
+  std::stable_sort(fused_rows.begin(), fused_rows.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return std::pair(variant_of(a), layout.cells[a].depth_slot) < std::pair(variant_of(b), layout.cells[b].depth_slot);
+  });
+  // Auto fuses on a GPU. On a CPU device (lavapipe) the separate passes
+  // are the faster: there each invocation of the fused pass loads its
+  // frame's constants lane by lane, where compute_pass.glsl loads them once
+  // for several samples (7 times slower over 2e4 samples on 2 cores).
+  const bool fuse = tuning.fusion == JudgeFusion::kFused ||
+                    (tuning.fusion == JudgeFusion::kAuto && context->properties().type != VK_PHYSICAL_DEVICE_TYPE_CPU);
+  if (fuse) {
+    Status fusing = Status::Ok();
+    for (std::uint32_t row = 0; row < fused_rows.size() && fusing.ok();) {
+      std::uint32_t end = row;
+      while (end < fused_rows.size() && variant_of(fused_rows[end]) == variant_of(fused_rows[row])) ++end;
+      const VariantInfo& variant = layout.cells[fused_rows[row]].cell.variant_info();
+      State::FusedVariant fused{.pipeline = {}, .first_row = row, .rows = end - row};
+      Expected<std::vector<std::uint32_t>> spirv = runs->CompileJudged(variant);
+      fusing = spirv.ok() ? StoreInto(state->pass->CreatePipeline(
+                                          *spirv, judge_shape, fmt::format("{}'s fused judge", variant.name)),
+                                      fused.pipeline)
+                          : spirv.status();
+      if (fusing.ok()) state->fused.push_back(std::move(fused));
+      row = end;
+    }
+    if (!fusing.ok()) {
+      // Auto falls back to the separate passes: the run is judged the same.
+      if (tuning.fusion == JudgeFusion::kFused) return fusing;
+      state->fused.clear();
+    }
+  }
 
   // What stays the same for the whole run: which depth slot each cell
   // reads, each slot's encoding and texel, and the counters, empty.
@@ -414,6 +484,10 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   std::stable_sort(row_order, row_order + state->cell_count(), [&](std::uint32_t a, std::uint32_t b) {
     return layout.cells[a].depth_slot < layout.cells[b].depth_slot;
   });
+  std::copy(fused_rows.begin(), fused_rows.end(), words + state->fused_rows_at());
+  for (std::size_t k = 0; k < layout.cells.size(); ++k) {
+    words[state->cell_conventions_at() + k] = layout.cells[k].convention_slot;
+  }
   DB_RETURN_IF_ERROR(state->Buffer(kLayout).FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kFirstNonFinite, state->first_bytes()));
@@ -589,7 +663,10 @@ void DeviceJudge::State::Bind(const DeviceRunBuffers& run, const Batch& batch) {
       std::max<VkDeviceSize>(frames * L::DB_JUDGE_FRAME_DRAWS * sizeof(double), 16),
       run.pixel_bytes,
       std::max<VkDeviceSize>(candidates_bytes(), 16),
-      candidate_counts_bytes()};
+      candidate_counts_bytes(),
+      std::max<VkDeviceSize>(FusedCopies(run)[0].second, 16),
+      std::max<VkDeviceSize>(FusedCopies(run)[1].second, 16),
+      std::max<VkDeviceSize>(FusedCopies(run)[2].second, 16)};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -622,10 +699,12 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceJ
                       .exact_production = exact_production ? 1u : 0u,
                       .seed_lo = static_cast<std::uint32_t>(seed),
                       .seed_hi = static_cast<std::uint32_t>(seed >> 32),
-                      .row_order = static_cast<std::uint32_t>(row_order_at())};
+                      .row_order = static_cast<std::uint32_t>(row_order_at()),
+                      .cell_conventions = static_cast<std::uint32_t>(cell_conventions_at())};
 }
 
-void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws) const {
+void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws,
+                                     const DeviceRunBuffers& run) const {
   if (clock.count() > 0) clock.RecordReset(commands, Query(lane, 0), kMarks);
   RecordMark(commands, kStoreStart);
   // Everything queued before (the last batch's judge reading the
@@ -643,6 +722,19 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass cons
     pass->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, slice_groups, 1, 1);
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  }
+  if (!fused.empty()) {
+    // After the sample pass wrote the pixels; the fused pass reads the copies.
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    const std::array<VkBuffer, 3> from = {run.frame_params, run.depth_params, run.pixels};
+    const auto copies = FusedCopies(run);
+    for (std::size_t c = 0; c < copies.size(); ++c) {
+      const VkBufferCopy region{0, 0, copies[c].second};
+      vkCmdCopyBuffer(commands, from[c], Buffer(copies[c].first).handle(), 1, &region);
+    }
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
   RecordMark(commands, kSampled);
@@ -684,13 +776,28 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, L::JudgePass constants
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-  pass->Bind(commands, judge_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
-  const auto rows = static_cast<std::uint32_t>(cell_count() + (encodings ? depth_slots : 0));
   const std::uint32_t groups_per_row = (constants.count + judge_groups.samples - 1) / judge_groups.samples;
+  // A dispatch of `pipeline` over `rows` accumulators of the row order
+  // that starts at layout word `row_order`.
+  const auto dispatch = [&](VkPipeline pipeline, std::size_t row_order, std::size_t rows) {
+    if (rows == 0) return;
+    pass->Bind(commands, pipeline, VK_PIPELINE_BIND_POINT_COMPUTE, lane);
+    constants.row_order = static_cast<std::uint32_t>(row_order);
+    pass->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, groups_per_row, static_cast<std::uint32_t>(rows), 1);
+  };
   for (std::uint32_t phase = 0; phase < 2; ++phase) {
     constants.phase = phase;
-    pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, groups_per_row, rows, 1);
+    if (fused.empty()) {
+      dispatch(judge_pipeline.get(), row_order_at(), cell_count() + (encodings ? depth_slots : 0));
+    } else {
+      // Each variant's cells in its own program; the depth slots' rows
+      // (after the cells' in the row order) in judge.comp's.
+      for (const FusedVariant& variant : fused) {
+        dispatch(variant.pipeline.get(), fused_rows_at() + variant.first_row, variant.rows);
+      }
+      dispatch(judge_pipeline.get(), row_order_at() + cell_count(), encodings ? depth_slots : 0);
+    }
     RecordMark(commands, phase == 0 ? kJudged : kMaximaFound);
     // Phase 1 reads the maxima and candidates phase 0 left; the copy below
     // reads both phases' maxima.
@@ -779,13 +886,18 @@ Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, s
   // read its positions. The storage pass's inputs go up first, the
   // backend's next, the reference's while the first two passes run.
   DB_RETURN_IF_ERROR(s.UploadForStorage(batch, device, pool));
+  // Fused, the last batch reads the backend's frame constants and pixels
+  // until its storage submission has copied them.
+  if (!s.fused.empty()) DB_RETURN_IF_ERROR(s.pass->Wait(StoreSlot(1 - s.lane)));
   DB_ASSIGN_OR_RETURN(const DeviceRunBuffers run, s.runs->Stage(batch, s.every_cell, &pool));
+  for (const auto& [binding, bytes] : s.FusedCopies(run)) DB_RETURN_IF_ERROR(s.Grow(binding, bytes));
   s.Bind(run, batch);
   const L::JudgePass constants = s.PassConstants(batch, device, run);
   const bool draws = device.draw_seed.has_value();
   DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
-      [&](VkCommandBuffer commands) { s.RecordStore(commands, constants, draws); }, StoreSlot(s.lane)));
-  DB_RETURN_IF_ERROR(s.runs->QueueStaged());
+      [&](VkCommandBuffer commands) { s.RecordStore(commands, constants, draws, run); }, StoreSlot(s.lane)));
+  // Fused, the judge's own programs reconstruct (from what Stage staged).
+  if (s.fused.empty()) DB_RETURN_IF_ERROR(s.runs->QueueStaged());
   DB_RETURN_IF_ERROR(s.UploadForReference(batch, device, pool));
   // This batch joins the accumulators once the next one is queued (or at
   // Flush).
@@ -801,10 +913,13 @@ Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, s
 
 double DeviceJudge::waited_seconds() const { return state_->waited; }
 
+bool DeviceJudge::fused() const { return !state_->fused.empty(); }
+
 std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
   std::vector<std::pair<std::string, double>> out;
   if (state_->clock.count() == 0) return out;
-  for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(kPassNames[k], state_->pass_seconds[k]);
+  const auto& names = fused() ? kFusedPassNames : kPassNames;
+  for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(names[k], state_->pass_seconds[k]);
   return out;
 }
 

@@ -67,10 +67,21 @@ namespace depthbench {
 // section 2). Either gives the same counts.
 enum class JudgeBinMerge : std::uint8_t { kAuto, kWorkgroupTable, kDeviceCounters };
 
+// Where the positions are judged. kSeparate: the backend's reconstruction
+// pass writes them to device memory and judge.comp reads them back;
+// kFused: one program per variant (shaders/judge/fused.comp, around the
+// variant's function as the backend compiles it) reconstructs each sample
+// and judges it in the same invocation, so no position goes through
+// memory. kAuto: fused on a GPU where every variant of the run compiles
+// into that program (an HLSL function does not), else separate (on a CPU
+// device the separate passes are faster).
+enum class JudgeFusion : std::uint8_t { kAuto, kFused, kSeparate };
+
 // How the judge works on its device; any choice records the same figures
 // (tests run each way).
 struct DeviceJudgeTuning {
   JudgeBinMerge bins = JudgeBinMerge::kAuto;
+  JudgeFusion fusion = JudgeFusion::kAuto;
   // How many candidates for the index of its maximum each accumulator
   // lists per batch (shaders/judge/judge.comp); one with more is judged
   // again whole. 0: every accumulator is.
@@ -115,13 +126,17 @@ class DeviceJudge {
   // this judge was made: with the host's time around Judge, it says which
   // side a batch waits for.
   double waited_seconds() const;
+  // Whether each variant's reconstruction runs in the judge's program
+  // (JudgeFusion).
+  bool fused() const;
   // The device's seconds in each of its passes for the batches finished so
   // far, by name, in the order they run: "idle" (from one batch's end to
   // the next one's start: the device waiting for the host), "sample",
   // "store", "reconstruction" (the backend's pass, with any wait for the
-  // judge's submission after it), "reference", "judge" (phase 0: the
-  // histograms) and "maxima" (phase 1). Empty where the device's queue
-  // writes no timestamps.
+  // judge's submission after it; where the judge is fused, "wait": that
+  // wait alone), "reference", "judge" (phase 0: the histograms; fused,
+  // "reconstruction+judge") and "maxima" (phase 1). Empty where the
+  // device's queue writes no timestamps.
   std::vector<std::pair<std::string, double>> pass_seconds() const;
   // The reference the device computed for the last batch Judge was given,
   // in the host's layout (for tests and diagnosis; it finishes the batches

@@ -97,6 +97,17 @@ layout(std430, set = 0, binding = 18) writeonly buffer Pixels { uint pixel_bits[
 layout(std430, set = 0, binding = 19) buffer Candidates { uvec4 candidates[]; };
 layout(std430, set = 0, binding = 20) buffer CandidateCounts { uint candidate_counts[]; };
 
+#ifdef DB_FUSED_PASS
+// What the fused pass reconstructs from (fused.comp): the Vulkan backend's
+// per frame FrameParams, per (frame, hardware convention) DepthParams and
+// per sample pixel (laid out as the backend has it), copied on the device
+// at the start of each batch, so that the backend's buffers are free for
+// the next batch's upload while this one is judged.
+layout(std430, set = 0, binding = 21) readonly buffer FrameParamsBuffer { FrameParams frame_params[]; };
+layout(std430, set = 0, binding = 22) readonly buffer DepthParamsBuffer { DepthParams depth_params[]; };
+layout(std430, set = 0, binding = 23) readonly buffer FusedPixels { uint pixel_bits[]; };
+#endif
+
 layout(push_constant) uniform Pass { JudgePass pass; };
 
 uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }

@@ -22,6 +22,7 @@ const char* PassName(VariantPass pass) {
   switch (pass) {
     case VariantPass::kSpeed: return "speed";
     case VariantPass::kRaster: return "raster";
+    case VariantPass::kJudged: return "judged";
     case VariantPass::kAccuracy: break;
   }
   return "accuracy";
@@ -30,7 +31,7 @@ const char* PassName(VariantPass pass) {
 // Whether the program is generated around the variant's function rather
 // than read from a file of the shader directory.
 bool Generated(const VariantInfo& variant, VariantPass pass) {
-  return variant.user != nullptr || pass == VariantPass::kRaster;
+  return variant.user != nullptr || pass == VariantPass::kRaster || pass == VariantPass::kJudged;
 }
 
 // The program around a variant's function: for a user's, the contract's
@@ -42,6 +43,12 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
   const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
   auto include = [](const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); };
   std::string text = hlsl ? "" : "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  if (pass == VariantPass::kJudged) {
+    // The judge counts in 64-bit integers and raises 64-bit maxima.
+    text +=
+        "#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require\n"
+        "#extension GL_EXT_shader_atomic_int64 : require\n";
+  }
   if (user == nullptr) {
     text += include(dir / "common.glsl");
     text += include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
@@ -63,6 +70,7 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
     case VariantPass::kRaster:
       text += include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
       break;
+    case VariantPass::kJudged: text += include(dir / "judge" / "fused.comp"); break;
   }
   return text;
 }
@@ -147,6 +155,10 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources) {
   const UserShader* user = variant.user;
+  if (pass == VariantPass::kJudged && user != nullptr && user->language == ShaderLanguage::kHlsl) {
+    return Unavailable(fmt::format("the device judge's fused program is GLSL; {} is an HLSL function",
+                                   user->path.string()));
+  }
   if (!Generated(variant, pass)) return CompileShader(BuiltInProgram(variant, pass, shader_dir), ShaderStage::kCompute, sources);
   const bool raster = pass == VariantPass::kRaster;
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();

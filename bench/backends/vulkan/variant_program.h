@@ -7,7 +7,8 @@
 // included by its path so that compile errors name the user's file and
 // line. The raster form's fragment program is generated for every variant
 // the same way, around its function: shared/variants/NAME.h for a built-in
-// one, the contract and the user's file for the user's.
+// one, the contract and the user's file for the user's; so is the device
+// judge's fused program.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +25,9 @@ enum class VariantPass : std::uint8_t {
   kAccuracy,  // compute_pass.glsl: positions of the sweep's samples
   kSpeed,     // speed/speed_pass.glsl: the timed full-screen pass
   kRaster,    // raster/raster_pass.glsl: the raster form's reconstruction, a fragment program
+  // judge/fused.comp: the compute form's reconstruction judged in the same
+  // program (the device judge's fused pass); GLSL only.
+  kJudged,
 };
 
 // SPIR-V of `variant`'s pass, from the programs in `shader_dir`. The text

@@ -235,6 +235,7 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   Expected<DeviceRunBuffers> Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                    ThreadPool* pool) override;
   Status QueueStaged() override;
+  Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const override;
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -403,6 +404,12 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(const VariantInf
                                fmt::format("'{}'", VariantProgramName(variant, VariantPass::kAccuracy, shader_dir_)));
 }
 
+Expected<std::vector<std::uint32_t>> VulkanBackend::CompileJudged(const VariantInfo& variant) const {
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compiled,
+                      CompileVariant(variant, VariantPass::kJudged, shader_dir_));
+  return ApplyArithmeticProbes(compiled, options_.arithmetic_probes);
+}
+
 Expected<RenderedDepths> VulkanBackend::RenderDepths(const ShaderInputs& batch) {
   if (raster_ == nullptr) return Unavailable(name() + " renders depths only when prepared for the raster form");
   if (batch.count == 0) return RenderedDepths{};
@@ -487,7 +494,11 @@ DeviceRunBuffers VulkanBackend::BuffersOf(const ShaderInputs& batch, const Slice
                           buffers_[kStoredDepths].handle(),
                           DepthSlotsOf(batch) * slices.length * sizeof(float),
                           buffers_[kPixels].handle(),
-                          std::size_t{slices.length} * sizeof(std::uint32_t)};
+                          std::size_t{slices.length} * sizeof(std::uint32_t),
+                          buffers_[kFrames].handle(),
+                          batch.frame_params.size() * sizeof(f32::FrameParams),
+                          buffers_[kDepthParams].handle(),
+                          batch.depth_params.size() * sizeof(f32::DepthParams)};
 }
 
 Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
@@ -595,11 +606,13 @@ Status VulkanBackend::EnsureCapacity(Binding binding, VkDeviceSize bytes) {
     positions_held_in_ = positions_access_;
   }
   // The output is filled with kUnwrittenBits on the device before each
-  // run; a judge on the device may copy the texels it stored (for tests).
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                   (binding == kPositions      ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT}
-                                    : binding == kStoredDepths ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_SRC_BIT}
-                                                               : VkBufferUsageFlags{0});
+  // run; a judge on the device may copy the inputs (the texels it stored,
+  // for tests; the frames' constants and the pixels, for its fused pass).
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+      (binding == kPositions ? VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT}
+       : binding == kCellSlices ? VkBufferUsageFlags{0}
+                                : VkBufferUsageFlags{VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
   // The previous run has completed (Run waits), so the old buffer can go.
   return context_->GrowHostBuffer(buffers_[binding], bytes, usage, access);
 }

@@ -51,6 +51,12 @@ struct DeviceRunBuffers {
   // The pixels the pass reads (x | y << 16), sample i at lead + i.
   VkBuffer pixels = VK_NULL_HANDLE;
   VkDeviceSize pixel_bytes = 0;
+  // The frames' constants the pass reads: the batch's FrameParams, and its
+  // DepthParams (kHardwareConventionCount per frame).
+  VkBuffer frame_params = VK_NULL_HANDLE;
+  VkDeviceSize frame_param_bytes = 0;
+  VkBuffer depth_params = VK_NULL_HANDLE;
+  VkDeviceSize depth_param_bytes = 0;
 };
 
 // What a Vulkan backend offers a judge on its device
@@ -68,6 +74,9 @@ struct DeviceRunBuffers {
 //      submission to the queue reads the positions after a barrier. They
 //      stay valid until the backend's next run or Stage, which waits for
 //      the pass.
+// Or, in place of step 3, the caller runs the reconstruction itself, in
+// its own program around each variant's function (CompileJudged), from
+// the buffers Stage returned.
 // Unavailable for the raster form.
 class DeviceResidentRuns {
  public:
@@ -82,6 +91,11 @@ class DeviceResidentRuns {
   // The staged run's reconstruction, queued; refused where nothing is
   // staged (a Run in between discards what Stage staged).
   virtual Status QueueStaged() = 0;
+  // `variant`'s function in the device judge's fused program
+  // (VariantPass::kJudged), compiled as this backend compiles its own pass:
+  // the same source of the function and the same arithmetic probes.
+  // Unavailable for a variant the program cannot hold (an HLSL function).
+  virtual Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const = 0;
 };
 
 }  // namespace depthbench
