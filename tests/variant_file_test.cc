@@ -195,6 +195,26 @@ TEST_F(VariantFileTest, CompileErrorsNameTheUsersLineAndNothingGenerated) {
   EXPECT_EQ(message.find("program>"), std::string::npos) << message;
 }
 
+// The device judge's fused program holds a GLSL function as the accuracy
+// pass does; an HLSL one it refuses, so that `--judge-fusion auto` keeps
+// the separate passes (device_judge.h's JudgeFusion).
+TEST_F(VariantFileTest, OnlyAGlslFunctionCompilesIntoTheFusedJudge) {
+  const fs::path shaders = fs::path(DEPTHBENCH_SOURCE_DIR) / "shaders";
+  auto glsl = AddFile((kExamples / "divide_subtract_first.glsl").string());
+  ASSERT_TRUE(glsl.ok()) << glsl.status().message();
+  auto fused = CompileVariant(catalogue_->Info(*glsl), VariantPass::kJudged, shaders);
+  ASSERT_TRUE(fused.ok()) << fused.status().message();
+  auto alone = CompileVariant(catalogue_->Info(*glsl), VariantPass::kAccuracy, shaders);
+  ASSERT_TRUE(alone.ok()) << alone.status().message();
+  EXPECT_GT(fused->size(), alone->size() + 1000);  // the judge's rows come with the function
+  auto unity = AddFile((kExamples / "unity_world_position.hlsl").string());
+  ASSERT_TRUE(unity.ok()) << unity.status().message();
+  auto refused = CompileVariant(catalogue_->Info(*unity), VariantPass::kJudged, shaders);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kUnavailable);
+  EXPECT_NE(refused.status().message().find("HLSL"), std::string::npos) << refused.status().message();
+}
+
 TEST_F(VariantFileTest, CpuBackendSaysItCannotRunAShaderFile) {
   auto unity = AddFile((kExamples / "unity_world_position.hlsl").string());
   ASSERT_TRUE(unity.ok());
