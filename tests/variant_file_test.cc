@@ -215,6 +215,36 @@ TEST_F(VariantFileTest, OnlyAGlslFunctionCompilesIntoTheFusedJudge) {
   EXPECT_NE(refused.status().message().find("HLSL"), std::string::npos) << refused.status().message();
 }
 
+// Fused, a user's GLSL function gets a program of its own beside the one
+// of the built-in variants (its contract cannot be defined twice), and the
+// cells of both record what the host judge records.
+TEST_F(VariantFileTest, AUsersFunctionIsJudgedFusedAsOnTheHost) {
+  auto edit = AddFile((kExamples / "divide_subtract_first.glsl").string());
+  ASSERT_TRUE(edit.ok()) << edit.status().message();
+  SweepOptions options;
+  options.seed = 5;
+  options.samples = 20'000;
+  options.batch_size = 3000;  // several batches, each ending inside a frame
+  options.cells = {{Variant::kDivide, Convention::kStandard, Format::kD32Sfloat},
+                   {Variant::kPq, Convention::kReversed, Format::kX8D24Unorm},
+                   catalogue_->MakeCell(*edit, Convention::kStandard, Format::kD32Sfloat),
+                   catalogue_->MakeCell(*edit, Convention::kReversed, Format::kX8D24Unorm)};
+  Backend* backends[] = {vulkan_.get()};
+  options.judge = JudgeSite::kHost;
+  auto host = RunSweep(options, backends);
+  ASSERT_TRUE(host.ok()) << host.status().message();
+  options.judge = JudgeSite::kDevice;
+  options.device_tuning.fusion = JudgeFusion::kFused;
+  auto fused = RunSweep(options, backends);
+  ASSERT_TRUE(fused.ok()) << fused.status().message();
+  ASSERT_EQ(host->cells.size(), 4u);
+  ASSERT_EQ(fused->cells.size(), 4u);
+  for (std::size_t c = 0; c < host->cells.size(); ++c) {
+    EXPECT_TRUE(host->cells[c].stats == fused->cells[c].stats) << host->cells[c].cell.Name();
+    EXPECT_GT(fused->cells[c].stats.All().finite, 10'000u) << host->cells[c].cell.Name();
+  }
+}
+
 TEST_F(VariantFileTest, CpuBackendSaysItCannotRunAShaderFile) {
   auto unity = AddFile((kExamples / "unity_world_position.hlsl").string());
   ASSERT_TRUE(unity.ok());
