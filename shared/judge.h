@@ -79,16 +79,6 @@ DB_FN uint db_texel_word(uint kind, uint unorm_bits) { return (kind & 0xffu) | (
 DB_FN uint db_texel_kind(uint word) { return word & 0xffu; }
 DB_FN uint db_texel_unorm_bits(uint word) { return word >> 8u; }
 
-// A cell's word for the fused pass (bindings.glsl's Layout, written by the
-// host):
-//   bits 0-7    its convention's slot within a frame's DepthParams;
-//   bits 8-31   the case of the fused program's switch that reconstructs it.
-DB_FN uint db_fused_cell_word(uint convention_slot, uint program_case) {
-  return (convention_slot & 0xffu) | (program_case << 8u);
-}
-DB_FN uint db_fused_cell_convention(uint word) { return word & 0xffu; }
-DB_FN uint db_fused_cell_case(uint word) { return word >> 8u; }
-
 // A sample's coverage word (bindings.glsl's Coverage: uploaded by the host,
 // or written by the sample pass):
 //   bits 0-7    the coverage kind (bands.h's Coverage, 0 for a natural
@@ -135,7 +125,7 @@ struct JudgePass {
   uint seed_lo;           // the sampler's seed (the sample pass's)
   uint seed_hi;
   uint row_order;  // where the judge's order of accumulators starts in the run's layout
-  // Where each cell's word for the fused pass (shaders/judge/fused.comp)
-  // lies in the run's layout: db_fused_cell_word.
-  uint fused_cells;
+  // Where each cell's convention slot within a frame's DepthParams lies in
+  // the run's layout (the fused pass's: shaders/judge/fused.comp).
+  uint cell_conventions;
 };

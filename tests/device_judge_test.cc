@@ -635,15 +635,6 @@ TEST(DeviceJudgeWords, TheCoverageWordKeepsEachField) {
                     {0xffu, 0xffffffu}});
 }
 
-TEST(DeviceJudgeWords, TheFusedCellWordKeepsEachField) {
-  ExpectFieldsRoundTrip(
-      PackedWord<2>{[](const std::array<std::uint32_t, 2>& f) { return W::db_fused_cell_word(f[0], f[1]); },
-                    [](std::uint32_t w) {
-                      return std::array<std::uint32_t, 2>{W::db_fused_cell_convention(w), W::db_fused_cell_case(w)};
-                    },
-                    {0xffu, 0xffffffu}});
-}
-
 TEST(DeviceJudgeWords, TheReferenceInfoWordKeepsEachField) {
   ExpectFieldsRoundTrip(PackedWord<3>{
       [](const std::array<std::uint32_t, 3>& f) { return W::db_reference_info_word(f[0], f[1], f[2] != 0); },

@@ -212,15 +212,14 @@ struct DeviceJudge::State {
   DeviceObject<VkPipeline> store_pipeline;
   DeviceObject<VkPipeline> reference_pipeline;
   DeviceObject<VkPipeline> judge_pipeline;
-  // Where the judge is fused (JudgeFusion): its programs (one for the
-  // run's built-in variants, one for each user's function), and the rows
-  // of each: `rows` cells from `first_row` of the fused row order. Empty
-  // where it is not fused.
-  struct FusedProgram {
+  // Where the judge is fused (JudgeFusion): per variant of the run, its
+  // program, and its rows: `rows` cells from `first_row` of the fused row
+  // order. Empty where it is not.
+  struct FusedVariant {
     DeviceObject<VkPipeline> pipeline;
     std::uint32_t first_row = 0, rows = 0;
   };
-  std::vector<FusedProgram> fused;
+  std::vector<FusedVariant> fused;
   // [lane][binding]: lane 0 holds the bindings every lane shares (kPositions
   // and kTexels unused: the backend owns them); PerBatch ones are per lane.
   std::array<std::array<VulkanBuffer, kBindingCount>, kLanes> lane_buffers;
@@ -265,9 +264,9 @@ struct DeviceJudge::State {
   std::size_t row_order_at() const { return cell_count() + 2 * depth_slots + pipelines; }
   // The fused passes' rows: the cells grouped by variant.
   std::size_t fused_rows_at() const { return row_order_at() + accumulators(); }
-  // Per cell, its word for the fused pass (judge.h's db_fused_cell_word).
-  std::size_t fused_cells_at() const { return fused_rows_at() + cell_count(); }
-  std::size_t layout_words() const { return fused_cells_at() + cell_count(); }
+  // Per cell, its convention slot within a frame's DepthParams.
+  std::size_t cell_conventions_at() const { return fused_rows_at() + cell_count(); }
+  std::size_t layout_words() const { return cell_conventions_at() + cell_count(); }
   // Whether the storage pass produces the pipelines' floats (float32
   // production) or the host uploads them (exact production, which rounds
   // with MPFR where a tie needs it).
@@ -426,22 +425,15 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(shaders / "judge" / name));
     DB_RETURN_IF_ERROR(StoreInto(state->pass->CreatePipeline(spirv, specialization, "the device judge"), *pipeline));
   }
-  // The fused programs: one holds every built-in variant of the run (a
-  // user's function defines the contract, so each has a program of its
-  // own). A program's rows are its cells in the order of their depth
-  // slots, as the judge's are (below), so that the rows running at once
-  // share a slot's reference in the device's cache; each cell's word says
-  // which case of its program's switch reconstructs it.
-  const auto program_of = [&](std::uint32_t k) {
-    const VariantInfo& variant = layout.cells[k].cell.variant_info();
-    return variant.user == nullptr ? -1 : static_cast<int>(layout.cells[k].cell.variant);
-  };
+  // The fused programs: one per variant of the run, whose rows are its
+  // cells (grouped by variant in the fused row order, each group's by
+  // depth slot as below).
   std::vector<std::uint32_t> fused_rows(layout.cells.size());
   std::iota(fused_rows.begin(), fused_rows.end(), 0u);
+  const auto variant_of = [&](std::uint32_t k) { return static_cast<int>(layout.cells[k].cell.variant); };
   std::stable_sort(fused_rows.begin(), fused_rows.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return std::pair(program_of(a), layout.cells[a].depth_slot) < std::pair(program_of(b), layout.cells[b].depth_slot);
+    return std::pair(variant_of(a), layout.cells[a].depth_slot) < std::pair(variant_of(b), layout.cells[b].depth_slot);
   });
-  std::vector<std::uint32_t> fused_case(layout.cells.size(), 0);
   // Auto fuses on a GPU. On a CPU device (lavapipe) the separate passes
   // are the faster: there each invocation of the fused pass loads its
   // frame's constants lane by lane, where compute_pass.glsl loads them once
@@ -452,18 +444,13 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
     Status fusing = Status::Ok();
     for (std::uint32_t row = 0; row < fused_rows.size() && fusing.ok();) {
       std::uint32_t end = row;
-      while (end < fused_rows.size() && program_of(fused_rows[end]) == program_of(fused_rows[row])) ++end;
-      // The program's variants, each a case of its switch.
-      std::vector<const VariantInfo*> variants;
-      for (std::uint32_t r = row; r < end; ++r) {
-        const VariantInfo* variant = &layout.cells[fused_rows[r]].cell.variant_info();
-        const auto at = std::find(variants.begin(), variants.end(), variant);
-        fused_case[fused_rows[r]] = static_cast<std::uint32_t>(at - variants.begin());
-        if (at == variants.end()) variants.push_back(variant);
-      }
-      State::FusedProgram fused{.pipeline = {}, .first_row = row, .rows = end - row};
-      Expected<std::vector<std::uint32_t>> spirv = runs->CompileJudged(variants);
-      fusing = spirv.ok() ? StoreInto(state->pass->CreatePipeline(*spirv, judge_shape, "the fused judge"), fused.pipeline)
+      while (end < fused_rows.size() && variant_of(fused_rows[end]) == variant_of(fused_rows[row])) ++end;
+      const VariantInfo& variant = layout.cells[fused_rows[row]].cell.variant_info();
+      State::FusedVariant fused{.pipeline = {}, .first_row = row, .rows = end - row};
+      Expected<std::vector<std::uint32_t>> spirv = runs->CompileJudged(variant);
+      fusing = spirv.ok() ? StoreInto(state->pass->CreatePipeline(
+                                          *spirv, judge_shape, fmt::format("{}'s fused judge", variant.name)),
+                                      fused.pipeline)
                           : spirv.status();
       if (fusing.ok()) state->fused.push_back(std::move(fused));
       row = end;
@@ -499,7 +486,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   });
   std::copy(fused_rows.begin(), fused_rows.end(), words + state->fused_rows_at());
   for (std::size_t k = 0; k < layout.cells.size(); ++k) {
-    words[state->fused_cells_at() + k] = L::db_fused_cell_word(layout.cells[k].convention_slot, fused_case[k]);
+    words[state->cell_conventions_at() + k] = layout.cells[k].convention_slot;
   }
   DB_RETURN_IF_ERROR(state->Buffer(kLayout).FlushHostWrites());
   DB_RETURN_IF_ERROR(state->Grow(kCounts, state->counts_bytes()));
@@ -713,7 +700,7 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceJ
                       .seed_lo = static_cast<std::uint32_t>(seed),
                       .seed_hi = static_cast<std::uint32_t>(seed >> 32),
                       .row_order = static_cast<std::uint32_t>(row_order_at()),
-                      .fused_cells = static_cast<std::uint32_t>(fused_cells_at())};
+                      .cell_conventions = static_cast<std::uint32_t>(cell_conventions_at())};
 }
 
 void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws,
@@ -804,10 +791,10 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, L::JudgePass constants
     if (fused.empty()) {
       dispatch(judge_pipeline.get(), row_order_at(), cell_count() + (encodings ? depth_slots : 0));
     } else {
-      // Each fused program's cells; the depth slots' rows
+      // Each variant's cells in its own program; the depth slots' rows
       // (after the cells' in the row order) in judge.comp's.
-      for (const FusedProgram& program : fused) {
-        dispatch(program.pipeline.get(), fused_rows_at() + program.first_row, program.rows);
+      for (const FusedVariant& variant : fused) {
+        dispatch(variant.pipeline.get(), fused_rows_at() + variant.first_row, variant.rows);
       }
       dispatch(judge_pipeline.get(), row_order_at() + cell_count(), encodings ? depth_slots : 0);
     }

@@ -34,73 +34,43 @@ bool Generated(const VariantInfo& variant, VariantPass pass) {
   return variant.user != nullptr || pass == VariantPass::kRaster || pass == VariantPass::kJudged;
 }
 
-std::string Include(const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); }
-
-// A variant's function and what it needs, ending with RECONSTRUCT defined
-// as what calls it: for a user's, the contract's settings, the shared
-// headers, the contract, the user's file; for a built-in one, the shared
-// headers (unless `shared_headers` is false: an earlier part included
-// them, and they carry no include guard) and its shared/variants/ header.
-std::string FunctionPart(const VariantInfo& variant, const std::filesystem::path& dir, bool shared_headers = true) {
+// The program around a variant's function: for a user's, the contract's
+// settings, the shared headers, the contract, the user's file; for a
+// built-in one, the shared headers and its shared/variants/ header; then
+// the pass.
+std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& dir) {
   const UserShader* user = variant.user;
   const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
-  std::string text;
+  auto include = [](const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); };
+  std::string text = hlsl ? "" : "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  if (pass == VariantPass::kJudged) {
+    // The judge counts in 64-bit integers and raises 64-bit maxima.
+    text +=
+        "#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require\n"
+        "#extension GL_EXT_shader_atomic_int64 : require\n";
+  }
   if (user == nullptr) {
-    if (shared_headers) text += Include(dir / "common.glsl");
-    text += Include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
+    text += include(dir / "common.glsl");
+    text += include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
+    text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   } else {
     text += fmt::format(
         "#define DB_USER_ENTRY {}\n#define DB_USER_UV_BOTTOM_LEFT {}\n#define DB_USER_VIEW_LEFT_HANDED {}\n",
         user->entry, user->uv_bottom_left ? 1 : 0, user->view_left_handed ? 1 : 0);
-    text += Include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
-    text += Include(dir / "user" / "contract.inc");
-    text += Include(user->path);
+    text += include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
+    text += include(dir / "user" / "contract.inc");
+    text += include(user->path);
+    text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   }
-  return text + fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
-}
-
-constexpr const char* kGlslStart = "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
-
-// The device judge's fused program: the variants' functions, a switch
-// over them, and fused.comp, which calls RECONSTRUCT with the case of the
-// cell it judges (db_fused_case).
-std::string JudgedProgram(std::span<const VariantInfo* const> variants, const std::filesystem::path& dir) {
-  // The judge counts in 64-bit integers and raises 64-bit maxima.
-  std::string text = std::string(kGlslStart) +
-                     "#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require\n"
-                     "#extension GL_EXT_shader_atomic_int64 : require\n";
-  std::string cases;
-  for (std::size_t i = 0; i < variants.size(); ++i) {
-    text += FunctionPart(*variants[i], dir, /*shared_headers=*/i == 0) + "#undef RECONSTRUCT\n";
-    cases += fmt::format("    case {}u: return {}(frame, depth, uv, stored);\n", i, ReconstructFunctionName(*variants[i]));
-  }
-  text += fmt::format(
-      "vec3 db_fused_reconstruct(uint which, FrameParams frame, DepthParams depth, vec2 uv, float stored) {{\n"
-      "  switch (which) {{\n{}  }}\n"
-      "  return vec3(uintBitsToFloat(0x7fa00badu));  // no such case: judged as unwritten\n"
-      "}}\n"
-      "#define RECONSTRUCT(frame, depth, uv, stored) db_fused_reconstruct(db_fused_case, frame, depth, uv, stored)\n",
-      cases);
-  return text + Include(dir / "judge" / "fused.comp");
-}
-
-// The program around a variant's function, then its pass.
-std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& dir) {
-  if (pass == VariantPass::kJudged) {
-    const VariantInfo* one[] = {&variant};
-    return JudgedProgram(one, dir);
-  }
-  const bool hlsl = variant.user != nullptr && variant.user->language == ShaderLanguage::kHlsl;
-  std::string text = (hlsl ? "" : kGlslStart) + FunctionPart(variant, dir);
   switch (pass) {
-    case VariantPass::kAccuracy: text += Include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
+    case VariantPass::kAccuracy: text += include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
     case VariantPass::kSpeed:
-      text += Include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
+      text += include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
       break;
     case VariantPass::kRaster:
-      text += Include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
+      text += include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
       break;
-    case VariantPass::kJudged: break;  // above
+    case VariantPass::kJudged: text += include(dir / "judge" / "fused.comp"); break;
   }
   return text;
 }
@@ -233,20 +203,6 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
   }
   if (!kept.empty()) kept.pop_back();
   return CompileError(kept);
-}
-
-Expected<std::vector<std::uint32_t>> CompileJudgedVariants(std::span<const VariantInfo* const> variants,
-                                                           const std::filesystem::path& shader_dir) {
-  if (variants.size() == 1) return CompileVariant(*variants[0], VariantPass::kJudged, shader_dir);
-  for (const VariantInfo* variant : variants) {
-    if (variant->user != nullptr) {
-      return InvalidArgument(fmt::format("a fused judge program holds built-in variants, or one user's function "
-                                         "alone; {} is a user's among {} variants",
-                                         variant->name, variants.size()));
-    }
-  }
-  const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
-  return CompileShaderSource(JudgedProgram(variants, dir), "<the fused judge's program>", dir, ShaderLanguage::kGlsl);
 }
 
 }  // namespace depthbench

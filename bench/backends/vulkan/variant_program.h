@@ -13,7 +13,6 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -27,8 +26,7 @@ enum class VariantPass : std::uint8_t {
   kSpeed,     // speed/speed_pass.glsl: the timed full-screen pass
   kRaster,    // raster/raster_pass.glsl: the raster form's reconstruction, a fragment program
   // judge/fused.comp: the compute form's reconstruction judged in the same
-  // program (the device judge's fused pass); GLSL only. See
-  // CompileJudgedVariants for a program around several variants.
+  // program (the device judge's fused pass); GLSL only.
   kJudged,
 };
 
@@ -37,14 +35,6 @@ enum class VariantPass : std::uint8_t {
 Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources = nullptr);
-
-// The device judge's fused program around several variants' functions:
-// built-in ones, or a single user's GLSL function (two users' files would
-// define the same contract twice). Its fused.comp calls variants[i]'s
-// function for the cells whose case is i; an unknown case leaves the
-// position unwritten. Unavailable for an HLSL function.
-Expected<std::vector<std::uint32_t>> CompileJudgedVariants(std::span<const VariantInfo* const> variants,
-                                                           const std::filesystem::path& shader_dir);
 
 // The function of the program that holds the variant's arithmetic (what a
 // static cost model counts): <name>_world_position, or the user's entry.

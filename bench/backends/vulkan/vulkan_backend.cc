@@ -235,7 +235,7 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   Expected<DeviceRunBuffers> Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                    ThreadPool* pool) override;
   Status QueueStaged() override;
-  Expected<std::vector<std::uint32_t>> CompileJudged(std::span<const VariantInfo* const> variants) const override;
+  Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const override;
 
  private:
   VulkanBackend(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir,
@@ -404,9 +404,9 @@ Expected<DeviceObject<VkPipeline>> VulkanBackend::BuildPipeline(const VariantInf
                                fmt::format("'{}'", VariantProgramName(variant, VariantPass::kAccuracy, shader_dir_)));
 }
 
-Expected<std::vector<std::uint32_t>> VulkanBackend::CompileJudged(
-    std::span<const VariantInfo* const> variants) const {
-  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compiled, CompileJudgedVariants(variants, shader_dir_));
+Expected<std::vector<std::uint32_t>> VulkanBackend::CompileJudged(const VariantInfo& variant) const {
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compiled,
+                      CompileVariant(variant, VariantPass::kJudged, shader_dir_));
   return ApplyArithmeticProbes(compiled, options_.arithmetic_probes);
 }
 

@@ -91,13 +91,11 @@ class DeviceResidentRuns {
   // The staged run's reconstruction, queued; refused where nothing is
   // staged (a Run in between discards what Stage staged).
   virtual Status QueueStaged() = 0;
-  // The device judge's fused program around `variants`' functions
-  // (CompileJudgedVariants, variant_program.h), compiled as this backend
-  // compiles its own pass: the same source of each function and the same
-  // arithmetic probes. Unavailable for a variant the program cannot hold
-  // (an HLSL function).
-  virtual Expected<std::vector<std::uint32_t>> CompileJudged(
-      std::span<const VariantInfo* const> variants) const = 0;
+  // `variant`'s function in the device judge's fused program
+  // (VariantPass::kJudged), compiled as this backend compiles its own pass:
+  // the same source of the function and the same arithmetic probes.
+  // Unavailable for a variant the program cannot hold (an HLSL function).
+  virtual Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const = 0;
 };
 
 }  // namespace depthbench
