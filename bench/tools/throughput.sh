@@ -10,7 +10,8 @@
 # the host's cores; --judge device: binned where they are). With DEVICE (a
 # part of a Vulkan device's name, as --device takes it, "nvidia"): that
 # device with either judge at 10^7 and 10^8 samples, and with its own
-# judge at 10^9, each in its default batches. Each ends with the raster
+# judge at 10^9, each in its default batches (and at 10^9 with the
+# reconstruction pass apart from the judge's, --judge-fusion separate). Each ends with the raster
 # form (--pipeline raster, judged on the host) beside the compute form
 # with the same judge and samples, so that the two rates compare. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
@@ -62,8 +63,11 @@ else
   done
   # And the device judge over a sweep long enough that a run's fixed
   # costs (its set-up, its first and last batches) fade.
+  # Fused (the default on a GPU) and with the reconstruction apart.
   labels+=("$device, device judge, 1e9 samples")
   arguments+=("--backend vulkan --device $device --judge device --samples 1e9")
+  labels+=("$device, device judge, separate passes, 1e9 samples")
+  arguments+=("--backend vulkan --device $device --judge device --judge-fusion separate --samples 1e9")
   for form in compute raster; do
     labels+=("$device, $form form, host judge, 1e7")
     arguments+=("--backend vulkan --device $device --judge host --pipeline $form --samples 1e7")
