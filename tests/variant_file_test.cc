@@ -219,12 +219,11 @@ TEST_F(VariantFileTest, OnlyAGlslFunctionCompilesIntoTheFusedJudge) {
 // of the built-in variants (its contract cannot be defined twice), and the
 // cells of both record what the host judge records.
 TEST_F(VariantFileTest, AUsersFunctionIsJudgedFusedAsOnTheHost) {
+  SweepOptions options;
+  options.batch_size = 3000;  // several batches, each ending inside a frame
+  options.samples = 20'000;
   auto edit = AddFile((kExamples / "divide_subtract_first.glsl").string());
   ASSERT_TRUE(edit.ok()) << edit.status().message();
-  SweepOptions options;
-  options.seed = 5;
-  options.samples = 20'000;
-  options.batch_size = 3000;  // several batches, each ending inside a frame
   options.cells = {{Variant::kDivide, Convention::kStandard, Format::kD32Sfloat},
                    {Variant::kPq, Convention::kReversed, Format::kX8D24Unorm},
                    catalogue_->MakeCell(*edit, Convention::kStandard, Format::kD32Sfloat),
