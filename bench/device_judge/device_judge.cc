@@ -317,7 +317,6 @@ struct DeviceJudge::State {
   Status UploadForReference(const Batch& batch, const DeviceJudgeInputs& device, ThreadPool& pool);
   void Bind(const DeviceRunBuffers& run, const Batch& batch);
   L::JudgePass PassConstants(const Batch& batch, const DeviceJudgeInputs& device, const DeviceRunBuffers& run) const;
-  // The sample pass where the device draws (`draws`), and the storage pass.
   // The fused pass's copies of the backend's frame constants and pixels,
   // by binding, and their bytes (none where the judge is not fused).
   std::array<std::pair<Binding, VkDeviceSize>, 3> FusedCopies(const DeviceRunBuffers& run) const {
@@ -326,8 +325,8 @@ struct DeviceJudge::State {
              {kDepthParams, copies ? run.depth_param_bytes : 0},
              {kFusedPixels, copies ? run.pixel_bytes : 0}}};
   }
-  // Fused, then the copies of the backend's frame constants and pixels
-  // the fused pass reads.
+  // The sample pass where the device draws (`draws`); fused, the copies of
+  // the backend's frame constants and pixels (FusedCopies); the storage pass.
   void RecordStore(VkCommandBuffer commands, L::JudgePass constants, bool draws, const DeviceRunBuffers& run) const;
   // The reference and judge passes, and the copy of the maxima.
   void Record(VkCommandBuffer commands, L::JudgePass constants, bool encodings) const;
@@ -642,6 +641,7 @@ Status DeviceJudge::State::UploadForReference(const Batch& batch, const DeviceJu
 // Points every binding at the bytes this batch uses.
 void DeviceJudge::State::Bind(const DeviceRunBuffers& run, const Batch& batch) {
   const std::size_t count = batch.count, frames = batch.frames.size(), slot_samples = depth_slots * count;
+  const auto copies = FusedCopies(run);
   const std::array<VkDeviceSize, kBindingCount> bytes = {
       layout_words() * sizeof(std::uint32_t),
       run.position_bytes,
@@ -664,9 +664,9 @@ void DeviceJudge::State::Bind(const DeviceRunBuffers& run, const Batch& batch) {
       run.pixel_bytes,
       std::max<VkDeviceSize>(candidates_bytes(), 16),
       candidate_counts_bytes(),
-      std::max<VkDeviceSize>(FusedCopies(run)[0].second, 16),
-      std::max<VkDeviceSize>(FusedCopies(run)[1].second, 16),
-      std::max<VkDeviceSize>(FusedCopies(run)[2].second, 16)};
+      std::max<VkDeviceSize>(copies[0].second, 16),
+      std::max<VkDeviceSize>(copies[1].second, 16),
+      std::max<VkDeviceSize>(copies[2].second, 16)};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
@@ -913,12 +913,10 @@ Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, s
 
 double DeviceJudge::waited_seconds() const { return state_->waited; }
 
-bool DeviceJudge::fused() const { return !state_->fused.empty(); }
-
 std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
   std::vector<std::pair<std::string, double>> out;
   if (state_->clock.count() == 0) return out;
-  const auto& names = fused() ? kFusedPassNames : kPassNames;
+  const auto& names = state_->fused.empty() ? kPassNames : kFusedPassNames;
   for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(names[k], state_->pass_seconds[k]);
   return out;
 }

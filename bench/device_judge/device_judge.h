@@ -126,9 +126,6 @@ class DeviceJudge {
   // this judge was made: with the host's time around Judge, it says which
   // side a batch waits for.
   double waited_seconds() const;
-  // Whether each variant's reconstruction runs in the judge's program
-  // (JudgeFusion).
-  bool fused() const;
   // The device's seconds in each of its passes for the batches finished so
   // far, by name, in the order they run: "idle" (from one batch's end to
   // the next one's start: the device waiting for the host), "sample",

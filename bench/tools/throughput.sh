@@ -11,9 +11,10 @@
 # part of a Vulkan device's name, as --device takes it, "nvidia"): that
 # device with either judge at 10^7 and 10^8 samples, and with its own
 # judge at 10^9, each in its default batches (and at 10^9 with the
-# reconstruction pass apart from the judge's, --judge-fusion separate). Each ends with the raster
-# form (--pipeline raster, judged on the host) beside the compute form
-# with the same judge and samples, so that the two rates compare. DEPTHBENCH names another program to run (a packed copy's
+# reconstruction pass apart from the judge's, --judge-fusion separate).
+# Each ends with the raster form (--pipeline raster, judged on the host)
+# beside the compute form with the same judge and samples, so that the two
+# rates compare. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
