@@ -16,8 +16,8 @@ DB_CONST_UINT(DB_JUDGE_DISTANCE_SLOTS, 5u)
 DB_CONST_UINT(DB_JUDGE_JOINT_SLOTS, 110u)
 DB_CONST_UINT(DB_JUDGE_SLOTS, 123u)
 // Counts of one slot after its bins: NaN, Inf, stored non-finite,
-// degenerate, outside, and one unused, so that a slot is a whole number of
-// 64-bit words.
+// degenerate, outside, and undrawn (the raster form's texels the
+// rasterizer left as cleared): a slot is a whole number of 64-bit words.
 DB_CONST_UINT(DB_JUDGE_COUNTS, 6u)
 DB_CONST_UINT(DB_JUDGE_SLOT_UINTS, 780u)  // DB_JUDGE_METRICS * DB_JUDGE_BINS + DB_JUDGE_COUNTS
 
@@ -45,6 +45,15 @@ DB_CONST_UINT(DB_JUDGE_INFINITE_RATIO_BAND, 10u)
 DB_CONST_UINT(DB_JUDGE_STATUS_JUDGED, 0u)
 DB_CONST_UINT(DB_JUDGE_STATUS_DEGENERATE, 1u)
 DB_CONST_UINT(DB_JUDGE_STATUS_OUTSIDE, 2u)
+DB_CONST_UINT(DB_JUDGE_STATUS_UNDRAWN, 3u)
+
+// How the batch's depths were produced (bench/pipeline/batch.h's
+// ProductionModel): in float32 by the storage pass, exactly by the host,
+// or by the backend's rasterizer (the raster form: its texels, and per
+// texel whether it was drawn, come from the backend).
+DB_CONST_UINT(DB_JUDGE_PRODUCTION_FLOAT32, 0u)
+DB_CONST_UINT(DB_JUDGE_PRODUCTION_EXACT, 1u)
+DB_CONST_UINT(DB_JUDGE_PRODUCTION_RASTER, 2u)
 
 // The 32-bit words the host and the passes exchange. Each is built and
 // read here alone, so that C++ and GLSL cannot disagree about a field's
@@ -121,7 +130,7 @@ struct JudgePass {
   uint cells;
   uint depth_slots;       // slices of the reference buffers, and the depth slots' accumulators
   uint accumulators;      // cells, or cells + depth_slots when the encodings' errors are recorded too
-  uint exact_production;  // 1: depths are produced exactly (ProductionModel::kExact), 0: in float32
+  uint production;        // DB_JUDGE_PRODUCTION_*
   uint seed_lo;           // the sampler's seed (the sample pass's)
   uint seed_hi;
   uint row_order;  // where the judge's order of accumulators starts in the run's layout

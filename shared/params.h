@@ -116,7 +116,17 @@ struct RasterConstants {
   uint convention_slot;  // the slot's or cell's convention within a frame's DepthParams
   uint output_offset;    // pass 2: first float of the cell's positions: slices of x, then y, then z
   uint viewport_height;  // the atlas viewport's height in texels: a power of two
+  uint coverage_word;    // fetch.comp: the slot's first word of coverage bytes in the copy it reads
+  uint slices;           // no_geometry.comp: the position slices the run writes (3 per cell)
 };
+
+// What the raster form says of each (depth slot, sample) texel after pass 1
+// (shaders/raster/fetch.comp), for a judge on the device: drawn; left as
+// cleared by the rasterizer (nothing of the sample's to judge); or never
+// drawn, the host having no geometry for the sample.
+DB_CONST_UINT(DB_RASTER_TEXEL_DRAWN, 0u)
+DB_CONST_UINT(DB_RASTER_TEXEL_UNDRAWN, 1u)
+DB_CONST_UINT(DB_RASTER_TEXEL_NO_GEOMETRY, 2u)
 
 // Where one cell's inputs and outputs lie in the batch's buffers.
 struct CellSlice {

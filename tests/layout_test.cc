@@ -142,7 +142,9 @@ TEST_F(LayoutTest, RasterConstantsMatchesStd430) {
   EXPECT_MEMBER_AT(draw, RasterConstants, convention_slot);
   EXPECT_MEMBER_AT(draw, RasterConstants, output_offset);
   EXPECT_MEMBER_AT(draw, RasterConstants, viewport_height);
-  EXPECT_EQ(MembersOf("draw"), 8) << "a RasterConstants member is not listed above";
+  EXPECT_MEMBER_AT(draw, RasterConstants, coverage_word);
+  EXPECT_MEMBER_AT(draw, RasterConstants, slices);
+  EXPECT_EQ(MembersOf("draw"), 10) << "a RasterConstants member is not listed above";
   EXPECT_EQ(Offset("draw_end"), static_cast<int>(sizeof(f32::RasterConstants)));
 }
 

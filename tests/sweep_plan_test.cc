@@ -71,11 +71,10 @@ TEST(SweepPlanTest, TheShardAndTheDistanceBandComeFromTheOptions) {
 }
 
 TEST(SweepPlanTest, DeviceJudgingIsWantedWhereTheSiteSaysSo) {
-  EXPECT_TRUE(WantsDeviceJudge(JudgeSite::kAuto, true, PassKind::kCompute));
-  EXPECT_FALSE(WantsDeviceJudge(JudgeSite::kAuto, true, PassKind::kRaster));
-  EXPECT_FALSE(WantsDeviceJudge(JudgeSite::kAuto, false, PassKind::kCompute));
-  EXPECT_TRUE(WantsDeviceJudge(JudgeSite::kDevice, false, PassKind::kRaster));
-  EXPECT_FALSE(WantsDeviceJudge(JudgeSite::kHost, true, PassKind::kCompute));
+  EXPECT_TRUE(WantsDeviceJudge(JudgeSite::kAuto, true));
+  EXPECT_FALSE(WantsDeviceJudge(JudgeSite::kAuto, false));
+  EXPECT_TRUE(WantsDeviceJudge(JudgeSite::kDevice, false));
+  EXPECT_FALSE(WantsDeviceJudge(JudgeSite::kHost, true));
 }
 
 // Each bad field is refused, naming its constraint; nothing is clamped.

@@ -180,7 +180,8 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
   cmd->add_option("--judge", flags->judge,
                   "where the Vulkan backend's outputs are judged: 'host' (read back, binned on the host's cores), "
                   "'device' (binned on the GPU where they are, histograms read back; needs float64 and 64-bit "
-                  "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way")
+                  "atomics), or 'auto' (default): the device for a GPU, the host for lavapipe. Same results either way. "
+                  "The raster form is judged on its device only where it is the one backend")
       ->check(CLI::IsMember({"auto", "host", "device"}))
       ->type_name("WHERE")
       ->group("Backends");
@@ -188,7 +189,8 @@ void AddRunCommand(CLI::App& app, CommandAction& action) {
                   "how the device judges: 'fused': each variant's reconstruction inside the judge's program, so "
                   "that no position goes through device memory (GLSL variants only); 'separate': the backend's "
                   "pass writes the positions and the judge reads them; 'auto' (default): fused on a GPU where "
-                  "every variant is GLSL, separate on lavapipe (faster there). Same results either way")
+                  "every variant is GLSL and the form is compute, separate on lavapipe and for --pipeline raster. Same "
+                  "results either way")
       ->check(CLI::IsMember({"auto", "fused", "separate"}))
       ->type_name("HOW")
       ->group("Backends");

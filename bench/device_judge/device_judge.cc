@@ -37,7 +37,8 @@ static_assert(L::DB_JUDGE_DISTANCE_SLOTS == kDistanceBands && L::DB_JUDGE_JOINT_
 static_assert(L::DB_JUDGE_SLOT_UINTS == L::DB_JUDGE_METRICS * L::DB_JUDGE_BINS + L::DB_JUDGE_COUNTS);
 static_assert(L::DB_JUDGE_STATUS_JUDGED == static_cast<unsigned>(ReferenceStatus::kJudged) &&
               L::DB_JUDGE_STATUS_DEGENERATE == static_cast<unsigned>(ReferenceStatus::kDegenerate) &&
-              L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside));
+              L::DB_JUDGE_STATUS_OUTSIDE == static_cast<unsigned>(ReferenceStatus::kOutside) &&
+              L::DB_JUDGE_STATUS_UNDRAWN == static_cast<unsigned>(ReferenceStatus::kUndrawn));
 static_assert(static_cast<int>(Coverage::kNatural) == 0 && CoverageBand(Coverage::kStoredZero) == 0);
 static_assert(sizeof(L::JudgePass) == 64);
 static_assert(L::DB_JUDGE_FRAME_DRAWS == 7 + 9 + 2);  // shared/draw.h's DrawFrame, its rotation's nine
@@ -93,6 +94,7 @@ enum Binding : std::uint32_t {
   kFrameParams,
   kDepthParams,
   kFusedPixels,
+  kTexelStatus,  // the backend's, where its rasterizer drew the texels
   kBindingCount,
 };
 // The reference and the counters live in device memory alone (atomics
@@ -101,7 +103,7 @@ enum Binding : std::uint32_t {
 // after the batch, the histograms and counts at a flush.
 bool DeviceOnly(Binding b) { return (b >= kReference && b <= kUnwritten) || b >= kCandidates; }
 // The bindings whose buffers the backend owns (DeviceRunBuffers).
-bool Backends(Binding b) { return b == kPositions || b == kTexels || b == kPixels; }
+bool Backends(Binding b) { return b == kPositions || b == kTexels || b == kPixels || b == kTexelStatus; }
 // What the host writes for every batch: one buffer per lane (below), so
 // that it writes the next batch's while the device reads the last's.
 bool PerBatch(Binding b) { return b != kLayout && !Backends(b) && !DeviceOnly(b); }
@@ -242,7 +244,7 @@ struct DeviceJudge::State {
   std::size_t pipelines = 0;
   std::uint32_t last_count = 0;  // samples of the last batch judged
   DeviceRunBuffers last_run;     // the backend's buffers for it
-  bool exact_production = false;
+  ProductionModel production = ProductionModel::kFloat32;
   bool record_distances = true;
   JudgeGroups judge_groups;
   double waited = 0.0;  // seconds Judge spent waiting for the device's passes
@@ -269,8 +271,12 @@ struct DeviceJudge::State {
   std::size_t layout_words() const { return cell_conventions_at() + cell_count(); }
   // Whether the storage pass produces the pipelines' floats (float32
   // production) or the host uploads them (exact production, which rounds
-  // with MPFR where a tie needs it).
-  bool device_produces() const { return !exact_production; }
+  // with MPFR where a tie needs it; the raster form, whose floats are the
+  // host's model of a rasterizer).
+  bool device_produces() const { return production == ProductionModel::kFloat32; }
+  // Whether the backend's rasterizer stores the texels (the raster form),
+  // rather than the storage pass.
+  bool rasterized() const { return production == ProductionModel::kRaster; }
   std::size_t maxima() const { return counted_slots() * L::DB_JUDGE_METRICS; }
 
   VkDeviceSize counts_bytes() const { return counted_slots() * L::DB_JUDGE_SLOT_UINTS * sizeof(std::uint32_t); }
@@ -365,8 +371,9 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   DeviceResidentRuns* runs = backend.device_resident();
   if (runs == nullptr) return Unavailable("the " + backend.name() + " backend runs on no device to judge on");
   const std::shared_ptr<VulkanContext>& context = runs->context();
-  if (production == ProductionModel::kRaster) {
-    return Unavailable("the device judge reads the compute form's outputs; the raster form is judged on the host");
+  if (production == ProductionModel::kRaster && tuning.fusion == JudgeFusion::kFused) {
+    return Unavailable("the raster form reconstructs in a fragment pass, which the device judge cannot fuse with its "
+                       "own (--judge-fusion separate)");
   }
   for (const Encoding& encoding : layout.encodings) {
     if (Info(encoding.convention).orthographic()) {
@@ -384,7 +391,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   state->runs = runs;
   state->context = context;
   state->record_distances = record_distances;
-  state->exact_production = production == ProductionModel::kExact;
+  state->production = production;
   state->depth_slots = layout.encodings.size();
   const std::vector<std::uint32_t> pipeline_of_slot = PipelineOfSlots(layout.encodings);
   for (std::uint32_t p : pipeline_of_slot) state->pipelines = std::max<std::size_t>(state->pipelines, p + 1);
@@ -438,7 +445,8 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   // frame's constants lane by lane, where compute_pass.glsl loads them once
   // for several samples (7 times slower over 2e4 samples on 2 cores).
   const bool fuse = tuning.fusion == JudgeFusion::kFused ||
-                    (tuning.fusion == JudgeFusion::kAuto && context->properties().type != VK_PHYSICAL_DEVICE_TYPE_CPU);
+                    (tuning.fusion == JudgeFusion::kAuto && context->properties().type != VK_PHYSICAL_DEVICE_TYPE_CPU &&
+                     production != ProductionModel::kRaster);
   if (fuse) {
     Status fusing = Status::Ok();
     for (std::uint32_t row = 0; row < fused_rows.size() && fusing.ok();) {
@@ -494,6 +502,7 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
   DB_RETURN_IF_ERROR(state->Grow(kUnwritten, state->unwritten_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kCandidates, state->candidates_bytes()));
   DB_RETURN_IF_ERROR(state->Grow(kCandidateCounts, state->candidate_counts_bytes()));
+  DB_RETURN_IF_ERROR(state->Grow(kTexelStatus, 16));  // bound, unread, where the backend has none
   for (VulkanBuffer& readback : state->batch_readbacks) {
     DB_RETURN_IF_ERROR(StoreInto(context->CreateHostBuffer(state->maxima_bytes() + state->unwritten_bytes(),
                                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, HostAccess::kReadback),
@@ -666,14 +675,16 @@ void DeviceJudge::State::Bind(const DeviceRunBuffers& run, const Batch& batch) {
       candidate_counts_bytes(),
       std::max<VkDeviceSize>(copies[0].second, 16),
       std::max<VkDeviceSize>(copies[1].second, 16),
-      std::max<VkDeviceSize>(copies[2].second, 16)};
+      std::max<VkDeviceSize>(copies[2].second, 16),
+      std::max<VkDeviceSize>(run.texel_status_bytes, 16)};
   std::array<VkDescriptorBufferInfo, kBindingCount> infos{};
   std::array<VkWriteDescriptorSet, kBindingCount> writes{};
   for (std::uint32_t b = 0; b < kBindingCount; ++b) {
-    const VkBuffer backends = b == kPositions ? run.positions
-                              : b == kTexels  ? run.texels
-                              : b == kPixels  ? run.pixels
-                                              : VK_NULL_HANDLE;
+    const VkBuffer backends = b == kPositions     ? run.positions
+                              : b == kTexels      ? run.texels
+                              : b == kPixels      ? run.pixels
+                              : b == kTexelStatus ? run.texel_status
+                                                  : VK_NULL_HANDLE;
     infos[b] = {backends != VK_NULL_HANDLE ? backends : Buffer(static_cast<Binding>(b)).handle(), 0, bytes[b]};
     writes[b].dstBinding = b;
     writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -696,7 +707,9 @@ L::JudgePass DeviceJudge::State::PassConstants(const Batch& batch, const DeviceJ
                       .cells = static_cast<std::uint32_t>(cell_count()),
                       .depth_slots = static_cast<std::uint32_t>(depth_slots),
                       .accumulators = static_cast<std::uint32_t>(accumulators()),
-                      .exact_production = exact_production ? 1u : 0u,
+                      .production = production == ProductionModel::kExact    ? L::DB_JUDGE_PRODUCTION_EXACT
+                                    : production == ProductionModel::kRaster ? L::DB_JUDGE_PRODUCTION_RASTER
+                                                                             : L::DB_JUDGE_PRODUCTION_FLOAT32,
                       .seed_lo = static_cast<std::uint32_t>(seed),
                       .seed_hi = static_cast<std::uint32_t>(seed >> 32),
                       .row_order = static_cast<std::uint32_t>(row_order_at()),
@@ -747,13 +760,15 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass cons
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
-  // Every slice whole.
-  constants.phase = 1;
-  pass->PushConstants(commands, &constants, sizeof(constants));
-  vkCmdDispatch(commands, slice_groups, slots, 1);
-  // The reconstruction pass (the backend's, queued next) and the reference read them.
-  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  // Every slice whole, but where the backend's rasterizer stores them.
+  if (!rasterized()) {
+    constants.phase = 1;
+    pass->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, slice_groups, slots, 1);
+    // The reconstruction pass (the backend's, queued next) and the reference read them.
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  }
   RecordMark(commands, kStored);
 }
 
@@ -916,7 +931,9 @@ double DeviceJudge::waited_seconds() const { return state_->waited; }
 std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
   std::vector<std::pair<std::string, double>> out;
   if (state_->clock.count() == 0) return out;
-  const auto& names = state_->fused.empty() ? kPassNames : kFusedPassNames;
+  std::array<const char*, kMarks> names = state_->fused.empty() ? kPassNames : kFusedPassNames;
+  // The raster form's depth, fetch and reconstruction passes, in one submission.
+  if (state_->rasterized()) names[kJudgeStart] = "raster";
   for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(names[k], state_->pass_seconds[k]);
   return out;
 }
@@ -979,6 +996,7 @@ Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumu
   State& s = *state_;
   DB_RETURN_IF_ERROR(s.CheckSizes(cells, encodings));
   DB_RETURN_IF_ERROR(s.FinishAll());
+  DB_RETURN_IF_ERROR(s.runs->FinishQueued());
   // The counts come back and are cleared on the device in one submission.
   const ValidationScope validation(*s.context);
   DB_RETURN_IF_ERROR(s.pass->Submit([&s](VkCommandBuffer commands) {
@@ -1012,6 +1030,7 @@ Status DeviceJudge::Flush(std::span<CellAccumulator> cells, std::span<CellAccumu
     to.stored_nonfinite += tally[2];
     to.degenerate += tally[3];
     to.outside += tally[4];
+    to.undrawn += tally[5];
   }
   return Status::Ok();
 }

@@ -175,9 +175,12 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   // listed once for every depth slot's loop below, where the host stores
   // the texels: [chunk * kChunk + k].
   const std::size_t chunks = (count + kChunk - 1) / kChunk;
-  pick_samples_.resize(for_host ? chunks * kChunk : 0);
-  pick_counts_.resize(for_host ? chunks : 0);
-  pool.ParallelFor(for_host ? chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
+  // The host stores the texels where it judges, and for the raster form,
+  // whose device counts its own texels against the host's model's.
+  const bool host_stores = for_host || raster;
+  pick_samples_.resize(host_stores ? chunks * kChunk : 0);
+  pick_counts_.resize(host_stores ? chunks : 0);
+  pool.ParallelFor(host_stores ? chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t c = begin; c < end; ++c) {
       std::uint32_t* list = pick_samples_.data() + c * kChunk;
       std::uint32_t listed = 0;
@@ -244,10 +247,10 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   });
 
   batch.depth_slots = static_cast<std::uint32_t>(slots);
-  batch.depths.resize(for_host ? slots * count : 0);
-  batch.codes.resize(for_host ? slots * count : 0);
+  batch.depths.resize(host_stores ? slots * count : 0);
+  batch.codes.resize(host_stores ? slots * count : 0);
   batch.reference.Resize(for_host ? slots * count : 0);
-  pool.ParallelFor(for_host ? slots * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
+  pool.ParallelFor(host_stores ? slots * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t s = job / chunks, chunk = job % chunks;
       const std::size_t lo = chunk * kChunk, n = std::min<std::size_t>(count - lo, kChunk);
@@ -261,7 +264,7 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
         batch.codes[s * count + i] = edge.code;
         batch.depths[s * count + i] = edge.fetched;
       }
-      ReferenceChunk(batch, s, lo, n);
+      if (for_host) ReferenceChunk(batch, s, lo, n);
     }
   });
 }

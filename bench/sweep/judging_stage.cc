@@ -198,7 +198,7 @@ Expected<std::unique_ptr<JudgingStage>> MakeJudgingStage(const SweepOptions& opt
                                                          const RunLayout& layout, bool record_distances) {
   const ProductionModel production = options.domain.production;
   const bool gpu = backend.device().kind == DeviceKind::kGpu;
-  if (WantsDeviceJudge(options.judge, gpu, PassKindOf(production))) {
+  if (WantsDeviceJudge(options.judge, gpu)) {
     Expected<std::unique_ptr<DeviceJudge>> judge =
         DeviceJudge::Create(backend, layout, production, record_distances, options.device_tuning);
     if (judge.ok()) {

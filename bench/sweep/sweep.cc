@@ -250,10 +250,23 @@ Expected<Results> RunSweep(const SweepOptions& requested, std::span<Backend* con
   Results results;
   results.run = DescribeRun(options, cells, backends);
   const bool record_distances = !LoneDistanceBand(options).has_value();
+  // The raster form's rendered texels are the stored values every backend
+  // reconstructs from: beside other backends the host adopts them and
+  // judges them all (a judge on the device renders its own).
+  SweepOptions stage_options = options;
+  if (PassKindOf(options.domain.production) == PassKind::kRaster && backends.size() > 1) {
+    if (options.judge == JudgeSite::kDevice) {
+      return InvalidArgument(
+          "--judge device: the raster form is judged on its device only where it is the run's one backend; run "
+          "the backends one at a time, or judge on the host");
+    }
+    stage_options.judge = JudgeSite::kHost;
+  }
   std::vector<std::unique_ptr<JudgingStage>> stages(backends.size());
   std::vector<StageTraits> traits;
   for (std::size_t b = 0; b < backends.size(); ++b) {
-    DB_RETURN_IF_ERROR(StoreInto(MakeJudgingStage(options, *backends[b], layout, record_distances), stages[b]));
+    DB_RETURN_IF_ERROR(
+        StoreInto(MakeJudgingStage(stage_options, *backends[b], layout, record_distances), stages[b]));
     traits.push_back(stages[b]->traits());
     if (traits.back().site == JudgeSite::kDevice) results.run.backends[b].judge = JudgedOn::kDevice;
   }
@@ -264,8 +277,10 @@ Expected<Results> RunSweep(const SweepOptions& requested, std::span<Backend* con
   // Storage and production errors belong to an encoding, whatever reads it
   // (one accumulator per depth slot), and are copied into its cells.
   Tally encodings(layout.encodings.size(), /*record_distances=*/true);
-  SweepLoop loop(plan, options, builder, DepthRenderer(options.domain.production, backends), stages, encodings,
-                 results.run);
+  // (A judge on the device renders the texels itself, as part of its run.)
+  Backend* renderer =
+      plan.built_for == BatchFor::kHostJudge ? DepthRenderer(options.domain.production, backends) : nullptr;
+  SweepLoop loop(plan, options, builder, renderer, stages, encodings, results.run);
   SweepProgress progress;
   DB_RETURN_IF_ERROR(StoreInto(loop.Run(started), progress));
 

@@ -27,11 +27,11 @@ std::optional<int> LoneDistanceBand(const SweepOptions& options) {
   return OnlyDistanceBand(options.domain.camera_distance);
 }
 
-bool WantsDeviceJudge(JudgeSite site, bool gpu, PassKind pass) {
+bool WantsDeviceJudge(JudgeSite site, bool gpu) {
   switch (site) {
     case JudgeSite::kHost: return false;
     case JudgeSite::kDevice: return true;
-    case JudgeSite::kAuto: return gpu && pass == PassKind::kCompute;
+    case JudgeSite::kAuto: return gpu;
   }
   return false;
 }

@@ -50,10 +50,10 @@ struct SweepPlan {
 // SweepPlan::only_distance_band); the stages need it before the plan.
 std::optional<int> LoneDistanceBand(const SweepOptions& options);
 
-// Whether a backend on a device of this kind is judged on its device, for
-// the form `pass`: kDevice asks for it; kAuto picks it for a GPU in the
-// compute form (a CPU device judges faster on the host's vector loops).
-bool WantsDeviceJudge(JudgeSite site, bool gpu, PassKind pass);
+// Whether a backend on a device of this kind is judged on its device:
+// kDevice asks for it; kAuto picks it for a GPU (a CPU device judges
+// faster on the host's vector loops), in either form.
+bool WantsDeviceJudge(JudgeSite site, bool gpu);
 
 // The plan for validated `options` and the stages (one per backend, in
 // order). `devices_can_draw`: whether the samples can be drawn on a device

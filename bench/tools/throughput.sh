@@ -12,9 +12,9 @@
 # device with either judge at 10^7 and 10^8 samples, and with its own
 # judge at 10^9, each in its default batches (and at 10^9 with the
 # reconstruction pass apart from the judge's, --judge-fusion separate).
-# Each ends with the raster form (--pipeline raster, judged on the host)
-# beside the compute form with the same judge and samples, so that the two
-# rates compare. DEPTHBENCH names another program to run (a packed copy's
+# Each ends with the raster form (--pipeline raster) beside the compute
+# form with the same judge and samples, so that the two rates compare: on
+# lavapipe judged on the host, on DEVICE with either judge. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
@@ -69,9 +69,11 @@ else
   arguments+=("--backend vulkan --device $device --judge device --samples 1e9")
   labels+=("$device, device judge, separate passes, 1e9 samples")
   arguments+=("--backend vulkan --device $device --judge device --judge-fusion separate --samples 1e9")
-  for form in compute raster; do
-    labels+=("$device, $form form, host judge, 1e7")
-    arguments+=("--backend vulkan --device $device --judge host --pipeline $form --samples 1e7")
+  for judge in host device; do
+    for form in compute raster; do
+      labels+=("$device, $form form, $judge judge, 1e7")
+      arguments+=("--backend vulkan --device $device --judge $judge --pipeline $form --samples 1e7")
+    done
   done
 fi
 declare -a rates peaks  # per configuration: space-separated figures of its runs

@@ -108,6 +108,11 @@ layout(std430, set = 0, binding = 22) readonly buffer DepthParamsBuffer { DepthP
 layout(std430, set = 0, binding = 23) readonly buffer FusedPixels { uint pixel_bits[]; };
 #endif
 
+// Per (depth slot, sample), laid out as the texels, where the backend's
+// rasterizer produced them (DB_JUDGE_PRODUCTION_RASTER): whether the texel
+// was drawn (shared/params.h's DB_RASTER_TEXEL_*). Unread otherwise.
+layout(std430, set = 0, binding = 24) readonly buffer TexelStatus { uint texel_status[]; };
+
 layout(push_constant) uniform Pass { JudgePass pass; };
 
 uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }

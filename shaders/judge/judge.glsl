@@ -130,6 +130,8 @@ void count(uint k, uint slot, uint status, bool holdable, bool is_nan, uint64_t 
     atomicAdd(counts[base + 3u], 1u);
   } else if (status == DB_JUDGE_STATUS_OUTSIDE) {
     atomicAdd(counts[base + 4u], 1u);
+  } else if (status == DB_JUDGE_STATUS_UNDRAWN) {
+    atomicAdd(counts[base + 5u], 1u);
   } else if (!holdable) {
     atomicAdd(counts[base + 2u], 1u);
   } else {

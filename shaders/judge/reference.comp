@@ -43,14 +43,14 @@ double decode(uint stores, uint convention, double near, double far, double a, d
   double value = float_value(value_bits);
   dvec2 v = dd(value);
   if (stores == DB_JUDGE_STORES_WINDOW_DEPTH) {
-    if (pass.exact_production != 0u) {
+    if (pass.production == DB_JUDGE_PRODUCTION_EXACT) {
       return eye_depth_from_window_depth(dd(near), dd(far), convention, v, dd_sub(dd(1.0lf), v)).x;
     }
     dvec2 ndc = (convention & DB_CONVENTION_CLIP_MINUS_ONE) == 0u ? v : dd_sub(dd_mul(v, dd(2.0lf)), dd(1.0lf));
     return dd_div(dd(b), dd_sub(ndc, dd(a))).x;
   }
   if (stores == DB_JUDGE_STORES_LINEAR) {
-    return dd_mul(v, dd(pass.exact_production != 0u ? far : a)).x;
+    return dd_mul(v, dd(pass.production == DB_JUDGE_PRODUCTION_EXACT ? far : a)).x;
   }
   return -value;
 }
@@ -129,6 +129,18 @@ void main() {
   precise double production = produced - t;
   precise double storage_square = storage * storage * scale;
   precise double production_square = production * production * scale;
+  // The raster form (batch.cc's ReferenceChunk and AdoptStoredDepths):
+  // a sample the host had no geometry for has no point to judge; a texel
+  // the rasterizer left as cleared holds no depth of the sample's.
+  if (pass.production == DB_JUDGE_PRODUCTION_RASTER) {
+    uint drawn = texel_status[slot * pass.slice_length + pass.lead + i];
+    if (drawn == DB_RASTER_TEXEL_NO_GEOMETRY) {
+      status = DB_JUDGE_STATUS_DEGENERATE;
+      inverse_out = 0.0lf;
+    } else if (drawn == DB_RASTER_TEXEL_UNDRAWN) {
+      status = DB_JUDGE_STATUS_UNDRAWN;
+    }
+  }
 
   // Bands: a stored-value pick takes the decade of the depth it denotes.
   precise double depth_over_near = (eye ? eye_depth : t) / near;

@@ -34,3 +34,11 @@ const int VIEWPORTS_PER_DRAW = 16;
 // would re-derive the depth it stores): a fragment that is not on the
 // drawing sample's own texel is another sample's, and is discarded.
 bool on_own_texel(vec4 frag_coord, uint drawing_sample) { return sample_at(frag_coord) == drawing_sample; }
+
+// Whether the host gave sample i anything to draw (all zero: nothing, the
+// rule of vulkan/raster_pass.cc's HasGeometry).
+bool has_geometry(uint i) {
+  RasterSample g = raster[i];
+  vec4 zero = vec4(0.0f);
+  return g.triangle0 != zero || g.triangle1 != zero || g.triangle2 != zero;
+}

@@ -54,6 +54,9 @@ enum Binding : std::uint32_t {
   kAtlases,
   kPositions,
   kAttributes,  // what pass 2a captures for pass 2b: kAttributesPerSample vec4s a sample
+  kFetched,        // fetch.comp's outputs: per (depth slot, sample) the fetched value,
+  kTexelStatus,    // and its DB_RASTER_TEXEL_* status,
+  kCoverageCopies,  // from the copy of pass 1's coverage the host reads (readback_)
   kBindingCount
 };
 // shaders/raster/atlas.inc's ATTRIBUTES_PER_SAMPLE.
@@ -69,7 +72,7 @@ std::array<VkDeviceSize, kInputBindings> InputBytes(const ShaderInputs& batch) {
 constexpr VkShaderStageFlags kDrawStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 // The draws, and the fetch that reads pass 1's texels back (fetch.comp).
 constexpr VkShaderStageFlags kSetStages = kDrawStages | VK_SHADER_STAGE_COMPUTE_BIT;
-constexpr std::uint32_t kFetchWorkgroup = 64;  // fetch.comp's local size
+constexpr std::uint32_t kFetchWorkgroup = 64;  // fetch.comp's and no_geometry.comp's local size
 
 // gbuffer.frag's specialization constant VIEW_Z; capture.frag's and the
 // reconstruction's LIGHT_VOLUME; capture.frag's COMPUTE_ATTRIBUTES.
@@ -94,6 +97,12 @@ bool HasGeometry(const f32::RasterSample& sample) {
   return !(IsZero(sample.triangle0) && IsZero(sample.triangle1) && IsZero(sample.triangle2));
 }
 
+// Per sample of `batch`, 1 where HasGeometry.
+std::vector<std::uint8_t> GeometryOf(const ShaderInputs& batch) {
+  std::vector<std::uint8_t> geometry(batch.count);
+  for (std::uint32_t i = 0; i < batch.count; ++i) geometry[i] = HasGeometry(batch.raster[i]) ? 1 : 0;
+  return geometry;
+}
 // A texel's bits as ShaderInputs::codes holds them: X8_D24 keeps its depth
 // in the low 24 bits of the word, the other 8 are undefined.
 std::uint32_t CodeOf(Format format, const std::byte* texel) {
@@ -356,10 +365,10 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> capture, stage("capture.frag", ShaderStage::kFragment));
   DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> cover, stage("atlas_cover.vert", ShaderStage::kVertex));
   const VkPipelineLayout layout = pass_->pipeline_layout();
-  {
-    const std::filesystem::path path = shader_dir / "raster" / "fetch.comp";
+  for (auto [file, pipeline] : {std::pair{"fetch.comp", &fetch_}, std::pair{"no_geometry.comp", &no_geometry_}}) {
+    const std::filesystem::path path = shader_dir / "raster" / file;
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, CompileShader(path, ShaderStage::kCompute, &sources));
-    DB_ASSIGN_OR_RETURN(fetch_, pass_->CreatePipeline(spirv, VkSpecializationInfo{}, path.string()));
+    DB_ASSIGN_OR_RETURN(*pipeline, pass_->CreatePipeline(spirv, VkSpecializationInfo{}, path.string()));
   }
 
   for (Slot& slot : slots_) {
@@ -544,7 +553,8 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
     coverage_offsets_[s] = readback_bytes;
     readback_bytes += AlignedTo4(texels);
   }
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(readback_, readback_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(readback_, readback_bytes,
+                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                               HostAccess::kReadback));
   return Status::Ok();
 }
@@ -553,7 +563,7 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
 // buffers, room for the positions of `which`, the descriptors and the
 // samples' viewports.
 Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                         const std::vector<bool>& drawn) {
+                         const std::vector<bool>& drawn, HostAccess outputs) {
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
@@ -561,14 +571,19 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(EnsureAtlases(rows));
   if (atlas_rows_ != rows_before) rendered_.reset();
   DB_RETURN_IF_ERROR(Upload(batch, rows));
-  // A render alone writes no positions but the fetched texels of every
-  // depth slot, in the same buffer.
-  const VkDeviceSize position_bytes =
-      std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), VkDeviceSize{count} * slots_.size()) *
-      sizeof(float);
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(
-      positions_, position_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-      HostAccess::kReadback));
+  // The outputs go where their reader is: a buffer the host maps, or
+  // device memory alone.
+  if (outputs != outputs_) {
+    positions_ = VulkanBuffer();
+    fetched_texels_ = VulkanBuffer();
+    outputs_ = outputs;
+  }
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkDeviceSize position_bytes = std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), 1) * sizeof(float);
+  const VkDeviceSize texel_bytes = VkDeviceSize{count} * slots_.size() * sizeof(float);
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(positions_, position_bytes, storage, outputs_));
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(fetched_texels_, texel_bytes, storage, outputs_));
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(texel_status_, texel_bytes, storage, HostAccess::kNone));
   const VkDeviceSize attribute_bytes = kAttributesPerSample * count * sizeof(glm::vec4);
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(attributes_, attribute_bytes,
                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -585,6 +600,9 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
       {},
       {positions_.handle(), 0, position_bytes},
       {attributes_.handle(), 0, attribute_bytes},
+      {fetched_texels_.handle(), 0, texel_bytes},
+      {texel_status_.handle(), 0, texel_bytes},
+      {readback_.handle(), 0, VK_WHOLE_SIZE},
   }};
   for (std::uint32_t set = 0; set < atlases_.size(); ++set) {
     const VkDescriptorImageInfo image{sampler_.get(), atlases_[set].value.view.get(),
@@ -622,23 +640,27 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
 }
 
 Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
+  DB_RETURN_IF_ERROR(FinishResident());
+  staged_resident_.reset();
   std::vector<bool> drawn(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
   rendered_.reset();
-  DB_RETURN_IF_ERROR(Stage(batch, {}, drawn));
+  DB_RETURN_IF_ERROR(Stage(batch, {}, drawn, HostAccess::kReadback));
   const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, {}, drawn, rows, 0); }));
+  const RunShape shape{batch.count, batch.first_offset};
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, shape, {}, drawn, true, rows, 0); }));
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-  DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
-  CompareTexels(batch, drawn);
+  DB_RETURN_IF_ERROR(fetched_texels_.InvalidateForHostReads());
+  const std::vector<std::uint8_t> geometry = GeometryOf(batch);
+  CompareTexels(batch.count, batch.codes, geometry, drawn);
   // The batch's own fetched value where nothing was drawn, as for the codes.
   const std::size_t count = batch.count;
   fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
-  const auto* device_fetched = static_cast<const float*>(positions_.mapped());
+  const auto* device_fetched = static_cast<const float*>(fetched_texels_.mapped());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!drawn[s]) continue;
     for (std::size_t i = 0; i < count; ++i) {
-      if (HasGeometry(batch.raster[i])) fetched_[s * count + i] = device_fetched[s * count + i];
+      if (geometry[i] != 0) fetched_[s * count + i] = device_fetched[s * count + i];
     }
   }
   rendered_ = RenderedBatch{batch.first_index, batch.count};
@@ -647,53 +669,98 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
 
 Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                        std::uint32_t unwritten_bits) {
+  DB_RETURN_IF_ERROR(FinishResident());
+  staged_resident_.reset();
   // Pass 1 again only where Render did not just draw this batch.
   const bool rendered = rendered_ && rendered_->first_index == batch.first_index && rendered_->count == batch.count;
   std::vector<bool> drawn(slots_.size(), false);
   if (!rendered) {
     for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
   }
-  DB_RETURN_IF_ERROR(Stage(batch, which, drawn));
-  const std::uint32_t count = batch.count;
-  const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
-  DB_RETURN_IF_ERROR(
-      pass_->Submit([&](VkCommandBuffer commands) { Record(commands, batch, which, drawn, rows, unwritten_bits); }));
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kReadback));
+  const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
+  const RunShape shape{batch.count, batch.first_offset};
+  DB_RETURN_IF_ERROR(pass_->Submit(
+      [&](VkCommandBuffer commands) { Record(commands, shape, which, drawn, false, rows, unwritten_bits); }));
   DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
   if (!rendered) {
     DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-    CompareTexels(batch, drawn);
+    CompareTexels(batch.count, batch.codes, GeometryOf(batch), drawn);
     // Only some slots may have been drawn: none of the atlases holds a whole render now.
     rendered_.reset();
   }
-
-  // Nothing was drawn for a sample without geometry: it has no position.
-  auto* positions = static_cast<float*>(positions_.mapped());
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (HasGeometry(batch.raster[i])) continue;
-    for (std::size_t slice = 0; slice < 3 * which.size(); ++slice) {
-      positions[slice * count + i] = std::numeric_limits<float>::quiet_NaN();
-    }
-  }
-  return positions;
+  return static_cast<const float*>(positions_.mapped());
 }
 
-void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                        const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const {
+Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                                     std::uint32_t unwritten_bits) {
+  DB_RETURN_IF_ERROR(FinishResident());
+  rendered_.reset();
+  staged_resident_.reset();
+  std::vector<bool> drawn(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone));
+  const std::uint32_t count = batch.count;
+  staged_resident_ = ResidentRun{.shape = {count, batch.first_offset},
+                                 .which = {which.begin(), which.end()},
+                                 .unwritten_bits = unwritten_bits,
+                                 .codes = {batch.codes.begin(), batch.codes.begin() + std::ptrdiff_t{count} *
+                                                                                          static_cast<std::ptrdiff_t>(
+                                                                                              slots_.size())},
+                                 .geometry = GeometryOf(batch)};
+  const VkDeviceSize texel_bytes = VkDeviceSize{count} * slots_.size() * sizeof(float);
+  DeviceRunBuffers buffers;
+  buffers.positions = positions_.handle();
+  buffers.position_bytes = VkDeviceSize{3} * count * which.size() * sizeof(float);
+  buffers.lead = 0;
+  buffers.slice_length = count;
+  buffers.texels = fetched_texels_.handle();
+  buffers.texel_bytes = texel_bytes;
+  buffers.pixels = pixels_.handle();
+  buffers.pixel_bytes = VkDeviceSize{count} * sizeof(std::uint32_t);
+  buffers.frame_params = frames_.handle();
+  buffers.frame_param_bytes = batch.frame_params.size() * sizeof(f32::FrameParams);
+  buffers.depth_params = depth_params_.handle();
+  buffers.depth_param_bytes = batch.depth_params.size() * sizeof(f32::DepthParams);
+  buffers.texel_status = texel_status_.handle();
+  buffers.texel_status_bytes = texel_bytes;
+  return buffers;
+}
+
+Status RasterPass::QueueResident() {
+  if (!staged_resident_) return Internal("no resident raster run staged");
+  ResidentRun& run = *staged_resident_;
+  std::vector<bool> drawn(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  const std::uint32_t rows = (run.shape.count + kAtlasWidth - 1) / kAtlasWidth;
+  DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) {
+    Record(commands, run.shape, run.which, drawn, true, rows, run.unwritten_bits);
+  }));
+  queued_resident_ = std::move(staged_resident_);
+  staged_resident_.reset();
+  return Status::Ok();
+}
+
+Status RasterPass::FinishResident() {
+  if (!queued_resident_) return Status::Ok();
+  const ResidentRun run = std::move(*queued_resident_);
+  queued_resident_.reset();
+  DB_RETURN_IF_ERROR(pass_->Wait());
+  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+  std::vector<bool> drawn(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  CompareTexels(run.shape.count, run.codes, run.geometry, drawn);
+  return Status::Ok();
+}
+
+void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
+                        const std::vector<bool>& drawn, bool fetch, std::uint32_t rows,
+                        std::uint32_t unwritten_bits) const {
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    if (drawn[slot]) RecordProduction(commands, batch, slot, rows);
+    if (drawn[slot]) RecordProduction(commands, shape, slot, rows);
   }
+  if (fetch) RecordFetch(commands, shape, drawn);
   if (which.empty()) {
-    // A render alone: what a fetch returns for every drawn texel.
-    for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-      if (!drawn[slot]) continue;
-      pass_->Bind(commands, fetch_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, *slots_[slot].atlas);
-      f32::RasterConstants constants{};
-      constants.sample_count = batch.count;
-      constants.atlas_width = kAtlasWidth;
-      constants.output_offset = static_cast<std::uint32_t>(slot * batch.count);
-      pass_->PushConstants(commands, &constants, sizeof(constants));
-      vkCmdDispatch(commands, (batch.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
-    }
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                         VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                         VK_ACCESS_HOST_READ_BIT);
@@ -710,14 +777,16 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
   rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
   rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
   rendering.layerCount = 1;
-  f32::RasterConstants constants = {.sample_count = batch.count,
+  f32::RasterConstants constants = {.sample_count = shape.count,
                                     .atlas_width = kAtlasWidth,
                                     .samples_per_frame = kSamplesPerFrame,
-                                    .first_in_frame = batch.first_offset,
+                                    .first_in_frame = shape.first_offset,
                                     .conventions_per_frame = kHardwareConventionCount,
                                     .convention_slot = 0,
                                     .output_offset = 0,
-                                    .viewport_height = ViewportHeight(rows)};
+                                    .viewport_height = ViewportHeight(rows),
+                                    .coverage_word = 0,
+                                    .slices = static_cast<std::uint32_t>(3 * which.size())};
   const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
   const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
                                         std::any_of(which.begin(), which.end(), reads_volume)};
@@ -726,7 +795,7 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
     if (!captured[k]) continue;
     pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordSampleDraws(commands, batch.count, k == 1);
+    RecordSampleDraws(commands, shape.count, k == 1);
   }
   vkCmdEndRendering(commands);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -739,17 +808,46 @@ void RasterPass::Record(VkCommandBuffer commands, const ShaderInputs& batch, std
     pass_->Bind(commands, reconstruction_[static_cast<std::size_t>(variant)].get(), VK_PIPELINE_BIND_POINT_GRAPHICS,
                 *slots_[plan.depth_slot].atlas);
     constants.convention_slot = plan.convention_slot;
-    constants.output_offset = static_cast<std::uint32_t>(k * 3 * batch.count);
+    constants.output_offset = static_cast<std::uint32_t>(k * 3 * shape.count);
     pass_->PushConstants(commands, &constants, sizeof(constants));
     RecordDraws(commands, 1, rows, kTriangleVertices);  // atlas_cover.vert: the whole atlas
   }
   vkCmdEndRendering(commands);
-  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+
+  // Nothing was drawn for a sample without geometry: it has no position.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+  pass_->Bind(commands, no_geometry_.get(), VK_PIPELINE_BIND_POINT_COMPUTE);
+  constants.output_offset = 0;
+  pass_->PushConstants(commands, &constants, sizeof(constants));
+  vkCmdDispatch(commands, (shape.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                       VK_ACCESS_HOST_READ_BIT);
 }
 
-void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot_index,
+// After pass 1: what a fetch returns for every drawn texel, and its status.
+void RasterPass::RecordFetch(VkCommandBuffer commands, RunShape shape, const std::vector<bool>& drawn) const {
+  // The coverage copies (RecordProduction's) before the fetch reads them.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
+    if (!drawn[slot]) continue;
+    pass_->Bind(commands, fetch_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, *slots_[slot].atlas);
+    f32::RasterConstants constants{};
+    constants.sample_count = shape.count;
+    constants.atlas_width = kAtlasWidth;
+    constants.output_offset = static_cast<std::uint32_t>(slot * shape.count);
+    constants.coverage_word = static_cast<std::uint32_t>(coverage_offsets_[slot] / 4);
+    pass_->PushConstants(commands, &constants, sizeof(constants));
+    vkCmdDispatch(commands, (shape.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
+  }
+  // A judge on the device reads them next, in a later submission.
+  RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+}
+
+void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot_index,
                                   std::uint32_t rows) const {
   const Slot& slot = slots_[slot_index];
   const Atlas& atlas = atlases_[*slot.atlas];
@@ -787,15 +885,15 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, const ShaderInputs& 
   vkCmdBeginRendering(commands, &rendering);
   pass_->Bind(commands, slot.production.get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
   f32::RasterConstants constants{};
-  constants.sample_count = batch.count;
+  constants.sample_count = shape.count;
   constants.atlas_width = kAtlasWidth;
   constants.samples_per_frame = kSamplesPerFrame;
-  constants.first_in_frame = batch.first_offset;
+  constants.first_in_frame = shape.first_offset;
   constants.conventions_per_frame = kHardwareConventionCount;
   constants.convention_slot = slot.convention_slot;
   constants.viewport_height = ViewportHeight(rows);
   pass_->PushConstants(commands, &constants, sizeof(constants));
-  RecordDraws(commands, batch.count, rows, kTriangleVertices);
+  RecordDraws(commands, shape.count, rows, kTriangleVertices);
   vkCmdEndRendering(commands);
 
   // The texels and the coverage go to the host; the texels then to pass 2.
@@ -846,11 +944,11 @@ void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count
   }
 }
 
-void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn) {
-  const std::size_t count = batch.count;
+void RasterPass::CompareTexels(std::uint32_t count, std::span<const std::uint32_t> codes,
+                               std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn) {
   texels_.assign(slots_.size() * count, 0);
   texel_drawn_.assign(slots_.size() * count, 1);
-  std::copy_n(batch.codes.begin(), std::min(texels_.size(), batch.codes.size()), texels_.begin());
+  std::copy_n(codes.begin(), std::min(texels_.size(), codes.size()), texels_.begin());
   const auto* readback = static_cast<const std::byte*>(readback_.mapped());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!drawn[s]) continue;
@@ -860,13 +958,14 @@ void RasterPass::CompareTexels(const ShaderInputs& batch, const std::vector<bool
     const std::byte* coverage = readback + coverage_offsets_[s];
     RasterAgreement& agreement = agreement_[s];
     for (std::size_t i = 0; i < count; ++i) {
-      if (!HasGeometry(batch.raster[i])) continue;
-      const std::uint32_t host = batch.codes[s * count + i];
+      if (geometry[i] == 0) continue;
+      const std::uint32_t host = codes[s * count + i];
       const std::uint32_t device = CodeOf(format, texels + i * bytes);
       texels_[s * count + i] = device;
       ++agreement.texels;
       // An uncovered texel holds the clear value: it is counted apart,
-      // neither judged nor compared with the model.
+      // neither judged nor compared with the model (fetch.comp marks it
+      // undrawn for a judge on the device by the same byte).
       if (coverage[i] == std::byte{0}) {
         ++agreement.uncovered;
         texel_drawn_[s * count + i] = 0;

@@ -41,6 +41,7 @@
 
 #include "bench/backends/backend.h"
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/status.h"
 #include "bench/pipeline/shader_inputs.h"
@@ -89,6 +90,20 @@ class RasterPass {
   Expected<const float*> Run(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                              std::uint32_t unwritten_bits);
 
+  // A run whose outputs stay in device memory, for a judge there
+  // (DeviceResidentRuns, through the backend): uploads `batch` and returns
+  // the buffers the run writes: the positions of `which` (starting as
+  // `unwritten_bits`), laid out as Run's, and per depth slot and sample the
+  // fetched texel and its DB_RASTER_TEXEL_* status. QueueResident then
+  // queues pass 1 for every depth slot, the fetch, and pass 2, and returns
+  // at once. The batch's codes (the host's model) are kept:
+  // FinishResident, or the next StageResident, waits for the run and
+  // counts its texels into agreement().
+  Expected<DeviceRunBuffers> StageResident(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                           std::uint32_t unwritten_bits);
+  Status QueueResident();
+  Status FinishResident();
+
   // Per depth slot, since Create: RasterAgreement (raster_model.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
   // The texel bits pass 1 produced last, laid out as ShaderInputs::codes:
@@ -100,6 +115,20 @@ class RasterPass {
 
  private:
   struct Slot;  // what pass 1 draws for one depth slot
+  // What recording a submission needs of its batch.
+  struct RunShape {
+    std::uint32_t count = 0;
+    std::uint32_t first_offset = 0;
+  };
+  // A resident run staged or queued: what recording it and then comparing
+  // its texels with the host's model need.
+  struct ResidentRun {
+    RunShape shape;
+    std::vector<std::uint32_t> which;
+    std::uint32_t unwritten_bits = 0;
+    std::vector<std::uint32_t> codes;   // the batch's, laid out as ShaderInputs::codes
+    std::vector<std::uint8_t> geometry;  // per sample, 1 where the host gave it something to draw
+  };
   struct Atlas {
     VulkanImage value;     // the depth attachment or the G-buffer channel
     VulkanImage coverage;  // R8_UINT: 1 where pass 1 drew
@@ -112,17 +141,25 @@ class RasterPass {
                         std::uint32_t arithmetic_probes, std::vector<std::string>& sources);
   // `drawn`: per depth slot, whether the submission draws it (pass 1).
   Status CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const;
-  Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn);
+  // `outputs`: where the positions and fetched texels go (kReadback: the
+  // host reads them; kNone: a judge on the device does).
+  Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn,
+               HostAccess outputs);
   Status EnsureAtlases(std::uint32_t rows);
   Status Upload(const ShaderInputs& batch, std::uint32_t rows);
-  // `drawn`: per depth slot, whether pass 1 draws it; pass 2 draws `which`.
-  void Record(VkCommandBuffer commands, const ShaderInputs& batch, std::span<const std::uint32_t> which,
-              const std::vector<bool>& drawn, std::uint32_t rows, std::uint32_t unwritten_bits) const;
-  void RecordProduction(VkCommandBuffer commands, const ShaderInputs& batch, std::size_t slot,
-                        std::uint32_t rows) const;
+  // `drawn`: per depth slot, whether pass 1 draws it, and the fetch reads
+  // it (where `fetch`, or where pass 2 draws nothing); pass 2 draws `which`.
+  void Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
+              const std::vector<bool>& drawn, bool fetch, std::uint32_t rows, std::uint32_t unwritten_bits) const;
+  void RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot, std::uint32_t rows) const;
+  void RecordFetch(VkCommandBuffer commands, RunShape shape, const std::vector<bool>& drawn) const;
   void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows, std::uint32_t vertices) const;
   void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
-  void CompareTexels(const ShaderInputs& batch, const std::vector<bool>& drawn);
+  // Counts the texels pass 1 copied back into agreement_ against `codes`
+  // (the host's model), for the samples `geometry` marks, and keeps them in
+  // texels_ and texel_drawn_.
+  void CompareTexels(std::uint32_t count, std::span<const std::uint32_t> codes,
+                     std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::vector<CellPlan> cells_;
@@ -133,11 +170,16 @@ class RasterPass {
   DeviceObject<VkSampler> sampler_;
   std::array<DeviceObject<VkPipeline>, 2> capture_;  // pass 2a: the full-screen triangle, the light volume
   std::vector<DeviceObject<VkPipeline>> reconstruction_;  // pass 2b, indexed by Variant; null where no cell uses it
-  DeviceObject<VkPipeline> fetch_;  // shaders/raster/fetch.comp
+  DeviceObject<VkPipeline> fetch_;        // shaders/raster/fetch.comp
+  DeviceObject<VkPipeline> no_geometry_;  // shaders/raster/no_geometry.comp
 
   std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), atlas_rows_ rows each
   std::uint32_t atlas_rows_ = 0;
   VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
+  // Per (depth slot, sample): what a fetch returns, and its DB_RASTER_TEXEL_*
+  // status (shaders/raster/fetch.comp).
+  VulkanBuffer fetched_texels_, texel_status_;
+  HostAccess outputs_ = HostAccess::kReadback;  // what positions_ and fetched_texels_ are now
   VulkanBuffer attributes_;  // pass 2a's output: shaders/raster/capture.frag
   VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
   std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
@@ -150,6 +192,7 @@ class RasterPass {
     std::uint32_t count;
   };
   std::optional<RenderedBatch> rendered_;
+  std::optional<ResidentRun> staged_resident_, queued_resident_;
   std::vector<RasterAgreement> agreement_;
   std::vector<std::uint32_t> texels_;
   std::vector<float> fetched_;

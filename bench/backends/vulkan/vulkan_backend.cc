@@ -235,6 +235,7 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   Expected<DeviceRunBuffers> Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                    ThreadPool* pool) override;
   Status QueueStaged() override;
+  Status FinishQueued() override;
   Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const override;
 
  private:
@@ -262,6 +263,9 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   // `host_texels`: whether the run reads the batch's texels (depths), or
   // the caller of Stage writes them on the device.
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which, bool host_texels = true) const;
+  // Whether the raster form's device can bind the positions of `which`.
+  Status CheckRasterOutputs(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
+  Expected<DeviceRunBuffers> StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which);
   // What the compute form's device cannot address or dispatch.
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
@@ -288,6 +292,7 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   std::unique_ptr<RasterPass> raster_;  // the raster form, when prepared for it
   // What Stage uploaded, for QueueStaged to queue.
   std::optional<StagedRun> staged_;
+  bool raster_staged_ = false;  // Stage staged a raster run (RasterPass::StageResident)
   // Where the compute form's positions go: memory the host reads them from
   // (Run), or device memory alone, where a judge on the device reads them
   // (Stage); and the kind the buffer now is.
@@ -354,6 +359,7 @@ Status VulkanBackend::PrepareOnDevice(std::span<const CellPlan> cells, PassKind 
   pipelines_ = std::move(pipelines);
   raster_ = std::move(raster);
   staged_.reset();  // its dispatches would bind the replaced pipelines
+  raster_staged_ = false;
   // The probes change the program as much as an edit would.
   const std::string probes = ArithmeticProbesName(options_.arithmetic_probes);
   program_ = {options_.shader_dir.empty() ? "default" : options_.shader_dir,
@@ -438,12 +444,9 @@ Expected<std::span<const float>> VulkanBackend::RunOnDevice(const ShaderInputs& 
   const std::size_t output_floats = std::size_t{3} * batch.count * which.size();
   if (output_floats == 0) return std::span<const float>();
   DB_RETURN_IF_ERROR(CheckBatch(batch, which));
+  raster_staged_ = false;  // a Run discards what Stage staged
   if (raster_ != nullptr) {
-    if (output_floats * sizeof(float) > context_->properties().limits.maxStorageBufferRange) {
-      return InvalidArgument(fmt::format("{} cells of {} samples write {} bytes; the device binds at most {}",
-                                         which.size(), batch.count, output_floats * sizeof(float),
-                                         context_->properties().limits.maxStorageBufferRange));
-    }
+    DB_RETURN_IF_ERROR(CheckRasterOutputs(batch, which));
     const ValidationScope validation(*context_);
     DB_ASSIGN_OR_RETURN(const float* positions, raster_->Run(batch, which, kUnwrittenBits));
     DB_RETURN_IF_ERROR(validation.Check("Run"));
@@ -504,9 +507,8 @@ DeviceRunBuffers VulkanBackend::BuffersOf(const ShaderInputs& batch, const Slice
 Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                 ThreadPool* pool) {
   staged_.reset();
-  if (raster_ != nullptr) {
-    return Unavailable("the raster form reads its positions back; only the compute form leaves them on the device");
-  }
+  raster_staged_ = false;
+  if (raster_ != nullptr) return StageRaster(batch, which);
   if (batch.count == 0 || which.empty()) {
     staged_ = StagedRun{};  // no dispatch to queue
     return DeviceRunBuffers{};
@@ -522,7 +524,41 @@ Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::
   return buffers;
 }
 
+// The raster form's resident run: the batch's codes are the host's model,
+// which the device's texels are counted against.
+Expected<DeviceRunBuffers> VulkanBackend::StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which) {
+  if (batch.count == 0 || which.empty()) {
+    DB_RETURN_IF_ERROR(raster_->FinishResident().WithContext(DeviceContext()));
+    staged_ = StagedRun{};  // no draw to queue
+    return DeviceRunBuffers{};
+  }
+  DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
+  DB_RETURN_IF_ERROR(CheckRasterOutputs(batch, which).WithContext(DeviceContext()));
+  const ValidationScope validation(*context_);
+  Expected<DeviceRunBuffers> buffers = raster_->StageResident(batch, which, kUnwrittenBits);
+  if (!buffers.ok()) return buffers.status().WithContext(DeviceContext());
+  DB_RETURN_IF_ERROR(validation.Check("Stage").WithContext(DeviceContext()));
+  staged_ = StagedRun{};
+  raster_staged_ = true;
+  return buffers;
+}
+
+Status VulkanBackend::FinishQueued() {
+  const ValidationScope validation(*context_);
+  Status status = raster_ != nullptr ? raster_->FinishResident() : pass_->Wait();
+  if (status.ok()) status = validation.Check("FinishQueued");
+  return status.WithContext(DeviceContext());
+}
+
 Status VulkanBackend::QueueStaged() {
+  if (raster_staged_) {
+    raster_staged_ = false;
+    staged_.reset();
+    const ValidationScope validation(*context_);
+    Status status = raster_->QueueResident();
+    if (status.ok()) status = validation.Check("QueueStaged");
+    return status.WithContext(DeviceContext());
+  }
   if (!staged_) {
     return Internal("no staged run to queue: Stage comes first, and a Run after it discards what it staged");
   }
@@ -533,6 +569,13 @@ Status VulkanBackend::QueueStaged() {
   Status status = pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) { Record(commands, run); });
   if (status.ok()) status = validation.Check("QueueStaged");
   return status.WithContext(DeviceContext());
+}
+
+Status VulkanBackend::CheckRasterOutputs(const ShaderInputs& batch, std::span<const std::uint32_t> which) const {
+  const std::uint64_t bytes = std::uint64_t{3} * batch.count * which.size() * sizeof(float);
+  if (bytes <= context_->properties().limits.maxStorageBufferRange) return Status::Ok();
+  return InvalidArgument(fmt::format("{} cells of {} samples write {} bytes; the device binds at most {}", which.size(),
+                                     batch.count, bytes, context_->properties().limits.maxStorageBufferRange));
 }
 
 // Outputs a shader never wrote would be judged as if it had: refused, with

@@ -34,7 +34,7 @@ Expected<std::unique_ptr<Backend>> MakeVulkanBackend(std::shared_ptr<VulkanConte
 // judge's say the same.
 Status UnwrittenOutputs(const Cell& cell, const std::string& unwritten);
 
-// The buffers of a staged run of the compute form (DeviceResidentRuns),
+// The buffers of a staged run (DeviceResidentRuns),
 // in device memory. Its positions: component c (x, y, z) of sample i of
 // the k-th cell listed is element (k * 3 + c) * slice_length + lead + i
 // of `positions`' first `position_bytes`; an element the shader did not
@@ -57,11 +57,16 @@ struct DeviceRunBuffers {
   VkDeviceSize frame_param_bytes = 0;
   VkBuffer depth_params = VK_NULL_HANDLE;
   VkDeviceSize depth_param_bytes = 0;
+  // The raster form's: per texel, laid out as `texels`, whether the
+  // rasterizer drew it (shared/params.h's DB_RASTER_TEXEL_*). Null for the
+  // compute form, whose texels are all stored.
+  VkBuffer texel_status = VK_NULL_HANDLE;
+  VkDeviceSize texel_status_bytes = 0;
 };
 
 // What a Vulkan backend offers a judge on its device
-// (Backend::device_resident): runs of the compute form whose positions
-// stay in device memory, nothing read back or checked on the host. The
+// (Backend::device_resident): runs whose positions stay in device memory,
+// nothing read back or checked on the host. The
 // judge sequences each run's steps with its own passes on the device's
 // queue; the backend never calls back:
 //   1. Stage(batch, which, pool) waits for the backend's last run, uploads
@@ -77,7 +82,11 @@ struct DeviceRunBuffers {
 // Or, in place of step 3, the caller runs the reconstruction itself, in
 // its own program around each variant's function (CompileJudged), from
 // the buffers Stage returned.
-// Unavailable for the raster form.
+// The raster form renders its own texels: Stage uploads what it draws
+// (the batch's codes are kept, to count how the device's texels agree
+// with them), step 2 has nothing to write, and QueueStaged queues the
+// depth pass, the fetch of every texel (into `texels`, with
+// `texel_status`) and the reconstruction.
 class DeviceResidentRuns {
  public:
   virtual ~DeviceResidentRuns() = default;
@@ -91,6 +100,10 @@ class DeviceResidentRuns {
   // The staged run's reconstruction, queued; refused where nothing is
   // staged (a Run in between discards what Stage staged).
   virtual Status QueueStaged() = 0;
+  // Waits for the run QueueStaged queued, if any, and takes in what the
+  // host keeps of it: the raster form's agreement with the host's model
+  // (Backend::raster_agreement). Stage does the same for the run before.
+  virtual Status FinishQueued() = 0;
   // `variant`'s function in the device judge's fused program
   // (VariantPass::kJudged), compiled as this backend compiles its own pass:
   // the same source of the function and the same arithmetic probes.
