@@ -602,6 +602,26 @@ TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheRasterForm) {
   EXPECT_GT(reached.maxima, 100u);
 }
 
+// Beside another backend, the raster form's rendered texels are the stored
+// values of all of them, adopted and judged on the host: asking for the
+// device judge there is refused (auto judges on the host).
+TEST_F(DeviceJudgeTest, TheRasterFormBesideAnotherBackendIsJudgedOnTheHost) {
+  SweepOptions options = Options(TypicalDomain());
+  options.samples = 3000;
+  options.domain.production = ProductionModel::kRaster;
+  auto vulkan = MakeVulkanBackend(Context(), BackendOptions{});
+  ASSERT_TRUE(vulkan.ok()) << vulkan.status().message();
+  auto cpu = MakeCpuBackend();
+  Backend* backends[] = {vulkan->get(), cpu.get()};
+  options.judge = JudgeSite::kDevice;
+  auto refused = RunSweep(options, backends);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find("only where it is the run's one backend"), std::string::npos)
+      << refused.status().message();
+  EXPECT_TRUE(Context()->TakeValidationMessages().empty());
+}
+
 // shared/judge.h's packed words, field by field. A word's fields, as
 // numbers (a flag as 0 or 1), and the largest each holds.
 template <std::size_t N>
