@@ -118,6 +118,8 @@ struct RasterConstants {
   uint viewport_height;  // the atlas viewport's height in texels: a power of two
   uint coverage_word;    // fetch.comp: the slot's first word of coverage bytes in the copy it reads
   uint slices;           // no_geometry.comp: the position slices the run writes (3 per cell)
+  uint first_texel;      // sample i lies at texel (first_texel + i) mod (atlas_width * atlas_rows), row by row
+  uint atlas_rows;
 };
 
 // What the raster form says of each (depth slot, sample) texel after pass 1

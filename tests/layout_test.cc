@@ -144,7 +144,9 @@ TEST_F(LayoutTest, RasterConstantsMatchesStd430) {
   EXPECT_MEMBER_AT(draw, RasterConstants, viewport_height);
   EXPECT_MEMBER_AT(draw, RasterConstants, coverage_word);
   EXPECT_MEMBER_AT(draw, RasterConstants, slices);
-  EXPECT_EQ(MembersOf("draw"), 10) << "a RasterConstants member is not listed above";
+  EXPECT_MEMBER_AT(draw, RasterConstants, first_texel);
+  EXPECT_MEMBER_AT(draw, RasterConstants, atlas_rows);
+  EXPECT_EQ(MembersOf("draw"), 12) << "a RasterConstants member is not listed above";
   EXPECT_EQ(Offset("draw_end"), static_cast<int>(sizeof(f32::RasterConstants)));
 }
 

@@ -25,7 +25,8 @@ vec2 atlas_viewport_centre() { return vec2(float(draw.atlas_width) - ATLAS_GUARD
 vec2 atlas_viewport_half() { return vec2(float(draw.atlas_width), 0.5f * float(draw.viewport_height)); }
 
 vec2 atlas_texel(uint sample_index) {
-  return vec2(float(sample_index % draw.atlas_width), float(sample_index / draw.atlas_width));
+  uint texel = texel_of(sample_index);
+  return vec2(float(texel % draw.atlas_width), float(texel / draw.atlas_width));
 }
 
 // `clip`, a clip position of the sample's frame, moved to the atlas.

@@ -16,7 +16,8 @@ layout(set = 0, binding = 4) uniform sampler2D depth_texture;
 layout(std430, set = 0, binding = 7) writeonly buffer Fetched { float fetched[]; };
 layout(std430, set = 0, binding = 8) writeonly buffer TexelStatus { uint texel_status[]; };
 // The copy of pass 1's coverage attachments the host reads too: one byte a
-// texel, 1 where the rasterizer drew, from word draw.coverage_word.
+// texel, 1 where the rasterizer drew, laid out as the whole atlas from
+// word draw.coverage_word.
 layout(std430, set = 0, binding = 9) readonly buffer CoverageCopy { uint coverage_words[]; };
 
 void main() {
@@ -24,9 +25,9 @@ void main() {
   if (i >= draw.sample_count) {
     return;
   }
-  ivec2 texel = ivec2(int(i % draw.atlas_width), int(i / draw.atlas_width));
-  fetched[draw.output_offset + i] = texelFetch(depth_texture, texel, 0).r;
-  uint covered = (coverage_words[draw.coverage_word + i / 4u] >> (8u * (i % 4u))) & 0xffu;
+  uint t = texel_of(i);
+  fetched[draw.output_offset + i] = texelFetch(depth_texture, ivec2(int(t % draw.atlas_width), int(t / draw.atlas_width)), 0).r;
+  uint covered = (coverage_words[draw.coverage_word + t / 4u] >> (8u * (t % 4u))) & 0xffu;
   texel_status[draw.output_offset + i] = !has_geometry(i) ? DB_RASTER_TEXEL_NO_GEOMETRY
                                          : covered == 0u  ? DB_RASTER_TEXEL_UNDRAWN
                                                           : DB_RASTER_TEXEL_DRAWN;

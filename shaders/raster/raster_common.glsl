@@ -2,8 +2,8 @@
 // buffers of the one descriptor set both passes draw with, the draw's push
 // constants, and where a sample's frame is.
 //
-// The atlas: sample i of the batch is drawn into texel (i % atlas_width,
-// i / atlas_width) of an image as wide as atlas_width, as instance i of a
+// The atlas: sample i of the batch is drawn into texel texel_of(i)
+// (atlas.inc) of an image as wide as atlas_width, as instance i of a
 // draw, its geometry moved by whole pixels so that its frame's pixel lands
 // on that texel; the geometry then rasterizes as it would at its real
 // pixel, and a fragment finds its sample from gl_FragCoord alone. Two ways

@@ -232,6 +232,13 @@ VkRenderingAttachmentInfo ClearedAttachment(const VulkanImage& image, VkImageLay
   return attachment;
 }
 
+// The atlas's rows. The atlas has a fixed size, and sample g of the sweep
+// always lies at texel g mod its size (RunShape), so that a sample is
+// rasterized at the same window position whatever batch it is in: a
+// device's interpolation rounds differently elsewhere (on lavapipe, 0.2%
+// of r32_sfloat texels changed between batches of 1024 and 4096 samples).
+// Its 262144 texels hold the device judge's default batch.
+constexpr std::uint32_t kMostAtlasRows = 1024;
 // The one viewport of a batch's draws, `rows` atlas rows: powers of two
 // wide and high, the atlas and kAtlasGuard texels around it, y up
 // (shaders/raster/atlas_placement.glsl).
@@ -442,12 +449,26 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
   return Status::Ok();
 }
 
-std::uint64_t RasterPass::MaxBatchSamples() const {
+std::uint32_t RasterPass::AtlasRows() const {
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
   // The atlas viewport is a power of two high, the rows and their guard.
   const std::uint32_t viewport_rows = std::bit_floor(limits.maxViewportDimensions[1]) - 2 * kAtlasGuard;
-  const std::uint32_t rows = std::min({limits.maxImageDimension2D, limits.maxFramebufferHeight, viewport_rows});
-  return std::uint64_t{kAtlasWidth} * rows;
+  return std::min({limits.maxImageDimension2D, limits.maxFramebufferHeight, viewport_rows, kMostAtlasRows});
+}
+
+std::uint64_t RasterPass::MaxBatchSamples() const { return std::uint64_t{kAtlasWidth} * AtlasRows(); }
+
+RasterPass::RunShape RasterPass::ShapeOf(const ShaderInputs& batch) const {
+  const std::uint32_t texels = kAtlasWidth * AtlasRows();
+  RunShape shape{.count = batch.count,
+                 .first_offset = batch.first_offset,
+                 .first_texel = static_cast<std::uint32_t>(batch.first_index % texels)};
+  // The rows the batch's texels lie in; all of them where they wrap round.
+  const std::uint32_t last = shape.first_texel + std::max(batch.count, 1u) - 1;
+  const bool wraps = last >= texels;
+  shape.first_row = wraps ? 0 : shape.first_texel / kAtlasWidth;
+  shape.rows = wraps ? AtlasRows() : last / kAtlasWidth - shape.first_row + 1;
+  return shape;
 }
 
 Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const {
@@ -464,10 +485,10 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
                                          codes_needed, batch.codes.size()));
     }
   }
-  const std::uint64_t rows = (std::uint64_t{batch.count} + kAtlasWidth - 1) / kAtlasWidth;
+  const std::uint64_t rows = AtlasRows();
   if (std::uint64_t{batch.count} > MaxBatchSamples()) {
-    return InvalidArgument(fmt::format("a batch of {} samples needs an atlas of {} rows; the device renders at most {}",
-                                       batch.count, rows, MaxBatchSamples() / kAtlasWidth));
+    return InvalidArgument(fmt::format("a batch of {} samples needs more than the atlas's {} rows of {} texels",
+                                       batch.count, rows, kAtlasWidth));
   }
   // Pass 2a's viewport of a sample lies up to a frame's size beyond the atlas.
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
@@ -480,7 +501,7 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
         static_cast<float>(rows) + height > limits.viewportBoundsRange[1]) {
       return InvalidArgument(fmt::format(
           "a {}x{} frame's viewports reach beyond what the device allows (at most {}x{}, within [{}, {}]) with an "
-          "atlas of {} rows; run fewer samples at once",
+          "atlas of {} rows",
           width, height, limits.maxViewportDimensions[0], limits.maxViewportDimensions[1],
           limits.viewportBoundsRange[0], limits.viewportBoundsRange[1], rows));
     }
@@ -488,18 +509,12 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
   return Status::Ok();
 }
 
-// The atlases only grow, so that batches of varying sizes do not recreate
-// them; a new one is made readable at once, so that pass 2's descriptors
-// are valid for every atlas whether or not the run draws it.
-Status RasterPass::EnsureAtlases(std::uint32_t rows) {
-  if (rows <= atlas_rows_) return Status::Ok();
-  const std::uint32_t most = static_cast<std::uint32_t>(MaxBatchSamples() / kAtlasWidth);
-  const std::uint32_t grown = std::min(std::max(rows, atlas_rows_ + atlas_rows_ / 2), most);
-  for (Atlas& atlas : atlases_) {
-    atlas.value.Reset();
-    atlas.coverage.Reset();
-  }
-  atlas_rows_ = 0;
+// The atlases are made once, whole (kMostAtlasRows); each is made
+// readable at once, so that pass 2's descriptors are valid for every atlas
+// whether or not the run draws it.
+Status RasterPass::EnsureAtlases() {
+  if (atlases_made_) return Status::Ok();
+  const std::uint32_t rows = AtlasRows();
   for (const Slot& slot : slots_) {
     if (!slot.atlas) continue;
     const Format format = slot.encoding.format;
@@ -509,10 +524,10 @@ Status RasterPass::EnsureAtlases(std::uint32_t rows) {
                                   (depth ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
                                          : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
     DB_ASSIGN_OR_RETURN(atlas.value,
-                        context_->CreateImage(VulkanFormatOf(format), {kAtlasWidth, grown}, use,
+                        context_->CreateImage(VulkanFormatOf(format), {kAtlasWidth, rows}, use,
                                               depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT));
     DB_ASSIGN_OR_RETURN(atlas.coverage,
-                        context_->CreateImage(kCoverageFormat, {kAtlasWidth, grown},
+                        context_->CreateImage(kCoverageFormat, {kAtlasWidth, rows},
                                               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                                               VK_IMAGE_ASPECT_COLOR_BIT));
   }
@@ -523,11 +538,11 @@ Status RasterPass::EnsureAtlases(std::uint32_t rows) {
                          VK_ACCESS_SHADER_READ_BIT);
     }
   }));
-  atlas_rows_ = grown;
+  atlases_made_ = true;
   return Status::Ok();
 }
 
-Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
+Status RasterPass::Upload(const ShaderInputs& batch) {
   const std::array<VkDeviceSize, kInputBindings> bytes = InputBytes(batch);
   const std::array<const void*, kInputBindings> data = {batch.frame_params.data(), batch.depth_params.data(),
                                                         batch.pixels.data(), batch.raster.data()};
@@ -540,12 +555,13 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t rows) {
     DB_RETURN_IF_ERROR(buffer.FlushHostWrites());
   }
 
-  // Pass 1's texels and coverage, slot after slot, each at a multiple of 4
-  // bytes as copies of depth aspects require.
+  // Pass 1's texels and coverage, slot after slot, each laid out as its
+  // whole atlas and at a multiple of 4 bytes, as copies of depth aspects
+  // require.
   texel_offsets_.assign(slots_.size(), 0);
   coverage_offsets_.assign(slots_.size(), 0);
   VkDeviceSize readback_bytes = 0;
-  const VkDeviceSize texels = VkDeviceSize{kAtlasWidth} * rows;
+  const VkDeviceSize texels = MaxBatchSamples();
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!slots_[s].atlas) continue;
     texel_offsets_[s] = readback_bytes;
@@ -566,11 +582,8 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
                          const std::vector<bool>& drawn, HostAccess outputs) {
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
-  const std::uint32_t rows = (count + kAtlasWidth - 1) / kAtlasWidth;
-  const std::uint32_t rows_before = atlas_rows_;
-  DB_RETURN_IF_ERROR(EnsureAtlases(rows));
-  if (atlas_rows_ != rows_before) rendered_.reset();
-  DB_RETURN_IF_ERROR(Upload(batch, rows));
+  DB_RETURN_IF_ERROR(EnsureAtlases());
+  DB_RETURN_IF_ERROR(Upload(batch));
   // The outputs go where their reader is: a buffer the host maps, or
   // device memory alone.
   if (outputs != outputs_) {
@@ -625,10 +638,12 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   const std::uint32_t padded = (count + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
   viewports_.resize(padded);
   scissors_.resize(padded);
+  const RunShape shape = ShapeOf(batch);
   for (std::uint32_t i = 0; i < padded; ++i) {
     const std::uint32_t sample = std::min(i, count - 1);
     const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
-    const std::uint32_t x = sample % kAtlasWidth, y = sample / kAtlasWidth;
+    const std::uint32_t texel = shape.TexelOf(sample, AtlasRows());
+    const std::uint32_t x = texel % kAtlasWidth, y = texel / kAtlasWidth;
     const auto pixel_x = static_cast<float>(batch.pixels[sample] & 0xffffu);
     const auto pixel_y = static_cast<float>(batch.pixels[sample] >> 16);
     // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
@@ -646,13 +661,12 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
   rendered_.reset();
   DB_RETURN_IF_ERROR(Stage(batch, {}, drawn, HostAccess::kReadback));
-  const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
-  const RunShape shape{batch.count, batch.first_offset};
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, shape, {}, drawn, true, rows, 0); }));
+  const RunShape shape = ShapeOf(batch);
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, shape, {}, drawn, true, 0); }));
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
   DB_RETURN_IF_ERROR(fetched_texels_.InvalidateForHostReads());
   const std::vector<std::uint8_t> geometry = GeometryOf(batch);
-  CompareTexels(batch.count, batch.codes, geometry, drawn);
+  CompareTexels(shape, batch.codes, geometry, drawn);
   // The batch's own fetched value where nothing was drawn, as for the codes.
   const std::size_t count = batch.count;
   fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
@@ -678,14 +692,13 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
     for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
   }
   DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kReadback));
-  const std::uint32_t rows = (batch.count + kAtlasWidth - 1) / kAtlasWidth;
-  const RunShape shape{batch.count, batch.first_offset};
+  const RunShape shape = ShapeOf(batch);
   DB_RETURN_IF_ERROR(pass_->Submit(
-      [&](VkCommandBuffer commands) { Record(commands, shape, which, drawn, false, rows, unwritten_bits); }));
+      [&](VkCommandBuffer commands) { Record(commands, shape, which, drawn, false, unwritten_bits); }));
   DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
   if (!rendered) {
     DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-    CompareTexels(batch.count, batch.codes, GeometryOf(batch), drawn);
+    CompareTexels(shape, batch.codes, GeometryOf(batch), drawn);
     // Only some slots may have been drawn: none of the atlases holds a whole render now.
     rendered_.reset();
   }
@@ -701,7 +714,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
   DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone));
   const std::uint32_t count = batch.count;
-  staged_resident_ = ResidentRun{.shape = {count, batch.first_offset},
+  staged_resident_ = ResidentRun{.shape = ShapeOf(batch),
                                  .which = {which.begin(), which.end()},
                                  .unwritten_bits = unwritten_bits,
                                  .codes = {batch.codes.begin(), batch.codes.begin() + std::ptrdiff_t{count} *
@@ -732,9 +745,8 @@ Status RasterPass::QueueResident() {
   ResidentRun& run = *staged_resident_;
   std::vector<bool> drawn(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
-  const std::uint32_t rows = (run.shape.count + kAtlasWidth - 1) / kAtlasWidth;
   DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) {
-    Record(commands, run.shape, run.which, drawn, true, rows, run.unwritten_bits);
+    Record(commands, run.shape, run.which, drawn, true, run.unwritten_bits);
   }));
   queued_resident_ = std::move(staged_resident_);
   staged_resident_.reset();
@@ -749,15 +761,14 @@ Status RasterPass::FinishResident() {
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
   std::vector<bool> drawn(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
-  CompareTexels(run.shape.count, run.codes, run.geometry, drawn);
+  CompareTexels(run.shape, run.codes, run.geometry, drawn);
   return Status::Ok();
 }
 
 void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
-                        const std::vector<bool>& drawn, bool fetch, std::uint32_t rows,
-                        std::uint32_t unwritten_bits) const {
+                        const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const {
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    if (drawn[slot]) RecordProduction(commands, shape, slot, rows);
+    if (drawn[slot]) RecordProduction(commands, shape, slot);
   }
   if (fetch) RecordFetch(commands, shape, drawn);
   if (which.empty()) {
@@ -775,7 +786,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   // then the positions (2b).
   VkRenderingInfo rendering{};
   rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-  rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
+  rendering.renderArea = shape.Area();
   rendering.layerCount = 1;
   f32::RasterConstants constants = {.sample_count = shape.count,
                                     .atlas_width = kAtlasWidth,
@@ -784,9 +795,11 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
                                     .conventions_per_frame = kHardwareConventionCount,
                                     .convention_slot = 0,
                                     .output_offset = 0,
-                                    .viewport_height = ViewportHeight(rows),
+                                    .viewport_height = ViewportHeight(AtlasRows()),
                                     .coverage_word = 0,
-                                    .slices = static_cast<std::uint32_t>(3 * which.size())};
+                                    .slices = static_cast<std::uint32_t>(3 * which.size()),
+                                    .first_texel = shape.first_texel,
+                                    .atlas_rows = AtlasRows()};
   const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
   const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
                                         std::any_of(which.begin(), which.end(), reads_volume)};
@@ -810,7 +823,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
     constants.convention_slot = plan.convention_slot;
     constants.output_offset = static_cast<std::uint32_t>(k * 3 * shape.count);
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordDraws(commands, 1, rows, kTriangleVertices);  // atlas_cover.vert: the whole atlas
+    RecordDraws(commands, 1, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
   }
   vkCmdEndRendering(commands);
 
@@ -839,6 +852,8 @@ void RasterPass::RecordFetch(VkCommandBuffer commands, RunShape shape, const std
     constants.atlas_width = kAtlasWidth;
     constants.output_offset = static_cast<std::uint32_t>(slot * shape.count);
     constants.coverage_word = static_cast<std::uint32_t>(coverage_offsets_[slot] / 4);
+    constants.first_texel = shape.first_texel;
+    constants.atlas_rows = AtlasRows();
     pass_->PushConstants(commands, &constants, sizeof(constants));
     vkCmdDispatch(commands, (shape.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
   }
@@ -847,8 +862,7 @@ void RasterPass::RecordFetch(VkCommandBuffer commands, RunShape shape, const std
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
 }
 
-void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot_index,
-                                  std::uint32_t rows) const {
+void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot_index) const {
   const Slot& slot = slots_[slot_index];
   const Atlas& atlas = atlases_[*slot.atlas];
   const bool depth = IsDepthFormat(slot.encoding.format);
@@ -877,7 +891,7 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
   const VkRenderingAttachmentInfo depth_attachment = ClearedAttachment(atlas.value, value_layout, far);
   VkRenderingInfo rendering{};
   rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-  rendering.renderArea = {{0, 0}, {kAtlasWidth, rows}};
+  rendering.renderArea = shape.Area();
   rendering.layerCount = 1;
   rendering.colorAttachmentCount = static_cast<std::uint32_t>(colors.size());
   rendering.pColorAttachments = colors.data();
@@ -891,9 +905,11 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
   constants.first_in_frame = shape.first_offset;
   constants.conventions_per_frame = kHardwareConventionCount;
   constants.convention_slot = slot.convention_slot;
-  constants.viewport_height = ViewportHeight(rows);
+  constants.viewport_height = ViewportHeight(AtlasRows());
+  constants.first_texel = shape.first_texel;
+  constants.atlas_rows = AtlasRows();
   pass_->PushConstants(commands, &constants, sizeof(constants));
-  RecordDraws(commands, shape.count, rows, kTriangleVertices);
+  RecordDraws(commands, shape.count, shape, kTriangleVertices);
   vkCmdEndRendering(commands);
 
   // The texels and the coverage go to the host; the texels then to pass 2.
@@ -902,9 +918,13 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kAttachmentStages, kAttachmentWrites,
                        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     VkBufferImageCopy region{};
-    region.bufferOffset = image == &atlas.value ? texel_offsets_[slot_index] : coverage_offsets_[slot_index];
+    // The batch's rows, where they lie in the whole atlas's layout.
+    const std::uint32_t texel_bytes = image == &atlas.value ? TexelBytes(slot.encoding.format) : 1;
+    region.bufferOffset = (image == &atlas.value ? texel_offsets_[slot_index] : coverage_offsets_[slot_index]) +
+                          VkDeviceSize{shape.first_row} * kAtlasWidth * texel_bytes;
     region.imageSubresource = {image->aspect, 0, 0, 1};
-    region.imageExtent = {kAtlasWidth, rows, 1};
+    region.imageOffset = {0, static_cast<std::int32_t>(shape.first_row), 0};
+    region.imageExtent = {kAtlasWidth, shape.rows, 1};
     vkCmdCopyImageToBuffer(commands, image->image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1,
                            &region);
   }
@@ -918,10 +938,10 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
 // Pass 1 and 2b: one draw for the whole batch through the atlas viewport
 // (pass 1: instance i is sample i, which the vertex stage places on its
 // texel; 2b: one instance over the atlas).
-void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows,
+void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape,
                              std::uint32_t vertices) const {
-  const VkViewport viewport = AtlasViewport(rows);
-  const VkRect2D scissor = {{0, 0}, {kAtlasWidth, rows}};
+  const VkViewport viewport = AtlasViewport(AtlasRows());
+  const VkRect2D scissor = shape.Area();
   vkCmdSetViewport(commands, 0, 1, &viewport);
   vkCmdSetScissor(commands, 0, 1, &scissor);
   vkCmdDraw(commands, vertices, count, 0, 0);
@@ -944,8 +964,9 @@ void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count
   }
 }
 
-void RasterPass::CompareTexels(std::uint32_t count, std::span<const std::uint32_t> codes,
+void RasterPass::CompareTexels(RunShape shape, std::span<const std::uint32_t> codes,
                                std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn) {
+  const std::size_t count = shape.count;
   texels_.assign(slots_.size() * count, 0);
   texel_drawn_.assign(slots_.size() * count, 1);
   std::copy_n(codes.begin(), std::min(texels_.size(), codes.size()), texels_.begin());
@@ -960,13 +981,14 @@ void RasterPass::CompareTexels(std::uint32_t count, std::span<const std::uint32_
     for (std::size_t i = 0; i < count; ++i) {
       if (geometry[i] == 0) continue;
       const std::uint32_t host = codes[s * count + i];
-      const std::uint32_t device = CodeOf(format, texels + i * bytes);
+      const std::uint32_t texel = shape.TexelOf(static_cast<std::uint32_t>(i), AtlasRows());
+      const std::uint32_t device = CodeOf(format, texels + std::size_t{texel} * bytes);
       texels_[s * count + i] = device;
       ++agreement.texels;
       // An uncovered texel holds the clear value: it is counted apart,
       // neither judged nor compared with the model (fetch.comp marks it
       // undrawn for a judge on the device by the same byte).
-      if (coverage[i] == std::byte{0}) {
+      if (coverage[texel] == std::byte{0}) {
         ++agreement.uncovered;
         texel_drawn_[s * count + i] = 0;
         continue;

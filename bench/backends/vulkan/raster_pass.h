@@ -20,8 +20,10 @@
 //      then a fragment, as in the compute form's dispatch, and the
 //      geometry is drawn once per encoding (1) and once per run (2a).
 //
-// Sample i is texel (i % kAtlasWidth, i / kAtlasWidth) of every atlas, and
-// is instance i of one draw per pass and slot or cell, its geometry moved
+// Sample i of a batch is texel t = (g + i) mod the atlas's size, (t %
+// kAtlasWidth, t / kAtlasWidth), of every atlas, g being the sweep's index
+// of the batch's first sample, so that a sample's texel does not depend on
+// the batch it is in; it is instance i of one draw per pass and slot or cell, its geometry moved
 // by whole pixels so that its frame's pixel lands on that texel
 // (shaders/raster/atlas_placement.glsl): it rasterizes as at its real
 // pixel. Pass 1's fragments off their own texel are discarded; pass 2's
@@ -115,11 +117,25 @@ class RasterPass {
 
  private:
   struct Slot;  // what pass 1 draws for one depth slot
-  // What recording a submission needs of its batch.
+  // What recording a submission needs of its batch (ShapeOf): its samples,
+  // where its first lies in its frame and in the atlas, and the atlas rows
+  // its texels lie in.
   struct RunShape {
     std::uint32_t count = 0;
     std::uint32_t first_offset = 0;
+    std::uint32_t first_texel = 0;  // the sweep's index of the first sample, modulo the atlas's texels
+    std::uint32_t first_row = 0;
+    std::uint32_t rows = 0;
+    // Sample i's texel, row by row, in an atlas of `atlas_rows` rows
+    // (shaders/raster/atlas.inc's texel_of).
+    std::uint32_t TexelOf(std::uint32_t i, std::uint32_t atlas_rows) const {
+      return (first_texel + i) % (kAtlasWidth * atlas_rows);
+    }
+    VkRect2D Area() const { return {{0, static_cast<std::int32_t>(first_row)}, {kAtlasWidth, rows}}; }
   };
+  RunShape ShapeOf(const ShaderInputs& batch) const;
+  // Rows of every atlas: as many as the device allows, up to kMostAtlasRows.
+  std::uint32_t AtlasRows() const;
   // A resident run staged or queued: what recording it and then comparing
   // its texels with the host's model need.
   struct ResidentRun {
@@ -145,20 +161,20 @@ class RasterPass {
   // host reads them; kNone: a judge on the device does).
   Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn,
                HostAccess outputs);
-  Status EnsureAtlases(std::uint32_t rows);
-  Status Upload(const ShaderInputs& batch, std::uint32_t rows);
+  Status EnsureAtlases();
+  Status Upload(const ShaderInputs& batch);
   // `drawn`: per depth slot, whether pass 1 draws it, and the fetch reads
   // it (where `fetch`, or where pass 2 draws nothing); pass 2 draws `which`.
   void Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
-              const std::vector<bool>& drawn, bool fetch, std::uint32_t rows, std::uint32_t unwritten_bits) const;
-  void RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot, std::uint32_t rows) const;
+              const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const;
+  void RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot) const;
   void RecordFetch(VkCommandBuffer commands, RunShape shape, const std::vector<bool>& drawn) const;
-  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, std::uint32_t rows, std::uint32_t vertices) const;
+  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape, std::uint32_t vertices) const;
   void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
   // Counts the texels pass 1 copied back into agreement_ against `codes`
   // (the host's model), for the samples `geometry` marks, and keeps them in
   // texels_ and texel_drawn_.
-  void CompareTexels(std::uint32_t count, std::span<const std::uint32_t> codes,
+  void CompareTexels(RunShape shape, std::span<const std::uint32_t> codes,
                      std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
@@ -173,8 +189,8 @@ class RasterPass {
   DeviceObject<VkPipeline> fetch_;        // shaders/raster/fetch.comp
   DeviceObject<VkPipeline> no_geometry_;  // shaders/raster/no_geometry.comp
 
-  std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), atlas_rows_ rows each
-  std::uint32_t atlas_rows_ = 0;
+  std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), AtlasRows() rows each
+  bool atlases_made_ = false;
   VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
   // Per (depth slot, sample): what a fetch returns, and its DB_RASTER_TEXEL_*
   // status (shaders/raster/fetch.comp).
