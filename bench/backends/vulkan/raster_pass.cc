@@ -666,7 +666,7 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
   DB_RETURN_IF_ERROR(fetched_texels_.InvalidateForHostReads());
   const std::vector<std::uint8_t> geometry = GeometryOf(batch);
-  CompareTexels(shape, batch.codes, geometry, drawn);
+  CompareTexels(shape, batch.codes, geometry, drawn, nullptr);
   // The batch's own fetched value where nothing was drawn, as for the codes.
   const std::size_t count = batch.count;
   fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
@@ -698,7 +698,7 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
   DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
   if (!rendered) {
     DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-    CompareTexels(shape, batch.codes, GeometryOf(batch), drawn);
+    CompareTexels(shape, batch.codes, GeometryOf(batch), drawn, nullptr);
     // Only some slots may have been drawn: none of the atlases holds a whole render now.
     rendered_.reset();
   }
@@ -706,8 +706,8 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
 }
 
 Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                                     std::uint32_t unwritten_bits) {
-  DB_RETURN_IF_ERROR(FinishResident());
+                                                     std::uint32_t unwritten_bits, ThreadPool* pool) {
+  DB_RETURN_IF_ERROR(FinishResident(pool));
   rendered_.reset();
   staged_resident_.reset();
   std::vector<bool> drawn(slots_.size());
@@ -717,10 +717,15 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   staged_resident_ = ResidentRun{.shape = ShapeOf(batch),
                                  .which = {which.begin(), which.end()},
                                  .unwritten_bits = unwritten_bits,
-                                 .codes = {batch.codes.begin(), batch.codes.begin() + std::ptrdiff_t{count} *
-                                                                                          static_cast<std::ptrdiff_t>(
-                                                                                              slots_.size())},
+                                 .codes = {},
                                  .geometry = GeometryOf(batch)};
+  std::vector<std::uint32_t>& codes = staged_resident_->codes;
+  codes.resize(std::size_t{count} * slots_.size());
+  if (pool != nullptr) {
+    pool->Copy(codes.data(), batch.codes.data(), codes.size() * sizeof(std::uint32_t));
+  } else {
+    std::copy_n(batch.codes.begin(), codes.size(), codes.begin());
+  }
   const VkDeviceSize texel_bytes = VkDeviceSize{count} * slots_.size() * sizeof(float);
   DeviceRunBuffers buffers;
   buffers.positions = positions_.handle();
@@ -753,7 +758,7 @@ Status RasterPass::QueueResident() {
   return Status::Ok();
 }
 
-Status RasterPass::FinishResident() {
+Status RasterPass::FinishResident(ThreadPool* pool) {
   if (!queued_resident_) return Status::Ok();
   const ResidentRun run = std::move(*queued_resident_);
   queued_resident_.reset();
@@ -761,7 +766,7 @@ Status RasterPass::FinishResident() {
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
   std::vector<bool> drawn(slots_.size());
   for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
-  CompareTexels(run.shape, run.codes, run.geometry, drawn);
+  CompareTexels(run.shape, run.codes, run.geometry, drawn, pool);
   return Status::Ok();
 }
 
@@ -965,38 +970,51 @@ void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count
 }
 
 void RasterPass::CompareTexels(RunShape shape, std::span<const std::uint32_t> codes,
-                               std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn) {
+                               std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn,
+                               ThreadPool* pool) {
   const std::size_t count = shape.count;
-  texels_.assign(slots_.size() * count, 0);
-  texel_drawn_.assign(slots_.size() * count, 1);
-  std::copy_n(codes.begin(), std::min(texels_.size(), codes.size()), texels_.begin());
+  texels_.resize(slots_.size() * count);
+  texel_drawn_.resize(slots_.size() * count);
   const auto* readback = static_cast<const std::byte*>(readback_.mapped());
-  for (std::size_t s = 0; s < slots_.size(); ++s) {
-    if (!drawn[s]) continue;
+  const std::uint32_t atlas_texels = kAtlasWidth * AtlasRows();
+  // Each slot apart (its texels, its agreement): on the pool's threads.
+  const auto compare = [&](std::size_t s) {
+    std::uint32_t* kept = texels_.data() + s * count;
+    std::uint8_t* kept_drawn = texel_drawn_.data() + s * count;
+    std::copy_n(codes.begin() + static_cast<std::ptrdiff_t>(s * count), count, kept);
+    std::fill_n(kept_drawn, count, std::uint8_t{1});
+    if (!drawn[s]) return;
     const Format format = slots_[s].encoding.format;
     const std::uint32_t bytes = TexelBytes(format);
     const std::byte* texels = readback + texel_offsets_[s];
     const std::byte* coverage = readback + coverage_offsets_[s];
     RasterAgreement& agreement = agreement_[s];
-    for (std::size_t i = 0; i < count; ++i) {
+    std::uint32_t texel = shape.first_texel;  // sample i's (RunShape::TexelOf), stepped
+    for (std::size_t i = 0; i < count; ++i, texel = texel + 1 == atlas_texels ? 0 : texel + 1) {
       if (geometry[i] == 0) continue;
-      const std::uint32_t host = codes[s * count + i];
-      const std::uint32_t texel = shape.TexelOf(static_cast<std::uint32_t>(i), AtlasRows());
+      const std::uint32_t host = kept[i];
       const std::uint32_t device = CodeOf(format, texels + std::size_t{texel} * bytes);
-      texels_[s * count + i] = device;
+      kept[i] = device;
       ++agreement.texels;
       // An uncovered texel holds the clear value: it is counted apart,
       // neither judged nor compared with the model (fetch.comp marks it
       // undrawn for a judge on the device by the same byte).
       if (coverage[texel] == std::byte{0}) {
         ++agreement.uncovered;
-        texel_drawn_[s * count + i] = 0;
+        kept_drawn[i] = 0;
         continue;
       }
       agreement.differing += device != host ? 1 : 0;
       agreement.max_code_distance = std::max(agreement.max_code_distance, CodeDistance(format, device, host));
     }
+  };
+  if (pool == nullptr) {
+    for (std::size_t s = 0; s < slots_.size(); ++s) compare(s);
+    return;
   }
+  pool->ParallelFor(slots_.size(), [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t s = begin; s < end; ++s) compare(s);
+  });
 }
 
 }  // namespace depthbench

@@ -46,6 +46,7 @@
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/status.h"
+#include "bench/base/thread_pool.h"
 #include "bench/pipeline/shader_inputs.h"
 
 namespace depthbench {
@@ -101,10 +102,11 @@ class RasterPass {
   // at once. The batch's codes (the host's model) are kept:
   // FinishResident, or the next StageResident, waits for the run and
   // counts its texels into agreement().
+  // `pool`, where given, copies and compares on its threads.
   Expected<DeviceRunBuffers> StageResident(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                                           std::uint32_t unwritten_bits);
+                                           std::uint32_t unwritten_bits, ThreadPool* pool);
   Status QueueResident();
-  Status FinishResident();
+  Status FinishResident(ThreadPool* pool = nullptr);
 
   // Per depth slot, since Create: RasterAgreement (raster_model.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
@@ -173,9 +175,9 @@ class RasterPass {
   void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
   // Counts the texels pass 1 copied back into agreement_ against `codes`
   // (the host's model), for the samples `geometry` marks, and keeps them in
-  // texels_ and texel_drawn_.
-  void CompareTexels(RunShape shape, std::span<const std::uint32_t> codes,
-                     std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn);
+  // texels_ and texel_drawn_; each slot on a thread of `pool`, if given.
+  void CompareTexels(RunShape shape, std::span<const std::uint32_t> codes, std::span<const std::uint8_t> geometry,
+                     const std::vector<bool>& drawn, ThreadPool* pool);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::vector<CellPlan> cells_;

@@ -265,7 +265,8 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
   Status CheckBatch(const ShaderInputs& batch, std::span<const std::uint32_t> which, bool host_texels = true) const;
   // Whether the raster form's device can bind the positions of `which`.
   Status CheckRasterOutputs(const ShaderInputs& batch, std::span<const std::uint32_t> which) const;
-  Expected<DeviceRunBuffers> StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which);
+  Expected<DeviceRunBuffers> StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                         ThreadPool* pool);
   // What the compute form's device cannot address or dispatch.
   Status CheckRun(const ShaderInputs& batch, std::span<const std::uint32_t> which, const BindingBytes& bytes) const;
   Status CheckEveryOutputWritten(const float* positions, const ShaderInputs& batch,
@@ -508,7 +509,7 @@ Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::
                                                 ThreadPool* pool) {
   staged_.reset();
   raster_staged_ = false;
-  if (raster_ != nullptr) return StageRaster(batch, which);
+  if (raster_ != nullptr) return StageRaster(batch, which, pool);
   if (batch.count == 0 || which.empty()) {
     staged_ = StagedRun{};  // no dispatch to queue
     return DeviceRunBuffers{};
@@ -526,16 +527,17 @@ Expected<DeviceRunBuffers> VulkanBackend::Stage(const ShaderInputs& batch, std::
 
 // The raster form's resident run: the batch's codes are the host's model,
 // which the device's texels are counted against.
-Expected<DeviceRunBuffers> VulkanBackend::StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which) {
+Expected<DeviceRunBuffers> VulkanBackend::StageRaster(const ShaderInputs& batch, std::span<const std::uint32_t> which,
+                                                      ThreadPool* pool) {
   if (batch.count == 0 || which.empty()) {
-    DB_RETURN_IF_ERROR(raster_->FinishResident().WithContext(DeviceContext()));
+    DB_RETURN_IF_ERROR(raster_->FinishResident(pool).WithContext(DeviceContext()));
     staged_ = StagedRun{};  // no draw to queue
     return DeviceRunBuffers{};
   }
   DB_RETURN_IF_ERROR(CheckBatch(batch, which).WithContext(DeviceContext()));
   DB_RETURN_IF_ERROR(CheckRasterOutputs(batch, which).WithContext(DeviceContext()));
   const ValidationScope validation(*context_);
-  Expected<DeviceRunBuffers> buffers = raster_->StageResident(batch, which, kUnwrittenBits);
+  Expected<DeviceRunBuffers> buffers = raster_->StageResident(batch, which, kUnwrittenBits, pool);
   if (!buffers.ok()) return buffers.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Stage").WithContext(DeviceContext()));
   staged_ = StagedRun{};
