@@ -162,6 +162,18 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
   auto read = ResultsFromJson(ToJson(*device), "device.json");
   ASSERT_TRUE(read.ok()) << read.status().message();
   EXPECT_EQ(read->run.stages.device_passes, t.device_passes);
+  EXPECT_EQ(read->run.stages.judge_host_steps, t.judge_host_steps);
+  // The judge's thread: its steps in order, each some time, within the
+  // judging they make up.
+  std::vector<std::string> steps;
+  double host_total = 0.0;
+  for (const auto& [step, seconds] : t.judge_host_steps) {
+    steps.push_back(step);
+    EXPECT_GT(seconds, 0.0) << step;
+    host_total += seconds;
+  }
+  EXPECT_EQ(steps, (std::vector<std::string>{"finish", "upload", "stage", "queue"}));
+  EXPECT_LE(host_total, t.judging);
   Reached reached;
   for (std::size_t c = 0; c < host->cells.size(); ++c) {
     const CellStats& a = host->cells[c].stats;

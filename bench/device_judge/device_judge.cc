@@ -204,6 +204,24 @@ constexpr std::array<const char*, kMarks> kFusedPassNames = {"idle",      "sampl
                                                              "reference", "reconstruction+judge",
                                                              "maxima"};
 
+// The steps of Judge on the host (DeviceJudge::host_seconds).
+enum HostStep : std::uint32_t { kFinishStep, kUploadStep, kStageStep, kQueueStep, kHostSteps };
+constexpr std::array<const char*, kHostSteps> kHostStepNames = {"finish", "upload", "stage", "queue"};
+// Adds the time since the last lap to a step.
+class Laps {
+ public:
+  explicit Laps(std::array<double, kHostSteps>& into) : into_(into) {}
+  void Lap(HostStep step) {
+    const auto now = std::chrono::steady_clock::now();
+    into_[step] += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  std::array<double, kHostSteps>& into_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 }  // namespace
 
 struct DeviceJudge::State {
@@ -248,6 +266,9 @@ struct DeviceJudge::State {
   bool record_distances = true;
   JudgeGroups judge_groups;
   double waited = 0.0;  // seconds Judge spent waiting for the device's passes
+  // The host's seconds in each step of Judge (host_seconds), named by
+  // kHostStepNames.
+  std::array<double, kHostSteps> host_steps{};
   // Each lane's batch writes kMarks timestamps (Mark), where the device's
   // queue writes them; Finish adds the intervals into pass_seconds.
   TimestampQueries clock;
@@ -893,7 +914,9 @@ Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, s
   // This batch goes to the lane the batch before last used, whose work is
   // long done; the last batch's may still run on the device meanwhile.
   s.lane = static_cast<std::uint32_t>(s.batches % kLanes);
+  Laps laps(s.host_steps);
   DB_RETURN_IF_ERROR(s.Finish(s.lane));
+  laps.Lap(kFinishStep);
   // On the device's queue, in this order: the sample and storage passes,
   // which write what the backend's reconstruction reads beyond what the
   // host uploads to it (the texels, and the pixels where the device
@@ -901,32 +924,45 @@ Status DeviceJudge::Judge(const Batch& batch, const DeviceJudgeInputs& device, s
   // read its positions. The storage pass's inputs go up first, the
   // backend's next, the reference's while the first two passes run.
   DB_RETURN_IF_ERROR(s.UploadForStorage(batch, device, pool));
+  laps.Lap(kUploadStep);
   // Fused, the last batch reads the backend's frame constants and pixels
   // until its storage submission has copied them.
   if (!s.fused.empty()) DB_RETURN_IF_ERROR(s.pass->Wait(StoreSlot(1 - s.lane)));
+  laps.Lap(kFinishStep);
   DB_ASSIGN_OR_RETURN(const DeviceRunBuffers run, s.runs->Stage(batch, s.every_cell, &pool));
   for (const auto& [binding, bytes] : s.FusedCopies(run)) DB_RETURN_IF_ERROR(s.Grow(binding, bytes));
   s.Bind(run, batch);
   const L::JudgePass constants = s.PassConstants(batch, device, run);
   const bool draws = device.draw_seed.has_value();
+  laps.Lap(kStageStep);
   DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
       [&](VkCommandBuffer commands) { s.RecordStore(commands, constants, draws, run); }, StoreSlot(s.lane)));
   // Fused, the judge's own programs reconstruct (from what Stage staged).
   if (s.fused.empty()) DB_RETURN_IF_ERROR(s.runs->QueueStaged());
+  laps.Lap(kQueueStep);
   DB_RETURN_IF_ERROR(s.UploadForReference(batch, device, pool));
+  laps.Lap(kUploadStep);
   // This batch joins the accumulators once the next one is queued (or at
   // Flush).
   DB_RETURN_IF_ERROR(s.pass->SubmitWithoutWaiting(
       [&](VkCommandBuffer commands) { s.Record(commands, constants, !encodings.empty()); }, JudgeSlot(s.lane)));
+  laps.Lap(kQueueStep);
   s.pending[s.lane] = {
       .queued = true, .count = batch.count, .cells = cells, .encodings = encodings, .order = s.batches++};
   s.last_count = batch.count;
   s.last_run = run;
   DB_RETURN_IF_ERROR(s.Finish(1 - s.lane));
+  laps.Lap(kFinishStep);
   return validation.Check("judging on the device");
 }
 
 double DeviceJudge::waited_seconds() const { return state_->waited; }
+
+std::vector<std::pair<std::string, double>> DeviceJudge::host_seconds() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (std::uint32_t k = 0; k < kHostSteps; ++k) out.emplace_back(kHostStepNames[k], state_->host_steps[k]);
+  return out;
+}
 
 std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
   std::vector<std::pair<std::string, double>> out;

@@ -135,6 +135,14 @@ class DeviceJudge {
   // "reconstruction+judge") and "maxima" (phase 1). Empty where the
   // device's queue writes no timestamps.
   std::vector<std::pair<std::string, double>> pass_seconds() const;
+  // The host's seconds in each step of Judge, since this judge was made, in
+  // order: "finish" (joining the batches the device finished, waits
+  // included: waited_seconds), "upload" (the judge's inputs), "stage" (the
+  // backend's staging of its run: its upload and, in the raster form, the
+  // comparison of the run before's texels) and "queue" (recording and
+  // submitting the passes). Where the device idles, one of these is what
+  // it waits for.
+  std::vector<std::pair<std::string, double>> host_seconds() const;
   // The reference the device computed for the last batch Judge was given,
   // in the host's layout (for tests and diagnosis; it finishes the batches
   // in flight).

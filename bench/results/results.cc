@@ -63,13 +63,23 @@ const CellResult* Results::Find(const Cell& cell, const std::string& backend) co
   return nullptr;
 }
 
-void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
-  auto it = std::find_if(device_passes.begin(), device_passes.end(), [&](const auto& p) { return p.first == name; });
-  if (it == device_passes.end()) {
-    device_passes.emplace_back(name, seconds);
+namespace {
+// Adds `seconds` to the entry called `name`, a new one going last.
+void AddNamedSeconds(std::vector<std::pair<std::string, double>>& to, const std::string& name, double seconds) {
+  auto it = std::find_if(to.begin(), to.end(), [&](const auto& p) { return p.first == name; });
+  if (it == to.end()) {
+    to.emplace_back(name, seconds);
   } else {
     it->second += seconds;
   }
+}
+}  // namespace
+
+void StageSeconds::AddDevicePass(const std::string& name, double seconds) {
+  AddNamedSeconds(device_passes, name, seconds);
+}
+void StageSeconds::AddJudgeHostStep(const std::string& name, double seconds) {
+  AddNamedSeconds(judge_host_steps, name, seconds);
 }
 
 // ---------------------------------------------------------------- fields
@@ -326,6 +336,7 @@ const JsonFields<StageSeconds>& StageFields() {
       JsonMember("build_waited", &StageSeconds::build_waited),
       JsonMember("device_waited", &StageSeconds::device_waited),
       JsonMemberOr("device_passes", &StageSeconds::device_passes, JsonArray{JsonObject{pass}}, {}),
+      JsonMemberOr("judge_host_steps", &StageSeconds::judge_host_steps, JsonArray{JsonObject{pass}}, {}),
   }};
   return fields;
 }
@@ -640,6 +651,7 @@ Expected<Results> MergeResults(const std::vector<Results>& parts, const std::vec
     stages.build_waited += part.run.stages.build_waited;
     stages.device_waited += part.run.stages.device_waited;
     for (const auto& [name, seconds] : part.run.stages.device_passes) stages.AddDevicePass(name, seconds);
+    for (const auto& [name, seconds] : part.run.stages.judge_host_steps) stages.AddJudgeHostStep(name, seconds);
     merged.run.reconstructions += part.run.reconstructions;
     merged.run.samples_judged += part.run.samples_judged;
     merged.run.partial = merged.run.partial || part.run.partial;

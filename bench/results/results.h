@@ -84,6 +84,11 @@ struct StageSeconds {
   std::vector<std::pair<std::string, double>> device_passes;
   // Adds `seconds` to the pass called `name`, a new one going last.
   void AddDevicePass(const std::string& name, double seconds);
+  // The host's seconds in each step of the device judges' work on their
+  // thread (DeviceJudge::host_seconds, summed over devices), in order:
+  // what the device waits for when it idles; empty where no device judged.
+  std::vector<std::pair<std::string, double>> judge_host_steps;
+  void AddJudgeHostStep(const std::string& name, double seconds);
 
   bool empty() const { return build == 0.0 && judging == 0.0; }
 };

@@ -64,15 +64,18 @@ void PrintRunHeader(const Results& results, std::ostream& out) {
     if (t.device_waited > 0) out << fmt::format(" ({:.2f} s waiting for the device)", t.device_waited);
     if (t.build_waited > 0) out << fmt::format("; the build waited {:.2f} s", t.build_waited);
     out << "\n";
-    if (!t.device_passes.empty()) {
-      out << "device passes:";
+    const auto list = [&](const char* title, const std::vector<std::pair<std::string, double>>& entries) {
+      if (entries.empty()) return;
+      out << title;
       const char* separator = " ";
-      for (const auto& [name, seconds] : t.device_passes) {
+      for (const auto& [name, seconds] : entries) {
         out << fmt::format("{}{} {:.3f} s", separator, name, seconds);
         separator = ", ";
       }
       out << "\n";
-    }
+    };
+    list("device passes:", t.device_passes);
+    list("the device judge's thread:", t.judge_host_steps);
   }
   out << "bits lost = log2(relative error / 2^-24), from 0 (float32's own rounding) to 24 (nothing left); relative "
          "to the distance from the camera\n\n";

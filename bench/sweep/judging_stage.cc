@@ -186,6 +186,7 @@ class DeviceJudgingStage final : public JudgingStage {
   void AddTimes(StageSeconds& stages) const override {
     stages.device_waited += judge_->waited_seconds();
     for (const auto& [name, seconds] : judge_->pass_seconds()) stages.AddDevicePass(name, seconds);
+    for (const auto& [name, seconds] : judge_->host_seconds()) stages.AddJudgeHostStep(name, seconds);
   }
 
  private:
