@@ -23,11 +23,11 @@
 // Sample i of a batch is texel t = (g + i) mod the atlas's size, (t %
 // kAtlasWidth, t / kAtlasWidth), of every atlas, g being the sweep's index
 // of the batch's first sample, so that a sample's texel does not depend on
-// the batch it is in; it is instance i of one draw per pass and slot or cell, its geometry moved
-// by whole pixels so that its frame's pixel lands on that texel
-// (shaders/raster/atlas_placement.glsl): it rasterizes as at its real
-// pixel. Pass 1's fragments off their own texel are discarded; pass 2's
-// primitives are clipped to it.
+// the batch it is in. It is instance i of one draw per pass and slot or
+// cell, its geometry moved by whole pixels so that its frame's pixel lands
+// on that texel (shaders/raster/atlas_placement.glsl): it rasterizes as at
+// its real pixel. Pass 1's fragments off their own texel are discarded;
+// pass 2's primitives are clipped to it.
 #pragma once
 
 #include <array>
@@ -165,8 +165,8 @@ class RasterPass {
                HostAccess outputs);
   Status EnsureAtlases();
   Status Upload(const ShaderInputs& batch);
-  // `drawn`: per depth slot, whether pass 1 draws it, and the fetch reads
-  // it (where `fetch`, or where pass 2 draws nothing); pass 2 draws `which`.
+  // `drawn`: per depth slot, whether pass 1 draws it and, where `fetch`,
+  // the fetch reads it; pass 2 draws `which` (none: pass 1 alone).
   void Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
               const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const;
   void RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot) const;
