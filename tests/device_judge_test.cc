@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -99,6 +100,24 @@ struct Reached {
   }
 };
 
+// The names of timed steps in order, and their sum; each step's seconds
+// are checked to be at least zero, or above it.
+std::pair<std::vector<std::string>, double> NamesAndTotal(const std::vector<std::pair<std::string, double>>& steps,
+                                                          bool each_positive) {
+  std::vector<std::string> names;
+  double total = 0.0;
+  for (const auto& [name, seconds] : steps) {
+    names.push_back(name);
+    if (each_positive) {
+      EXPECT_GT(seconds, 0.0) << name;
+    } else {
+      EXPECT_GE(seconds, 0.0) << name;
+    }
+    total += seconds;
+  }
+  return {names, total};
+}
+
 void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJudgeTuning tuning = {},
                           bool device_draws = true) {
   SCOPED_TRACE(name);
@@ -129,13 +148,7 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
   // interval lies on the device's timeline apart from the others, within
   // the run; the judge's and the reconstruction's always take some time,
   // and so does the sample pass where the device draws.
-  std::vector<std::string> names;
-  double device_total = 0.0;
-  for (const auto& [pass, seconds] : t.device_passes) {
-    names.push_back(pass);
-    EXPECT_GE(seconds, 0.0) << pass;
-    device_total += seconds;
-  }
+  const auto [names, device_total] = NamesAndTotal(t.device_passes, /*each_positive=*/false);
   // Fused (by request, or by default on a GPU), the reconstruction runs in
   // the judge's phase 0, and the interval before the judge's submission is
   // a wait.
@@ -165,13 +178,7 @@ void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJ
   EXPECT_EQ(read->run.stages.judge_host_steps, t.judge_host_steps);
   // The judge's thread: its steps in order, each some time, within the
   // judging they make up.
-  std::vector<std::string> steps;
-  double host_total = 0.0;
-  for (const auto& [step, seconds] : t.judge_host_steps) {
-    steps.push_back(step);
-    EXPECT_GT(seconds, 0.0) << step;
-    host_total += seconds;
-  }
+  const auto [steps, host_total] = NamesAndTotal(t.judge_host_steps, /*each_positive=*/true);
   EXPECT_EQ(steps, (std::vector<std::string>{"finish", "upload", "stage", "queue"}));
   EXPECT_LE(host_total, t.judging);
   Reached reached;
