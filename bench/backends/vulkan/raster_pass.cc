@@ -456,6 +456,12 @@ std::uint32_t RasterPass::AtlasRows() const {
   return std::min({limits.maxImageDimension2D, limits.maxFramebufferHeight, viewport_rows, kMostAtlasRows});
 }
 
+std::vector<bool> RasterPass::EverySlot() const {
+  std::vector<bool> drawn(slots_.size());
+  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  return drawn;
+}
+
 std::uint64_t RasterPass::MaxBatchSamples() const { return std::uint64_t{kAtlasWidth} * AtlasRows(); }
 
 RasterPass::RunShape RasterPass::ShapeOf(const ShaderInputs& batch) const {
@@ -657,8 +663,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
 Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   DB_RETURN_IF_ERROR(FinishResident());
   staged_resident_.reset();
-  std::vector<bool> drawn(slots_.size());
-  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  const std::vector<bool> drawn = EverySlot();
   rendered_.reset();
   DB_RETURN_IF_ERROR(Stage(batch, {}, drawn, HostAccess::kReadback));
   const RunShape shape = ShapeOf(batch);
@@ -710,8 +715,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   DB_RETURN_IF_ERROR(FinishResident(pool));
   rendered_.reset();
   staged_resident_.reset();
-  std::vector<bool> drawn(slots_.size());
-  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  const std::vector<bool> drawn = EverySlot();
   DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone));
   const std::uint32_t count = batch.count;
   staged_resident_ = ResidentRun{.shape = ShapeOf(batch),
@@ -748,8 +752,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
 Status RasterPass::QueueResident() {
   if (!staged_resident_) return Internal("no resident raster run staged");
   ResidentRun& run = *staged_resident_;
-  std::vector<bool> drawn(slots_.size());
-  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  const std::vector<bool> drawn = EverySlot();
   DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) {
     Record(commands, run.shape, run.which, drawn, true, run.unwritten_bits);
   }));
@@ -764,8 +767,7 @@ Status RasterPass::FinishResident(ThreadPool* pool) {
   queued_resident_.reset();
   DB_RETURN_IF_ERROR(pass_->Wait());
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-  std::vector<bool> drawn(slots_.size());
-  for (std::size_t s = 0; s < slots_.size(); ++s) drawn[s] = slots_[s].atlas.has_value();
+  const std::vector<bool> drawn = EverySlot();
   CompareTexels(run.shape, run.codes, run.geometry, drawn, pool);
   return Status::Ok();
 }

@@ -138,6 +138,9 @@ class RasterPass {
   RunShape ShapeOf(const ShaderInputs& batch) const;
   // Rows of every atlas: as many as the device allows, up to kMostAtlasRows.
   std::uint32_t AtlasRows() const;
+  // Per depth slot, whether a prepared cell reads it (it has an atlas):
+  // what a whole pass 1 draws.
+  std::vector<bool> EverySlot() const;
   // A resident run staged or queued: what recording it and then comparing
   // its texels with the host's model need.
   struct ResidentRun {

@@ -540,7 +540,6 @@ Expected<DeviceRunBuffers> VulkanBackend::StageRaster(const ShaderInputs& batch,
   Expected<DeviceRunBuffers> buffers = raster_->StageResident(batch, which, kUnwrittenBits, pool);
   if (!buffers.ok()) return buffers.status().WithContext(DeviceContext());
   DB_RETURN_IF_ERROR(validation.Check("Stage").WithContext(DeviceContext()));
-  staged_ = StagedRun{};
   raster_staged_ = true;
   return buffers;
 }
@@ -555,7 +554,6 @@ Status VulkanBackend::FinishQueued() {
 Status VulkanBackend::QueueStaged() {
   if (raster_staged_) {
     raster_staged_ = false;
-    staged_.reset();
     const ValidationScope validation(*context_);
     Status status = raster_->QueueResident();
     if (status.ok()) status = validation.Check("QueueStaged");
