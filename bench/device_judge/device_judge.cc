@@ -968,9 +968,23 @@ std::vector<std::pair<std::string, double>> DeviceJudge::pass_seconds() const {
   std::vector<std::pair<std::string, double>> out;
   if (state_->clock.count() == 0) return out;
   std::array<const char*, kMarks> names = state_->fused.empty() ? kPassNames : kFusedPassNames;
-  // The raster form's depth, fetch and reconstruction passes, in one submission.
+  // The raster form's depth, fetch and reconstruction passes, in one
+  // submission between the judge's: its parts where the backend times
+  // them, and what is left of the interval ("raster idle": the device
+  // waiting for the submission, or between its parts).
   if (state_->rasterized()) names[kJudgeStart] = "raster";
-  for (std::uint32_t k = 0; k < kMarks; ++k) out.emplace_back(names[k], state_->pass_seconds[k]);
+  const std::vector<std::pair<std::string, double>> parts =
+      state_->rasterized() ? state_->runs->part_seconds() : std::vector<std::pair<std::string, double>>{};
+  for (std::uint32_t k = 0; k < kMarks; ++k) {
+    if (k != kJudgeStart || parts.empty()) {
+      out.emplace_back(names[k], state_->pass_seconds[k]);
+      continue;
+    }
+    double rest = state_->pass_seconds[k];
+    for (const auto& part : parts) rest -= part.second;
+    out.insert(out.end(), parts.begin(), parts.end());
+    out.emplace_back("raster idle", std::max(rest, 0.0));
+  }
   return out;
 }
 

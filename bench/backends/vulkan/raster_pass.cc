@@ -342,6 +342,9 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
   // bind its slot's.
   DB_ASSIGN_OR_RETURN(pass->pass_, ComputePass::Create(pass->context_, bindings, sizeof(f32::RasterConstants),
                                                        kSetStages, std::max(atlases, 1u)));
+  if (TimestampQueries::Supported(*pass->context_).ok()) {
+    DB_ASSIGN_OR_RETURN(pass->clock_, TimestampQueries::Create(*pass->context_, kRasterParts + 1));
+  }
   DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
   DB_RETURN_IF_ERROR(pass->context_->GrowHostBuffer(pass->cube_indices_, sizeof(kCubeIndices),
                                                     VK_BUFFER_USAGE_INDEX_BUFFER_BIT, HostAccess::kUpload));
@@ -769,15 +772,36 @@ Status RasterPass::FinishResident(ThreadPool* pool) {
   DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
   const std::vector<bool> drawn = EverySlot();
   CompareTexels(run.shape, run.codes, run.geometry, drawn, pool);
+  if (clock_.count() > 0 && !run.which.empty()) {
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps, clock_.Read(0, kRasterParts + 1));
+    for (std::uint32_t k = 0; k < kRasterParts; ++k) part_seconds_[k] += clock_.IntervalNs(stamps[k], stamps[k + 1]) * 1e-9;
+  }
   return Status::Ok();
+}
+
+std::vector<std::pair<std::string, double>> RasterPass::part_seconds() const {
+  if (clock_.count() == 0) return {};
+  constexpr std::array<const char*, kRasterParts> kNames = {"depth", "fetch", "attributes", "reconstruction",
+                                                            "no geometry"};
+  std::vector<std::pair<std::string, double>> out;
+  for (std::uint32_t k = 0; k < kRasterParts; ++k) out.emplace_back(kNames[k], part_seconds_[k]);
+  return out;
 }
 
 void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
                         const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const {
+  // Part k starts at timestamp k (Part); FinishResident reads them.
+  const auto mark = [&](std::uint32_t part) {
+    if (clock_.count() > 0) clock_.RecordWrite(commands, part);
+  };
+  if (clock_.count() > 0) clock_.RecordReset(commands, 0, kRasterParts + 1);
+  mark(kDepthPart);
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     if (drawn[slot]) RecordProduction(commands, shape, slot);
   }
+  mark(kFetchPart);
   if (fetch) RecordFetch(commands, shape, drawn);
+  mark(kAttributesPart);
   if (which.empty()) {
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                         VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
@@ -820,6 +844,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   vkCmdEndRendering(commands);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  mark(kReconstructionPart);
 
   vkCmdBeginRendering(commands, &rendering);
   for (std::size_t k = 0; k < which.size(); ++k) {
@@ -837,10 +862,12 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   // Nothing was drawn for a sample without geometry: it has no position.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+  mark(kNoGeometryPart);
   pass_->Bind(commands, no_geometry_.get(), VK_PIPELINE_BIND_POINT_COMPUTE);
   constants.output_offset = 0;
   pass_->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, (shape.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
+  mark(kRasterParts);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                       VK_ACCESS_HOST_READ_BIT);

@@ -37,12 +37,14 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <vulkan/vulkan.h>
 
 #include "bench/backends/backend.h"
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/timestamps.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/backends/vulkan/vulkan_context.h"
 #include "bench/base/status.h"
@@ -108,6 +110,12 @@ class RasterPass {
   Status QueueResident();
   Status FinishResident(ThreadPool* pool = nullptr);
 
+  // The device seconds of each part of the resident runs finished since
+  // Create, in the order a submission runs them (the depth passes, the
+  // fetch, the attributes, the reconstruction, the NaNs of samples without
+  // geometry); empty where the device cannot time its queue.
+  std::vector<std::pair<std::string, double>> part_seconds() const;
+
   // Per depth slot, since Create: RasterAgreement (raster_model.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
   // The texel bits pass 1 produced last, laid out as ShaderInputs::codes:
@@ -150,6 +158,8 @@ class RasterPass {
     std::vector<std::uint32_t> codes;   // the batch's, laid out as ShaderInputs::codes
     std::vector<std::uint8_t> geometry;  // per sample, 1 where the host gave it something to draw
   };
+  // The parts of a submission, each timed apart (part_seconds).
+  enum Part : std::uint32_t { kDepthPart, kFetchPart, kAttributesPart, kReconstructionPart, kNoGeometryPart, kRasterParts };
   struct Atlas {
     VulkanImage value;     // the depth attachment or the G-buffer channel
     VulkanImage coverage;  // R8_UINT: 1 where pass 1 drew
@@ -214,6 +224,10 @@ class RasterPass {
   };
   std::optional<RenderedBatch> rendered_;
   std::optional<ResidentRun> staged_resident_, queued_resident_;
+  // A timestamp before each part of a submission and one after the last
+  // (Record); part_seconds_ sums a resident run's parts when it finishes.
+  TimestampQueries clock_;
+  std::array<double, kRasterParts> part_seconds_{};
   std::vector<RasterAgreement> agreement_;
   std::vector<std::uint32_t> texels_;
   std::vector<float> fetched_;

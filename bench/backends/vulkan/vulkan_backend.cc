@@ -236,6 +236,9 @@ class VulkanBackend final : public Backend, public DeviceResidentRuns {
                                    ThreadPool* pool) override;
   Status QueueStaged() override;
   Status FinishQueued() override;
+  std::vector<std::pair<std::string, double>> part_seconds() const override {
+    return raster_ != nullptr ? raster_->part_seconds() : std::vector<std::pair<std::string, double>>{};
+  }
   Expected<std::vector<std::uint32_t>> CompileJudged(const VariantInfo& variant) const override;
 
  private:

@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/backends/backend.h"
@@ -104,6 +105,9 @@ class DeviceResidentRuns {
   // host keeps of it: the raster form's agreement with the host's model
   // (Backend::raster_agreement). Stage does the same for the run before.
   virtual Status FinishQueued() = 0;
+  // The device seconds of the finished runs' own parts, in order, where
+  // the runs time them (the raster form's: RasterPass::part_seconds).
+  virtual std::vector<std::pair<std::string, double>> part_seconds() const { return {}; }
   // `variant`'s function in the device judge's fused program
   // (VariantPass::kJudged), compiled as this backend compiles its own pass:
   // the same source of the function and the same arithmetic probes.
