@@ -359,6 +359,66 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   std::filesystem::remove_all(copy);
 }
 
+// Pass 2a draws each sample at its real pixel, through its frame's own
+// viewport: what the rasterizer interpolates there depends on the frame
+// and the pixel alone, not on where the sample lies in the batch or the
+// atlas. Frames 1 to 7 of the batch are made copies of frame 0 (its
+// constants, pixels and geometry), so that each sample of frame 0 has seven
+// twins at other atlas texels; where a twin's depth texel is the same bits,
+// its position must be too. Drawing pass 2a at the sample's atlas texel,
+// as the raster form once did, gives lavapipe other roundings of the rays
+// at other texels.
+TEST_F(RasterPassTest, TheAttributesDependOnTheFrameAndPixelAlone) {
+  const RunLayout layout = MakeRunLayout(std::vector<Cell>{{Variant::kFrustumRay, Convention::kLinear, Format::kR32Sfloat},
+                                                           {Variant::kEyeRay, Convention::kLinear, Format::kR32SfloatViewZ},
+                                                           {Variant::kVolumeRay, Convention::kLinear, Format::kR32Sfloat}});
+  Status status = raster_->Prepare(layout.cells, PassKind::kRaster);
+  ASSERT_TRUE(status.ok()) << status.message();
+  constexpr std::uint32_t kFrames = 8;
+  Batch batch = BuildBatch(layout, 0, kFrames * kSamplesPerFrame);
+  const std::uint32_t count = batch.count;
+  ASSERT_EQ(batch.frame_count(), kFrames);
+  for (std::uint32_t f = 1; f < kFrames; ++f) {
+    batch.frame_params[f] = batch.frame_params[0];
+    std::copy_n(batch.depth_params.begin(), kHardwareConventionCount,
+                batch.depth_params.begin() + f * kHardwareConventionCount);
+    for (std::uint32_t j = 0; j < kSamplesPerFrame; ++j) {
+      const std::uint32_t twin = f * kSamplesPerFrame + j;
+      batch.pixels[twin] = batch.pixels[j];
+      batch.raster[twin] = batch.raster[j];
+      for (std::uint32_t slot = 0; slot < batch.depth_slots; ++slot) {
+        batch.codes[slot * count + twin] = batch.codes[slot * count + j];
+        batch.depths[slot * count + twin] = batch.depths[slot * count + j];
+      }
+    }
+  }
+  std::vector<float> scratch;
+  const std::vector<std::uint32_t> which = AllIndices(layout);
+  auto positions = raster_->Run(batch, which, scratch);
+  ASSERT_TRUE(positions.ok()) << positions.status().message();
+  const std::vector<std::uint32_t> texels = raster_->raster_texels();
+  ASSERT_EQ(texels.size(), std::size_t{batch.depth_slots} * count);
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const std::uint32_t slot = layout.cells[which[k]].depth_slot;
+    std::size_t compared = 0, differing = 0;
+    for (std::uint32_t j = 0; j < kSamplesPerFrame; ++j) {
+      if (!HasGeometry(batch.raster[j])) continue;
+      for (std::uint32_t f = 1; f < kFrames; ++f) {
+        const std::uint32_t twin = f * kSamplesPerFrame + j;
+        if (texels[slot * count + twin] != texels[slot * count + j]) continue;
+        ++compared;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const float* component = positions->data() + (k * 3 + c) * count;
+          differing += std::bit_cast<std::uint32_t>(component[twin]) != std::bit_cast<std::uint32_t>(component[j]);
+        }
+      }
+    }
+    const std::string name = layout.cells[which[k]].cell.Name();
+    EXPECT_GT(compared, 200u) << name;
+    EXPECT_EQ(differing, 0u) << name << ": twins on the same texel bits reconstruct differently";
+  }
+}
+
 // A variant from the user's file, GLSL or HLSL, gets its raster program by
 // the same mechanism as the built-in ones, and runs the compute form's
 // arithmetic on the same stored depth: the same bits (d32_sfloat, so that

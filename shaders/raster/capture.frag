@@ -4,8 +4,8 @@
 // sample's pixel, from the full-screen triangle (the three rays) or from
 // the light volume's back faces (LIGHT_VOLUME: the view-space position),
 // stored as float32, exactly, for the sample's reconstructions to read
-// (raster_pass.glsl). The sample's scissor keeps the primitive to its own
-// texel. With COMPUTE_ATTRIBUTES (the compute-attributes probe,
+// (raster_pass.glsl). The sample's scissor keeps the primitive to one
+// pixel, and the vertex stage names the sample. With COMPUTE_ATTRIBUTES (the compute-attributes probe,
 // vulkan/arithmetic_probe.h) it stores instead what the compute form
 // computes at the pixel from the frame's constants: the run then differs
 // from one without it by what the interpolation does alone.
@@ -21,9 +21,10 @@ layout(location = 0) in vec3 frustum_ray;
 layout(location = 1) in vec3 eye_ray_view;
 layout(location = 2) in vec3 eye_ray_world;
 layout(location = 3) in vec3 volume_position;
+layout(location = 4) flat in uint sample_index;
 
 void main() {
-  uint i = sample_at(gl_FragCoord);
+  uint i = sample_index;
   uint base = ATTRIBUTES_PER_SAMPLE * i;
   vec3 rays[3] = vec3[](frustum_ray, eye_ray_view, eye_ray_world);
   vec3 volume = volume_position;

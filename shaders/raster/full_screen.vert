@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_ARB_shader_viewport_layer_array : require
 // Pass 2a of the raster form: the frame's full-screen triangle, per sample,
-// through the sample's own viewport (its scissor keeps the sample's texel;
-// raster_common.glsl).
+// through the frame's own viewport at the sample's real pixel, its scissor
+// keeping that pixel alone (raster_common.glsl).
 // Each vertex emits the screen attributes at its own uv, computed from the
 // frame's constants in float32 as the engines' vertex stages do (Pettineo
 // 2009's frustum ray; the eye-ray post's view- and world-space rays); the
@@ -15,6 +15,7 @@ layout(location = 0) out vec3 frustum_ray;
 layout(location = 1) out vec3 eye_ray_view;
 layout(location = 2) out vec3 eye_ray_world;
 layout(location = 3) out vec3 volume_position;  // the light-volume form's; none here
+layout(location = 4) flat out uint sample_index;
 
 void main() {
   FrameParams frame = frames[frame_of(uint(gl_InstanceIndex))];
@@ -27,5 +28,6 @@ void main() {
   eye_ray_world =
       interpolate_screen_attribute(frame.eye_ray_world_origin, frame.eye_ray_world_du, frame.eye_ray_world_dv, uv);
   volume_position = vec3(0.0f);
+  sample_index = uint(gl_InstanceIndex);
   gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
 }

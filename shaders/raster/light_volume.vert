@@ -16,6 +16,7 @@ layout(location = 0) out vec3 frustum_ray;  // the full-screen form's; none here
 layout(location = 1) out vec3 eye_ray_view;
 layout(location = 2) out vec3 eye_ray_world;
 layout(location = 3) out vec3 volume_position;
+layout(location = 4) flat out uint sample_index;
 
 // Vertex c is corner c of the cube: the centre plus (c & 1, c & 2, c & 4 ?
 // +half : -half) along x, y, z. The draw is indexed (vulkan/raster_pass.cc's
@@ -36,5 +37,6 @@ void main() {
   frustum_ray = vec3(0.0f);
   eye_ray_view = vec3(0.0f);
   eye_ray_world = vec3(0.0f);
+  sample_index = uint(gl_InstanceIndex);
   gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
 }

@@ -2,22 +2,25 @@
 // buffers of the one descriptor set both passes draw with, the draw's push
 // constants, and where a sample's frame is.
 //
-// The atlas: sample i of the batch is drawn into texel texel_of(i)
-// (atlas.inc) of an image as wide as atlas_width, as instance i of a
-// draw, its geometry moved by whole pixels so that its frame's pixel lands
-// on that texel; the geometry then rasterizes as it would at its real
-// pixel, and a fragment finds its sample from gl_FragCoord alone. Two ways
-// to move it (vulkan/raster_pass.cc):
-// - pass 1's small triangles, a few pixels across: the vertex stage moves
-//   them into one viewport over the atlas (atlas_placement.glsl), and a
-//   fragment off the sample's texel is discarded; one draw a depth slot;
+// Sample i of the batch is instance i of a draw. Where it is drawn
+// (vulkan/raster_pass.cc):
+// - pass 1's small triangle, a few pixels across, into texel texel_of(i)
+//   (atlas.inc) of an atlas image as wide as atlas_width: the vertex stage
+//   moves it by whole pixels into one viewport over the atlas
+//   (atlas_placement.glsl), so that its frame's pixel lands on that
+//   texel, and a fragment off the sample's texel is discarded; one draw a
+//   depth slot. Pass 2b's fragments then find their sample from
+//   gl_FragCoord alone;
 // - pass 2a's full-screen triangle and light volume, which span the frame:
-//   each sample through a viewport of its own, placed by the host, with a
-//   one-texel scissor. A scissor is the only way to keep such a primitive
-//   to one texel and leave its interpolation as it is (clipping it to the
-//   texel makes new vertices, whose attributes the clipper rounds afresh,
-//   and the fragment no longer gets the full-screen interpolation); the
-//   draws are VIEWPORTS_PER_DRAW samples each, once a run, not per cell.
+//   through the frame's own viewport, at the sample's real pixel, with a
+//   one-pixel scissor there; the vertex stage names the sample to the
+//   fragment (a flat input). A device's interpolation rounds differently
+//   at other window positions (on lavapipe, moving every sample onto its
+//   atlas texel moved the ray variants' median error by 0.15 bit), and a
+//   scissor is the only way to keep such a primitive to one pixel and
+//   leave its interpolation as it is (clipping it to the pixel makes new
+//   vertices, whose attributes the clipper rounds afresh); the draws are
+//   VIEWPORTS_PER_DRAW samples each, once a run, not per cell.
 layout(std430, set = 0, binding = 0) readonly buffer Frames { FrameParams frames[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_params[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };  // x | y << 16

@@ -499,20 +499,18 @@ Status RasterPass::CheckRun(const ShaderInputs& batch, const std::vector<bool>& 
     return InvalidArgument(fmt::format("a batch of {} samples needs more than the atlas's {} rows of {} texels",
                                        batch.count, rows, kAtlasWidth));
   }
-  // Pass 2a's viewport of a sample lies up to a frame's size beyond the atlas.
+  // Pass 2a draws through each frame's own viewport, into a window as large.
   const VkPhysicalDeviceLimits& limits = context_->properties().limits;
   for (const f32::FrameParams& frame : batch.frame_params) {
     const float width = frame.resolution.x;
     const float height = frame.resolution.y;
-    if (width > static_cast<float>(limits.maxViewportDimensions[0]) ||
-        height > static_cast<float>(limits.maxViewportDimensions[1]) ||
-        -width < limits.viewportBoundsRange[0] ||
-        static_cast<float>(rows) + height > limits.viewportBoundsRange[1]) {
+    const float most_width = static_cast<float>(std::min(limits.maxViewportDimensions[0], limits.maxFramebufferWidth));
+    const float most_height =
+        static_cast<float>(std::min(limits.maxViewportDimensions[1], limits.maxFramebufferHeight));
+    if (width > most_width || height > most_height || height > limits.viewportBoundsRange[1]) {
       return InvalidArgument(fmt::format(
-          "a {}x{} frame's viewports reach beyond what the device allows (at most {}x{}, within [{}, {}]) with an "
-          "atlas of {} rows",
-          width, height, limits.maxViewportDimensions[0], limits.maxViewportDimensions[1],
-          limits.viewportBoundsRange[0], limits.viewportBoundsRange[1], rows));
+          "a {}x{} frame is larger than the device's viewports and framebuffers (at most {}x{}, within [{}, {}])",
+          width, height, most_width, most_height, limits.viewportBoundsRange[0], limits.viewportBoundsRange[1]));
     }
   }
   return Status::Ok();
@@ -641,24 +639,23 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
     pass_->WriteDescriptors(writes, set);
   }
 
-  // Pass 2a: sample i's viewport puts its frame's pixel on texel i; the
-  // scissor keeps that texel alone. Whole draws: the last one's unused
-  // viewports repeat its last sample's.
+  // Pass 2a: sample i's viewport is its frame's, as the engine sets it,
+  // and its scissor keeps the sample's pixel alone. Whole draws: the last
+  // one's unused viewports repeat its last sample's.
   const std::uint32_t padded = (count + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
   viewports_.resize(padded);
   scissors_.resize(padded);
-  const RunShape shape = ShapeOf(batch);
+  capture_area_ = {{0, 0}, {1, 1}};
   for (std::uint32_t i = 0; i < padded; ++i) {
     const std::uint32_t sample = std::min(i, count - 1);
     const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
-    const std::uint32_t texel = shape.TexelOf(sample, AtlasRows());
-    const std::uint32_t x = texel % kAtlasWidth, y = texel / kAtlasWidth;
-    const auto pixel_x = static_cast<float>(batch.pixels[sample] & 0xffffu);
-    const auto pixel_y = static_cast<float>(batch.pixels[sample] >> 16);
     // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
-    viewports_[i] = {static_cast<float>(x) - pixel_x, static_cast<float>(y) - pixel_y + resolution.y, resolution.x,
-                     -resolution.y, 0.0f, 1.0f};
-    scissors_[i] = {{static_cast<std::int32_t>(x), static_cast<std::int32_t>(y)}, {1, 1}};
+    viewports_[i] = {0.0f, resolution.y, resolution.x, -resolution.y, 0.0f, 1.0f};
+    scissors_[i] = {{static_cast<std::int32_t>(batch.pixels[sample] & 0xffffu),
+                     static_cast<std::int32_t>(batch.pixels[sample] >> 16)},
+                    {1, 1}};
+    capture_area_.extent.width = std::max(capture_area_.extent.width, static_cast<std::uint32_t>(resolution.x));
+    capture_area_.extent.height = std::max(capture_area_.extent.height, static_cast<std::uint32_t>(resolution.y));
   }
   return Status::Ok();
 }
@@ -834,7 +831,10 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
   const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
                                         std::any_of(which.begin(), which.end(), reads_volume)};
-  vkCmdBeginRendering(commands, &rendering);
+  // Pass 2a draws over its frames' windows, not the atlas.
+  VkRenderingInfo capturing = rendering;
+  capturing.renderArea = capture_area_;
+  vkCmdBeginRendering(commands, &capturing);
   for (std::size_t k = 0; k < capture_.size(); ++k) {
     if (!captured[k]) continue;
     pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS);

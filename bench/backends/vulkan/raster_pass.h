@@ -24,10 +24,12 @@
 // kAtlasWidth, t / kAtlasWidth), of every atlas, g being the sweep's index
 // of the batch's first sample, so that a sample's texel does not depend on
 // the batch it is in. It is instance i of one draw per pass and slot or
-// cell, its geometry moved by whole pixels so that its frame's pixel lands
-// on that texel (shaders/raster/atlas_placement.glsl): it rasterizes as at
-// its real pixel. Pass 1's fragments off their own texel are discarded;
-// pass 2's primitives are clipped to it.
+// cell. Pass 1 moves its triangle by whole pixels so that its frame's
+// pixel lands on that texel (shaders/raster/atlas_placement.glsl), and
+// discards fragments off it; pass 2b covers the atlas. Pass 2a draws at
+// the sample's real pixel, through its frame's own viewport and a
+// one-pixel scissor there (a device's interpolation depends on the window
+// position; shaders/raster/raster_common.glsl).
 #pragma once
 
 #include <array>
@@ -215,6 +217,7 @@ class RasterPass {
   VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
   std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
   std::vector<VkRect2D> scissors_;
+  VkRect2D capture_area_{};  // pass 2a's render area: the run's largest frame
   std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
 
   // The batch whose every depth slot the atlases hold (Render), if any.
