@@ -56,7 +56,7 @@ enum Binding : std::uint32_t {
   kAttributes,  // what pass 2a captures for pass 2b: kAttributesPerSample vec4s a sample
   kFetched,        // fetch.comp's outputs: per (depth slot, sample) the fetched value,
   kTexelStatus,    // and its DB_RASTER_TEXEL_* status,
-  kCoverageCopies,  // from the copy of pass 1's coverage the host reads (readback_)
+  kCoverageCopies,  // from the copy of pass 1's coverage the host reads (Lane::readback)
   kBindingCount
 };
 // shaders/raster/atlas.inc's ATTRIBUTES_PER_SAMPLE.
@@ -338,12 +338,12 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
     bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kSetStages, nullptr};
   }
   bindings[kAtlases].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  // A set per atlas: the sets differ in the atlas alone, and a cell's draws
-  // bind its slot's.
+  // A set per atlas and lane (SetOf): a lane's sets differ in the atlas
+  // alone, and a cell's draws bind its slot's. A command buffer per lane.
   DB_ASSIGN_OR_RETURN(pass->pass_, ComputePass::Create(pass->context_, bindings, sizeof(f32::RasterConstants),
-                                                       kSetStages, std::max(atlases, 1u)));
+                                                       kSetStages, std::max(atlases, 1u) * kLanes, kLanes));
   if (TimestampQueries::Supported(*pass->context_).ok()) {
-    DB_ASSIGN_OR_RETURN(pass->clock_, TimestampQueries::Create(*pass->context_, kRasterParts + 1));
+    DB_ASSIGN_OR_RETURN(pass->clock_, TimestampQueries::Create(*pass->context_, kLanes * (kRasterParts + 1)));
   }
   DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
   DB_RETURN_IF_ERROR(pass->context_->GrowHostBuffer(pass->cube_indices_, sizeof(kCubeIndices),
@@ -549,11 +549,12 @@ Status RasterPass::EnsureAtlases() {
   return Status::Ok();
 }
 
-Status RasterPass::Upload(const ShaderInputs& batch) {
+Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane) {
+  Lane& to = lanes_[lane];
   const std::array<VkDeviceSize, kInputBindings> bytes = InputBytes(batch);
   const std::array<const void*, kInputBindings> data = {batch.frame_params.data(), batch.depth_params.data(),
                                                         batch.pixels.data(), batch.raster.data()};
-  const std::array<VulkanBuffer*, kInputBindings> buffers = {&frames_, &depth_params_, &pixels_, &geometry_};
+  const std::array<VulkanBuffer*, kInputBindings> buffers = {&to.frames, &to.depth_params, &to.pixels, &to.geometry};
   for (std::size_t binding = 0; binding < kInputBindings; ++binding) {
     VulkanBuffer& buffer = *buffers[binding];
     DB_RETURN_IF_ERROR(context_->GrowHostBuffer(buffer, bytes[binding], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
@@ -576,7 +577,7 @@ Status RasterPass::Upload(const ShaderInputs& batch) {
     coverage_offsets_[s] = readback_bytes;
     readback_bytes += AlignedTo4(texels);
   }
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(readback_, readback_bytes,
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.readback, readback_bytes,
                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                               HostAccess::kReadback));
   return Status::Ok();
@@ -586,26 +587,27 @@ Status RasterPass::Upload(const ShaderInputs& batch) {
 // buffers, room for the positions of `which`, the descriptors and the
 // samples' viewports.
 Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                         const std::vector<bool>& drawn, HostAccess outputs) {
+                         const std::vector<bool>& drawn, HostAccess outputs, std::uint32_t lane) {
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   DB_RETURN_IF_ERROR(EnsureAtlases());
-  DB_RETURN_IF_ERROR(Upload(batch));
+  DB_RETURN_IF_ERROR(Upload(batch, lane));
+  Lane& to = lanes_[lane];
   // The outputs go where their reader is: a buffer the host maps, or
   // device memory alone.
-  if (outputs != outputs_) {
-    positions_ = VulkanBuffer();
-    fetched_texels_ = VulkanBuffer();
-    outputs_ = outputs;
+  if (outputs != to.outputs) {
+    to.positions = VulkanBuffer();
+    to.fetched_texels = VulkanBuffer();
+    to.outputs = outputs;
   }
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   const VkDeviceSize position_bytes = std::max<VkDeviceSize>(VkDeviceSize{3} * count * which.size(), 1) * sizeof(float);
   const VkDeviceSize texel_bytes = VkDeviceSize{count} * slots_.size() * sizeof(float);
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(positions_, position_bytes, storage, outputs_));
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(fetched_texels_, texel_bytes, storage, outputs_));
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(texel_status_, texel_bytes, storage, HostAccess::kNone));
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.positions, position_bytes, storage, to.outputs));
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.fetched_texels, texel_bytes, storage, to.outputs));
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.texel_status, texel_bytes, storage, HostAccess::kNone));
   const VkDeviceSize attribute_bytes = kAttributesPerSample * count * sizeof(glm::vec4);
-  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(attributes_, attribute_bytes,
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.attributes, attribute_bytes,
                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                               HostAccess::kNone));
 
@@ -613,19 +615,19 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   // and each at its atlas.
   const std::array<VkDeviceSize, kInputBindings> input_bytes = InputBytes(batch);
   const std::array<VkDescriptorBufferInfo, kBindingCount> infos = {{
-      {frames_.handle(), 0, input_bytes[kFrames]},
-      {depth_params_.handle(), 0, input_bytes[kDepthParams]},
-      {pixels_.handle(), 0, input_bytes[kPixels]},
-      {geometry_.handle(), 0, input_bytes[kGeometry]},
+      {to.frames.handle(), 0, input_bytes[kFrames]},
+      {to.depth_params.handle(), 0, input_bytes[kDepthParams]},
+      {to.pixels.handle(), 0, input_bytes[kPixels]},
+      {to.geometry.handle(), 0, input_bytes[kGeometry]},
       {},
-      {positions_.handle(), 0, position_bytes},
-      {attributes_.handle(), 0, attribute_bytes},
-      {fetched_texels_.handle(), 0, texel_bytes},
-      {texel_status_.handle(), 0, texel_bytes},
-      {readback_.handle(), 0, VK_WHOLE_SIZE},
+      {to.positions.handle(), 0, position_bytes},
+      {to.attributes.handle(), 0, attribute_bytes},
+      {to.fetched_texels.handle(), 0, texel_bytes},
+      {to.texel_status.handle(), 0, texel_bytes},
+      {to.readback.handle(), 0, VK_WHOLE_SIZE},
   }};
-  for (std::uint32_t set = 0; set < atlases_.size(); ++set) {
-    const VkDescriptorImageInfo image{sampler_.get(), atlases_[set].value.view.get(),
+  for (std::uint32_t atlas = 0; atlas < atlases_.size(); ++atlas) {
+    const VkDescriptorImageInfo image{sampler_.get(), atlases_[atlas].value.view.get(),
                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     std::array<VkWriteDescriptorSet, kBindingCount> writes{};
     for (std::uint32_t binding = 0; binding < kBindingCount; ++binding) {
@@ -636,7 +638,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
     }
     writes[kAtlases].pBufferInfo = nullptr;
     writes[kAtlases].pImageInfo = &image;
-    pass_->WriteDescriptors(writes, set);
+    pass_->WriteDescriptors(writes, SetOf(lane, atlas));
   }
 
   // Pass 2a: sample i's viewport is its frame's, as the engine sets it,
@@ -665,17 +667,18 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   staged_resident_.reset();
   const std::vector<bool> drawn = EverySlot();
   rendered_.reset();
-  DB_RETURN_IF_ERROR(Stage(batch, {}, drawn, HostAccess::kReadback));
+  DB_RETURN_IF_ERROR(Stage(batch, {}, drawn, HostAccess::kReadback, 0));
   const RunShape shape = ShapeOf(batch);
-  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, shape, {}, drawn, true, 0); }));
-  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-  DB_RETURN_IF_ERROR(fetched_texels_.InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(pass_->Submit([&](VkCommandBuffer commands) { Record(commands, 0, shape, {}, drawn, true, 0); }));
+  const Lane& lane = lanes_[0];
+  DB_RETURN_IF_ERROR(lane.readback.InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(lane.fetched_texels.InvalidateForHostReads());
   const std::vector<std::uint8_t> geometry = GeometryOf(batch);
-  CompareTexels(shape, batch.codes, geometry, drawn, nullptr);
+  CompareTexels(0, shape, batch.codes, geometry, drawn, nullptr);
   // The batch's own fetched value where nothing was drawn, as for the codes.
   const std::size_t count = batch.count;
   fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
-  const auto* device_fetched = static_cast<const float*>(fetched_texels_.mapped());
+  const auto* device_fetched = static_cast<const float*>(lane.fetched_texels.mapped());
   for (std::size_t s = 0; s < slots_.size(); ++s) {
     if (!drawn[s]) continue;
     for (std::size_t i = 0; i < count; ++i) {
@@ -696,27 +699,32 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
   if (!rendered) {
     for (const std::uint32_t index : which) drawn[cells_[index].depth_slot] = true;
   }
-  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kReadback));
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kReadback, 0));
   const RunShape shape = ShapeOf(batch);
   DB_RETURN_IF_ERROR(pass_->Submit(
-      [&](VkCommandBuffer commands) { Record(commands, shape, which, drawn, false, unwritten_bits); }));
-  DB_RETURN_IF_ERROR(positions_.InvalidateForHostReads());
+      [&](VkCommandBuffer commands) { Record(commands, 0, shape, which, drawn, false, unwritten_bits); }));
+  const Lane& lane = lanes_[0];
+  DB_RETURN_IF_ERROR(lane.positions.InvalidateForHostReads());
   if (!rendered) {
-    DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
-    CompareTexels(shape, batch.codes, GeometryOf(batch), drawn, nullptr);
+    DB_RETURN_IF_ERROR(lane.readback.InvalidateForHostReads());
+    CompareTexels(0, shape, batch.codes, GeometryOf(batch), drawn, nullptr);
     // Only some slots may have been drawn: none of the atlases holds a whole render now.
     rendered_.reset();
   }
-  return static_cast<const float*>(positions_.mapped());
+  return static_cast<const float*>(lane.positions.mapped());
 }
 
 Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, std::span<const std::uint32_t> which,
                                                      std::uint32_t unwritten_bits, ThreadPool* pool) {
-  DB_RETURN_IF_ERROR(FinishResident(pool));
+  // The lane the run before last used: the device may still draw the last.
+  const auto lane = static_cast<std::uint32_t>(resident_runs_ % kLanes);
+  DB_RETURN_IF_ERROR(FinishLane(lane, pool));
   rendered_.reset();
   staged_resident_.reset();
   const std::vector<bool> drawn = EverySlot();
-  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone));
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone, lane));
+  staged_lane_ = lane;
+  const Lane& to = lanes_[lane];
   const std::uint32_t count = batch.count;
   staged_resident_ = ResidentRun{.shape = ShapeOf(batch),
                                  .which = {which.begin(), which.end()},
@@ -732,19 +740,19 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   }
   const VkDeviceSize texel_bytes = VkDeviceSize{count} * slots_.size() * sizeof(float);
   DeviceRunBuffers buffers;
-  buffers.positions = positions_.handle();
+  buffers.positions = to.positions.handle();
   buffers.position_bytes = VkDeviceSize{3} * count * which.size() * sizeof(float);
   buffers.lead = 0;
   buffers.slice_length = count;
-  buffers.texels = fetched_texels_.handle();
+  buffers.texels = to.fetched_texels.handle();
   buffers.texel_bytes = texel_bytes;
-  buffers.pixels = pixels_.handle();
+  buffers.pixels = to.pixels.handle();
   buffers.pixel_bytes = VkDeviceSize{count} * sizeof(std::uint32_t);
-  buffers.frame_params = frames_.handle();
+  buffers.frame_params = to.frames.handle();
   buffers.frame_param_bytes = batch.frame_params.size() * sizeof(f32::FrameParams);
-  buffers.depth_params = depth_params_.handle();
+  buffers.depth_params = to.depth_params.handle();
   buffers.depth_param_bytes = batch.depth_params.size() * sizeof(f32::DepthParams);
-  buffers.texel_status = texel_status_.handle();
+  buffers.texel_status = to.texel_status.handle();
   buffers.texel_status_bytes = texel_bytes;
   return buffers;
 }
@@ -753,26 +761,41 @@ Status RasterPass::QueueResident() {
   if (!staged_resident_) return Internal("no resident raster run staged");
   ResidentRun& run = *staged_resident_;
   const std::vector<bool> drawn = EverySlot();
-  DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting([&](VkCommandBuffer commands) {
-    Record(commands, run.shape, run.which, drawn, true, run.unwritten_bits);
-  }));
-  queued_resident_ = std::move(staged_resident_);
+  const std::uint32_t lane = staged_lane_;
+  DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting(
+      [&](VkCommandBuffer commands) {
+        Record(commands, lane, run.shape, run.which, drawn, true, run.unwritten_bits);
+      },
+      lane));
+  lanes_[lane].queued = std::move(staged_resident_);
+  lanes_[lane].order = resident_runs_++;
   staged_resident_.reset();
   return Status::Ok();
 }
 
-Status RasterPass::FinishResident(ThreadPool* pool) {
-  if (!queued_resident_) return Status::Ok();
-  const ResidentRun run = std::move(*queued_resident_);
-  queued_resident_.reset();
-  DB_RETURN_IF_ERROR(pass_->Wait());
-  DB_RETURN_IF_ERROR(readback_.InvalidateForHostReads());
+Status RasterPass::FinishLane(std::uint32_t lane, ThreadPool* pool) {
+  Lane& from = lanes_[lane];
+  if (!from.queued) return Status::Ok();
+  const ResidentRun run = std::move(*from.queued);
+  from.queued.reset();
+  DB_RETURN_IF_ERROR(pass_->Wait(lane));
+  DB_RETURN_IF_ERROR(from.readback.InvalidateForHostReads());
   const std::vector<bool> drawn = EverySlot();
-  CompareTexels(run.shape, run.codes, run.geometry, drawn, pool);
+  CompareTexels(lane, run.shape, run.codes, run.geometry, drawn, pool);
   if (clock_.count() > 0 && !run.which.empty()) {
-    DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps, clock_.Read(0, kRasterParts + 1));
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps,
+                        clock_.Read(lane * (kRasterParts + 1), kRasterParts + 1));
     for (std::uint32_t k = 0; k < kRasterParts; ++k) part_seconds_[k] += clock_.IntervalNs(stamps[k], stamps[k + 1]) * 1e-9;
   }
+  return Status::Ok();
+}
+
+// Oldest first, so that texels() ends as the last run's.
+Status RasterPass::FinishResident(ThreadPool* pool) {
+  std::array<std::uint32_t, kLanes> order{};
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) order[lane] = lane;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return lanes_[a].order < lanes_[b].order; });
+  for (const std::uint32_t lane : order) DB_RETURN_IF_ERROR(FinishLane(lane, pool));
   return Status::Ok();
 }
 
@@ -785,19 +808,22 @@ std::vector<std::pair<std::string, double>> RasterPass::part_seconds() const {
   return out;
 }
 
-void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
-                        const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const {
-  // Part k starts at timestamp k (Part); FinishResident reads them.
+void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape shape,
+                        std::span<const std::uint32_t> which, const std::vector<bool>& drawn, bool fetch,
+                        std::uint32_t unwritten_bits) const {
+  const Lane& on = lanes_[lane];
+  // Part k starts at the lane's timestamp k (Part); FinishLane reads them.
+  const std::uint32_t first_query = lane * (kRasterParts + 1);
   const auto mark = [&](std::uint32_t part) {
-    if (clock_.count() > 0) clock_.RecordWrite(commands, part);
+    if (clock_.count() > 0) clock_.RecordWrite(commands, first_query + part);
   };
-  if (clock_.count() > 0) clock_.RecordReset(commands, 0, kRasterParts + 1);
+  if (clock_.count() > 0) clock_.RecordReset(commands, first_query, kRasterParts + 1);
   mark(kDepthPart);
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
-    if (drawn[slot]) RecordProduction(commands, shape, slot);
+    if (drawn[slot]) RecordProduction(commands, lane, shape, slot);
   }
   mark(kFetchPart);
-  if (fetch) RecordFetch(commands, shape, drawn);
+  if (fetch) RecordFetch(commands, lane, shape, drawn);
   mark(kAttributesPart);
   if (which.empty()) {
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
@@ -805,8 +831,8 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
                         VK_ACCESS_HOST_READ_BIT);
     return;
   }
-  vkCmdFillBuffer(commands, positions_.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
-  vkCmdFillBuffer(commands, attributes_.handle(), 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(commands, on.positions.handle(), 0, VK_WHOLE_SIZE, unwritten_bits);
+  vkCmdFillBuffer(commands, on.attributes.handle(), 0, VK_WHOLE_SIZE, 0);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
 
@@ -837,7 +863,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   vkCmdBeginRendering(commands, &capturing);
   for (std::size_t k = 0; k < capture_.size(); ++k) {
     if (!captured[k]) continue;
-    pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
+    pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
     pass_->PushConstants(commands, &constants, sizeof(constants));
     RecordSampleDraws(commands, shape.count, k == 1);
   }
@@ -851,7 +877,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
     const CellPlan& plan = cells_[which[k]];
     const Variant variant = plan.cell.variant;
     pass_->Bind(commands, reconstruction_[static_cast<std::size_t>(variant)].get(), VK_PIPELINE_BIND_POINT_GRAPHICS,
-                *slots_[plan.depth_slot].atlas);
+                SetOf(lane, *slots_[plan.depth_slot].atlas));
     constants.convention_slot = plan.convention_slot;
     constants.output_offset = static_cast<std::uint32_t>(k * 3 * shape.count);
     pass_->PushConstants(commands, &constants, sizeof(constants));
@@ -863,7 +889,7 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
   mark(kNoGeometryPart);
-  pass_->Bind(commands, no_geometry_.get(), VK_PIPELINE_BIND_POINT_COMPUTE);
+  pass_->Bind(commands, no_geometry_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, SetOf(lane, 0));
   constants.output_offset = 0;
   pass_->PushConstants(commands, &constants, sizeof(constants));
   vkCmdDispatch(commands, (shape.count + kFetchWorkgroup - 1) / kFetchWorkgroup, 1, 1);
@@ -874,13 +900,14 @@ void RasterPass::Record(VkCommandBuffer commands, RunShape shape, std::span<cons
 }
 
 // After pass 1: what a fetch returns for every drawn texel, and its status.
-void RasterPass::RecordFetch(VkCommandBuffer commands, RunShape shape, const std::vector<bool>& drawn) const {
+void RasterPass::RecordFetch(VkCommandBuffer commands, std::uint32_t lane, RunShape shape,
+                             const std::vector<bool>& drawn) const {
   // The coverage copies (RecordProduction's) before the fetch reads them.
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   for (std::size_t slot = 0; slot < slots_.size(); ++slot) {
     if (!drawn[slot]) continue;
-    pass_->Bind(commands, fetch_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, *slots_[slot].atlas);
+    pass_->Bind(commands, fetch_.get(), VK_PIPELINE_BIND_POINT_COMPUTE, SetOf(lane, *slots_[slot].atlas));
     f32::RasterConstants constants{};
     constants.sample_count = shape.count;
     constants.atlas_width = kAtlasWidth;
@@ -896,7 +923,8 @@ void RasterPass::RecordFetch(VkCommandBuffer commands, RunShape shape, const std
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
 }
 
-void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot_index) const {
+void RasterPass::RecordProduction(VkCommandBuffer commands, std::uint32_t lane, RunShape shape,
+                                  std::size_t slot_index) const {
   const Slot& slot = slots_[slot_index];
   const Atlas& atlas = atlases_[*slot.atlas];
   const bool depth = IsDepthFormat(slot.encoding.format);
@@ -931,7 +959,7 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
   rendering.pColorAttachments = colors.data();
   rendering.pDepthAttachment = depth ? &depth_attachment : nullptr;
   vkCmdBeginRendering(commands, &rendering);
-  pass_->Bind(commands, slot.production.get(), VK_PIPELINE_BIND_POINT_GRAPHICS);
+  pass_->Bind(commands, slot.production.get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
   f32::RasterConstants constants{};
   constants.sample_count = shape.count;
   constants.atlas_width = kAtlasWidth;
@@ -959,7 +987,8 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, RunShape shape, std:
     region.imageSubresource = {image->aspect, 0, 0, 1};
     region.imageOffset = {0, static_cast<std::int32_t>(shape.first_row), 0};
     region.imageExtent = {kAtlasWidth, shape.rows, 1};
-    vkCmdCopyImageToBuffer(commands, image->image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.handle(), 1,
+    vkCmdCopyImageToBuffer(commands, image->image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           lanes_[lane].readback.handle(), 1,
                            &region);
   }
   RecordImageBarrier(commands, atlas.value, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
@@ -998,13 +1027,13 @@ void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count
   }
 }
 
-void RasterPass::CompareTexels(RunShape shape, std::span<const std::uint32_t> codes,
+void RasterPass::CompareTexels(std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> codes,
                                std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn,
                                ThreadPool* pool) {
   const std::size_t count = shape.count;
   texels_.resize(slots_.size() * count);
   texel_drawn_.resize(slots_.size() * count);
-  const auto* readback = static_cast<const std::byte*>(readback_.mapped());
+  const auto* readback = static_cast<const std::byte*>(lanes_[lane].readback.mapped());
   const std::uint32_t atlas_texels = kAtlasWidth * AtlasRows();
   // Each slot apart (its texels, its agreement): on the pool's threads.
   const auto compare = [&](std::size_t s) {

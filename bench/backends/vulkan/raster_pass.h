@@ -174,25 +174,34 @@ class RasterPass {
                         std::uint32_t arithmetic_probes, std::vector<std::string>& sources);
   // `drawn`: per depth slot, whether the submission draws it (pass 1).
   Status CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const;
-  // `outputs`: where the positions and fetched texels go (kReadback: the
-  // host reads them; kNone: a judge on the device does).
+  // Into lane `lane`. `outputs`: where the positions and fetched texels go
+  // (kReadback: the host reads them; kNone: a judge on the device does).
   Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn,
-               HostAccess outputs);
+               HostAccess outputs, std::uint32_t lane);
   Status EnsureAtlases();
-  Status Upload(const ShaderInputs& batch);
-  // `drawn`: per depth slot, whether pass 1 draws it and, where `fetch`,
-  // the fetch reads it; pass 2 draws `which` (none: pass 1 alone).
-  void Record(VkCommandBuffer commands, RunShape shape, std::span<const std::uint32_t> which,
+  Status Upload(const ShaderInputs& batch, std::uint32_t lane);
+  // Records a submission of lane `lane`. `drawn`: per depth slot, whether
+  // pass 1 draws it and, where `fetch`, the fetch reads it; pass 2 draws
+  // `which` (none: pass 1 alone).
+  void Record(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> which,
               const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const;
-  void RecordProduction(VkCommandBuffer commands, RunShape shape, std::size_t slot) const;
-  void RecordFetch(VkCommandBuffer commands, RunShape shape, const std::vector<bool>& drawn) const;
+  void RecordProduction(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, std::size_t slot) const;
+  void RecordFetch(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, const std::vector<bool>& drawn) const;
+  // The descriptor set of `atlas` in `lane`.
+  std::uint32_t SetOf(std::uint32_t lane, std::uint32_t atlas) const {
+    return lane * static_cast<std::uint32_t>(std::max<std::size_t>(atlases_.size(), 1)) + atlas;
+  }
+  // Waits for the resident run queued in `lane`, if any, and counts its
+  // texels (CompareTexels) and times its parts.
+  Status FinishLane(std::uint32_t lane, ThreadPool* pool);
   void RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape, std::uint32_t vertices) const;
   void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
   // Counts the texels pass 1 copied back into agreement_ against `codes`
   // (the host's model), for the samples `geometry` marks, and keeps them in
   // texels_ and texel_drawn_; each slot on a thread of `pool`, if given.
-  void CompareTexels(RunShape shape, std::span<const std::uint32_t> codes, std::span<const std::uint8_t> geometry,
-                     const std::vector<bool>& drawn, ThreadPool* pool);
+  // Reads lane `lane`'s readback.
+  void CompareTexels(std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> codes,
+                     std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn, ThreadPool* pool);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::vector<CellPlan> cells_;
@@ -208,12 +217,25 @@ class RasterPass {
 
   std::vector<Atlas> atlases_;  // per depth slot the cells read (Slot::atlas), AtlasRows() rows each
   bool atlases_made_ = false;
-  VulkanBuffer frames_, depth_params_, pixels_, geometry_, positions_, readback_;
-  // Per (depth slot, sample): what a fetch returns, and its DB_RASTER_TEXEL_*
-  // status (shaders/raster/fetch.comp).
-  VulkanBuffer fetched_texels_, texel_status_;
-  HostAccess outputs_ = HostAccess::kReadback;  // what positions_ and fetched_texels_ are now
-  VulkanBuffer attributes_;  // pass 2a's output: shaders/raster/capture.frag
+  // What one submission reads and writes beyond the atlases. Resident
+  // runs take the lanes in turn, so that the host stages a batch into one
+  // while the device draws the batch before from the other; the other
+  // runs use lane 0 once every resident run has finished.
+  struct Lane {
+    VulkanBuffer frames, depth_params, pixels, geometry, positions;
+    VulkanBuffer readback;  // pass 1's texels and coverage, for the host
+    // Per (depth slot, sample): what a fetch returns, and its
+    // DB_RASTER_TEXEL_* status (shaders/raster/fetch.comp).
+    VulkanBuffer fetched_texels, texel_status;
+    HostAccess outputs = HostAccess::kReadback;  // what positions and fetched_texels are now
+    VulkanBuffer attributes;  // pass 2a's output: shaders/raster/capture.frag
+    std::optional<ResidentRun> queued;  // the resident run queued here and not yet finished
+    std::uint64_t order = 0;            // when it was queued, counted over the resident runs
+  };
+  static constexpr std::uint32_t kLanes = 2;
+  std::array<Lane, kLanes> lanes_;
+  std::uint64_t resident_runs_ = 0;  // queued since Create
+  std::uint32_t staged_lane_ = 0;    // the lane of staged_resident_
   VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
   std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
   std::vector<VkRect2D> scissors_;
@@ -226,9 +248,10 @@ class RasterPass {
     std::uint32_t count;
   };
   std::optional<RenderedBatch> rendered_;
-  std::optional<ResidentRun> staged_resident_, queued_resident_;
-  // A timestamp before each part of a submission and one after the last
-  // (Record); part_seconds_ sums a resident run's parts when it finishes.
+  std::optional<ResidentRun> staged_resident_;
+  // Per lane, a timestamp before each part of a submission and one after
+  // the last (Record); part_seconds_ sums a resident run's parts when it
+  // finishes.
   TimestampQueries clock_;
   std::array<double, kRasterParts> part_seconds_{};
   std::vector<RasterAgreement> agreement_;
