@@ -1,9 +1,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_ARB_shader_viewport_layer_array : require
-// Pass 2a of the raster form: the frame's full-screen triangle, per sample,
-// through the frame's own viewport at the sample's real pixel, its scissor
-// keeping that pixel alone (raster_common.glsl).
+// Pass 2a of the raster form: the frame's full-screen triangle, per sample
+// (instance i draws sample_of_instance[i]), through the frame's own
+// viewport at the sample's real pixel, its scissor keeping that pixel
+// alone (raster_common.glsl).
 // Each vertex emits the screen attributes at its own uv, computed from the
 // frame's constants in float32 as the engines' vertex stages do (Pettineo
 // 2009's frustum ray; the eye-ray post's view- and world-space rays); the
@@ -18,7 +19,8 @@ layout(location = 3) out vec3 volume_position;  // the light-volume form's; none
 layout(location = 4) flat out uint sample_index;
 
 void main() {
-  FrameParams frame = frames[frame_of(uint(gl_InstanceIndex))];
+  uint i = sample_of_instance[gl_InstanceIndex];
+  FrameParams frame = frames[frame_of(i)];
   // uv (0, 0), (2, 0), (0, 2): a triangle whose inside covers the screen.
   vec2 uv = vec2(gl_VertexIndex == 1 ? 2.0f : 0.0f, gl_VertexIndex == 2 ? 2.0f : 0.0f);
   vec2 ndc = ndc_from_uv(uv);
@@ -28,6 +30,6 @@ void main() {
   eye_ray_world =
       interpolate_screen_attribute(frame.eye_ray_world_origin, frame.eye_ray_world_du, frame.eye_ray_world_dv, uv);
   volume_position = vec3(0.0f);
-  sample_index = uint(gl_InstanceIndex);
+  sample_index = i;
   gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
 }

@@ -27,8 +27,9 @@ float corner_coordinate(float centre, float half_edge, uint corner, uint bit) {
 }
 
 void main() {
-  uint frame_index = frame_of(uint(gl_InstanceIndex));
-  vec4 volume = raster[gl_InstanceIndex].volume;
+  uint i = sample_of_instance[gl_InstanceIndex];
+  uint frame_index = frame_of(i);
+  vec4 volume = raster[i].volume;
   uint corner = uint(gl_VertexIndex);
   vec4 world = vec4(corner_coordinate(volume.x, volume.w, corner, 1u), corner_coordinate(volume.y, volume.w, corner, 2u),
                     corner_coordinate(volume.z, volume.w, corner, 4u), 1.0f);
@@ -37,6 +38,6 @@ void main() {
   frustum_ray = vec3(0.0f);
   eye_ray_view = vec3(0.0f);
   eye_ray_world = vec3(0.0f);
-  sample_index = uint(gl_InstanceIndex);
+  sample_index = i;
   gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
 }

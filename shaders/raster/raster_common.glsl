@@ -26,6 +26,9 @@ layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_
 layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };  // x | y << 16
 layout(std430, set = 0, binding = 3) readonly buffer Samples { RasterSample raster[]; };
 layout(push_constant) uniform Draw { RasterConstants draw; };
+// Pass 2a: the sample instance i draws (its samples go block by block of
+// the window, vulkan/raster_pass.cc's OrderCaptures).
+layout(std430, set = 0, binding = 10) readonly buffer DrawOrder { uint sample_of_instance[]; };
 
 // Pass 2a's viewports a draw sets: its instances take them in turn, so the
 // host starts every such draw at a multiple of this.

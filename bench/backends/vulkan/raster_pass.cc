@@ -36,6 +36,13 @@ constexpr std::uint32_t kAtlasGuard = 128;
 // samples a draw. Every device with multiViewport has at least 16
 // viewports (the minimum of maxViewports).
 constexpr std::uint32_t kViewportsPerDraw = 16;
+// Pass 2a draws the samples block by block of the window, each block a
+// render pass instance over it alone: lavapipe's work for a render pass
+// grows with its area (2e5 full-screen triangles through render areas of
+// 1024, 4096 and 8192 pixels square: 1.0, 6.5 and 22 s), and the samples'
+// real pixels span whole frames (one area over the largest frame: 2.5 s;
+// blocks of 64, 128, 256 and 512 pixels: 2.8, 1.5, 1.1 to 1.3 and 1.2 s).
+constexpr std::uint32_t kCaptureBlock = 256;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
 constexpr std::uint32_t kTriangleVertices = 3;
 // The light volume's twelve triangles as corners of its cube
@@ -57,6 +64,7 @@ enum Binding : std::uint32_t {
   kFetched,        // fetch.comp's outputs: per (depth slot, sample) the fetched value,
   kTexelStatus,    // and its DB_RASTER_TEXEL_* status,
   kCoverageCopies,  // from the copy of pass 1's coverage the host reads (Lane::readback)
+  kDrawOrder,       // pass 2a: the sample each instance draws (CaptureBlock)
   kBindingCount
 };
 // shaders/raster/atlas.inc's ATTRIBUTES_PER_SAMPLE.
@@ -563,6 +571,12 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane) {
     DB_RETURN_IF_ERROR(buffer.FlushHostWrites());
   }
 
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.draw_order,
+                                              std::max<std::size_t>(draw_order_.size(), 1) * sizeof(std::uint32_t),
+                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, HostAccess::kUpload));
+  std::memcpy(to.draw_order.mapped(), draw_order_.data(), draw_order_.size() * sizeof(std::uint32_t));
+  DB_RETURN_IF_ERROR(to.draw_order.FlushHostWrites());
+
   // Pass 1's texels and coverage, slot after slot, each laid out as its
   // whole atlas and at a multiple of 4 bytes, as copies of depth aspects
   // require.
@@ -591,6 +605,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   DB_RETURN_IF_ERROR(EnsureAtlases());
+  OrderCaptures(batch);
   DB_RETURN_IF_ERROR(Upload(batch, lane));
   Lane& to = lanes_[lane];
   // The outputs go where their reader is: a buffer the host maps, or
@@ -625,6 +640,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
       {to.fetched_texels.handle(), 0, texel_bytes},
       {to.texel_status.handle(), 0, texel_bytes},
       {to.readback.handle(), 0, VK_WHOLE_SIZE},
+      {to.draw_order.handle(), 0, VK_WHOLE_SIZE},
   }};
   for (std::uint32_t atlas = 0; atlas < atlases_.size(); ++atlas) {
     const VkDescriptorImageInfo image{sampler_.get(), atlases_[atlas].value.view.get(),
@@ -641,25 +657,49 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
     pass_->WriteDescriptors(writes, SetOf(lane, atlas));
   }
 
-  // Pass 2a: sample i's viewport is its frame's, as the engine sets it,
-  // and its scissor keeps the sample's pixel alone. Whole draws: the last
-  // one's unused viewports repeat its last sample's.
-  const std::uint32_t padded = (count + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
-  viewports_.resize(padded);
-  scissors_.resize(padded);
-  capture_area_ = {{0, 0}, {1, 1}};
-  for (std::uint32_t i = 0; i < padded; ++i) {
-    const std::uint32_t sample = std::min(i, count - 1);
-    const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
-    // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
-    viewports_[i] = {0.0f, resolution.y, resolution.x, -resolution.y, 0.0f, 1.0f};
-    scissors_[i] = {{static_cast<std::int32_t>(batch.pixels[sample] & 0xffffu),
-                     static_cast<std::int32_t>(batch.pixels[sample] >> 16)},
-                    {1, 1}};
-    capture_area_.extent.width = std::max(capture_area_.extent.width, static_cast<std::uint32_t>(resolution.x));
-    capture_area_.extent.height = std::max(capture_area_.extent.height, static_cast<std::uint32_t>(resolution.y));
-  }
   return Status::Ok();
+}
+
+// Pass 2a: instance i draws sample draw_order_[i], through its frame's
+// viewport as the engine sets it, and a scissor that keeps the sample's
+// pixel alone. The samples go block by block of the window (kCaptureBlock),
+// each block's padded to whole draws by repeating its last sample (which
+// then writes the same attributes again).
+void RasterPass::OrderCaptures(const ShaderInputs& batch) {
+  const std::uint32_t count = batch.count;
+  const auto x_of = [&](std::uint32_t i) { return batch.pixels[i] & 0xffffu; };
+  const auto y_of = [&](std::uint32_t i) { return batch.pixels[i] >> 16; };
+  const std::uint32_t columns = 0x10000u / kCaptureBlock;
+  const auto block_of = [&](std::uint32_t i) { return y_of(i) / kCaptureBlock * columns + x_of(i) / kCaptureBlock; };
+  // A counting sort by block, stable, so that a block's samples keep their order.
+  std::vector<std::uint32_t> starts(columns * columns + 1, 0);
+  for (std::uint32_t i = 0; i < count; ++i) ++starts[block_of(i) + 1];
+  for (std::size_t b = 1; b < starts.size(); ++b) starts[b] += starts[b - 1];
+  std::vector<std::uint32_t> sorted(count);
+  std::vector<std::uint32_t> next(starts.begin(), starts.end() - 1);
+  for (std::uint32_t i = 0; i < count; ++i) sorted[next[block_of(i)]++] = i;
+
+  draw_order_.clear();
+  viewports_.clear();
+  scissors_.clear();
+  capture_blocks_.clear();
+  for (std::uint32_t b = 0; b + 1 < starts.size(); ++b) {
+    if (starts[b] == starts[b + 1]) continue;
+    const auto first = static_cast<std::uint32_t>(draw_order_.size());
+    const std::uint32_t samples = starts[b + 1] - starts[b];
+    const std::uint32_t padded = (samples + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
+    for (std::uint32_t k = 0; k < padded; ++k) {
+      const std::uint32_t sample = sorted[starts[b] + std::min(k, samples - 1)];
+      const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
+      draw_order_.push_back(sample);
+      // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
+      viewports_.push_back({0.0f, resolution.y, resolution.x, -resolution.y, 0.0f, 1.0f});
+      scissors_.push_back({{static_cast<std::int32_t>(x_of(sample)), static_cast<std::int32_t>(y_of(sample))}, {1, 1}});
+    }
+    const VkOffset2D corner = {static_cast<std::int32_t>(b % columns * kCaptureBlock),
+                               static_cast<std::int32_t>(b / columns * kCaptureBlock)};
+    capture_blocks_.push_back({{corner, {kCaptureBlock, kCaptureBlock}}, first, padded});
+  }
 }
 
 Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
@@ -857,17 +897,19 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
   const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
   const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
                                         std::any_of(which.begin(), which.end(), reads_volume)};
-  // Pass 2a draws over its frames' windows, not the atlas.
-  VkRenderingInfo capturing = rendering;
-  capturing.renderArea = capture_area_;
-  vkCmdBeginRendering(commands, &capturing);
-  for (std::size_t k = 0; k < capture_.size(); ++k) {
-    if (!captured[k]) continue;
-    pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
-    pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordSampleDraws(commands, shape.count, k == 1);
+  // Pass 2a draws at the samples' real pixels, a block of the window at a time.
+  for (const CaptureBlock& block : capture_blocks_) {
+    VkRenderingInfo capturing = rendering;
+    capturing.renderArea = block.area;
+    vkCmdBeginRendering(commands, &capturing);
+    for (std::size_t k = 0; k < capture_.size(); ++k) {
+      if (!captured[k]) continue;
+      pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
+      pass_->PushConstants(commands, &constants, sizeof(constants));
+      RecordSampleDraws(commands, block, k == 1);
+    }
+    vkCmdEndRendering(commands);
   }
-  vkCmdEndRendering(commands);
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   mark(kReconstructionPart);
@@ -1010,15 +1052,17 @@ void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunS
   vkCmdDraw(commands, vertices, count, 0, 0);
 }
 
-// Pass 2a: kViewportsPerDraw samples a draw, instance i taking viewport
+// Pass 2a over one block: kViewportsPerDraw instances a draw (a block's
+// instances start at a multiple of it), instance i taking viewport
 // i % kViewportsPerDraw, which the draw has just set; a full-screen
 // triangle each, or a light volume (`cubes`).
-void RasterPass::RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const {
+void RasterPass::RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock& block, bool cubes) const {
   if (cubes) vkCmdBindIndexBuffer(commands, cube_indices_.handle(), 0, VK_INDEX_TYPE_UINT16);
-  for (std::uint32_t first = 0; first < count; first += kViewportsPerDraw) {
+  const std::uint32_t end = block.first + block.instances;
+  for (std::uint32_t first = block.first; first < end; first += kViewportsPerDraw) {
     vkCmdSetViewport(commands, 0, kViewportsPerDraw, viewports_.data() + first);
     vkCmdSetScissor(commands, 0, kViewportsPerDraw, scissors_.data() + first);
-    const std::uint32_t instances = std::min(kViewportsPerDraw, count - first);
+    const std::uint32_t instances = std::min(kViewportsPerDraw, end - first);
     if (cubes) {
       vkCmdDrawIndexed(commands, static_cast<std::uint32_t>(kCubeIndices.size()), instances, 0, 0, first);
     } else {

@@ -195,7 +195,16 @@ class RasterPass {
   // texels (CompareTexels) and times its parts.
   Status FinishLane(std::uint32_t lane, ThreadPool* pool);
   void RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape, std::uint32_t vertices) const;
-  void RecordSampleDraws(VkCommandBuffer commands, std::uint32_t count, bool cubes) const;
+  // Pass 2a's draw order: a render pass instance over each block of the
+  // window that holds samples' pixels, and its instances
+  // [first, first + instances) of draw_order_ (OrderCaptures).
+  struct CaptureBlock {
+    VkRect2D area;
+    std::uint32_t first;
+    std::uint32_t instances;
+  };
+  void OrderCaptures(const ShaderInputs& batch);
+  void RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock& block, bool cubes) const;
   // Counts the texels pass 1 copied back into agreement_ against `codes`
   // (the host's model), for the samples `geometry` marks, and keeps them in
   // texels_ and texel_drawn_; each slot on a thread of `pool`, if given.
@@ -223,6 +232,7 @@ class RasterPass {
   // runs use lane 0 once every resident run has finished.
   struct Lane {
     VulkanBuffer frames, depth_params, pixels, geometry, positions;
+    VulkanBuffer draw_order;  // draw_order_, for pass 2a's vertex stage
     VulkanBuffer readback;  // pass 1's texels and coverage, for the host
     // Per (depth slot, sample): what a fetch returns, and its
     // DB_RASTER_TEXEL_* status (shaders/raster/fetch.comp).
@@ -237,9 +247,12 @@ class RasterPass {
   std::uint64_t resident_runs_ = 0;  // queued since Create
   std::uint32_t staged_lane_ = 0;    // the lane of staged_resident_
   VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
-  std::vector<VkViewport> viewports_;  // pass 2a's, per sample of the run, padded to whole draws
+  // Pass 2a's, per instance (OrderCaptures): the sample it draws, its
+  // viewport and scissor; and the blocks.
+  std::vector<std::uint32_t> draw_order_;
+  std::vector<VkViewport> viewports_;
   std::vector<VkRect2D> scissors_;
-  VkRect2D capture_area_{};  // pass 2a's render area: the run's largest frame
+  std::vector<CaptureBlock> capture_blocks_;
   std::vector<VkDeviceSize> texel_offsets_, coverage_offsets_;  // per depth slot, into readback_
 
   // The batch whose every depth slot the atlases hold (Render), if any.
