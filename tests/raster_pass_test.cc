@@ -327,9 +327,9 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   std::ifstream in(pass);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   in.close();
-  const std::string call = "vec3 p = RECONSTRUCT(frame, depth, uv, stored);";
+  const std::string call = "function(rasterized_frame(i, light_volume), depth, uv, stored)";
   ASSERT_NE(text.find(call), std::string::npos);
-  text.replace(text.find(call), call.size(), "vec3 p = volume_position.xyz;");
+  text.replace(text.find(call), call.size(), "rasterized_frame(i, light_volume).volume_position_origin.xyz");
   std::ofstream(pass) << text;
 
   BackendOptions options;

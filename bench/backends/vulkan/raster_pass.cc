@@ -24,6 +24,11 @@ struct RasterPass::Slot {
   std::uint32_t convention_slot = 0;
   std::optional<std::uint32_t> atlas;  // none when no prepared cell reads the slot
   DeviceObject<VkPipeline> production;
+  // Pass 2b of the built-in cells that read the slot, in one program
+  // (shaders/raster/raster_cells.glsl), and their indices among the
+  // prepared cells.
+  DeviceObject<VkPipeline> reconstruction;
+  std::vector<std::uint32_t> built_in_cells;
 };
 
 namespace {
@@ -43,6 +48,8 @@ constexpr std::uint32_t kViewportsPerDraw = 16;
 // real pixels span whole frames (one area over the largest frame: 2.5 s;
 // blocks of 64, 128, 256 and 512 pixels: 2.8, 1.5, 1.1 to 1.3 and 1.2 s).
 constexpr std::uint32_t kCaptureBlock = 256;
+// raster_cells.glsl's NO_SLICE: a prepared cell the run does not list.
+constexpr std::uint32_t kNoSlice = 0xffffffffu;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
 constexpr std::uint32_t kTriangleVertices = 3;
 // The light volume's twelve triangles as corners of its cube
@@ -65,6 +72,7 @@ enum Binding : std::uint32_t {
   kTexelStatus,    // and its DB_RASTER_TEXEL_* status,
   kCoverageCopies,  // from the copy of pass 1's coverage the host reads (Lane::readback)
   kDrawOrder,       // pass 2a: the sample each instance draws (CaptureBlock)
+  kCellSlices,      // pass 2b: per prepared cell, its slice of the positions in this run
   kBindingCount
 };
 // shaders/raster/atlas.inc's ATTRIBUTES_PER_SAMPLE.
@@ -440,10 +448,32 @@ Status RasterPass::BuildPipelines(std::span<const CellPlan> cells, const std::fi
                                                                                : "the raster form's full-screen rays"));
   }
 
-  // Pass 2b: one program per variant over the whole atlas.
+  // Pass 2b: one program per depth slot for its built-in cells, and one
+  // per user's variant, each over the whole atlas.
+  for (std::uint32_t index = 0; index < cells.size(); ++index) {
+    const CellPlan& plan = cells[index];
+    if (plan.cell.variant_info().user == nullptr) slots_[plan.depth_slot].built_in_cells.push_back(index);
+  }
+  for (Slot& slot : slots_) {
+    if (slot.built_in_cells.empty()) continue;
+    std::vector<RasterCell> programs;
+    for (const std::uint32_t index : slot.built_in_cells) {
+      const Variant variant = cells[index].cell.variant;
+      programs.push_back({&cells[index].cell.variant_info(), index, variant == Variant::kVolumeRay});
+    }
+    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> fragment,
+                        module(CompileRasterCells(programs, shader_dir, &sources),
+                               fmt::format("the raster program of {}/{}", Info(slot.encoding.convention).name,
+                                           Info(slot.encoding.format).name)));
+    DrawState state;
+    state.vertex = cover.get();
+    state.fragment = fragment.get();
+    DB_ASSIGN_OR_RETURN(slot.reconstruction, CreateGraphicsPipeline(device(), layout, state, "the raster program"));
+  }
   reconstruction_.clear();
   reconstruction_.resize(kMostVariants);
   for (const CellPlan& plan : cells) {
+    if (plan.cell.variant_info().user == nullptr) continue;
     const Variant variant = plan.cell.variant;
     DeviceObject<VkPipeline>& pipeline = reconstruction_[static_cast<std::size_t>(variant)];
     if (pipeline.get() != VK_NULL_HANDLE) continue;
@@ -622,6 +652,13 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.fetched_texels, texel_bytes, storage, to.outputs));
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.texel_status, texel_bytes, storage, HostAccess::kNone));
   const VkDeviceSize attribute_bytes = kAttributesPerSample * count * sizeof(glm::vec4);
+  // Where each listed cell's positions go (raster_cells.glsl's cell_slices).
+  std::vector<std::uint32_t> slices(std::max<std::size_t>(cells_.size(), 1), kNoSlice);
+  for (std::size_t k = 0; k < which.size(); ++k) slices[which[k]] = static_cast<std::uint32_t>(k);
+  DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.cell_slices, slices.size() * sizeof(std::uint32_t),
+                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, HostAccess::kUpload));
+  std::memcpy(to.cell_slices.mapped(), slices.data(), slices.size() * sizeof(std::uint32_t));
+  DB_RETURN_IF_ERROR(to.cell_slices.FlushHostWrites());
   DB_RETURN_IF_ERROR(context_->GrowHostBuffer(to.attributes, attribute_bytes,
                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                               HostAccess::kNone));
@@ -641,6 +678,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
       {to.texel_status.handle(), 0, texel_bytes},
       {to.readback.handle(), 0, VK_WHOLE_SIZE},
       {to.draw_order.handle(), 0, VK_WHOLE_SIZE},
+      {to.cell_slices.handle(), 0, VK_WHOLE_SIZE},
   }};
   for (std::uint32_t atlas = 0; atlas < atlases_.size(); ++atlas) {
     const VkDescriptorImageInfo image{sampler_.get(), atlases_[atlas].value.view.get(),
@@ -915,9 +953,25 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
   mark(kReconstructionPart);
 
   vkCmdBeginRendering(commands, &rendering);
+  // A draw per depth slot for its built-in cells (those the run does not
+  // list write nothing), then one per user's cell.
+  std::vector<bool> listed(cells_.size(), false);
+  for (const std::uint32_t index : which) listed[index] = true;
+  for (const Slot& slot : slots_) {
+    if (std::none_of(slot.built_in_cells.begin(), slot.built_in_cells.end(),
+                     [&](std::uint32_t index) { return listed[index]; })) {
+      continue;
+    }
+    pass_->Bind(commands, slot.reconstruction.get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, *slot.atlas));
+    constants.convention_slot = slot.convention_slot;
+    constants.output_offset = 0;
+    pass_->PushConstants(commands, &constants, sizeof(constants));
+    RecordDraws(commands, 1, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
+  }
   for (std::size_t k = 0; k < which.size(); ++k) {
     const CellPlan& plan = cells_[which[k]];
     const Variant variant = plan.cell.variant;
+    if (plan.cell.variant_info().user == nullptr) continue;
     pass_->Bind(commands, reconstruction_[static_cast<std::size_t>(variant)].get(), VK_PIPELINE_BIND_POINT_GRAPHICS,
                 SetOf(lane, *slots_[plan.depth_slot].atlas));
     constants.convention_slot = plan.convention_slot;

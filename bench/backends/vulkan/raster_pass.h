@@ -220,7 +220,9 @@ class RasterPass {
   std::unique_ptr<ComputePass> pass_;
   DeviceObject<VkSampler> sampler_;
   std::array<DeviceObject<VkPipeline>, 2> capture_;  // pass 2a: the full-screen triangle, the light volume
-  std::vector<DeviceObject<VkPipeline>> reconstruction_;  // pass 2b, indexed by Variant; null where no cell uses it
+  // Pass 2b of the users' variants, indexed by Variant; null where no cell uses it (the
+  // built-in cells run in their slot's program, Slot::reconstruction).
+  std::vector<DeviceObject<VkPipeline>> reconstruction_;
   DeviceObject<VkPipeline> fetch_;        // shaders/raster/fetch.comp
   DeviceObject<VkPipeline> no_geometry_;  // shaders/raster/no_geometry.comp
 
@@ -232,7 +234,8 @@ class RasterPass {
   // runs use lane 0 once every resident run has finished.
   struct Lane {
     VulkanBuffer frames, depth_params, pixels, geometry, positions;
-    VulkanBuffer draw_order;  // draw_order_, for pass 2a's vertex stage
+    VulkanBuffer draw_order;   // draw_order_, for pass 2a's vertex stage
+    VulkanBuffer cell_slices;  // per prepared cell, its positions' slice in the run (kCellSlices)
     VulkanBuffer readback;  // pass 1's texels and coverage, for the host
     // Per (depth slot, sample): what a fetch returns, and its
     // DB_RASTER_TEXEL_* status (shaders/raster/fetch.comp).

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <string>
+#include <string_view>
 #include <unordered_map>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -38,11 +40,14 @@ bool Generated(const VariantInfo& variant, VariantPass pass) {
 // settings, the shared headers, the contract, the user's file; for a
 // built-in one, the shared headers and its shared/variants/ header; then
 // the pass.
+std::string Include(const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); }
+constexpr std::string_view kGlslPreamble = "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+
 std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& dir) {
   const UserShader* user = variant.user;
   const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
-  auto include = [](const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); };
-  std::string text = hlsl ? "" : "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  const auto include = Include;
+  std::string text = hlsl ? "" : std::string(kGlslPreamble);
   if (pass == VariantPass::kJudged) {
     // The judge counts in 64-bit integers and raises 64-bit maxima.
     text +=
@@ -203,6 +208,29 @@ Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, 
   }
   if (!kept.empty()) kept.pop_back();
   return CompileError(kept);
+}
+
+Expected<std::vector<std::uint32_t>> CompileRasterCells(std::span<const RasterCell> cells,
+                                                        const std::filesystem::path& shader_dir,
+                                                        std::vector<std::string>* sources) {
+  const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
+  const auto include = Include;
+  std::string text = std::string(kGlslPreamble) + include(dir / "common.glsl");
+  std::string body;
+  std::vector<std::string_view> names;
+  for (const RasterCell& cell : cells) {
+    if (cell.variant == nullptr || cell.variant->user != nullptr) {
+      return InvalidArgument("a raster program of several cells runs built-in variants only");
+    }
+    text += include(dir.parent_path() / "shared" / "variants" / (std::string(cell.variant->name) + ".h"));
+    body += fmt::format("  DB_RASTER_CELL_AT({}, {}, {}u)\n", ReconstructFunctionName(*cell.variant),
+                        cell.light_volume ? "true" : "false", cell.cell);
+    names.push_back(cell.variant->name);
+  }
+  text += include(dir / "raster" / "raster_cells.glsl");
+  text += "void main() {\n  DB_RASTER_CELLS_BEGIN\n" + body + "}\n";
+  return CompileShaderSource(text, fmt::format("<the raster program of {}>", fmt::join(names, ", ")), dir,
+                             ShaderLanguage::kGlsl, ShaderStage::kFragment, sources);
 }
 
 }  // namespace depthbench

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,21 @@ enum class VariantPass : std::uint8_t {
 Expected<std::vector<std::uint32_t>> CompileVariant(const VariantInfo& variant, VariantPass pass,
                                                     const std::filesystem::path& shader_dir,
                                                     std::vector<std::string>* sources = nullptr);
+
+// One cell of the raster form's program of a depth slot
+// (raster/raster_cells.glsl): a built-in variant, its index in the run's
+// list of cells, and whether its rays come from the light volume.
+struct RasterCell {
+  const VariantInfo* variant = nullptr;
+  std::uint32_t cell = 0;
+  bool light_volume = false;
+};
+// SPIR-V of the fragment program that runs `cells`, built-in variants
+// reading one depth slot, each as its own raster program would
+// (VariantPass::kRaster), from the programs in `shader_dir`.
+Expected<std::vector<std::uint32_t>> CompileRasterCells(std::span<const RasterCell> cells,
+                                                        const std::filesystem::path& shader_dir,
+                                                        std::vector<std::string>* sources = nullptr);
 
 // The function of the program that holds the variant's arithmetic (what a
 // static cost model counts): <name>_world_position, or the user's entry.
