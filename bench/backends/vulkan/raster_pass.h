@@ -13,12 +13,14 @@
 //      at each sample's pixel, from the frame's full-screen triangle (the
 //      rays) and, where a volume_ray cell runs, the back faces of the
 //      sample's light volume (its view-space position), captured as
-//      float32 (shaders/raster/capture.frag); (b) per cell, one triangle
-//      over the atlas whose fragments run the variant's program
-//      (shaders/raster/raster_pass.glsl around its function) on the slot's
-//      texel and the captured attributes. Every cell's per-sample cost is
-//      then a fragment, as in the compute form's dispatch, and the
-//      geometry is drawn once per encoding (1) and once per run (2a).
+//      float32 (shaders/raster/capture.frag); (b) per depth slot, one
+//      triangle over the atlas whose fragments run the functions of the
+//      slot's built-in cells (shaders/raster/raster_cells.glsl), and per
+//      user's cell one whose fragments run its program
+//      (shaders/raster/raster_pass.glsl or the HLSL pass around its
+//      function), on the slot's texel and the captured attributes. The
+//      geometry is drawn once per encoding (1) and once per run (2a), and
+//      a texel is fetched once per slot (2b).
 //
 // Sample i of a batch is texel t = (g + i) mod the atlas's size, (t %
 // kAtlasWidth, t / kAtlasWidth), of every atlas, g being the sweep's index
