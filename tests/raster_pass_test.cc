@@ -359,6 +359,35 @@ TEST_F(RasterPassTest, LightVolumesDrawTheirBackFaces) {
   std::filesystem::remove_all(copy);
 }
 
+// The built-in cells of a depth slot reconstruct in one draw, each into
+// the slice the run lists it at: a run of some cells, in another order,
+// writes each one's positions where that run puts them, the same bits as
+// in a run of every cell, and nothing else.
+TEST_F(RasterPassTest, ARunOfSomeCellsWritesTheirSlicesAlone) {
+  const RunLayout layout = RepresentativeLayout();
+  ASSERT_TRUE(raster_->Prepare(layout.cells, PassKind::kRaster).ok());
+  const Batch batch = BuildBatch(layout, 0, 500);
+  const std::uint32_t count = batch.count;
+  std::vector<float> scratch;
+  const std::vector<std::uint32_t> every = AllIndices(layout);
+  auto all = raster_->Run(batch, every, scratch);
+  ASSERT_TRUE(all.ok()) << all.status().message();
+  const std::vector<float> whole(all->begin(), all->end());
+  // Every third cell, last first: slots keep some of their cells.
+  std::vector<std::uint32_t> some;
+  for (std::uint32_t index = 0; index < layout.cells.size(); index += 3) some.insert(some.begin(), index);
+  ASSERT_GT(some.size(), 3u);
+  auto part = raster_->Run(batch, some, scratch);
+  ASSERT_TRUE(part.ok()) << part.status().message();
+  ASSERT_EQ(part->size(), std::size_t{3} * some.size() * count);
+  for (std::size_t k = 0; k < some.size(); ++k) {
+    const std::size_t slice = std::size_t{3} * count;
+    EXPECT_EQ(std::memcmp(part->data() + k * slice, whole.data() + some[k] * slice, slice * sizeof(float)), 0)
+        << layout.cells[some[k]].cell.Name() << ", listed " << k << "th";
+  }
+  EXPECT_TRUE(context_->TakeValidationMessages().empty());
+}
+
 // Pass 2a draws each sample at its real pixel, through its frame's own
 // viewport: what the rasterizer interpolates there depends on the frame
 // and the pixel alone, not on where the sample lies in the batch or the
