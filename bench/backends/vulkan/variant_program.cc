@@ -41,12 +41,15 @@ bool Generated(const VariantInfo& variant, VariantPass pass) {
 // built-in one, the shared headers and its shared/variants/ header; then
 // the pass.
 std::string Include(const std::filesystem::path& path) { return fmt::format("#include \"{}\"\n", path.string()); }
+// A built-in variant's header, shared/variants/NAME.h beside the shader directory `dir`.
+std::filesystem::path BuiltInHeader(const std::filesystem::path& dir, const VariantInfo& variant) {
+  return dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h");
+}
 constexpr std::string_view kGlslPreamble = "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
 
 std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const std::filesystem::path& dir) {
   const UserShader* user = variant.user;
   const bool hlsl = user != nullptr && user->language == ShaderLanguage::kHlsl;
-  const auto include = Include;
   std::string text = hlsl ? "" : std::string(kGlslPreamble);
   if (pass == VariantPass::kJudged) {
     // The judge counts in 64-bit integers and raises 64-bit maxima.
@@ -55,27 +58,27 @@ std::string GeneratedProgram(const VariantInfo& variant, VariantPass pass, const
         "#extension GL_EXT_shader_atomic_int64 : require\n";
   }
   if (user == nullptr) {
-    text += include(dir / "common.glsl");
-    text += include(dir.parent_path() / "shared" / "variants" / (std::string(variant.name) + ".h"));
+    text += Include(dir / "common.glsl");
+    text += Include(BuiltInHeader(dir, variant));
     text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   } else {
     text += fmt::format(
         "#define DB_USER_ENTRY {}\n#define DB_USER_UV_BOTTOM_LEFT {}\n#define DB_USER_VIEW_LEFT_HANDED {}\n",
         user->entry, user->uv_bottom_left ? 1 : 0, user->view_left_handed ? 1 : 0);
-    text += include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
-    text += include(dir / "user" / "contract.inc");
-    text += include(user->path);
+    text += Include(hlsl ? dir / "user" / "common.hlsl" : dir / "common.glsl");
+    text += Include(dir / "user" / "contract.inc");
+    text += Include(user->path);
     text += fmt::format("#define RECONSTRUCT {}\n", ReconstructFunctionName(variant));
   }
   switch (pass) {
-    case VariantPass::kAccuracy: text += include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
+    case VariantPass::kAccuracy: text += Include(hlsl ? dir / "user" / "compute_pass.hlsl" : dir / "compute_pass.glsl"); break;
     case VariantPass::kSpeed:
-      text += include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
+      text += Include(hlsl ? dir / "user" / "speed_pass.hlsl" : dir / "speed" / "speed_pass.glsl");
       break;
     case VariantPass::kRaster:
-      text += include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
+      text += Include(hlsl ? dir / "user" / "raster_pass.hlsl" : dir / "raster" / "raster_pass.glsl");
       break;
-    case VariantPass::kJudged: text += include(dir / "judge" / "fused.comp"); break;
+    case VariantPass::kJudged: text += Include(dir / "judge" / "fused.comp"); break;
   }
   return text;
 }
@@ -214,20 +217,19 @@ Expected<std::vector<std::uint32_t>> CompileRasterCells(std::span<const RasterCe
                                                         const std::filesystem::path& shader_dir,
                                                         std::vector<std::string>* sources) {
   const std::filesystem::path dir = std::filesystem::absolute(shader_dir).lexically_normal();
-  const auto include = Include;
-  std::string text = std::string(kGlslPreamble) + include(dir / "common.glsl");
+  std::string text = std::string(kGlslPreamble) + Include(dir / "common.glsl");
   std::string body;
   std::vector<std::string_view> names;
   for (const RasterCell& cell : cells) {
     if (cell.variant == nullptr || cell.variant->user != nullptr) {
       return InvalidArgument("a raster program of several cells runs built-in variants only");
     }
-    text += include(dir.parent_path() / "shared" / "variants" / (std::string(cell.variant->name) + ".h"));
+    text += Include(BuiltInHeader(dir, *cell.variant));
     body += fmt::format("  DB_RASTER_CELL_AT({}, {}, {}u)\n", ReconstructFunctionName(*cell.variant),
                         cell.light_volume ? "true" : "false", cell.cell);
     names.push_back(cell.variant->name);
   }
-  text += include(dir / "raster" / "raster_cells.glsl");
+  text += Include(dir / "raster" / "raster_cells.glsl");
   text += "void main() {\n  DB_RASTER_CELLS_BEGIN\n" + body + "}\n";
   return CompileShaderSource(text, fmt::format("<the raster program of {}>", fmt::join(names, ", ")), dir,
                              ShaderLanguage::kGlsl, ShaderStage::kFragment, sources);
