@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_ARB_shader_viewport_layer_array : require
 // Pass 2a of the raster form: the frame's full-screen triangle, per sample
-// (instance i draws sample_of_instance[i]), through the frame's own
+// (vertices 3k to 3k + 2 draw drawn_sample[k]), through the frame's own
 // viewport at the sample's real pixel, its scissor keeping that pixel
 // alone (raster_common.glsl).
 // Each vertex emits the screen attributes at its own uv, computed from the
@@ -19,10 +19,12 @@ layout(location = 3) out vec3 volume_position;  // the light-volume form's; none
 layout(location = 4) flat out uint sample_index;
 
 void main() {
-  uint i = sample_of_instance[gl_InstanceIndex];
+  uint slot = uint(gl_VertexIndex) / 3u;
+  uint vertex = uint(gl_VertexIndex) % 3u;
+  uint i = drawn_sample[slot];
   FrameParams frame = frames[frame_of(i)];
   // uv (0, 0), (2, 0), (0, 2): a triangle whose inside covers the screen.
-  vec2 uv = vec2(gl_VertexIndex == 1 ? 2.0f : 0.0f, gl_VertexIndex == 2 ? 2.0f : 0.0f);
+  vec2 uv = vec2(vertex == 1u ? 2.0f : 0.0f, vertex == 2u ? 2.0f : 0.0f);
   vec2 ndc = ndc_from_uv(uv);
   gl_Position = vec4(ndc.x, ndc.y, 0.0f, 1.0f);
   frustum_ray = interpolate_screen_attribute(frame.frustum_ray_origin, frame.frustum_ray_du, frame.frustum_ray_dv, uv);
@@ -31,5 +33,5 @@ void main() {
       interpolate_screen_attribute(frame.eye_ray_world_origin, frame.eye_ray_world_du, frame.eye_ray_world_dv, uv);
   volume_position = vec3(0.0f);
   sample_index = i;
-  gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
+  gl_ViewportIndex = int(slot % uint(VIEWPORTS_PER_DRAW));
 }

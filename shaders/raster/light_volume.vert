@@ -20,17 +20,19 @@ layout(location = 4) flat out uint sample_index;
 
 // Vertex c is corner c of the cube: the centre plus (c & 1, c & 2, c & 4 ?
 // +half : -half) along x, y, z. The draw is indexed (vulkan/raster_pass.cc's
-// kCubeIndices), so the eight corners are shaded once a cube.
+// kCubeIndices), so the eight corners are shaded once a cube; vertices 8k
+// to 8k + 7 are the cube of drawn_sample[k].
 
 float corner_coordinate(float centre, float half_edge, uint corner, uint bit) {
   return (corner & bit) != 0u ? centre + half_edge : centre - half_edge;
 }
 
 void main() {
-  uint i = sample_of_instance[gl_InstanceIndex];
+  uint slot = uint(gl_VertexIndex) / 8u;
+  uint i = drawn_sample[slot];
   uint frame_index = frame_of(i);
   vec4 volume = raster[i].volume;
-  uint corner = uint(gl_VertexIndex);
+  uint corner = uint(gl_VertexIndex) % 8u;
   vec4 world = vec4(corner_coordinate(volume.x, volume.w, corner, 1u), corner_coordinate(volume.y, volume.w, corner, 2u),
                     corner_coordinate(volume.z, volume.w, corner, 4u), 1.0f);
   gl_Position = depth_of(frame_index, 0u).view_projection * world;
@@ -39,5 +41,5 @@ void main() {
   eye_ray_view = vec3(0.0f);
   eye_ray_world = vec3(0.0f);
   sample_index = i;
-  gl_ViewportIndex = gl_InstanceIndex % VIEWPORTS_PER_DRAW;
+  gl_ViewportIndex = int(slot % uint(VIEWPORTS_PER_DRAW));
 }

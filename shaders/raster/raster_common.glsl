@@ -2,9 +2,10 @@
 // buffers of the one descriptor set both passes draw with, the draw's push
 // constants, and where a sample's frame is.
 //
-// Sample i of the batch is instance i of a draw. Where it is drawn
-// (vulkan/raster_pass.cc):
-// - pass 1's small triangle, a few pixels across, into texel texel_of(i)
+// Where sample i of the batch is drawn (vulkan/raster_pass.cc); every draw
+// is one instance of many vertices, as a mesh's, where instances of a few
+// vertices each would leave most of a GPU's vertex lanes idle:
+// - pass 1's small triangle, vertices 3i to 3i + 2, a few pixels across, into texel texel_of(i)
 //   (atlas.inc) of an atlas image as wide as atlas_width: the vertex stage
 //   moves it by whole pixels into one viewport over the atlas
 //   (atlas_placement.glsl), so that its frame's pixel lands on that
@@ -26,12 +27,13 @@ layout(std430, set = 0, binding = 1) readonly buffer Depths { DepthParams depth_
 layout(std430, set = 0, binding = 2) readonly buffer Pixels { uint pixels[]; };  // x | y << 16
 layout(std430, set = 0, binding = 3) readonly buffer Samples { RasterSample raster[]; };
 layout(push_constant) uniform Draw { RasterConstants draw; };
-// Pass 2a: the sample instance i draws (its samples go block by block of
-// the window, vulkan/raster_pass.cc's OrderCaptures).
-layout(std430, set = 0, binding = 10) readonly buffer DrawOrder { uint sample_of_instance[]; };
+// Pass 2a: the sample that primitive k of the run's draws draws (its
+// samples go block by block of the window, vulkan/raster_pass.cc's
+// OrderCaptures).
+layout(std430, set = 0, binding = 10) readonly buffer DrawOrder { uint drawn_sample[]; };
 
-// Pass 2a's viewports a draw sets: its instances take them in turn, so the
-// host starts every such draw at a multiple of this.
+// Pass 2a's viewports a draw sets: primitive k takes viewport k modulo
+// this, so the host starts every such draw at a multiple of it.
 const int VIEWPORTS_PER_DRAW = 16;
 
 #include "atlas.inc"

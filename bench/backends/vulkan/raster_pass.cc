@@ -57,6 +57,18 @@ constexpr std::uint32_t kTriangleVertices = 3;
 // from outside: with the y-flipping viewport that is the front face.
 constexpr std::array<std::uint16_t, 36> kCubeIndices = {4, 6, 2, 4, 2, 0, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
                                                         6, 7, 3, 6, 3, 2, 2, 3, 1, 2, 1, 0, 4, 5, 7, 4, 7, 6};
+constexpr std::uint32_t kCubeCorners = 8;
+// A pass 2a draw's cubes, kViewportsPerDraw of them: cube k's corners are
+// vertices 8k to 8k + 7 (light_volume.vert).
+std::vector<std::uint16_t> DrawOfCubes(std::uint32_t cubes) {
+  std::vector<std::uint16_t> indices;
+  indices.reserve(cubes * kCubeIndices.size());
+  for (std::uint32_t k = 0; k < cubes; ++k) {
+    for (const std::uint16_t corner : kCubeIndices)
+      indices.push_back(static_cast<std::uint16_t>(k * kCubeCorners + corner));
+  }
+  return indices;
+}
 
 // The descriptor set both passes draw with (shaders/raster/): the batch's
 // inputs first.
@@ -67,11 +79,11 @@ enum Binding : std::uint32_t {
   kGeometry,
   kAtlases,
   kPositions,
-  kAttributes,  // what pass 2a captures for pass 2b: kAttributesPerSample vec4s a sample
-  kFetched,        // fetch.comp's outputs: per (depth slot, sample) the fetched value,
-  kTexelStatus,    // and its DB_RASTER_TEXEL_* status,
+  kAttributes,      // what pass 2a captures for pass 2b: kAttributesPerSample vec4s a sample
+  kFetched,         // fetch.comp's outputs: per (depth slot, sample) the fetched value,
+  kTexelStatus,     // and its DB_RASTER_TEXEL_* status,
   kCoverageCopies,  // from the copy of pass 1's coverage the host reads (Lane::readback)
-  kDrawOrder,       // pass 2a: the sample each instance draws (CaptureBlock)
+  kDrawOrder,       // pass 2a: the sample each primitive draws (CaptureBlock)
   kCellSlices,      // pass 2b: per prepared cell, its slice of the positions in this run
   kBindingCount
 };
@@ -362,9 +374,11 @@ Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanC
     DB_ASSIGN_OR_RETURN(pass->clock_, TimestampQueries::Create(*pass->context_, kLanes * (kRasterParts + 1)));
   }
   DB_ASSIGN_OR_RETURN(pass->sampler_, pass->context_->CreateTexelSampler());
-  DB_RETURN_IF_ERROR(pass->context_->GrowHostBuffer(pass->cube_indices_, sizeof(kCubeIndices),
-                                                    VK_BUFFER_USAGE_INDEX_BUFFER_BIT, HostAccess::kUpload));
-  std::memcpy(pass->cube_indices_.mapped(), kCubeIndices.data(), sizeof(kCubeIndices));
+  const std::vector<std::uint16_t> cubes = DrawOfCubes(kViewportsPerDraw);
+  const std::size_t cube_bytes = cubes.size() * sizeof(std::uint16_t);
+  DB_RETURN_IF_ERROR(pass->context_->GrowHostBuffer(pass->cube_indices_, cube_bytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                                                    HostAccess::kUpload));
+  std::memcpy(pass->cube_indices_.mapped(), cubes.data(), cube_bytes);
   DB_RETURN_IF_ERROR(pass->cube_indices_.FlushHostWrites());
   DB_RETURN_IF_ERROR(pass->BuildPipelines(cells, shader_dir, arithmetic_probes, sources));
   return pass;
@@ -698,9 +712,9 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   return Status::Ok();
 }
 
-// Pass 2a: instance i draws sample draw_order_[i], through its frame's
-// viewport as the engine sets it, and a scissor that keeps the sample's
-// pixel alone. The samples go block by block of the window (kCaptureBlock),
+// Pass 2a: primitive i of its draws draws sample draw_order_[i], through
+// its frame's viewport as the engine sets it, and a scissor that keeps the
+// sample's pixel alone. The samples go block by block of the window (kCaptureBlock),
 // each block's padded to whole draws by repeating its last sample (which
 // then writes the same attributes again).
 void RasterPass::OrderCaptures(const ShaderInputs& batch) {
@@ -966,7 +980,7 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
     constants.convention_slot = slot.convention_slot;
     constants.output_offset = 0;
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordDraws(commands, 1, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
+    RecordDraws(commands, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
   }
   for (std::size_t k = 0; k < which.size(); ++k) {
     const CellPlan& plan = cells_[which[k]];
@@ -977,7 +991,7 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
     constants.convention_slot = plan.convention_slot;
     constants.output_offset = static_cast<std::uint32_t>(k * 3 * shape.count);
     pass_->PushConstants(commands, &constants, sizeof(constants));
-    RecordDraws(commands, 1, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
+    RecordDraws(commands, shape, kTriangleVertices);  // atlas_cover.vert: the whole atlas
   }
   vkCmdEndRendering(commands);
 
@@ -1067,7 +1081,7 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, std::uint32_t lane, 
   constants.first_texel = shape.first_texel;
   constants.atlas_rows = AtlasRows();
   pass_->PushConstants(commands, &constants, sizeof(constants));
-  RecordDraws(commands, shape.count, shape, kTriangleVertices);
+  RecordDraws(commands, shape, kTriangleVertices * shape.count);
   vkCmdEndRendering(commands);
 
   // The texels and the coverage go to the host; the texels then to pass 2.
@@ -1095,32 +1109,34 @@ void RasterPass::RecordProduction(VkCommandBuffer commands, std::uint32_t lane, 
 }
 
 // Pass 1 and 2b: one draw for the whole batch through the atlas viewport
-// (pass 1: instance i is sample i, which the vertex stage places on its
-// texel; 2b: one instance over the atlas).
-void RasterPass::RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape,
-                             std::uint32_t vertices) const {
+// (pass 1: vertices 3i to 3i + 2 are sample i's triangle, which the vertex
+// stage places on its texel; 2b: one triangle over the atlas).
+void RasterPass::RecordDraws(VkCommandBuffer commands, RunShape shape, std::uint32_t vertices) const {
   const VkViewport viewport = AtlasViewport(AtlasRows());
   const VkRect2D scissor = shape.Area();
   vkCmdSetViewport(commands, 0, 1, &viewport);
   vkCmdSetScissor(commands, 0, 1, &scissor);
-  vkCmdDraw(commands, vertices, count, 0, 0);
+  vkCmdDraw(commands, vertices, 1, 0, 0);
 }
 
-// Pass 2a over one block: kViewportsPerDraw instances a draw (a block's
-// instances start at a multiple of it), instance i taking viewport
-// i % kViewportsPerDraw, which the draw has just set; a full-screen
-// triangle each, or a light volume (`cubes`).
+// Pass 2a over one block: kViewportsPerDraw samples a draw (a block's
+// samples start at a multiple of it), the draw's primitive k (sample
+// draw_order_[first + k]) taking viewport k, which the draw has just set;
+// a full-screen triangle each, or a light volume (`cubes`). The draw's
+// first vertex, or its vertex offset, names the block's sample
+// `first` to the vertex stage.
 void RasterPass::RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock& block, bool cubes) const {
   if (cubes) vkCmdBindIndexBuffer(commands, cube_indices_.handle(), 0, VK_INDEX_TYPE_UINT16);
-  const std::uint32_t end = block.first + block.instances;
+  const std::uint32_t end = block.first + block.samples;
   for (std::uint32_t first = block.first; first < end; first += kViewportsPerDraw) {
     vkCmdSetViewport(commands, 0, kViewportsPerDraw, viewports_.data() + first);
     vkCmdSetScissor(commands, 0, kViewportsPerDraw, scissors_.data() + first);
-    const std::uint32_t instances = std::min(kViewportsPerDraw, end - first);
+    const std::uint32_t samples = std::min(kViewportsPerDraw, end - first);
     if (cubes) {
-      vkCmdDrawIndexed(commands, static_cast<std::uint32_t>(kCubeIndices.size()), instances, 0, 0, first);
+      vkCmdDrawIndexed(commands, static_cast<std::uint32_t>(samples * kCubeIndices.size()), 1, 0,
+                       static_cast<std::int32_t>(first * kCubeCorners), 0);
     } else {
-      vkCmdDraw(commands, kTriangleVertices, instances, 0, first);
+      vkCmdDraw(commands, samples * kTriangleVertices, 1, first * kTriangleVertices, 0);
     }
   }
 }

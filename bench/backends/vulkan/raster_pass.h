@@ -196,14 +196,14 @@ class RasterPass {
   // Waits for the resident run queued in `lane`, if any, and counts its
   // texels (CompareTexels) and times its parts.
   Status FinishLane(std::uint32_t lane, ThreadPool* pool);
-  void RecordDraws(VkCommandBuffer commands, std::uint32_t count, RunShape shape, std::uint32_t vertices) const;
+  void RecordDraws(VkCommandBuffer commands, RunShape shape, std::uint32_t vertices) const;
   // Pass 2a's draw order: a render pass instance over each block of the
-  // window that holds samples' pixels, and its instances
-  // [first, first + instances) of draw_order_ (OrderCaptures).
+  // window that holds samples' pixels, and its samples
+  // [first, first + samples) of draw_order_ (OrderCaptures).
   struct CaptureBlock {
     VkRect2D area;
     std::uint32_t first;
-    std::uint32_t instances;
+    std::uint32_t samples;
   };
   void OrderCaptures(const ShaderInputs& batch);
   void RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock& block, bool cubes) const;
