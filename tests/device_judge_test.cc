@@ -586,10 +586,14 @@ TEST_F(DeviceJudgeTest, TheCpuBackendHasNoDeviceToJudgeOn) {
 // f/n 1e4 with the camera at the origin a few triangles within a float32
 // step of the far plane fail the depth test and leave their texel
 // uncovered (undrawn), and the samples that pick a stored value have no
-// geometry (degenerate): each path is reached and counted alike.
+// geometry (degenerate): each path is reached and counted alike. Eight
+// threads give the judging stage two (sweep_plan.cc), so that pass 2a is
+// recorded on both, each a share of the window's blocks
+// (RasterPass::RecordCapturesInParallel), whatever cores the machine has.
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheRasterForm) {
   SweepOptions options = Options(TypicalDomain());
   options.samples = 300000;
+  options.threads = 8;
   options.domain.ratio = {1e4, 1e4};
   options.domain.infinite_far = false;
   options.domain.camera_distance = {0.0, 0.0};

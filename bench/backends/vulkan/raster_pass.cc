@@ -48,6 +48,10 @@ constexpr std::uint32_t kViewportsPerDraw = 16;
 // real pixels span whole frames (one area over the largest frame: 2.5 s;
 // blocks of 64, 128, 256 and 512 pixels: 2.8, 1.5, 1.1 to 1.3 and 1.2 s).
 constexpr std::uint32_t kCaptureBlock = 256;
+// The fewest blocks worth a secondary command buffer of their own
+// (RecordCapturesInParallel): a batch of 262144 samples fills a few
+// hundred blocks.
+constexpr std::size_t kBlocksPerRecorder = 8;
 // raster_cells.glsl's NO_SLICE: a prepared cell the run does not list.
 constexpr std::uint32_t kNoSlice = 0xffffffffu;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UINT;
@@ -324,7 +328,12 @@ Status CheckRasterFeatures(const RasterFeatures& features, std::span<const CellP
 }
 
 RasterPass::RasterPass(std::shared_ptr<VulkanContext> context) : context_(std::move(context)) {}
-RasterPass::~RasterPass() = default;
+// The device may still run a lane's work: wait before its buffers and
+// command pools go.
+RasterPass::~RasterPass() {
+  if (pass_ == nullptr) return;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) (void)pass_->Wait(lane);
+}
 
 Expected<std::unique_ptr<RasterPass>> RasterPass::Create(std::shared_ptr<VulkanContext> context,
                                                          std::span<const CellPlan> cells,
@@ -822,7 +831,8 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
                                  .which = {which.begin(), which.end()},
                                  .unwritten_bits = unwritten_bits,
                                  .codes = {},
-                                 .geometry = GeometryOf(batch)};
+                                 .geometry = GeometryOf(batch),
+                                 .pool = pool};
   std::vector<std::uint32_t>& codes = staged_resident_->codes;
   codes.resize(std::size_t{count} * slots_.size());
   if (pool != nullptr) {
@@ -854,9 +864,10 @@ Status RasterPass::QueueResident() {
   ResidentRun& run = *staged_resident_;
   const std::vector<bool> drawn = EverySlot();
   const std::uint32_t lane = staged_lane_;
+  DB_ASSIGN_OR_RETURN(const std::vector<VkCommandBuffer> captures, RecordCapturesInParallel(lane, run));
   DB_RETURN_IF_ERROR(pass_->SubmitWithoutWaiting(
       [&](VkCommandBuffer commands) {
-        Record(commands, lane, run.shape, run.which, drawn, true, run.unwritten_bits);
+        Record(commands, lane, run.shape, run.which, drawn, true, run.unwritten_bits, captures);
       },
       lane));
   lanes_[lane].queued = std::move(staged_resident_);
@@ -902,7 +913,7 @@ std::vector<std::pair<std::string, double>> RasterPass::part_seconds() const {
 
 void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape shape,
                         std::span<const std::uint32_t> which, const std::vector<bool>& drawn, bool fetch,
-                        std::uint32_t unwritten_bits) const {
+                        std::uint32_t unwritten_bits, std::span<const VkCommandBuffer> captures) const {
   const Lane& on = lanes_[lane];
   // Part k starts at the lane's timestamp k (Part); FinishLane reads them.
   const std::uint32_t first_query = lane * (kRasterParts + 1);
@@ -934,33 +945,13 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
   rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
   rendering.renderArea = shape.Area();
   rendering.layerCount = 1;
-  f32::RasterConstants constants = {.sample_count = shape.count,
-                                    .atlas_width = kAtlasWidth,
-                                    .samples_per_frame = kSamplesPerFrame,
-                                    .first_in_frame = shape.first_offset,
-                                    .conventions_per_frame = kHardwareConventionCount,
-                                    .convention_slot = 0,
-                                    .output_offset = 0,
-                                    .viewport_height = ViewportHeight(AtlasRows()),
-                                    .coverage_word = 0,
-                                    .slices = static_cast<std::uint32_t>(3 * which.size()),
-                                    .first_texel = shape.first_texel,
-                                    .atlas_rows = AtlasRows()};
-  const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
-  const std::array<bool, 2> captured = {!std::all_of(which.begin(), which.end(), reads_volume),
-                                        std::any_of(which.begin(), which.end(), reads_volume)};
-  // Pass 2a draws at the samples' real pixels, a block of the window at a time.
-  for (const CaptureBlock& block : capture_blocks_) {
-    VkRenderingInfo capturing = rendering;
-    capturing.renderArea = block.area;
-    vkCmdBeginRendering(commands, &capturing);
-    for (std::size_t k = 0; k < capture_.size(); ++k) {
-      if (!captured[k]) continue;
-      pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
-      pass_->PushConstants(commands, &constants, sizeof(constants));
-      RecordSampleDraws(commands, block, k == 1);
-    }
-    vkCmdEndRendering(commands);
+  f32::RasterConstants constants = PassTwoConstants(shape, which.size());
+  // Pass 2a draws at the samples' real pixels, a block of the window at a
+  // time: here, or in the secondary command buffers recorded for it.
+  if (captures.empty()) {
+    RecordCaptures(commands, lane, constants, CapturedPrimitives(which), 0, capture_blocks_.size());
+  } else {
+    vkCmdExecuteCommands(commands, static_cast<std::uint32_t>(captures.size()), captures.data());
   }
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
@@ -1007,6 +998,110 @@ void RasterPass::Record(VkCommandBuffer commands, std::uint32_t lane, RunShape s
   RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                       VK_ACCESS_HOST_READ_BIT);
+}
+
+void RasterPass::RecordCaptures(VkCommandBuffer commands, std::uint32_t lane, const f32::RasterConstants& constants,
+                                std::array<bool, 2> captured, std::size_t begin, std::size_t end) const {
+  VkRenderingInfo capturing{};
+  capturing.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+  capturing.layerCount = 1;
+  for (std::size_t b = begin; b < end; ++b) {
+    const CaptureBlock& block = capture_blocks_[b];
+    capturing.renderArea = block.area;
+    vkCmdBeginRendering(commands, &capturing);
+    for (std::size_t k = 0; k < capture_.size(); ++k) {
+      if (!captured[k]) continue;
+      pass_->Bind(commands, capture_[k].get(), VK_PIPELINE_BIND_POINT_GRAPHICS, SetOf(lane, 0));
+      pass_->PushConstants(commands, &constants, sizeof(constants));
+      RecordSampleDraws(commands, block, k == 1);
+    }
+    vkCmdEndRendering(commands);
+  }
+}
+
+f32::RasterConstants RasterPass::PassTwoConstants(RunShape shape, std::size_t listed) const {
+  return {.sample_count = shape.count,
+          .atlas_width = kAtlasWidth,
+          .samples_per_frame = kSamplesPerFrame,
+          .first_in_frame = shape.first_offset,
+          .conventions_per_frame = kHardwareConventionCount,
+          .convention_slot = 0,
+          .output_offset = 0,
+          .viewport_height = ViewportHeight(AtlasRows()),
+          .coverage_word = 0,
+          .slices = static_cast<std::uint32_t>(3 * listed),
+          .first_texel = shape.first_texel,
+          .atlas_rows = AtlasRows()};
+}
+
+std::array<bool, 2> RasterPass::CapturedPrimitives(std::span<const std::uint32_t> which) const {
+  const auto reads_volume = [&](std::uint32_t index) { return cells_[index].cell.variant == Variant::kVolumeRay; };
+  return {!std::all_of(which.begin(), which.end(), reads_volume),
+          std::any_of(which.begin(), which.end(), reads_volume)};
+}
+
+// A driver records pass 2a's many small draws (each sets its viewports and
+// scissors) slowly: an H200's host took about 20 ms a batch of 262144
+// samples on one thread. Each recorder takes a run of whole blocks, about
+// as many samples each, and the primary runs them in block order. A
+// block's commands set all they use (pipeline, set, push constants,
+// dynamic state): a secondary command buffer inherits none of it.
+Expected<std::vector<VkCommandBuffer>> RasterPass::RecordCapturesInParallel(std::uint32_t lane,
+                                                                            const ResidentRun& run) {
+  const std::size_t blocks = capture_blocks_.size();
+  const auto recorders = static_cast<std::uint32_t>(
+      std::min<std::size_t>(run.pool == nullptr ? 1 : run.pool->size(), blocks / kBlocksPerRecorder));
+  if (recorders <= 1) return std::vector<VkCommandBuffer>{};
+
+  Lane& on = lanes_[lane];
+  while (on.recorders.size() < recorders) {
+    VkCommandPoolCreateInfo pool_info{};
+    pool_info.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+    pool_info.queueFamilyIndex = context_->properties().queue_family;
+    VkCommandPool handle = VK_NULL_HANDLE;
+    DB_RETURN_IF_ERROR(CheckVk(vkCreateCommandPool(device(), &pool_info, nullptr, &handle), "vkCreateCommandPool"));
+    Lane::Recorder recorder;
+    recorder.pool = DeviceObject<VkCommandPool>(device(), handle, vkDestroyCommandPool);
+    VkCommandBufferAllocateInfo buffer_info{};
+    buffer_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    buffer_info.commandPool = handle;
+    buffer_info.level = VK_COMMAND_BUFFER_LEVEL_SECONDARY;
+    buffer_info.commandBufferCount = 1;
+    DB_RETURN_IF_ERROR(
+        CheckVk(vkAllocateCommandBuffers(device(), &buffer_info, &recorder.commands), "vkAllocateCommandBuffers"));
+    on.recorders.push_back(std::move(recorder));
+  }
+  // Recorder g starts at the first block whose first sample is at least
+  // g / recorders of the way through the draw order.
+  std::vector<std::size_t> starts(recorders + 1, blocks);
+  const std::size_t total = draw_order_.size();
+  for (std::size_t g = 0, b = 0; g < recorders; ++g) {
+    while (b < blocks && std::size_t{capture_blocks_[b].first} * recorders < g * total) ++b;
+    starts[g] = b;
+  }
+  const f32::RasterConstants constants = PassTwoConstants(run.shape, run.which.size());
+  const std::array<bool, 2> captured = CapturedPrimitives(run.which);
+  std::vector<VkResult> results(recorders, VK_SUCCESS);
+  std::vector<VkCommandBuffer> secondaries(recorders);
+  run.pool->ParallelFor(recorders, [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t g = begin; g < end; ++g) {
+      secondaries[g] = on.recorders[g].commands;
+      results[g] = vkResetCommandPool(device(), on.recorders[g].pool.get(), 0);
+      VkCommandBufferInheritanceInfo inheritance{};
+      inheritance.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO;
+      VkCommandBufferBeginInfo begin_info{};
+      begin_info.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+      begin_info.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+      begin_info.pInheritanceInfo = &inheritance;
+      if (results[g] == VK_SUCCESS) results[g] = vkBeginCommandBuffer(secondaries[g], &begin_info);
+      if (results[g] != VK_SUCCESS) continue;
+      RecordCaptures(secondaries[g], lane, constants, captured, starts[g], starts[g + 1]);
+      results[g] = vkEndCommandBuffer(secondaries[g]);
+    }
+  });
+  for (const VkResult result : results) DB_RETURN_IF_ERROR(CheckVk(result, "recording pass 2a's blocks"));
+  return secondaries;
 }
 
 // After pass 1: what a fetch returns for every drawn texel, and its status.

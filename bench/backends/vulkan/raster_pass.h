@@ -161,6 +161,7 @@ class RasterPass {
     std::uint32_t unwritten_bits = 0;
     std::vector<std::uint32_t> codes;   // the batch's, laid out as ShaderInputs::codes
     std::vector<std::uint8_t> geometry;  // per sample, 1 where the host gave it something to draw
+    ThreadPool* pool = nullptr;          // where given, records pass 2a on its threads
   };
   // The parts of a submission, each timed apart (part_seconds).
   enum Part : std::uint32_t { kDepthPart, kFetchPart, kAttributesPart, kReconstructionPart, kNoGeometryPart, kRasterParts };
@@ -185,8 +186,22 @@ class RasterPass {
   // Records a submission of lane `lane`. `drawn`: per depth slot, whether
   // pass 1 draws it and, where `fetch`, the fetch reads it; pass 2 draws
   // `which` (none: pass 1 alone).
+  // `captures`: pass 2a's blocks recorded in secondary command buffers
+  // (RecordCapturesInParallel), run in this order; none: recorded here.
   void Record(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> which,
-              const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits) const;
+              const std::vector<bool>& drawn, bool fetch, std::uint32_t unwritten_bits,
+              std::span<const VkCommandBuffer> captures = {}) const;
+  f32::RasterConstants PassTwoConstants(RunShape shape, std::size_t listed) const;
+  // Whether pass 2a draws the full-screen triangles, and the light
+  // volumes, for the cells `which`.
+  std::array<bool, 2> CapturedPrimitives(std::span<const std::uint32_t> which) const;
+  // Pass 2a: capture_blocks_[begin, end), a render pass instance each.
+  void RecordCaptures(VkCommandBuffer commands, std::uint32_t lane, const f32::RasterConstants& constants,
+                      std::array<bool, 2> captured, std::size_t begin, std::size_t end) const;
+  // Pass 2a of `run`, staged in `lane`, recorded on the threads of its
+  // pool into the lane's secondary command buffers, in block order; none
+  // where it has no pool or too few blocks to share.
+  Expected<std::vector<VkCommandBuffer>> RecordCapturesInParallel(std::uint32_t lane, const ResidentRun& run);
   void RecordProduction(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, std::size_t slot) const;
   void RecordFetch(VkCommandBuffer commands, std::uint32_t lane, RunShape shape, const std::vector<bool>& drawn) const;
   // The descriptor set of `atlas` in `lane`.
@@ -244,6 +259,13 @@ class RasterPass {
     VulkanBuffer fetched_texels, texel_status;
     HostAccess outputs = HostAccess::kReadback;  // what positions and fetched_texels are now
     VulkanBuffer attributes;  // pass 2a's output: shaders/raster/capture.frag
+    // Pass 2a recorded on a pool's threads: per thread a command pool
+    // (command pools are not thread-safe) and its secondary command buffer.
+    struct Recorder {
+      DeviceObject<VkCommandPool> pool;
+      VkCommandBuffer commands = VK_NULL_HANDLE;  // freed with the pool
+    };
+    std::vector<Recorder> recorders;
     std::optional<ResidentRun> queued;  // the resident run queued here and not yet finished
     std::uint64_t order = 0;            // when it was queued, counted over the resident runs
   };
@@ -252,7 +274,7 @@ class RasterPass {
   std::uint64_t resident_runs_ = 0;  // queued since Create
   std::uint32_t staged_lane_ = 0;    // the lane of staged_resident_
   VulkanBuffer cube_indices_;  // kCubeIndices, for the light volumes
-  // Pass 2a's, per instance (OrderCaptures): the sample it draws, its
+  // Pass 2a's, per primitive (OrderCaptures): the sample it draws, its
   // viewport and scissor; and the blocks.
   std::vector<std::uint32_t> draw_order_;
   std::vector<VkViewport> viewports_;
