@@ -129,23 +129,19 @@ bool HasGeometry(const f32::RasterSample& sample) {
   return !(IsZero(sample.triangle0) && IsZero(sample.triangle1) && IsZero(sample.triangle2));
 }
 
-// Per sample of `batch`, 1 where HasGeometry.
-std::vector<std::uint8_t> GeometryOf(const ShaderInputs& batch) {
+// Per sample of `batch`, 1 where HasGeometry; on `pool`'s threads, if given.
+std::vector<std::uint8_t> GeometryOf(const ShaderInputs& batch, ThreadPool* pool = nullptr) {
   std::vector<std::uint8_t> geometry(batch.count);
-  for (std::uint32_t i = 0; i < batch.count; ++i) geometry[i] = HasGeometry(batch.raster[i]) ? 1 : 0;
-  return geometry;
-}
-// A texel's bits as ShaderInputs::codes holds them: X8_D24 keeps its depth
-// in the low 24 bits of the word, the other 8 are undefined.
-std::uint32_t CodeOf(Format format, const std::byte* texel) {
-  if (TexelBytes(format) == 2) {
-    std::uint16_t half = 0;
-    std::memcpy(&half, texel, sizeof(half));
-    return half;
+  const auto mark = [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t i = begin; i < end; ++i) geometry[i] = HasGeometry(batch.raster[i]) ? 1 : 0;
+  };
+  constexpr std::size_t kGrain = 16384;
+  if (pool == nullptr) {
+    mark(0, batch.count, 0);
+  } else {
+    pool->ParallelFor(batch.count, mark, kGrain);
   }
-  std::uint32_t word = 0;
-  std::memcpy(&word, texel, sizeof(word));
-  return format == Format::kX8D24Unorm ? word & 0x00ff'ffffu : word;
+  return geometry;
 }
 
 // What one graphics pipeline of the raster form differs in.
@@ -610,7 +606,7 @@ Status RasterPass::EnsureAtlases() {
   return Status::Ok();
 }
 
-Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane) {
+Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane, ThreadPool* pool) {
   Lane& to = lanes_[lane];
   const std::array<VkDeviceSize, kInputBindings> bytes = InputBytes(batch);
   const std::array<const void*, kInputBindings> data = {batch.frame_params.data(), batch.depth_params.data(),
@@ -620,7 +616,11 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane) {
     VulkanBuffer& buffer = *buffers[binding];
     DB_RETURN_IF_ERROR(context_->GrowHostBuffer(buffer, bytes[binding], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                                 HostAccess::kUpload));
-    std::memcpy(buffer.mapped(), data[binding], bytes[binding]);
+    if (pool != nullptr) {
+      pool->Copy(buffer.mapped(), data[binding], bytes[binding]);
+    } else {
+      std::memcpy(buffer.mapped(), data[binding], bytes[binding]);
+    }
     DB_RETURN_IF_ERROR(buffer.FlushHostWrites());
   }
 
@@ -654,12 +654,12 @@ Status RasterPass::Upload(const ShaderInputs& batch, std::uint32_t lane) {
 // buffers, room for the positions of `which`, the descriptors and the
 // samples' viewports.
 Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which,
-                         const std::vector<bool>& drawn, HostAccess outputs, std::uint32_t lane) {
+                         const std::vector<bool>& drawn, HostAccess outputs, std::uint32_t lane, ThreadPool* pool) {
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   DB_RETURN_IF_ERROR(EnsureAtlases());
   OrderCaptures(batch);
-  DB_RETURN_IF_ERROR(Upload(batch, lane));
+  DB_RETURN_IF_ERROR(Upload(batch, lane, pool));
   Lane& to = lanes_[lane];
   // The outputs go where their reader is: a buffer the host maps, or
   // device memory alone.
@@ -823,7 +823,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   rendered_.reset();
   staged_resident_.reset();
   const std::vector<bool> drawn = EverySlot();
-  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone, lane));
+  DB_RETURN_IF_ERROR(Stage(batch, which, drawn, HostAccess::kNone, lane, pool));
   staged_lane_ = lane;
   const Lane& to = lanes_[lane];
   const std::uint32_t count = batch.count;
@@ -831,7 +831,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
                                  .which = {which.begin(), which.end()},
                                  .unwritten_bits = unwritten_bits,
                                  .codes = {},
-                                 .geometry = GeometryOf(batch),
+                                 .geometry = GeometryOf(batch, pool),
                                  .pool = pool};
   std::vector<std::uint32_t>& codes = staged_resident_->codes;
   codes.resize(std::size_t{count} * slots_.size());
@@ -1248,32 +1248,61 @@ void RasterPass::CompareTexels(std::uint32_t lane, RunShape shape, std::span<con
   const auto compare = [&](std::size_t s) {
     std::uint32_t* kept = texels_.data() + s * count;
     std::uint8_t* kept_drawn = texel_drawn_.data() + s * count;
-    std::copy_n(codes.begin() + static_cast<std::ptrdiff_t>(s * count), count, kept);
+    const std::uint32_t* host_codes = codes.data() + s * count;
     std::fill_n(kept_drawn, count, std::uint8_t{1});
-    if (!drawn[s]) return;
+    if (!drawn[s]) {
+      std::copy_n(host_codes, count, kept);
+      return;
+    }
     const Format format = slots_[s].encoding.format;
-    const std::uint32_t bytes = TexelBytes(format);
     const std::byte* texels = readback + texel_offsets_[s];
     const std::byte* coverage = readback + coverage_offsets_[s];
-    RasterAgreement& agreement = agreement_[s];
-    std::uint32_t texel = shape.first_texel;  // sample i's (RunShape::TexelOf), stepped
-    for (std::size_t i = 0; i < count; ++i, texel = texel + 1 == atlas_texels ? 0 : texel + 1) {
-      if (geometry[i] == 0) continue;
-      const std::uint32_t host = kept[i];
-      const std::uint32_t device = CodeOf(format, texels + std::size_t{texel} * bytes);
-      kept[i] = device;
-      ++agreement.texels;
-      // An uncovered texel holds the clear value: it is counted apart,
-      // neither judged nor compared with the model (fetch.comp marks it
-      // undrawn for a judge on the device by the same byte).
-      if (coverage[texel] == std::byte{0}) {
-        ++agreement.uncovered;
-        kept_drawn[i] = 0;
-        continue;
+    // Counted here and added once: the slots' counts lie side by side in
+    // agreement_, and threads adding to them texel by texel would fight
+    // over their cache lines.
+    RasterAgreement counted;
+    const auto count_texels = [&](auto code_at) {
+      std::uint32_t texel = shape.first_texel;  // sample i's (RunShape::TexelOf), stepped
+      for (std::size_t i = 0; i < count; ++i, texel = texel + 1 == atlas_texels ? 0 : texel + 1) {
+        const std::uint32_t host = host_codes[i];
+        if (geometry[i] == 0) {
+          kept[i] = host;
+          continue;
+        }
+        const std::uint32_t device = code_at(texel);
+        kept[i] = device;
+        ++counted.texels;
+        // An uncovered texel holds the clear value: it is counted apart,
+        // neither judged nor compared with the model (fetch.comp marks it
+        // undrawn for a judge on the device by the same byte).
+        if (coverage[texel] == std::byte{0}) {
+          ++counted.uncovered;
+          kept_drawn[i] = 0;
+          continue;
+        }
+        if (device != host) {
+          ++counted.differing;
+          counted.max_code_distance = std::max(counted.max_code_distance, CodeDistance(format, device, host));
+        }
       }
-      agreement.differing += device != host ? 1 : 0;
-      agreement.max_code_distance = std::max(agreement.max_code_distance, CodeDistance(format, device, host));
+    };
+    // A texel's bits as ShaderInputs::codes holds them: X8_D24 keeps its
+    // depth in the low 24 bits of the word, the other 8 are undefined.
+    if (TexelBytes(format) == 2) {
+      count_texels([&](std::uint32_t texel) {
+        std::uint16_t half = 0;
+        std::memcpy(&half, texels + std::size_t{texel} * 2, sizeof(half));
+        return std::uint32_t{half};
+      });
+    } else {
+      const std::uint32_t mask = format == Format::kX8D24Unorm ? 0x00ff'ffffu : 0xffff'ffffu;
+      count_texels([&](std::uint32_t texel) {
+        std::uint32_t word = 0;
+        std::memcpy(&word, texels + std::size_t{texel} * 4, sizeof(word));
+        return word & mask;
+      });
     }
+    agreement_[s].Merge(counted);
   };
   if (pool == nullptr) {
     for (std::size_t s = 0; s < slots_.size(); ++s) compare(s);

@@ -179,10 +179,11 @@ class RasterPass {
   Status CheckRun(const ShaderInputs& batch, const std::vector<bool>& drawn) const;
   // Into lane `lane`. `outputs`: where the positions and fetched texels go
   // (kReadback: the host reads them; kNone: a judge on the device does).
+  // `pool`, where given, uploads on its threads.
   Status Stage(const ShaderInputs& batch, std::span<const std::uint32_t> which, const std::vector<bool>& drawn,
-               HostAccess outputs, std::uint32_t lane);
+               HostAccess outputs, std::uint32_t lane, ThreadPool* pool = nullptr);
   Status EnsureAtlases();
-  Status Upload(const ShaderInputs& batch, std::uint32_t lane);
+  Status Upload(const ShaderInputs& batch, std::uint32_t lane, ThreadPool* pool);
   // Records a submission of lane `lane`. `drawn`: per depth slot, whether
   // pass 1 draws it and, where `fetch`, the fetch reads it; pass 2 draws
   // `which` (none: pass 1 alone).
