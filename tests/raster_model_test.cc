@@ -5,10 +5,13 @@
 // pipelines' arithmetic differs. One pixel off is about 1e-3 of a ray, so
 // every bound below (a few ulps) tells a right pixel, face and matrix from
 // a wrong one.
+#include <bit>
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
+#include "bench/pipeline/batch.h"
 #include "bench/pipeline/encode.h"
 #include "bench/pipeline/raster_model.h"
 #include "bench/pipeline/shader_constants.h"
@@ -66,6 +69,43 @@ TEST(RasterModelTest, TheTrianglePutsTheSampledPointUnderItsPixel) {
     EXPECT_FLOAT_EQ(d.geometry.sample.volume.w, static_cast<float>(d.sample.eye_depth / 4.0));
   }
   EXPECT_GT(drawn, 3000);
+}
+
+TEST(RasterModelTest, TheTriangleTurnsByTheGoldenRatioFromSampleToSample) {
+  // Sample i's first corner lies at angle frac(i * 0.618...) of a turn
+  // around the pixel centre (x right, y down, in pixels), the others a
+  // third of a turn on. The corners' float32 rounding, 2^-24 of their
+  // distance from the origin (here the eye depth, a few thousand times
+  // the triangle's size on a frame thousands of pixels wide), and the
+  // float32 view matrix move them by up to a few 1e-4 rad; 2e-3 rad is
+  // allowed. A corner in the wrong octant or mirrored in its quarter is
+  // off by far more for all but a few angles.
+  int checked = 0;
+  for (const Drawn& d : DrawSamples(0.0, 2000)) {
+    if (!d.geometry.rendered_depth) continue;
+    const f32::RasterSample& g = d.geometry.sample;
+    std::array<glm::dvec3, 3> view;
+    for (int k = 0; k < 3; ++k) {
+      view[k] = glm::dvec3(glm::vec3(d.frame_params.world_view * std::array{g.triangle0, g.triangle1, g.triangle2}[k]));
+    }
+    const glm::dvec3 centre = (view[0] + view[1] + view[2]) / 3.0;
+    const double turn = std::fmod(static_cast<double>(d.sample.index) * 0.6180339887498948482, 1.0);
+    // The view units of a pixel at the triangle's depth (a frame's pixels
+    // need not be square).
+    const double tan_y = d.frame.tan_half_fov_y, depth = -centre.z;
+    const double pixel_x = 2.0 * d.frame.aspect * tan_y * depth / d.frame.width;
+    const double pixel_y = 2.0 * tan_y * depth / d.frame.height;
+    for (int k = 0; k < 3; ++k) {
+      // In pixels, with the screen's y down (view y is up).
+      const double angle =
+          std::atan2((centre.y - view[k].y) / pixel_y, (view[k].x - centre.x) / pixel_x) / (2.0 * std::numbers::pi);
+      double off = std::fmod(angle - turn - k / 3.0, 1.0);
+      off -= std::round(off);
+      EXPECT_LT(std::fabs(off), 2e-3 / (2.0 * std::numbers::pi)) << "sample " << d.sample.index << " corner " << k;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 1500);
 }
 
 TEST(RasterModelTest, NothingIsDrawnWhereFloatCornersCannotHoldTheTriangle) {
@@ -129,6 +169,43 @@ TEST(RasterModelTest, RasterizedDepthIsTheComputeFormsWithinUlps) {
     EXPECT_LT(worst, 16.0) << Info(encoding.convention).name << " " << Info(encoding.format).name;
     EXPECT_GT(worst, 0.0) << "the two pipelines round differently somewhere";
   }
+}
+
+TEST(RasterModelTest, OneModelPerSampleGivesEveryEncodingsValue) {
+  // A batch keeps one RasterTexelModel per sample for all its pipelines,
+  // which reuses the screen corners across matrices whose x, y and w rows
+  // agree. Asked in any order, among them a matrix whose x row differs
+  // (the screen must then be made again), it must give what a model made
+  // for each value alone gives, bit for bit.
+  std::vector<Encoding> encodings = MakeRunLayout(AllCells()).encodings;
+  std::vector<Encoding> twice(encodings.rbegin(), encodings.rend());
+  encodings.insert(encodings.end(), twice.begin(), twice.end());
+  int compared = 0, moved = 0;
+  for (const Drawn& d : DrawSamples(0.0, 500)) {
+    if (!d.geometry.rendered_depth) continue;
+    f32::DepthParams shifted = d.depth_params[0];
+    // x_ndc + 0.25: an eighth of the screen to the right.
+    for (int column = 0; column < 4; ++column) {
+      shifted.view_projection[column][0] += 0.25f * shifted.view_projection[column][3];
+    }
+    RasterTexelModel model(d.frame_params, d.sample.x, d.sample.y, d.geometry.sample);
+    for (std::size_t e = 0; e < encodings.size(); ++e) {
+      const Encoding encoding = encodings[e];
+      const bool hardware = Info(encoding.format).stores == DepthInput::kHardware;
+      const f32::DepthParams& depth =
+          e % 5 == 4 ? shifted : d.depth_params[hardware ? DepthSlot(encoding.convention) : 0];
+      const float alone =
+          RasterPipelineFloat(encoding, d.frame_params, depth, d.sample.x, d.sample.y, d.geometry.sample);
+      const float shared = model.Value(encoding, depth);
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(shared), std::bit_cast<std::uint32_t>(alone))
+          << "sample " << d.sample.index << ", " << Info(encoding.convention).name << " " << Info(encoding.format).name
+          << (e % 5 == 4 ? ", shifted matrix" : "");
+      ++compared;
+      moved += &depth == &shifted && std::isnan(alone) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(compared, 10000);
+  EXPECT_GT(moved, 1000) << "the shifted matrix moves the triangle off its pixel";
 }
 
 TEST(RasterModelTest, InterpolatedRaysAreTheComputeFormsWithinUlps) {

@@ -39,6 +39,36 @@ std::vector<std::uint32_t> PipelineOfSlots(std::span<const Encoding> encodings) 
   return pipeline_of_slot;
 }
 
+namespace {
+
+// The pipeline's float of the n samples whose entry in `floats` is NaN (in
+// the raster form, where the model of the rasterizer had no geometry),
+// gathered so that the four-lane production runs over them alone, as it
+// would over contiguous samples: each lane's result is its own.
+template <std::size_t kMost>
+void ProduceWhereNaN(Encoding encoding, ProductionModel model, const DepthMappings& mapping, const double* eye_depth,
+                     std::size_t n, float* floats) {
+  // (Only the first m elements are read; the compiler cannot tell.)
+  std::array<std::uint32_t, kMost> at{};
+  std::array<double, kMost> near{}, far{}, a{}, b{}, depth{};
+  std::array<float, kMost> produced{};
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (floats[i] == floats[i]) continue;
+    at[m] = static_cast<std::uint32_t>(i);
+    near[m] = mapping.near[i];
+    far[m] = mapping.far[i];
+    a[m] = mapping.a[i];
+    b[m] = mapping.b[i];
+    depth[m] = eye_depth[i];
+    ++m;
+  }
+  PipelineFloats(encoding, model, {near.data(), far.data(), a.data(), b.data()}, depth.data(), m, produced.data());
+  for (std::size_t j = 0; j < m; ++j) floats[at[j]] = produced[j];
+}
+
+}  // namespace
+
 BatchBuilder::BatchBuilder(const SampleSource& sampler, std::vector<Encoding> encodings, Isa isa)
     : sampler_(sampler),
       encodings_(std::move(encodings)),
@@ -201,6 +231,29 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
   for (auto* v : {&mapping_a_, &mapping_b_}) v->resize(host_produces ? pipelines * count : 0);
   produced_.resize(for_host ? pipelines * count : 0);
   batch.pipeline_floats.resize(host_produces ? pipelines * count : 0);
+  if (raster) {
+    // The host's model of the rasterizer, where there is geometry; NaN
+    // elsewhere, where the loop below keeps the compute form's float (such
+    // a sample is not judged). One model per sample serves every pipeline.
+    pool.ParallelFor(
+        count,
+        [&](std::size_t begin, std::size_t end, unsigned) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
+            RasterTexelModel model(batch.frame_params[frame], batch.pixels[i] & 0xffffu, batch.pixels[i] >> 16,
+                                   batch.raster[i]);
+            for (std::size_t k = 0; k < pipelines; ++k) {
+              const Encoding encoding = encodings_[pipeline_slots_[k]];
+              // Linear and view-z targets are drawn with the first convention's matrix.
+              const std::size_t drawn_with =
+                  Info(encoding.format).stores == DepthInput::kHardware ? DepthSlot(encoding.convention) : 0;
+              batch.pipeline_floats[k * count + i] =
+                  model.Value(encoding, batch.depth_params[frame * kHardwareConventionCount + drawn_with]);
+            }
+          }
+        },
+        256);
+  }
   pool.ParallelFor(host_produces ? pipelines * chunks : 0, [&](std::size_t begin, std::size_t end, unsigned) {
     for (std::size_t job = begin; job < end; ++job) {
       const std::size_t k = job / chunks;
@@ -227,18 +280,10 @@ void BatchBuilder::Build(std::uint64_t first, std::uint32_t count, Batch& batch,
       }
       const DepthMappings mapping = MappingOf(batch, k).At(lo);
       float* floats = batch.pipeline_floats.data() + k * count + lo;
-      PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
       if (raster) {
-        // The host's model of the rasterizer, where there is geometry (the
-        // rest keeps the compute form's float: it is not judged).
-        for (std::size_t i = lo; i < lo + n; ++i) {
-          const std::uint32_t frame = batch.FrameOf(static_cast<std::uint32_t>(i));
-          const std::size_t drawn_with = stores == DepthInput::kHardware ? convention : 0;
-          const float value = RasterPipelineFloat(encoding, batch.frame_params[frame],
-                                                  batch.depth_params[frame * kHardwareConventionCount + drawn_with],
-                                                  batch.pixels[i] & 0xffffu, batch.pixels[i] >> 16, batch.raster[i]);
-          if (value == value) floats[i - lo] = value;
-        }
+        ProduceWhereNaN<kChunk>(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
+      } else {
+        PipelineFloats(encoding, model_, mapping, samples.eye_depth.data() + lo, n, floats);
       }
       if (for_host) {
         DecodeEyeDepths(encoding, model_, mapping, floats, n, produced_.data() + k * count + lo, nullptr, isa_);

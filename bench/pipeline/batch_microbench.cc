@@ -22,8 +22,9 @@ namespace {
 
 constexpr std::uint32_t kBatch = 131072;  // as in reports/device-judge/h200.txt, sections 7 to 9
 
-void BM_BuildBatch(benchmark::State& state, BatchFor judge) {
-  const Domain domain = TypicalDomain();
+void BM_BuildBatch(benchmark::State& state, BatchFor judge, ProductionModel production) {
+  Domain domain = TypicalDomain();
+  domain.production = production;
   const RunLayout layout = MakeRunLayout(AllCells());
   const Sampler sampler(1, domain);
   const BatchBuilder builder(sampler, layout.encodings);
@@ -40,17 +41,24 @@ void BM_BuildBatch(benchmark::State& state, BatchFor judge) {
   state.counters["depth_slots"] = static_cast<double>(layout.encodings.size());
 }
 
-BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge)
+BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge, ProductionModel::kFloat32)
     ->RangeMultiplier(2)
     ->Range(1, 16)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge)
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge, ProductionModel::kFloat32)
     ->RangeMultiplier(2)
     ->Range(1, 16)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBatch, for_device_draws, BatchFor::kDeviceDraws)
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_draws, BatchFor::kDeviceDraws, ProductionModel::kFloat32)
+    ->RangeMultiplier(2)
+    ->Range(1, 16)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+// The raster form judged on its device: the host still makes each sample's
+// geometry and its model of every depth slot's texel.
+BENCHMARK_CAPTURE(BM_BuildBatch, raster_for_device_judge, BatchFor::kDeviceJudge, ProductionModel::kRaster)
     ->RangeMultiplier(2)
     ->Range(1, 16)
     ->UseRealTime()

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -48,29 +49,37 @@ L EdgeDistance(const glm::vec<2, L>& a, const glm::vec<2, L>& b, const glm::vec<
   return (e.x * (p.y - a.y) - e.y * (p.x - a.x)) / std::sqrt(e.x * e.x + e.y * e.y);
 }
 
-// GLSL's mat4 * vec4, in float32, one product and sum at a time in the
-// order a shader compiler emits them (glm pairs the sums instead).
+// Row `row` of GLSL's mat4 * vec4, in float32, one product and sum at a
+// time in the order a shader compiler emits them (glm pairs the sums
+// instead).
+float TransformRow(const glm::mat4& m, const glm::vec4& v, int row) {
+  float sum = m[0][row] * v.x;
+  sum = sum + m[1][row] * v.y;
+  sum = sum + m[2][row] * v.z;
+  sum = sum + m[3][row] * v.w;
+  return sum;
+}
 glm::vec4 Transform(const glm::mat4& m, const glm::vec4& v) {
   glm::vec4 out;
-  for (int row = 0; row < 4; ++row) {
-    float sum = m[0][row] * v.x;
-    sum = sum + m[1][row] * v.y;
-    sum = sum + m[2][row] * v.z;
-    sum = sum + m[3][row] * v.w;
-    out[row] = sum;
-  }
+  for (int row = 0; row < 4; ++row) out[row] = TransformRow(m, v, row);
   return out;
 }
 
-// A vertex after the vertex stage: its position on the frame's screen in
-// pixels (the float NDC taken exactly), its clip w, and the attribute.
-struct ScreenVertex {
-  glm::dvec2 screen;
-  double w;
-};
+// A vertex after the vertex stage.
+using ScreenVertex = RasterTexelModel::ScreenVertex;
 ScreenVertex ToScreen(const glm::vec4& clip, const f32::FrameParams& frame) {
   const double x = static_cast<double>(clip.x) / clip.w, y = static_cast<double>(clip.y) / clip.w;
   return {{(x + 1.0) * frame.resolution.x / 2.0, (1.0 - y) * frame.resolution.y / 2.0}, clip.w};
+}
+
+// Whether two matrices put every point at the same clip x, y and w.
+bool SameScreenRows(const glm::mat4& a, const glm::mat4& b) {
+  for (int column = 0; column < 4; ++column) {
+    for (int row : {0, 1, 3}) {
+      if (std::bit_cast<std::uint32_t>(a[column][row]) != std::bit_cast<std::uint32_t>(b[column][row])) return false;
+    }
+  }
+  return true;
 }
 
 // Screen-space barycentrics of p in the triangle, or nothing when p lies
@@ -103,6 +112,40 @@ T Interpolate(const std::array<ScreenVertex, 3>& v, const glm::dvec3& b, const s
 glm::dvec2 PixelCentre(std::uint32_t x, std::uint32_t y) { return {x + 0.5, y + 0.5}; }
 
 bool HasGeometry(const f32::RasterSample& g) { return g.triangle0.w != 0.0f; }
+
+// An angle by its cosine and sine.
+struct UnitAngle {
+  L cos, sin;
+  UnitAngle Plus(const UnitAngle& o) const { return {cos * o.cos - sin * o.sin, sin * o.cos + cos * o.sin}; }
+};
+// 0, 1/3 and 2/3 of a turn.
+constexpr L kSinThird = 0.866025403784438646763723170752936183L;  // sqrt(3) / 2
+constexpr std::array<UnitAngle, 3> kThirdTurns = {{{1.0L, 0.0L}, {-0.5L, kSinThird}, {-0.5L, -kSinThird}}};
+
+// The angle of `turns` (in [0, 1)) of a full turn. The C library reduces an
+// argument past pi/4 with a long remainder of pi/2 that took half the
+// build of a raster batch; here the reduction is exact in the turns
+// (multiplying by 8 and taking off whole eighths loses no bit), so only
+// angles within [0, pi/4] reach sinl and cosl.
+UnitAngle TurnOf(L turns) {
+  const L eighths = turns * 8.0L;
+  const int octant = static_cast<int>(eighths);  // 0 to 7
+  const L within = eighths - octant;             // [0, 1): of the octant, exactly
+  // From the octant's start, or back from its end on the odd ones, so the
+  // argument stays within [0, pi/4]:
+  const bool odd = (octant & 1) != 0;
+  const L angle = (odd ? 1.0L - within : within) * (std::numbers::pi_v<L> / 4.0L);
+  const L c = std::cos(angle), s = std::sin(angle);
+  // The octant's quarter turns, and the mirror of an odd octant in its
+  // quarter's diagonal.
+  const UnitAngle in_quarter = odd ? UnitAngle{s, c} : UnitAngle{c, s};
+  switch (octant / 2) {
+    case 0: return in_quarter;
+    case 1: return {-in_quarter.sin, in_quarter.cos};
+    case 2: return {-in_quarter.cos, -in_quarter.sin};
+    default: return {in_quarter.sin, -in_quarter.cos};
+  }
+}
 
 // The twelve triangles of the cube around `volume`, as corner indices
 // (bit 0: +x, bit 1: +y, bit 2: +z), two per face; the face's outward axis
@@ -143,12 +186,13 @@ RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample)
   // One pixel in view units at this depth, along x and (screen y down) y.
   const L pixel_x = 2.0L * tan_x * d / frame.width, pixel_y = 2.0L * tan_y * d / frame.height;
   // An equilateral triangle whose inscribed circle is centred on the pixel
-  // centre; its orientation turns from sample to sample.
-  const L turn = std::fmod(static_cast<L>(sample.index) * 0.6180339887498948482L, 1.0L) * 2.0L * std::numbers::pi_v<L>;
+  // centre; its orientation turns from sample to sample, by the golden
+  // ratio's fraction of a turn.
+  const UnitAngle first = TurnOf(std::fmod(static_cast<L>(sample.index) * 0.6180339887498948482L, 1.0L));
   std::array<glm::vec4, 3> corners;
   for (int k = 0; k < 3; ++k) {
-    const L angle = turn + k * 2.0L * std::numbers::pi_v<L> / 3.0L;
-    const L dx = 2.0L * kTriangleInradius * std::cos(angle), dy = 2.0L * kTriangleInradius * std::sin(angle);
+    const UnitAngle corner = first.Plus(kThirdTurns[k]);
+    const L dx = 2.0L * kTriangleInradius * corner.cos, dy = 2.0L * kTriangleInradius * corner.sin;
     const LVec3 view = centre_view + LVec3(dx * pixel_x, -dy * pixel_y, 0.0L);
     corners[k] = ToFloat4(camera + Rotate(frame.rotation, view), 1.0f);
   }
@@ -193,29 +237,44 @@ RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample)
 float RasterPipelineFloat(Encoding encoding, const f32::FrameParams& frame_params,
                           const f32::DepthParams& depth, std::uint32_t pixel_x, std::uint32_t pixel_y,
                           const f32::RasterSample& geometry) {
-  if (!HasGeometry(geometry)) return std::numeric_limits<float>::quiet_NaN();
-  const std::array<glm::vec4, 3> corners = {geometry.triangle0, geometry.triangle1, geometry.triangle2};
-  std::array<ScreenVertex, 3> vertices;
-  std::array<double, 3> window_z, view_z;
-  const bool gl_clip = (Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u;
-  for (int k = 0; k < 3; ++k) {
-    const glm::vec4 clip = Transform(depth.view_projection, corners[k]);
-    vertices[k] = ToScreen(clip, frame_params);
-    const float ndc_z = clip.z / clip.w;
-    window_z[k] = gl_clip ? ndc_z * 0.5f + 0.5f : ndc_z;
-    view_z[k] = Transform(frame_params.world_view, corners[k]).z;
+  return RasterTexelModel(frame_params, pixel_x, pixel_y, geometry).Value(encoding, depth);
+}
+
+RasterTexelModel::RasterTexelModel(const f32::FrameParams& frame_params, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                                   const f32::RasterSample& geometry)
+    : frame_params_(frame_params),
+      pixel_x_(pixel_x),
+      pixel_y_(pixel_y),
+      corners_{geometry.triangle0, geometry.triangle1, geometry.triangle2},
+      has_geometry_(HasGeometry(geometry)) {}
+
+float RasterTexelModel::Value(Encoding encoding, const f32::DepthParams& depth) {
+  constexpr float kNothing = std::numeric_limits<float>::quiet_NaN();
+  if (!has_geometry_) return kNothing;
+  if (!screen_of_ || !SameScreenRows(*screen_of_, depth.view_projection)) {
+    for (int k = 0; k < 3; ++k) vertices_[k] = ToScreen(Transform(depth.view_projection, corners_[k]), frame_params_);
+    barycentrics_ = Barycentrics(vertices_, PixelCentre(pixel_x_, pixel_y_));
+    screen_of_ = depth.view_projection;
+    view_z_.reset();
   }
-  const auto b = Barycentrics(vertices, PixelCentre(pixel_x, pixel_y));
-  if (!b) return std::numeric_limits<float>::quiet_NaN();
-  switch (Info(encoding.format).stores) {
-    case DepthInput::kHardware: return static_cast<float>(Interpolate(vertices, *b, window_z, false));
-    case DepthInput::kLinear: {
-      const auto z = static_cast<float>(Interpolate(vertices, *b, view_z, true));
-      return -z / frame_params.camera_position.w;
+  if (!barycentrics_) return kNothing;
+  const DepthInput stores = Info(encoding.format).stores;
+  if (stores == DepthInput::kHardware) {
+    const bool gl_clip = (Info(encoding.convention).bits & f32::DB_CONVENTION_CLIP_MINUS_ONE) != 0u;
+    std::array<double, 3> window_z;
+    for (int k = 0; k < 3; ++k) {
+      const float ndc_z = TransformRow(depth.view_projection, corners_[k], 2) / static_cast<float>(vertices_[k].w);
+      window_z[k] = gl_clip ? ndc_z * 0.5f + 0.5f : ndc_z;
     }
-    case DepthInput::kViewZ: return static_cast<float>(Interpolate(vertices, *b, view_z, true));
+    return static_cast<float>(Interpolate(vertices_, *barycentrics_, window_z, false));
   }
-  return std::numeric_limits<float>::quiet_NaN();
+  if (!view_z_) {
+    std::array<double, 3> view_z;
+    for (int k = 0; k < 3; ++k) view_z[k] = TransformRow(frame_params_.world_view, corners_[k], 2);
+    view_z_ = Interpolate(vertices_, *barycentrics_, view_z, true);
+  }
+  const auto z = static_cast<float>(*view_z_);
+  return stores == DepthInput::kLinear ? -z / frame_params_.camera_position.w : z;
 }
 
 f32::FrameParams RasterFrameParams(const f32::FrameParams& frame_params,

@@ -29,6 +29,7 @@
 // lavapipe is, is measured (tests/raster_model_test.cc).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 
@@ -86,6 +87,34 @@ struct RasterAgreement {
 float RasterPipelineFloat(Encoding encoding, const f32::FrameParams& frame_params,
                           const f32::DepthParams& depth, std::uint32_t pixel_x, std::uint32_t pixel_y,
                           const f32::RasterSample& geometry);
+
+// RasterPipelineFloat for one sample in many encodings. What they share is
+// computed once: the triangle's screen corners and the pixel's barycentrics
+// (the same for every view-projection matrix whose x, y and w rows are the
+// same bits, as the conventions' are), and its interpolated view z. The
+// values are RasterPipelineFloat's, bit for bit.
+class RasterTexelModel {
+ public:
+  RasterTexelModel(const f32::FrameParams& frame_params, std::uint32_t pixel_x, std::uint32_t pixel_y,
+                   const f32::RasterSample& geometry);
+  float Value(Encoding encoding, const f32::DepthParams& depth);
+
+  struct ScreenVertex {
+    glm::dvec2 screen;  // on the frame's screen, in pixels (the float NDC taken exactly)
+    double w;           // clip w
+  };
+
+ private:
+  const f32::FrameParams& frame_params_;
+  std::uint32_t pixel_x_, pixel_y_;
+  std::array<glm::vec4, 3> corners_;
+  bool has_geometry_;
+  // The screen, for the matrix whose x, y and w rows it was made with.
+  std::optional<glm::mat4> screen_of_;
+  std::array<ScreenVertex, 3> vertices_{};
+  std::optional<glm::dvec3> barycentrics_;
+  std::optional<double> view_z_;  // interpolated at the pixel (perspective-correct), for that screen
+};
 
 // The FrameParams a raster pass's fragment hands the variant at pixel
 // (x, y): its screen attributes replaced by the values the rasterizer
