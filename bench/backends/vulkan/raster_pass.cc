@@ -660,7 +660,7 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
   DB_RETURN_IF_ERROR(CheckRun(batch, drawn));
   const std::uint32_t count = batch.count;
   DB_RETURN_IF_ERROR(EnsureAtlases());
-  OrderCaptures(batch);
+  OrderCaptures(batch, pool);
   DB_RETURN_IF_ERROR(Upload(batch, lane, pool));
   Lane& to = lanes_[lane];
   // The outputs go where their reader is: a buffer the host maps, or
@@ -727,8 +727,9 @@ Status RasterPass::Stage(const ShaderInputs& batch, std::span<const std::uint32_
 // its frame's viewport as the engine sets it, and a scissor that keeps the
 // sample's pixel alone. The samples go block by block of the window (kCaptureBlock),
 // each block's padded to whole draws by repeating its last sample (which
-// then writes the same attributes again).
-void RasterPass::OrderCaptures(const ShaderInputs& batch) {
+// then writes the same attributes again). The blocks' primitives are
+// written on `pool`'s threads, if given.
+void RasterPass::OrderCaptures(const ShaderInputs& batch, ThreadPool* pool) {
   const std::uint32_t count = batch.count;
   const auto x_of = [&](std::uint32_t i) { return batch.pixels[i] & 0xffffu; };
   const auto y_of = [&](std::uint32_t i) { return batch.pixels[i] >> 16; };
@@ -742,26 +743,43 @@ void RasterPass::OrderCaptures(const ShaderInputs& batch) {
   std::vector<std::uint32_t> next(starts.begin(), starts.end() - 1);
   for (std::uint32_t i = 0; i < count; ++i) sorted[next[block_of(i)]++] = i;
 
-  draw_order_.clear();
-  viewports_.clear();
-  scissors_.clear();
   capture_blocks_.clear();
+  std::vector<std::uint32_t> sorted_first;  // of each capture block, in `sorted`
+  std::uint32_t primitives = 0;
   for (std::uint32_t b = 0; b + 1 < starts.size(); ++b) {
     if (starts[b] == starts[b + 1]) continue;
-    const auto first = static_cast<std::uint32_t>(draw_order_.size());
     const std::uint32_t samples = starts[b + 1] - starts[b];
     const std::uint32_t padded = (samples + kViewportsPerDraw - 1) / kViewportsPerDraw * kViewportsPerDraw;
-    for (std::uint32_t k = 0; k < padded; ++k) {
-      const std::uint32_t sample = sorted[starts[b] + std::min(k, samples - 1)];
-      const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
-      draw_order_.push_back(sample);
-      // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
-      viewports_.push_back({0.0f, resolution.y, resolution.x, -resolution.y, 0.0f, 1.0f});
-      scissors_.push_back({{static_cast<std::int32_t>(x_of(sample)), static_cast<std::int32_t>(y_of(sample))}, {1, 1}});
-    }
     const VkOffset2D corner = {static_cast<std::int32_t>(b % columns * kCaptureBlock),
                                static_cast<std::int32_t>(b / columns * kCaptureBlock)};
-    capture_blocks_.push_back({{corner, {kCaptureBlock, kCaptureBlock}}, first, padded});
+    capture_blocks_.push_back({{corner, {kCaptureBlock, kCaptureBlock}}, primitives, padded});
+    sorted_first.push_back(starts[b]);
+    primitives += padded;
+  }
+  draw_order_.resize(primitives);
+  viewports_.resize(primitives);
+  scissors_.resize(primitives);
+  const auto write = [&](std::size_t begin, std::size_t end, unsigned) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const CaptureBlock& block = capture_blocks_[c];
+      const std::uint32_t samples = (c + 1 < capture_blocks_.size() ? sorted_first[c + 1] : count) - sorted_first[c];
+      for (std::uint32_t k = 0; k < block.samples; ++k) {
+        const std::uint32_t sample = sorted[sorted_first[c] + std::min(k, samples - 1)];
+        const glm::vec4& resolution = batch.frame_params[batch.FrameOf(sample)].resolution;
+        const std::size_t at = std::size_t{block.first} + k;
+        draw_order_[at] = sample;
+        // Negative height: y up in NDC, pixel row 0 at the top, as the frames' uv.
+        viewports_[at] = {0.0f, resolution.y, resolution.x, -resolution.y, 0.0f, 1.0f};
+        scissors_[at] = {{static_cast<std::int32_t>(x_of(sample)), static_cast<std::int32_t>(y_of(sample))}, {1, 1}};
+      }
+    }
+  };
+  // A thread's share is worth it from a few dozen blocks (a few thousand samples).
+  constexpr std::size_t kBlocksPerShare = 32;
+  if (pool == nullptr) {
+    write(0, capture_blocks_.size(), 0);
+  } else {
+    pool->ParallelFor(capture_blocks_.size(), write, kBlocksPerShare);
   }
 }
 
@@ -777,7 +795,7 @@ Expected<RenderedDepths> RasterPass::Render(const ShaderInputs& batch) {
   DB_RETURN_IF_ERROR(lane.readback.InvalidateForHostReads());
   DB_RETURN_IF_ERROR(lane.fetched_texels.InvalidateForHostReads());
   const std::vector<std::uint8_t> geometry = GeometryOf(batch);
-  CompareTexels(0, shape, batch.codes, geometry, drawn, nullptr);
+  CompareTexels(0, shape, batch.codes, geometry, drawn, /*keep=*/true, nullptr);
   // The batch's own fetched value where nothing was drawn, as for the codes.
   const std::size_t count = batch.count;
   fetched_.assign(batch.depths.begin(), batch.depths.begin() + static_cast<std::ptrdiff_t>(slots_.size() * count));
@@ -810,7 +828,7 @@ Expected<const float*> RasterPass::Run(const ShaderInputs& batch, std::span<cons
   DB_RETURN_IF_ERROR(lane.positions.InvalidateForHostReads());
   if (!rendered) {
     DB_RETURN_IF_ERROR(lane.readback.InvalidateForHostReads());
-    CompareTexels(0, shape, batch.codes, GeometryOf(batch), drawn, nullptr);
+    CompareTexels(0, shape, batch.codes, GeometryOf(batch), drawn, /*keep=*/true, nullptr);
     // Only some slots may have been drawn: none of the atlases holds a whole render now.
     rendered_.reset();
   }
@@ -886,7 +904,7 @@ Status RasterPass::FinishLane(std::uint32_t lane, ThreadPool* pool) {
   DB_RETURN_IF_ERROR(pass_->Wait(lane));
   DB_RETURN_IF_ERROR(from.readback.InvalidateForHostReads());
   const std::vector<bool> drawn = EverySlot();
-  CompareTexels(lane, run.shape, run.codes, run.geometry, drawn, pool);
+  CompareTexels(lane, run.shape, run.codes, run.geometry, drawn, /*keep=*/false, pool);
   if (clock_.count() > 0 && !run.which.empty()) {
     DB_ASSIGN_OR_RETURN(const std::vector<std::uint64_t> stamps,
                         clock_.Read(lane * (kRasterParts + 1), kRasterParts + 1));
@@ -895,7 +913,7 @@ Status RasterPass::FinishLane(std::uint32_t lane, ThreadPool* pool) {
   return Status::Ok();
 }
 
-// Oldest first, so that texels() ends as the last run's.
+// Oldest first, as they were queued.
 Status RasterPass::FinishResident(ThreadPool* pool) {
   std::array<std::uint32_t, kLanes> order{};
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) order[lane] = lane;
@@ -1239,21 +1257,21 @@ void RasterPass::RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock&
 }
 
 void RasterPass::CompareTexels(std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> codes,
-                               std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn,
+                               std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn, bool keep,
                                ThreadPool* pool) {
   const std::size_t count = shape.count;
-  texels_.resize(slots_.size() * count);
-  texel_drawn_.resize(slots_.size() * count);
+  texels_.resize(keep ? slots_.size() * count : 0);
+  texel_drawn_.resize(keep ? slots_.size() * count : 0);
   const auto* readback = static_cast<const std::byte*>(lanes_[lane].readback.mapped());
   const std::uint32_t atlas_texels = kAtlasWidth * AtlasRows();
   // Each slot apart (its texels, its agreement): on the pool's threads.
   const auto compare = [&](std::size_t s) {
-    std::uint32_t* kept = texels_.data() + s * count;
-    std::uint8_t* kept_drawn = texel_drawn_.data() + s * count;
+    std::uint32_t* kept = texels_.data() + (keep ? s * count : 0);
+    std::uint8_t* kept_drawn = texel_drawn_.data() + (keep ? s * count : 0);
     const std::uint32_t* host_codes = codes.data() + s * count;
-    std::fill_n(kept_drawn, count, std::uint8_t{1});
+    if (keep) std::fill_n(kept_drawn, count, std::uint8_t{1});
     if (!drawn[s]) {
-      std::copy_n(host_codes, count, kept);
+      if (keep) std::copy_n(host_codes, count, kept);
       return;
     }
     const Format format = slots_[s].encoding.format;
@@ -1268,18 +1286,18 @@ void RasterPass::CompareTexels(std::uint32_t lane, RunShape shape, std::span<con
       for (std::size_t i = 0; i < count; ++i, texel = texel + 1 == atlas_texels ? 0 : texel + 1) {
         const std::uint32_t host = host_codes[i];
         if (geometry[i] == 0) {
-          kept[i] = host;
+          if (keep) kept[i] = host;
           continue;
         }
         const std::uint32_t device = code_at(texel);
-        kept[i] = device;
+        if (keep) kept[i] = device;
         ++counted.texels;
         // An uncovered texel holds the clear value: it is counted apart,
         // neither judged nor compared with the model (fetch.comp marks it
         // undrawn for a judge on the device by the same byte).
         if (coverage[texel] == std::byte{0}) {
           ++counted.uncovered;
-          kept_drawn[i] = 0;
+          if (keep) kept_drawn[i] = 0;
           continue;
         }
         if (device != host) {

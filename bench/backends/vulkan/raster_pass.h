@@ -122,9 +122,10 @@ class RasterPass {
 
   // Per depth slot, since Create: RasterAgreement (raster_model.h).
   const std::vector<RasterAgreement>& agreement() const { return agreement_; }
-  // The texel bits pass 1 produced last, laid out as ShaderInputs::codes:
-  // the batch's own where it drew nothing (a sample without geometry, a
-  // slot the run did not need).
+  // The texel bits pass 1 produced in the last Render or Run, laid out as
+  // ShaderInputs::codes: the batch's own where it drew nothing (a sample
+  // without geometry, a slot the run did not need). A resident run keeps
+  // none.
   const std::vector<std::uint32_t>& texels() const { return texels_; }
   // The most samples the atlas holds.
   std::uint64_t MaxBatchSamples() const;
@@ -221,14 +222,16 @@ class RasterPass {
     std::uint32_t first;
     std::uint32_t samples;
   };
-  void OrderCaptures(const ShaderInputs& batch);
+  void OrderCaptures(const ShaderInputs& batch, ThreadPool* pool);
   void RecordSampleDraws(VkCommandBuffer commands, const CaptureBlock& block, bool cubes) const;
   // Counts the texels pass 1 copied back into agreement_ against `codes`
-  // (the host's model), for the samples `geometry` marks, and keeps them in
-  // texels_ and texel_drawn_; each slot on a thread of `pool`, if given.
-  // Reads lane `lane`'s readback.
+  // (the host's model), for the samples `geometry` marks, and, where `keep`,
+  // keeps them in texels_ and texel_drawn_ (a resident run's reader is the
+  // device); each slot on a thread of `pool`, if given. Reads lane `lane`'s
+  // readback.
   void CompareTexels(std::uint32_t lane, RunShape shape, std::span<const std::uint32_t> codes,
-                     std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn, ThreadPool* pool);
+                     std::span<const std::uint8_t> geometry, const std::vector<bool>& drawn, bool keep,
+                     ThreadPool* pool);
 
   std::shared_ptr<VulkanContext> context_;  // first: everything below belongs to its device
   std::vector<CellPlan> cells_;
