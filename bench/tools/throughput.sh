@@ -3,7 +3,7 @@
 # reconstructions per second and the peak resident memory, which must not
 # grow with the sample count.
 #
-#   bench/tools/throughput.sh [BUILD_DIR] [RUNS] [DEVICE]
+#   bench/tools/throughput.sh [BUILD_DIR] [RUNS] [DEVICE] [ROWS]
 #
 # Without DEVICE: the CPU backend at 10^6, 10^7 and 10^8 samples, and
 # lavapipe with either judge (--judge host: outputs read back and binned on
@@ -16,6 +16,9 @@
 # form with the same judge and samples, so that the two rates compare: on
 # lavapipe judged on the host, on DEVICE with either judge. DEPTHBENCH names another program to run (a packed copy's
 # run.sh, bench/tools/package_for_device.sh).
+#
+# ROWS, an extended regular expression, keeps only the configurations
+# whose label matches it ("form" keeps the compute and raster rows).
 #
 # Each configuration runs RUNS times (default 3), the configurations in
 # turn (A B C ... A B C ...), so that the drift of a shared machine's speed
@@ -75,6 +78,18 @@ else
       arguments+=("--backend vulkan --device $device --judge $judge --pipeline $form --samples 1e7")
     done
   done
+fi
+rows=${4:-}
+if [[ -n $rows ]]; then
+  kept_labels=() kept_arguments=()
+  for i in "${!labels[@]}"; do
+    if grep -Eq -- "$rows" <<<"${labels[i]}"; then
+      kept_labels+=("${labels[i]}")
+      kept_arguments+=("${arguments[i]}")
+    fi
+  done
+  ((${#kept_labels[@]} > 0)) || { echo "no configuration's label matches ROWS '$rows'" >&2; exit 2; }
+  labels=("${kept_labels[@]}") arguments=("${kept_arguments[@]}")
 fi
 declare -a rates peaks  # per configuration: space-separated figures of its runs
 
