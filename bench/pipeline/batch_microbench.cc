@@ -1,11 +1,12 @@
 // Google Benchmark of the host's share of a sweep: BatchBuilder::Build over
-// the default run's batches (the typical domain, every cell: 28 depth
-// slots), for the host's judge (texels and reference included), for a
-// judge on the device (what the host still does then: bench/device_judge/)
-// and for one that draws the samples too (the frames alone). items_per_second is
-// samples built per second; times the 106 cells it bounds the
-// reconstructions per second a sweep can verify on any device. The
-// argument is the number of threads.
+// batches of the typical domain with every cell of the catalogue (40 depth
+// slots; the default run's 106 cells have 28), for the host's judge
+// (texels and reference included), for a judge on the device (what the
+// host still does then: bench/device_judge/), for one that draws the
+// samples too (the frames alone), and for the raster form judged on its
+// device. items_per_second is samples built per second; times the cells it
+// bounds the reconstructions per second a sweep can verify on any device.
+// The argument is the number of threads.
 //
 //   build/bench/depthbench_batch_microbench --benchmark_repetitions=3
 #include <cstdint>
@@ -41,28 +42,17 @@ void BM_BuildBatch(benchmark::State& state, BatchFor judge, ProductionModel prod
   state.counters["depth_slots"] = static_cast<double>(layout.encodings.size());
 }
 
-BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge, ProductionModel::kFloat32)
-    ->RangeMultiplier(2)
-    ->Range(1, 16)
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge, ProductionModel::kFloat32)
-    ->RangeMultiplier(2)
-    ->Range(1, 16)
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_BuildBatch, for_device_draws, BatchFor::kDeviceDraws, ProductionModel::kFloat32)
-    ->RangeMultiplier(2)
-    ->Range(1, 16)
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond);
+// Each at 1, 2, 4, 8 and 16 threads.
+void Threads(benchmark::internal::Benchmark* b) {
+  b->RangeMultiplier(2)->Range(1, 16)->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+BENCHMARK_CAPTURE(BM_BuildBatch, for_host_judge, BatchFor::kHostJudge, ProductionModel::kFloat32)->Apply(Threads);
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_judge, BatchFor::kDeviceJudge, ProductionModel::kFloat32)->Apply(Threads);
+BENCHMARK_CAPTURE(BM_BuildBatch, for_device_draws, BatchFor::kDeviceDraws, ProductionModel::kFloat32)->Apply(Threads);
 // The raster form judged on its device: the host still makes each sample's
 // geometry and its model of every depth slot's texel.
 BENCHMARK_CAPTURE(BM_BuildBatch, raster_for_device_judge, BatchFor::kDeviceJudge, ProductionModel::kRaster)
-    ->RangeMultiplier(2)
-    ->Range(1, 16)
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond);
+    ->Apply(Threads);
 
 }  // namespace
 }  // namespace depthbench
