@@ -123,8 +123,8 @@ constexpr L kSinThird = 0.866025403784438646763723170752936183L;  // sqrt(3) / 2
 constexpr std::array<UnitAngle, 3> kThirdTurns = {{{1.0L, 0.0L}, {-0.5L, kSinThird}, {-0.5L, -kSinThird}}};
 
 // The angle of `turns` (in [0, 1)) of a full turn. The C library reduces an
-// argument past pi/4 with a long remainder of pi/2 that took half the
-// build of a raster batch; here the reduction is exact in the turns
+// argument past pi/4 with a long remainder of pi/2 that took a quarter of
+// the build of a raster batch; here the reduction is exact in the turns
 // (multiplying by 8 and taking off whole eighths loses no bit), so only
 // angles within [0, pi/4] reach sinl and cosl.
 UnitAngle TurnOf(L turns) {
