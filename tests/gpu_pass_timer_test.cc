@@ -226,6 +226,43 @@ TEST_F(GpuPassTimerTest, BandwidthProbeIsTheHostsMemoryAndFloorsThePass) {
   EXPECT_EQ(tiny.status().code(), StatusCode::kInvalidArgument);
 }
 
+// The stage probe on lavapipe: every stage runs, and counts each of its
+// invocations once (a fragment row that drew the triangle over the wrong
+// area, or a vertex row that drew another count of points, would time
+// other work than the compute row's); lavapipe names no processors. Eight
+// times the arithmetic takes longer in every stage: at 4096 multiply-adds
+// an invocation the arithmetic is most of a pass, so the factor of 2 asked
+// leaves room for what else a pass costs and for the noise of a busy
+// 2-core machine, while a probe whose count did not reach the program
+// would time the same at both counts.
+TEST_F(GpuPassTimerTest, StageProbeRunsEveryStageOnceAPixel) {
+  const Resolution size{128, 64};
+  auto light = timer_->MeasureStages(size, 128, 1, 3);
+  ASSERT_TRUE(light.ok()) << light.status().message();
+  auto heavy = timer_->MeasureStages(size, 1024, 1, 3);
+  ASSERT_TRUE(heavy.ok()) << heavy.status().message();
+  EXPECT_TRUE(heavy->left_out.empty());
+  EXPECT_EQ(heavy->fma_per_invocation, 4096u);
+  EXPECT_EQ(heavy->processors, 0u);
+  ASSERT_EQ(heavy->stages.size(), 3u);
+  const char* const names[] = {"compute", "vertex", "fragment"};
+  for (std::size_t s = 0; s < 3; ++s) {
+    SCOPED_TRACE(names[s]);
+    EXPECT_EQ(heavy->stages[s].stage, names[s]);
+    EXPECT_EQ(heavy->stages[s].invocations, 128u * 64u);
+    EXPECT_EQ(light->stages[s].invocations, 128u * 64u);
+    EXPECT_EQ(heavy->stages[s].processors_used, 0u);
+    ASSERT_EQ(heavy->stages[s].timing.ns_per_pass.size(), 3u);
+    auto light_ns = SummarizeTimings(light->stages[s].timing.ns_per_pass);
+    auto heavy_ns = SummarizeTimings(heavy->stages[s].timing.ns_per_pass);
+    ASSERT_TRUE(light_ns.ok() && heavy_ns.ok());
+    EXPECT_GT(heavy_ns->median, 2.0 * light_ns->median);
+  }
+  EXPECT_FALSE(timer_->MeasureStages({100, 3}, 16, 1, 1).ok());  // 300 invocations: not whole workgroups of 64
+  EXPECT_FALSE(timer_->MeasureStages({64, 64}, 0, 1, 1).ok());
+  EXPECT_FALSE(timer_->MeasureStages({65536, 64}, 16, 1, 1).ok());  // wider than any viewport lavapipe draws
+}
+
 TEST_F(GpuPassTimerTest, RefusesPairsThatDoNotExist) {
   Load({Convention::kLinear, Format::kR32Sfloat}, {16, 16});
   auto divide = timer_->TimePass(Info(Variant::kDivide), 1, 1, 3);

@@ -2,11 +2,13 @@
 // cells that do not exist and files of another schema, ranks within groups,
 // and compares the rankings of two runs of one device only.
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "bench/speed/speed_results.h"
+#include "bench/speed/speed_table.h"
 
 namespace depthbench {
 namespace {
@@ -87,6 +89,15 @@ SpeedResults Example() {
   probe.warmup_passes = 9;
   r.bandwidth = probe;
   r.floors = MemoryFloors(probe, r.gpu);
+  StageProbe stages;
+  stages.method = "multiply-adds";
+  stages.invocations = 1000;
+  stages.fma_per_invocation = 1000;
+  stages.processors = 132;
+  stages.stages = {{"compute", Summary(9, 10, 11), {9, 10, 11}, 4, 9, 132},
+                   {"fragment", Summary(300, 320, 340), {300, 320, 340}, 1, 2, 4}};
+  stages.left_out = {"vertex: no stores"};
+  r.stages = stages;
   return r;
 }
 
@@ -151,6 +162,39 @@ TEST(SpeedResultsTest, ReadsFilesWithoutABandwidthProbe) {
     EXPECT_TRUE(file.ok()) << entry.path() << ": " << file.status().message();
   }
   EXPECT_GE(files, 4);
+}
+
+// The stage probe: each stage's rate from its median (1e6 multiply-adds in
+// 10 ns: 1e14 a second), printed with its share of compute's and the
+// processors it ran on, and the warning where a drawing stage computes at
+// under half compute's rate; a file without the compute row, or with a
+// stage that does not exist, is refused at the field.
+TEST(SpeedResultsTest, StageProbeGivesEachStagesShareOfCompute) {
+  SpeedResults r = Example();
+  ASSERT_TRUE(r.stages.has_value());
+  EXPECT_DOUBLE_EQ(r.stages->fma_per_second(*r.stages->compute()), 1e14);
+  std::ostringstream out;
+  PrintSpeedHeader(r, out);
+  EXPECT_NE(out.str().find("compute  100000 G multiply-adds/s, on 132 of 132 processors"), std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("fragment 3125 G multiply-adds/s, 3.1% of compute's, on 4 of 132 processors"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("not measured: vertex: no stores"), std::string::npos);
+  EXPECT_NE(out.str().find("computes at 3.1% of their rate"), std::string::npos);
+
+  nlohmann::json json = ToJson(r);
+  json["stage_probe"]["stages"].erase(0);
+  auto no_compute = SpeedResultsFromJson(json, "stages.json");
+  ASSERT_FALSE(no_compute.ok());
+  EXPECT_NE(no_compute.status().message().find("stage_probe.stages"), std::string::npos)
+      << no_compute.status().message();
+  json = ToJson(r);
+  json["stage_probe"]["stages"][1]["stage"] = "geometry";
+  auto unknown = SpeedResultsFromJson(json, "stages.json");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("'geometry' is not a stage"), std::string::npos)
+      << unknown.status().message();
 }
 
 TEST(SpeedResultsTest, RefusesCellsThatDoNotExist) {

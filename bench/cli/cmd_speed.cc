@@ -164,8 +164,9 @@ void AddSpeedCommand(CLI::App& app, CommandAction& action) {
   CLI::App* cmd = app.add_subcommand(
       "speed",
       "Measure the speed side of the trade on a Vulkan device: GPU time per pixel of full-screen passes reading a "
-      "real depth image (memory-bound and ALU-bound), the SPIR-V instruction mix, the CPU backend's cost, and each "
-      "variant's cost against its p99.9 bits lost (the Pareto front)");
+      "real depth image (memory-bound and ALU-bound), the device's bandwidth, how fast its vertex and fragment "
+      "stages compute against compute (and, on NVIDIA, on how many processors), the SPIR-V instruction mix, the CPU "
+      "backend's cost, and each variant's cost against its p99.9 bits lost (the Pareto front)");
   cmd->footer(
       "Timing on lavapipe (the default device) is timing of JIT-compiled CPU code, not of a GPU; results are kept "
       "per device (reports/speed/<device>.json).\n\n"

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "bench/backends/vulkan/compute_pass.h"
+#include "bench/backends/vulkan/graphics_pipeline.h"
 #include "bench/backends/vulkan/shader_compiler.h"
 #include "bench/backends/vulkan/variant_program.h"
 #include "bench/base/files.h"
@@ -50,6 +51,20 @@ constexpr std::uint32_t kProbeWorkgroupSize = 256;
 constexpr std::uint32_t kMaxProbeGroups = 4096;
 // A smaller probe fits in caches and would time them, not memory.
 constexpr std::uint64_t kMinProbeBytes = std::uint64_t{1} << 20;
+
+// shaders/speed/stage_probe.glsl: its counts (one per stage, then one per
+// stage and processor), push constants, specialization constant (each
+// chain's multiply-adds), chains and the compute row's workgroup.
+constexpr std::uint32_t kStageCounts = 3;
+constexpr std::uint32_t kMostProcessors = 1024;
+struct StagePush {
+  std::uint32_t stage;
+  std::uint32_t width;
+};
+constexpr std::uint32_t kStageIterationsConstant = 0;
+constexpr std::uint32_t kStageChains = 4;
+constexpr std::uint32_t kStageWorkgroupSize = 64;
+constexpr std::uint32_t kMostStageIterations = 16384;
 
 std::uint32_t GroupsFor(std::uint32_t pixels) { return (pixels + kWorkgroupSide - 1) / kWorkgroupSide; }
 
@@ -467,6 +482,175 @@ Expected<BandwidthTiming> GpuPassTimer::MeasureBandwidth(std::uint64_t bytes, st
   DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimeInterleaved(*probe, pipelines, record, warmup, repetitions));
   DB_RETURN_IF_ERROR(validation.Check("the bandwidth probe"));
   return BandwidthTiming{size, size, std::move(timings.front())};
+}
+
+Expected<StageTimings> GpuPassTimer::MeasureStages(Resolution size, std::uint32_t iterations, std::uint32_t warmup,
+                                                   std::uint32_t repetitions) {
+  // The fragment row draws `size` in one viewport.
+  const VkPhysicalDeviceLimits& limits = device().limits;
+  const std::uint32_t most_width = std::min(limits.maxViewportDimensions[0], limits.maxFramebufferWidth);
+  const std::uint32_t most_height = std::min(limits.maxViewportDimensions[1], limits.maxFramebufferHeight);
+  if (size.width == 0 || size.height == 0 || size.width > most_width || size.height > most_height) {
+    return InvalidArgument(fmt::format("a stage probe of {}x{} invocations: '{}' draws at most {}x{}", size.width,
+                                       size.height, device().name, most_width, most_height));
+  }
+  const std::uint64_t invocations = std::uint64_t{size.width} * size.height;
+  if (invocations % kStageWorkgroupSize != 0 ||
+      invocations / kStageWorkgroupSize > device().limits.maxComputeWorkGroupCount[0]) {
+    return InvalidArgument(
+        fmt::format("a stage probe of {}x{} invocations: they must be whole workgroups of {}, "
+                    "at most {} of them",
+                    size.width, size.height, kStageWorkgroupSize, device().limits.maxComputeWorkGroupCount[0]));
+  }
+  if (iterations == 0 || iterations > kMostStageIterations) {
+    return InvalidArgument(fmt::format("a stage probe of {} iterations: 1 to {}", iterations, kMostStageIterations));
+  }
+  if (warmup == 0 || repetitions == 0) {
+    return InvalidArgument("a timed pass needs at least one warm-up pass and one repetition");
+  }
+  StageTimings result;
+  result.fma_per_invocation = kStageChains * iterations;
+  result.size = size;
+  result.processors = std::min(context_->stage_probe_features().processors, kMostProcessors);
+  const RasterFeatures& raster = context_->raster_features();
+  const bool draws = raster.graphics_queue && raster.dynamic_rendering;
+  const bool vertex = draws && context_->stage_probe_features().vertex_stores;
+  const bool fragment = draws && raster.fragment_stores;
+  if (!vertex) {
+    result.left_out.push_back(!draws ? "vertex: the device's queue cannot draw with dynamic rendering"
+                                     : "vertex: the device has no stores from the vertex stage "
+                                       "(vertexPipelineStoresAndAtomics)");
+  }
+  if (!fragment) {
+    result.left_out.push_back(!draws ? "fragment: the device's queue cannot draw with dynamic rendering"
+                                     : "fragment: the device has no stores from the fragment stage "
+                                       "(fragmentStoresAndAtomics)");
+  }
+
+  const ValidationScope validation(*context_);
+  const VkDescriptorSetLayoutBinding binding{
+      0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+      VK_SHADER_STAGE_COMPUTE_BIT | VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  const VkShaderStageFlags pushed = binding.stageFlags;
+  DB_ASSIGN_OR_RETURN(std::unique_ptr<ComputePass> probe,
+                      ComputePass::Create(context_, std::span(&binding, 1), sizeof(StagePush), pushed));
+  // Each program, with the processors' numbers read where the device names
+  // them (the define goes after the #version line).
+  const auto compile = [&](const char* file, ShaderStage stage) -> Expected<std::vector<std::uint32_t>> {
+    const std::filesystem::path path = shader_dir_ / "speed" / file;
+    DB_ASSIGN_OR_RETURN(std::string source, ReadFile(path, std::uintmax_t{1} << 20, "shader"));
+    if (result.processors > 0) {
+      const std::size_t line_end = source.find('\n');
+      source.insert(line_end == std::string::npos ? source.size() : line_end + 1, "#define STAGE_PROBE_PROCESSORS 1\n");
+    }
+    return CompileShaderSource(std::move(source), path.string(), path.parent_path(), ShaderLanguage::kGlsl, stage);
+  };
+  const auto module = [&](const char* file, ShaderStage stage) -> Expected<DeviceObject<VkShaderModule>> {
+    DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> spirv, compile(file, stage));
+    return CreateShaderModule(vk_device(), spirv, file);
+  };
+  // The counts, read back after one more pass of each stage.
+  constexpr VkDeviceSize kCountBytes = sizeof(std::uint32_t) * kStageCounts * (1 + kMostProcessors);
+  DB_ASSIGN_OR_RETURN(
+      VulkanBuffer counts,
+      context_->CreateHostBuffer(kCountBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                 HostAccess::kReadback));
+  const VkDescriptorBufferInfo counts_info{counts.handle(), 0, kCountBytes};
+  VkWriteDescriptorSet write{};
+  write.dstBinding = 0;
+  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  write.pBufferInfo = &counts_info;
+  probe->WriteDescriptors(std::span(&write, 1));
+
+  struct Row {
+    const char* name;
+    std::uint32_t stage;
+    DeviceObject<VkPipeline> pipeline;
+  };
+  std::vector<Row> rows;
+  rows.push_back({"compute", 0, {}});
+  if (vertex) rows.push_back({"vertex", 1, {}});
+  if (fragment) rows.push_back({"fragment", 2, {}});
+  VkRenderingInfo rendering{};
+  rendering.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+  rendering.renderArea = {{0, 0}, {size.width, size.height}};
+  rendering.layerCount = 1;
+  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(size.width), static_cast<float>(size.height), 0.0f, 1.0f};
+  const Recorder record = [&](VkCommandBuffer commands, VkPipeline pipeline, std::uint32_t passes) {
+    const Row& row =
+        *std::find_if(rows.begin(), rows.end(), [&](const Row& r) { return r.pipeline.get() == pipeline; });
+    const StagePush push{row.stage, size.width};
+    const bool draw = row.stage != 0;
+    probe->Bind(commands, pipeline, draw ? VK_PIPELINE_BIND_POINT_GRAPHICS : VK_PIPELINE_BIND_POINT_COMPUTE);
+    probe->PushConstants(commands, &push, sizeof(push));
+    for (std::uint32_t p = 0; p < passes; ++p) {
+      if (draw) {
+        vkCmdBeginRendering(commands, &rendering);
+        vkCmdSetViewport(commands, 0, 1, &viewport);
+        vkCmdSetScissor(commands, 0, 1, &rendering.renderArea);
+        vkCmdDraw(commands, row.stage == 1 ? static_cast<std::uint32_t>(invocations) : 3, 1, 0, 0);
+        vkCmdEndRendering(commands);
+      } else {
+        vkCmdDispatch(commands, static_cast<std::uint32_t>(invocations / kStageWorkgroupSize), 1, 1);
+      }
+      // Each pass waits for the one before, as the timed passes do.
+      RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    }
+  };
+
+  // The count of multiply-adds is a constant of each pipeline.
+  const VkSpecializationMapEntry iterations_entry{kStageIterationsConstant, 0, sizeof(iterations)};
+  const VkSpecializationInfo constants{1, &iterations_entry, sizeof(iterations), &iterations};
+  DB_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> compute_spirv,
+                      compile("stage_probe.comp", ShaderStage::kCompute));
+  DB_ASSIGN_OR_RETURN(rows.front().pipeline,
+                      probe->CreatePipeline(compute_spirv, constants, "the stage probe's compute row"));
+  if (vertex || fragment) {
+    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> points_vertex,
+                        module("stage_probe_points.vert", ShaderStage::kVertex));
+    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> screen_vertex,
+                        module("stage_probe_screen.vert", ShaderStage::kVertex));
+    DB_ASSIGN_OR_RETURN(const DeviceObject<VkShaderModule> probe_fragment,
+                        module("stage_probe.frag", ShaderStage::kFragment));
+    DrawState state;
+    state.fragment = probe_fragment.get();
+    state.vertex_constants = &constants;
+    state.fragment_constants = &constants;
+    for (Row& row : rows) {
+      if (row.stage == 0) continue;
+      const bool points = row.stage == 1;
+      state.vertex = points ? points_vertex.get() : screen_vertex.get();
+      state.topology = points ? VK_PRIMITIVE_TOPOLOGY_POINT_LIST : VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+      state.rasterizer_discard = points;
+      DB_ASSIGN_OR_RETURN(row.pipeline, CreateGraphicsPipeline(vk_device(), probe->pipeline_layout(), state,
+                                                               fmt::format("the stage probe's {} row", row.name)));
+    }
+  }
+
+  std::vector<VkPipeline> pipelines;
+  for (const Row& row : rows) pipelines.push_back(row.pipeline.get());
+  DB_ASSIGN_OR_RETURN(std::vector<PassTiming> timings, TimeInterleaved(*probe, pipelines, record, warmup, repetitions));
+  DB_RETURN_IF_ERROR(probe->Submit([&](VkCommandBuffer commands) {
+    vkCmdFillBuffer(commands, counts.handle(), 0, kCountBytes, 0);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    for (const VkPipeline pipeline : pipelines) record(commands, pipeline, 1);
+    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  }));
+  DB_RETURN_IF_ERROR(counts.InvalidateForHostReads());
+  DB_RETURN_IF_ERROR(validation.Check("the stage probe"));
+  const auto* const counted = static_cast<const std::uint32_t*>(counts.mapped());
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    StageTiming stage{rows[r].name, std::move(timings[r]), counted[rows[r].stage], 0};
+    const std::uint32_t* const by_processor = counted + kStageCounts + rows[r].stage * kMostProcessors;
+    stage.processors_used = static_cast<std::uint32_t>(
+        std::count_if(by_processor, by_processor + (result.processors > 0 ? kMostProcessors : 0),
+                      [](std::uint32_t n) { return n > 0; }));
+    result.stages.push_back(std::move(stage));
+  }
+  return result;
 }
 
 }  // namespace depthbench

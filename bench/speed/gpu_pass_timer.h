@@ -11,7 +11,10 @@
 // Pipelines are built on first use, one per (variant, convention, taps).
 // MeasureBandwidth, at any time, times the device's memory bandwidth with
 // the same machinery (shaders/speed/bandwidth.comp): what a memory-bound
-// pass can at best reach, for the memory-bound floor.
+// pass can at best reach, for the memory-bound floor. MeasureStages, at
+// any time, times the same arithmetic in the compute, vertex and fragment
+// stages (shaders/speed/stage_probe.glsl): whether a pass drawn by the
+// rasterizer computes as fast as the compute passes timed here.
 //
 // How passes are timed: the variants that compete (those reading the
 // loaded image) are timed together, interleaved, so that a slow drift of
@@ -70,6 +73,26 @@ struct BandwidthTiming {
   PassTiming timing;
 };
 
+// One shader stage's run of the stage probe (MeasureStages).
+struct StageTiming {
+  std::string stage;  // "compute", "vertex" or "fragment"
+  PassTiming timing;
+  // Invocations the stage counted in one pass (every pixel once: width *
+  // height), and how many processors ran them (0: the device does not name
+  // its processors).
+  std::uint64_t invocations = 0;
+  std::uint32_t processors_used = 0;
+};
+
+// The same arithmetic in each shader stage, timed as the passes are.
+struct StageTimings {
+  Resolution size{0, 0};  // a pass's invocations: size.width * size.height
+  std::uint32_t fma_per_invocation = 0;
+  std::uint32_t processors = 0;       // the device's (shaderSMCount); 0: not named
+  std::vector<StageTiming> stages;    // compute, vertex, fragment; those the device can run
+  std::vector<std::string> left_out;  // a stage not measured, and why
+};
+
 class GpuPassTimer {
  public:
   static constexpr double kMinWarmupNs = 20e6;
@@ -111,6 +134,20 @@ class GpuPassTimer {
   // buffers live for the call only. InvalidArgument when bytes is below
   // 1 MiB or warmup or repetitions is 0.
   Expected<BandwidthTiming> MeasureBandwidth(std::uint64_t bytes, std::uint32_t warmup, std::uint32_t repetitions);
+
+  // How fast each shader stage computes: `size` invocations of
+  // shaders/speed/stage_probe.glsl, each 4 * `iterations` fused
+  // multiply-adds, as a compute dispatch, as the vertex stage of as many
+  // points (the rasterizer discarding them) and as the fragment stage of a
+  // full-screen triangle over `size`, interleaved and timed as TimePasses
+  // times variants. A stage the device cannot run so (no graphics queue, no
+  // stores from it) is left out, with the reason. InvalidArgument when a
+  // side of `size` is 0 or past the device's viewport or framebuffer, when
+  // the invocations are not whole workgroups of 64 (or more of them than a
+  // dispatch may hold), when iterations is 0 or above 16384, or when
+  // warmup or repetitions is 0.
+  Expected<StageTimings> MeasureStages(Resolution size, std::uint32_t iterations, std::uint32_t warmup,
+                                       std::uint32_t repetitions);
 
  private:
   explicit GpuPassTimer(std::shared_ptr<VulkanContext> context, std::filesystem::path shader_dir);

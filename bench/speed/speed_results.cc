@@ -65,6 +65,13 @@ const GpuTiming* SpeedResults::FindGpu(const Cell& cell, Resolution resolution, 
   return nullptr;
 }
 
+const StageRate* StageProbe::compute() const {
+  for (const StageRate& stage : stages) {
+    if (stage.stage == "compute") return &stage;
+  }
+  return nullptr;
+}
+
 std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::vector<GpuTiming>& timings) {
   std::vector<MemoryFloor> floors;
   const double bytes_per_ns = probe.bytes_per_second() * 1e-9;
@@ -266,6 +273,53 @@ const JsonFields<BandwidthProbe>& BandwidthFields() {
   return fields;
 }
 
+const JsonFields<StageRate>& StageRateFields() {
+  static const JsonFields<StageRate> fields{
+      {
+          JsonMember("stage", &StageRate::stage),
+          JsonMember("ns_per_pass", &StageRate::ns_per_pass, JsonObject{SummaryFields()}),
+          JsonMember("repetitions_ns", &StageRate::repetitions_ns, JsonArray{JsonReal()}),
+          JsonMember("passes_per_repetition", &StageRate::passes_per_repetition),
+          JsonMember("warmup_passes", &StageRate::warmup_passes),
+          JsonMember("processors_used", &StageRate::processors_used),
+      },
+      [](const JsonReader& r, const StageRate& rate) -> Status {
+        if (rate.stage != "compute" && rate.stage != "vertex" && rate.stage != "fragment") {
+          DB_ASSIGN_OR_RETURN(const JsonReader stage, r.Field("stage"));
+          return stage.Error(fmt::format("'{}' is not a stage: compute, vertex or fragment", rate.stage));
+        }
+        if (!(rate.ns_per_pass.median > 0.0)) {
+          DB_ASSIGN_OR_RETURN(const JsonReader summary, r.Field("ns_per_pass"));
+          return summary.Error("the median must be above 0 ns");
+        }
+        return Status::Ok();
+      }};
+  return fields;
+}
+
+const JsonFields<StageProbe>& StageProbeFields() {
+  static const JsonFields<StageProbe> fields{
+      {
+          JsonMember("method", &StageProbe::method),
+          JsonMember("invocations", &StageProbe::invocations),
+          JsonMember("fma_per_invocation", &StageProbe::fma_per_invocation),
+          JsonMember("processors", &StageProbe::processors),
+          JsonMember("stages", &StageProbe::stages, JsonArray{JsonObject{StageRateFields()}}),
+          JsonMember("left_out", &StageProbe::left_out, JsonArray{JsonText()}),
+      },
+      [](const JsonReader& r, const StageProbe& probe) -> Status {
+        if (probe.invocations == 0 || probe.fma_per_invocation == 0) {
+          return r.Error("a stage probe needs invocations and multiply-adds");
+        }
+        if (probe.compute() == nullptr) {
+          DB_ASSIGN_OR_RETURN(const JsonReader stages, r.Field("stages"));
+          return stages.Error("the compute stage is missing: the others are compared with it");
+        }
+        return Status::Ok();
+      }};
+  return fields;
+}
+
 const JsonFields<MemoryFloor>& FloorFields() {
   static const JsonFields<MemoryFloor> fields{
       {
@@ -344,8 +398,10 @@ JsonFields<SpeedResults> SpeedResultsFields(const Catalogue& catalogue) {
       JsonMember("run", &SpeedResults::run, JsonObject{RunFields()}),
       JsonOptionalMember("bandwidth", &SpeedResults::bandwidth, JsonObject{BandwidthFields()}),
       JsonOnlyIf(JsonMember("memory_floor", &SpeedResults::floors, JsonArray{JsonObject{FloorFields()}}), HasBandwidth),
-      JsonOnlyIf(JsonDerived<SpeedResults>("bandwidth_bound_factor", [](const SpeedResults&) { return kBandwidthBoundFactor; }),
+      JsonOnlyIf(JsonDerived<SpeedResults>("bandwidth_bound_factor",
+                                           [](const SpeedResults&) { return kBandwidthBoundFactor; }),
                  HasBandwidth),
+      JsonOptionalMember("stage_probe", &SpeedResults::stages, JsonObject{StageProbeFields()}),
       JsonMember("gpu", &SpeedResults::gpu, JsonArray{JsonObject{GpuTimingFields(catalogue)}}),
       JsonMember("static", &SpeedResults::static_costs, JsonArray{JsonObject{StaticCostFields(catalogue)}}),
       JsonMember("cpu", &SpeedResults::cpu, JsonArray{JsonObject{CpuCostFields(catalogue)}}),

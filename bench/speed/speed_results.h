@@ -82,6 +82,36 @@ struct BandwidthProbe {
   double bytes_per_second() const { return static_cast<double>(bytes_read + bytes_written) / ns_per_pass.median * 1e9; }
 };
 
+// How fast one shader stage computed the stage probe's arithmetic
+// (GpuPassTimer::MeasureStages).
+struct StageRate {
+  std::string stage;  // "compute", "vertex" or "fragment"
+  TimingSummary ns_per_pass;
+  std::vector<double> repetitions_ns;
+  std::uint32_t passes_per_repetition = 1;
+  std::uint32_t warmup_passes = 0;
+  std::uint32_t processors_used = 0;  // 0: the device does not name its processors
+};
+
+// The same arithmetic timed in each shader stage: whether a pass the
+// rasterizer draws (an engine's full-screen reconstruction, the raster
+// form) computes as fast as the compute passes timed beside it.
+struct StageProbe {
+  std::string method;             // what each invocation computes, in words
+  std::uint64_t invocations = 0;  // a pass's
+  std::uint32_t fma_per_invocation = 0;
+  std::uint32_t processors = 0;  // the device's; 0: not named
+  std::vector<StageRate> stages;
+  std::vector<std::string> left_out;  // a stage not measured, and why
+
+  // Fused multiply-adds a second in `stage`, at its median.
+  double fma_per_second(const StageRate& stage) const {
+    return static_cast<double>(invocations) * fma_per_invocation / stage.ns_per_pass.median * 1e9;
+  }
+  // The compute row, or null.
+  const StageRate* compute() const;
+};
+
 // The memory-bound floor of a full-screen pass over one format at one
 // resolution: the bytes it must move, one reconstruction per pixel (the
 // texel read, the float written), over the measured bandwidth. No pass can
@@ -172,6 +202,7 @@ struct SpeedResults {
   SpeedRunInfo run;
   std::optional<BandwidthProbe> bandwidth;  // none in files made before the probe, or when it failed
   std::vector<MemoryFloor> floors;          // per format and resolution timed; empty without a probe
+  std::optional<StageProbe> stages;         // none in files made before the probe, or when it failed
   std::vector<GpuTiming> gpu;
   std::vector<StaticCost> static_costs;
   std::vector<CpuCost> cpu;

@@ -179,6 +179,59 @@ Expected<BandwidthProbe> ProbeBandwidth(GpuPassTimer& timer, const SpeedOptions&
   return probe;
 }
 
+namespace {
+
+// The stage probe (GpuPassTimer::MeasureStages): a pixel an invocation,
+// of the largest frame timed up to 1920x1080, each 1024 multiply-adds.
+// With that much arithmetic an invocation, an H100's compute passes ran at
+// over half its peak rate of multiply-adds; with 256, at a third: what
+// else an invocation does (its counts) weighed on them.
+constexpr Resolution kMostStageProbe{1920, 1080};
+constexpr std::uint32_t kStageProbeIterations = 256;
+
+// The one of most pixels (the first of those).
+Resolution LargestResolution(std::span<const Resolution> resolutions) {
+  return *std::max_element(resolutions.begin(), resolutions.end(), [](const Resolution& a, const Resolution& b) {
+    return std::uint64_t{a.width} * a.height < std::uint64_t{b.width} * b.height;
+  });
+}
+
+}  // namespace
+
+Expected<StageProbe> ProbeStages(GpuPassTimer& timer, const SpeedOptions& options) {
+  Resolution size = LargestResolution(options.resolutions);
+  if (std::uint64_t{size.width} * size.height > std::uint64_t{kMostStageProbe.width} * kMostStageProbe.height) {
+    size = kMostStageProbe;
+  }
+  DB_ASSIGN_OR_RETURN(StageTimings measured,
+                      timer.MeasureStages(size, kStageProbeIterations, options.warmup, options.repetitions));
+  StageProbe probe;
+  probe.method = fmt::format(
+      "{}x{} invocations, each {} fused multiply-adds in 4 independent chains (shaders/speed/stage_probe.glsl): "
+      "a compute dispatch, the vertex stage of as many points (rasterizer discard), the fragment stage of a "
+      "full-screen triangle; timed as the passes are",
+      measured.size.width, measured.size.height, measured.fma_per_invocation);
+  probe.invocations = std::uint64_t{measured.size.width} * measured.size.height;
+  probe.fma_per_invocation = measured.fma_per_invocation;
+  probe.processors = measured.processors;
+  probe.left_out = std::move(measured.left_out);
+  for (StageTiming& stage : measured.stages) {
+    if (stage.invocations != probe.invocations) {
+      return Internal(fmt::format("the stage probe's {} stage ran {} invocations of {}", stage.stage, stage.invocations,
+                                  probe.invocations));
+    }
+    StageRate rate;
+    rate.stage = std::move(stage.stage);
+    DB_ASSIGN_OR_RETURN(rate.ns_per_pass, SummarizeTimings(stage.timing.ns_per_pass));
+    rate.repetitions_ns = std::move(stage.timing.ns_per_pass);
+    rate.passes_per_repetition = stage.timing.passes_per_repetition;
+    rate.warmup_passes = stage.timing.warmup_passes;
+    rate.processors_used = stage.processors_used;
+    probe.stages.push_back(std::move(rate));
+  }
+  return probe;
+}
+
 Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path& shader_dir,
                                 const SpeedOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -199,10 +252,7 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
   run.repetitions = options.repetitions;
   run.alu_taps = options.alu_taps;
   run.resolutions = options.resolutions;
-  run.trade_resolution = *std::max_element(
-      options.resolutions.begin(), options.resolutions.end(), [](const Resolution& a, const Resolution& b) {
-        return std::uint64_t{a.width} * a.height < std::uint64_t{b.width} * b.height;
-      });
+  run.trade_resolution = LargestResolution(options.resolutions);
   run.cpu_compiler = MakeCpuBackend()->device().compiler;
 
   DB_ASSIGN_OR_RETURN(results.static_costs, MeasureStaticCosts(shader_dir, options.cells));
@@ -219,6 +269,16 @@ Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path
     } else {
       // The timings stand without it; only the floors are missing.
       results.skipped.push_back("memory-bound floors: the bandwidth probe failed: " + probe.status().message());
+    }
+    if (Interrupted()) return InterruptedError("no speed results written");
+    if (options.progress) options.progress(1, 1, "shader stages");
+    Expected<StageProbe> stages = ProbeStages(timer, options);
+    if (stages.ok()) {
+      results.stages = std::move(stages).value();
+    } else if (stages.status().code() == StatusCode::kInterrupted) {
+      return stages.status();
+    } else {
+      results.skipped.push_back("shader stages: the stage probe failed: " + stages.status().message());
     }
   }
   if (options.progress) options.progress(1, 1, "CPU backend");

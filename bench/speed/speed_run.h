@@ -66,9 +66,13 @@ Expected<std::vector<StaticCost>> MeasureStaticCosts(const std::filesystem::path
 // results keep it.
 Expected<BandwidthProbe> ProbeBandwidth(GpuPassTimer& timer, const SpeedOptions& options);
 
+// The shader stages' rates (GpuPassTimer::MeasureStages) as the results
+// keep them.
+Expected<StageProbe> ProbeStages(GpuPassTimer& timer, const SpeedOptions& options);
+
 // Everything but the trade, on `timer`'s device; run info filled in; the
-// memory-bound floors from the bandwidth probe, or, where the probe could
-// not run, a line in SpeedResults::skipped saying why.
+// memory-bound floors from the bandwidth probe and the stages' rates, or,
+// where a probe could not run, a line in SpeedResults::skipped saying why.
 Expected<SpeedResults> RunSpeed(GpuPassTimer& timer, const std::filesystem::path& shader_dir,
                                 const SpeedOptions& options);
 

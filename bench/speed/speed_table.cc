@@ -34,6 +34,39 @@ std::string Count(const OpCount& c) {
                                    : fmt::format("{} ({})", c.instructions, c.lanes);
 }
 
+// "3.1%": two significant digits.
+std::string Percent(double share) { return Readable(100.0 * share, 2) + "%"; }
+
+// A stage's rate, its share of the compute stage's and the processors it
+// ran on, a line each; then, where a drawing stage computes at under half
+// the compute rate, what that means for the timings below.
+void PrintStageProbe(const StageProbe& probe, std::ostream& out) {
+  out << fmt::format("shader stages: {} multiply-adds an invocation, {} invocations a pass ({}):\n",
+                     probe.fma_per_invocation, probe.invocations,
+                     probe.processors > 0 ? "processors named by VK_NV_shader_sm_builtins"
+                                          : "the device does not name its processors");
+  const StageRate* const compute = probe.compute();
+  double slowest_share = 1.0;
+  for (const StageRate& stage : probe.stages) {
+    const double share = probe.fma_per_second(stage) / probe.fma_per_second(*compute);
+    std::string line =
+        fmt::format("  {:<9}{} G multiply-adds/s", stage.stage, Readable(probe.fma_per_second(stage) * 1e-9, 3));
+    if (&stage != compute) {
+      line += fmt::format(", {} of compute's", Percent(share));
+      slowest_share = std::min(slowest_share, share);
+    }
+    if (probe.processors > 0) line += fmt::format(", on {} of {} processors", stage.processors_used, probe.processors);
+    out << line << "\n";
+  }
+  for (const std::string& reason : probe.left_out) out << "  not measured: " << reason << "\n";
+  if (slowest_share < 0.5) {
+    out << fmt::format(
+        "  note: the timings below are compute passes; a reconstruction drawn by the rasterizer (an engine's "
+        "full-screen pass, --pipeline raster) computes at {} of their rate on this device\n",
+        Percent(slowest_share));
+  }
+}
+
 }  // namespace
 
 void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
@@ -50,6 +83,9 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
                        Readable(b->bytes_per_second() * 1e-9, 3),
                        Readable(b->bytes_per_second() * 1e-9 * b->ns_per_pass.spread() / b->ns_per_pass.median, 2),
                        b->method, b->ns_per_pass.count);
+  }
+  if (const std::optional<StageProbe>& probe = results.stages) {
+    PrintStageProbe(*probe, out);
   }
   if (const std::optional<PassCostSplit> split = SplitPassCost(results.gpu)) {
     out << fmt::format(

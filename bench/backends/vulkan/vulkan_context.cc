@@ -151,6 +151,16 @@ std::optional<std::uint32_t> ChooseComputeQueueFamily(const std::vector<VkQueueF
   return chosen;
 }
 
+// Fills `properties` (a structure of vkGetPhysicalDeviceProperties2's
+// chain, its sType set) for `device`.
+template <class Properties>
+void QueryMoreProperties(VkPhysicalDevice device, Properties& properties) {
+  VkPhysicalDeviceProperties2 chain{};
+  chain.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  chain.pNext = &properties;
+  vkGetPhysicalDeviceProperties2(device, &chain);
+}
+
 bool HasDeviceExtension(VkPhysicalDevice device, std::string_view name) {
   std::uint32_t count = 0;
   if (vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr) != VK_SUCCESS) return false;
@@ -181,10 +191,7 @@ DeviceCandidate DescribeDevice(VkPhysicalDevice device) {
   if (basic.apiVersion >= VK_API_VERSION_1_2) {
     VkPhysicalDeviceDriverProperties driver{};
     driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
-    VkPhysicalDeviceProperties2 extended{};
-    extended.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
-    extended.pNext = &driver;
-    vkGetPhysicalDeviceProperties2(device, &extended);
+    QueryMoreProperties(device, driver);
     properties.driver_id = driver.driverID;
     properties.driver_name = driver.driverName;
     properties.driver_info = driver.driverInfo;
@@ -423,7 +430,8 @@ Status VulkanContext::CreateDevice() {
   // float64 arithmetic, where the device has it: the exact-division probe
   // (arithmetic_probe.h) divides in float64. What the raster form draws
   // with, where the device has it; the raster form checks what it lacks
-  // when it is prepared (RasterFeatures).
+  // when it is prepared (RasterFeatures). Stores from the vertex stage and
+  // the processors' numbers, for the speed timer's probe of the stages.
   VkPhysicalDeviceDepthClipControlFeaturesEXT clip_control{};
   clip_control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DEPTH_CLIP_CONTROL_FEATURES_EXT;
   VkPhysicalDeviceVulkan13Features features13{};
@@ -435,6 +443,9 @@ Status VulkanContext::CreateDevice() {
   const bool api12 = properties_.api_version >= VK_API_VERSION_1_2;
   const bool api13 = properties_.api_version >= VK_API_VERSION_1_3;
   const bool has_clip_control = HasDeviceExtension(physical_device_, VK_EXT_DEPTH_CLIP_CONTROL_EXTENSION_NAME);
+  const bool has_sm_builtins = HasDeviceExtension(physical_device_, VK_NV_SHADER_SM_BUILTINS_EXTENSION_NAME);
+  VkPhysicalDeviceShaderSMBuiltinsFeaturesNV sm_builtins{};
+  sm_builtins.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_SM_BUILTINS_FEATURES_NV;
   // Only structures the device knows go into the chain.
   void** next = &supported.pNext;
   const auto chain = [&next](auto& features) {
@@ -444,6 +455,7 @@ Status VulkanContext::CreateDevice() {
   if (api12) chain(features12);
   if (api13) chain(features13);
   if (has_clip_control) chain(clip_control);
+  if (has_sm_builtins) chain(sm_builtins);
   vkGetPhysicalDeviceFeatures2(physical_device_, &supported);
   const VkPhysicalDeviceFeatures& core = supported.features;
   shader_float64_ = core.shaderFloat64 == VK_TRUE;
@@ -456,6 +468,13 @@ Status VulkanContext::CreateDevice() {
                       .depth_clamp = core.depthClamp == VK_TRUE,
                       .fragment_stores = core.fragmentStoresAndAtomics == VK_TRUE,
                       .depth_clip_control = has_clip_control && clip_control.depthClipControl == VK_TRUE};
+  stage_probe_features_.vertex_stores = core.vertexPipelineStoresAndAtomics == VK_TRUE;
+  if (has_sm_builtins && sm_builtins.shaderSMBuiltins == VK_TRUE) {
+    VkPhysicalDeviceShaderSMBuiltinsPropertiesNV sm_properties{};
+    sm_properties.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_SM_BUILTINS_PROPERTIES_NV;
+    QueryMoreProperties(physical_device_, sm_properties);
+    stage_probe_features_.processors = sm_properties.shaderSMCount;
+  }
   // Enabling is the same chain with only what is wanted left on.
   VkPhysicalDeviceFeatures2 enabled{};
   enabled.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
@@ -465,6 +484,7 @@ Status VulkanContext::CreateDevice() {
   enabled.features.multiViewport = core.multiViewport;
   enabled.features.depthClamp = core.depthClamp;
   enabled.features.fragmentStoresAndAtomics = core.fragmentStoresAndAtomics;
+  enabled.features.vertexPipelineStoresAndAtomics = core.vertexPipelineStoresAndAtomics;
   // Of the 1.2 and 1.3 features, only these three are wanted.
   const VkBool32 viewport_index = features12.shaderOutputViewportIndex;
   const VkBool32 int64_atomics = features12.shaderBufferInt64Atomics;
@@ -480,11 +500,11 @@ Status VulkanContext::CreateDevice() {
   features13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
   features13.pNext = after13;
   features13.dynamicRendering = dynamic_rendering;
-  const char* const extensions[] = {VK_EXT_DEPTH_CLIP_CONTROL_EXTENSION_NAME};
-  if (has_clip_control) {
-    device_info.enabledExtensionCount = 1;
-    device_info.ppEnabledExtensionNames = extensions;
-  }
+  std::vector<const char*> extensions;
+  if (has_clip_control) extensions.push_back(VK_EXT_DEPTH_CLIP_CONTROL_EXTENSION_NAME);
+  if (has_sm_builtins) extensions.push_back(VK_NV_SHADER_SM_BUILTINS_EXTENSION_NAME);
+  device_info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+  device_info.ppEnabledExtensionNames = extensions.data();
   device_info.pNext = &enabled;
   DB_RETURN_IF_ERROR(CheckVk(vkCreateDevice(physical_device_, &device_info, nullptr, &device_), "vkCreateDevice"));
   vkGetDeviceQueue(device_, properties_.queue_family, 0, &queue_);

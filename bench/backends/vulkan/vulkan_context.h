@@ -188,6 +188,18 @@ struct RasterFeatures {
   bool depth_clip_control = false;      // VK_EXT_depth_clip_control: GL-style clip depth [-1, 1]
 };
 
+// What the speed timer's probe of the shader stages (GpuPassTimer::
+// MeasureStages) can see on the device (each enabled where offered).
+struct StageProbeFeatures {
+  // vertexPipelineStoresAndAtomics: the vertex stage can count its own
+  // invocations.
+  bool vertex_stores = false;
+  // VK_NV_shader_sm_builtins' shaderSMCount: how many processors the device
+  // has, whose number each invocation can read (gl_SMIDNV); 0 where the
+  // device does not name them.
+  std::uint32_t processors = 0;
+};
+
 // How the host uses a buffer, which decides the memory type it lives in.
 enum class HostAccess {
   kUpload,    // written by the host, read by shaders: coherent write-combined memory is best
@@ -214,6 +226,7 @@ class VulkanContext {
   // buffers (enabled wherever the device has them).
   bool int64_atomics() const { return int64_atomics_; }
   const RasterFeatures& raster_features() const { return raster_features_; }
+  const StageProbeFeatures& stage_probe_features() const { return stage_probe_features_; }
 
   bool validation_enabled() const { return validation_enabled_; }
   // The validation layer's warnings and errors since the last call.
@@ -260,6 +273,7 @@ class VulkanContext {
   bool shader_float64_ = false;
   bool int64_atomics_ = false;
   RasterFeatures raster_features_;
+  StageProbeFeatures stage_probe_features_;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
 };
 
