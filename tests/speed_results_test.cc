@@ -197,6 +197,30 @@ TEST(SpeedResultsTest, StageProbeGivesEachStagesShareOfCompute) {
       << unknown.status().message();
 }
 
+// A pass's fixed cost is the intercept of its time against its pixels; a
+// negative one (a smaller frame faster per pixel than the line through the
+// larger allows, as on an H100 whose 1920x1080 passes took 3.6 ps a pixel
+// and its 3840x2160 ones 4.1) is no cost, and the line says so instead.
+TEST(SpeedResultsTest, ANegativeFixedCostIsNotPrintedAsACost) {
+  SpeedResults r = Example();
+  r.gpu = {Timing(Variant::kDivide, 7410, Regime::kMemory), Timing(Variant::kDivide, 33600, Regime::kMemory)};
+  r.gpu[1].resolution = {3840, 2160};
+  std::ostringstream out;
+  PrintSpeedHeader(r, out);
+  EXPECT_NE(out.str().find("fixed cost per pass: not measurable here: the 1920x1080 passes took less per pixel than "
+                           "the 3840x2160 ones (the line through them meets 0 pixels at -1.3 µs"),
+            std::string::npos)
+      << out.str();
+  EXPECT_EQ(ToJson(r)["pass_cost_split"]["fixed_cost_measurable"], false);
+
+  r.gpu[0].ns_per_pass.median = 9000;  // 9 us and 33.6 us: 0.8 us fixed, 3.95 ps a pixel
+  std::ostringstream fitted;
+  PrintSpeedHeader(r, fitted);
+  EXPECT_NE(fitted.str().find("fixed cost per pass: 0.80 µs, apart from 3.95 ps per pixel"), std::string::npos)
+      << fitted.str();
+  EXPECT_EQ(ToJson(r)["pass_cost_split"]["fixed_cost_measurable"], true);
+}
+
 TEST(SpeedResultsTest, RefusesCellsThatDoNotExist) {
   nlohmann::json json = ToJson(Example());
   json["gpu"][1]["cell"] = "divide/linear/r32_sfloat";

@@ -425,6 +425,8 @@ json ToJson(const SpeedResults& results) {
   if (const std::optional<PassCostSplit> split = SplitPassCost(results.gpu)) {
     document["pass_cost_split"] = {{"cells", split->cells},
                                    {"fixed_ns", split->fixed_ns},
+                                   // Below 0, the intercept is not a cost (speed_table.cc).
+                                   {"fixed_cost_measurable", split->fixed_ns >= 0.0},
                                    {"ns_per_pixel", split->ns_per_pixel},
                                    {"smallest", ResolutionName(split->smallest)},
                                    {"largest", ResolutionName(split->largest)}};

@@ -88,11 +88,24 @@ void PrintSpeedHeader(const SpeedResults& results, std::ostream& out) {
     PrintStageProbe(*probe, out);
   }
   if (const std::optional<PassCostSplit> split = SplitPassCost(results.gpu)) {
-    out << fmt::format(
-        "fixed cost per pass: {} µs, apart from {} ps per pixel (memory-bound passes, the line through {} and {}; "
-        "median of {} cells): what a pass costs whatever its size\n",
-        Readable(split->fixed_ns * 1e-3, 2), Readable(split->ns_per_pixel * 1e3, 3), ResolutionName(split->smallest),
-        ResolutionName(split->largest), split->cells);
+    if (split->fixed_ns >= 0.0) {
+      out << fmt::format(
+          "fixed cost per pass: {} µs, apart from {} ps per pixel (memory-bound passes, the line through {} and {}; "
+          "median of {} cells): what a pass costs whatever its size\n",
+          Readable(split->fixed_ns * 1e-3, 2), Readable(split->ns_per_pixel * 1e3, 3), ResolutionName(split->smallest),
+          ResolutionName(split->largest), split->cells);
+    } else {
+      // A negative intercept is no cost: the smaller frame ran faster per
+      // pixel than the larger (its image and output may stay in the
+      // device's cache from pass to pass), and the line says nothing about
+      // a pass's fixed cost.
+      out << fmt::format(
+          "fixed cost per pass: not measurable here: the {} passes took less per pixel than the {} ones (the line "
+          "through them meets 0 pixels at {} µs; median of {} cells), as when a smaller frame stays in the "
+          "device's cache from pass to pass\n",
+          ResolutionName(split->smallest), ResolutionName(split->largest), Readable(split->fixed_ns * 1e-3, 2),
+          split->cells);
+    }
   }
   out << "figures are medians ±spread (interquartile range); a rank is 1 + the variants of the same convention, "
          "format, resolution and regime that are faster by more than the spread; '=' marks a rank shared with "
