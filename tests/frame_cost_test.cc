@@ -81,6 +81,30 @@ TEST(FrameCostTest, CostIsBytesAtTheBandwidthPlusOneReconstructionPerPixel) {
   EXPECT_FALSE(model.Cost(CellOf(Variant::kPq, Convention::kReversed, Format::kD32Sfloat)).ok());
 }
 
+// A cost's ALU part is a compute pass's; where the file's stage probe has
+// a drawing stage at under half compute's rate (an H100: 3.6%), the cost's
+// source says what a drawn pass computes at; at half or more, nothing.
+TEST(FrameCostTest, ACostSaysWhereTheDeviceDrawsFarSlowerThanItComputes) {
+  SpeedResults speed = Synthetic(1e12, 16e6, 0.0);
+  StageProbe probe;
+  probe.invocations = probe.fma_per_invocation = 1000;
+  probe.stages = {{"compute", {}, {}, 1, 1, 0}, {"vertex", {}, {}, 1, 1, 0}, {"fragment", {}, {}, 1, 1, 0}};
+  probe.stages[0].ns_per_pass.median = 100;
+  probe.stages[1].ns_per_pass.median = 150;   // 67%
+  probe.stages[2].ns_per_pass.median = 2800;  // 3.6%
+  speed.stages = probe;
+  const Cell d32 = CellOf(Variant::kDivide, Convention::kReversed, Format::kD32Sfloat);
+  const auto slow = FrameCostLookup({std::make_shared<const SpeedResults>(speed), "h100.json", {1000, 1000}, false});
+  ASSERT_TRUE(slow(d32));
+  EXPECT_EQ(slow(d32)->source,
+            "h100.json; ALU from compute passes: a pass drawn by the rasterizer computes at 3.6% of their rate on "
+            "this device (speed's stage probe)");
+  speed.stages->stages[2].ns_per_pass.median = 190;  // 53%: the slowest drawing stage at half or more
+  const auto near = FrameCostLookup({std::make_shared<const SpeedResults>(speed), "gpu.json", {1000, 1000}, false});
+  ASSERT_TRUE(near(d32));
+  EXPECT_EQ(near(d32)->source, "gpu.json");
+}
+
 // D24 and D32F tie on bytes without stencil; with it D32F moves twice the
 // bytes, more than the spread of the timings apart when memory matters.
 TEST(FrameCostTest, D24AndD32fNoLongerTieWithStencil) {

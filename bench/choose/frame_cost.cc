@@ -66,14 +66,25 @@ std::string FrameCostModel::Unit() const {
 
 CostLookup FrameCostLookup(FrameCostModel model) {
   const std::string unit = model.Unit();
-  return [model, unit](const Cell& cell) -> std::optional<CandidateCost> {
+  // The ALU part is a compute pass's; where the device draws far slower,
+  // the cost's source says so.
+  std::string source = model.source;
+  if (model.speed->stages) {
+    if (const std::optional<double> share = model.speed->stages->drawn_share(); share && *share < kSlowDrawnShare) {
+      source += fmt::format(
+          "; ALU from compute passes: a pass drawn by the rasterizer computes at {:.2g}% of their rate on this "
+          "device (speed's stage probe)",
+          100.0 * *share);
+    }
+  }
+  return [model, unit, source](const Cell& cell) -> std::optional<CandidateCost> {
     Expected<FrameCost> cost = model.Cost(cell);
     if (!cost.ok()) return std::nullopt;
     CandidateCost c;
     c.value = cost->total_us();
     c.spread = cost->spread_us;
     c.unit = unit;
-    c.source = model.source;
+    c.source = source;
     c.bytes_per_pixel = cost->bytes.moved();
     c.parts = fmt::format("{} B/px moved: {:.3g} µs memory + {:.3g} µs ALU", cost->bytes.moved(), cost->memory_us,
                           cost->alu_us);

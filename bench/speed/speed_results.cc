@@ -72,6 +72,17 @@ const StageRate* StageProbe::compute() const {
   return nullptr;
 }
 
+std::optional<double> StageProbe::drawn_share() const {
+  const StageRate* const base = compute();
+  std::optional<double> share;
+  for (const StageRate& stage : stages) {
+    if (&stage == base || base == nullptr) continue;
+    const double s = fma_per_second(stage) / fma_per_second(*base);
+    share = share ? std::min(*share, s) : s;
+  }
+  return share;
+}
+
 std::vector<MemoryFloor> MemoryFloors(const BandwidthProbe& probe, const std::vector<GpuTiming>& timings) {
   std::vector<MemoryFloor> floors;
   const double bytes_per_ns = probe.bytes_per_second() * 1e-9;

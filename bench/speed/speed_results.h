@@ -110,7 +110,14 @@ struct StageProbe {
   }
   // The compute row, or null.
   const StageRate* compute() const;
+  // The slowest drawing stage's rate over compute's; nullopt where neither
+  // drawing stage was measured.
+  std::optional<double> drawn_share() const;
 };
+// Below this share of compute's rate, a pass drawn by the rasterizer costs
+// what the compute passes' timings say no longer: speed and the frame costs
+// made from its file say so.
+inline constexpr double kSlowDrawnShare = 0.5;
 
 // The memory-bound floor of a full-screen pass over one format at one
 // resolution: the bytes it must move, one reconstruction per pixel (the

@@ -46,24 +46,21 @@ void PrintStageProbe(const StageProbe& probe, std::ostream& out) {
                      probe.processors > 0 ? "processors named by VK_NV_shader_sm_builtins"
                                           : "the device does not name its processors");
   const StageRate* const compute = probe.compute();
-  double slowest_share = 1.0;
   for (const StageRate& stage : probe.stages) {
-    const double share = probe.fma_per_second(stage) / probe.fma_per_second(*compute);
     std::string line =
         fmt::format("  {:<9}{} G multiply-adds/s", stage.stage, Readable(probe.fma_per_second(stage) * 1e-9, 3));
     if (&stage != compute) {
-      line += fmt::format(", {} of compute's", Percent(share));
-      slowest_share = std::min(slowest_share, share);
+      line += fmt::format(", {} of compute's", Percent(probe.fma_per_second(stage) / probe.fma_per_second(*compute)));
     }
     if (probe.processors > 0) line += fmt::format(", on {} of {} processors", stage.processors_used, probe.processors);
     out << line << "\n";
   }
   for (const std::string& reason : probe.left_out) out << "  not measured: " << reason << "\n";
-  if (slowest_share < 0.5) {
+  if (const std::optional<double> share = probe.drawn_share(); share && *share < kSlowDrawnShare) {
     out << fmt::format(
         "  note: the timings below are compute passes; a reconstruction drawn by the rasterizer (an engine's "
         "full-screen pass, --pipeline raster) computes at {} of their rate on this device\n",
-        Percent(slowest_share));
+        Percent(*share));
   }
 }
 
