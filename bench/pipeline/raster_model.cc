@@ -10,42 +10,59 @@
 namespace depthbench {
 namespace {
 
+// The geometry is built in double: its corners only have to be good
+// float32 values, and its checks hold a margin of a third of a pixel. Only
+// the truth, the ray's meeting with the plane of the float corners, is
+// worked out in long double. (In long double throughout, the x87 unit's
+// arithmetic and the C library's long-double sine and cosine took nearly
+// half of the build of a raster batch.)
 using L = long double;
-using LVec3 = glm::vec<3, L>;
+template <class T>
+using Vec3 = glm::vec<3, T>;
+using DVec2 = glm::dvec2;
 
-// The pixel's centre in NDC (y up), as PixelRay takes it.
-glm::vec<2, L> PixelNdc(const Frame& frame, std::uint32_t x, std::uint32_t y) {
-  return {(static_cast<L>(x) + 0.5L) * 2.0L / frame.width - 1.0L,
-          1.0L - (static_cast<L>(y) + 0.5L) * 2.0L / frame.height};
+// The pixel's ray at unit eye depth in view space (z = -1), through an
+// off-centre lens too: from the pixel's centre in NDC (y up), as PixelRay
+// takes it.
+template <class T>
+Vec3<T> PixelRayView(const Frame& frame, std::uint32_t x, std::uint32_t y) {
+  const T ndc_x = (static_cast<T>(x) + T(0.5)) * T(2) / frame.width - T(1);
+  const T ndc_y = T(1) - (static_cast<T>(y) + T(0.5)) * T(2) / frame.height;
+  const T tan_y = frame.tan_half_fov_y, tan_x = static_cast<T>(frame.aspect) * tan_y;
+  return {ndc_x * tan_x + frame.centre_x, ndc_y * tan_y + frame.centre_y, T(-1)};
 }
 
-LVec3 ToLong(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
-LVec3 Rotate(const glm::dmat3& r, const LVec3& v) {
-  return ToLong(r[0]) * v.x + ToLong(r[1]) * v.y + ToLong(r[2]) * v.z;
+template <class T>
+Vec3<T> Rotate(const glm::dmat3& r, const Vec3<T>& v) {
+  return Vec3<T>(r[0]) * v.x + Vec3<T>(r[1]) * v.y + Vec3<T>(r[2]) * v.z;
 }
 // The transpose: world directions into the camera's axes.
-LVec3 Unrotate(const glm::dmat3& r, const LVec3& v) {
-  return {glm::dot(ToLong(r[0]), v), glm::dot(ToLong(r[1]), v), glm::dot(ToLong(r[2]), v)};
+glm::dvec3 Unrotate(const glm::dmat3& r, const glm::dvec3& v) {
+  return {glm::dot(r[0], v), glm::dot(r[1], v), glm::dot(r[2], v)};
 }
-glm::vec4 ToFloat4(const LVec3& v, float w) {
+template <class T>
+glm::vec4 ToFloat4(const Vec3<T>& v, float w) {
   return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), w};
 }
-LVec3 Xyz(const glm::vec4& v) { return {v.x, v.y, v.z}; }
+template <class T>
+Vec3<T> Xyz(const glm::vec4& v) {
+  return {v.x, v.y, v.z};
+}
 
 // Where the exact camera puts world point q on the screen, in pixels (x
 // right, y down), or nothing when q is not in front of the camera.
-std::optional<glm::vec<2, L>> ExactScreen(const Frame& frame, const LVec3& q) {
-  const LVec3 view = Unrotate(frame.rotation, q - ToLong(frame.camera_position));
-  if (!(view.z < 0.0L)) return std::nullopt;
-  const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
-  const L ndc_x = (view.x / -view.z - frame.centre_x) / tan_x, ndc_y = (view.y / -view.z - frame.centre_y) / tan_y;
-  return glm::vec<2, L>((ndc_x + 1.0L) * frame.width / 2.0L, (1.0L - ndc_y) * frame.height / 2.0L);
+std::optional<DVec2> ExactScreen(const Frame& frame, const glm::dvec3& q) {
+  const glm::dvec3 view = Unrotate(frame.rotation, q - frame.camera_position);
+  if (!(view.z < 0.0)) return std::nullopt;
+  const double tan_y = frame.tan_half_fov_y, tan_x = frame.aspect * tan_y;
+  const double ndc_x = (view.x / -view.z - frame.centre_x) / tan_x, ndc_y = (view.y / -view.z - frame.centre_y) / tan_y;
+  return DVec2((ndc_x + 1.0) * frame.width / 2.0, (1.0 - ndc_y) * frame.height / 2.0);
 }
 
 // Signed distance, in pixels, of p from the line a->b; positive on the
 // left of a->b in a y-down frame for a clockwise-on-screen triangle.
-L EdgeDistance(const glm::vec<2, L>& a, const glm::vec<2, L>& b, const glm::vec<2, L>& p) {
-  const glm::vec<2, L> e = b - a;
+double EdgeDistance(const DVec2& a, const DVec2& b, const DVec2& p) {
+  const DVec2 e = b - a;
   return (e.x * (p.y - a.y) - e.y * (p.x - a.x)) / std::sqrt(e.x * e.x + e.y * e.y);
 }
 
@@ -115,27 +132,26 @@ bool HasGeometry(const f32::RasterSample& g) { return g.triangle0.w != 0.0f; }
 
 // An angle by its cosine and sine.
 struct UnitAngle {
-  L cos, sin;
+  double cos, sin;
   UnitAngle Plus(const UnitAngle& o) const { return {cos * o.cos - sin * o.sin, sin * o.cos + cos * o.sin}; }
 };
 // 0, 1/3 and 2/3 of a turn.
-constexpr L kSinThird = 0.866025403784438646763723170752936183L;  // sqrt(3) / 2
-constexpr std::array<UnitAngle, 3> kThirdTurns = {{{1.0L, 0.0L}, {-0.5L, kSinThird}, {-0.5L, -kSinThird}}};
+constexpr double kSinThird = 0.866025403784438646763723170752936183;  // sqrt(3) / 2
+constexpr std::array<UnitAngle, 3> kThirdTurns = {{{1.0, 0.0}, {-0.5, kSinThird}, {-0.5, -kSinThird}}};
 
 // The angle of `turns` (in [0, 1)) of a full turn. The C library reduces an
-// argument past pi/4 with a long remainder of pi/2 that took a quarter of
-// the build of a raster batch; here the reduction is exact in the turns
-// (multiplying by 8 and taking off whole eighths loses no bit), so only
-// angles within [0, pi/4] reach sinl and cosl.
-UnitAngle TurnOf(L turns) {
-  const L eighths = turns * 8.0L;
+// argument past pi/4 with a long remainder of pi/2; here the reduction is
+// exact in the turns (multiplying by 8 and taking off whole eighths loses
+// no bit), so only angles within [0, pi/4] reach sin and cos.
+UnitAngle TurnOf(double turns) {
+  const double eighths = turns * 8.0;
   const int octant = static_cast<int>(eighths);  // 0 to 7
-  const L within = eighths - octant;             // [0, 1): of the octant, exactly
+  const double within = eighths - octant;        // [0, 1): of the octant, exactly
   // From the octant's start, or back from its end on the odd ones, so the
   // argument stays within [0, pi/4]:
   const bool odd = (octant & 1) != 0;
-  const L angle = (odd ? 1.0L - within : within) * (std::numbers::pi_v<L> / 4.0L);
-  const L c = std::cos(angle), s = std::sin(angle);
+  const double angle = (odd ? 1.0 - within : within) * (std::numbers::pi / 4.0);
+  const double c = std::cos(angle), s = std::sin(angle);
   // The octant's quarter turns, and the mirror of an odd octant in its
   // quarter's diagonal.
   const UnitAngle in_quarter = odd ? UnitAngle{s, c} : UnitAngle{c, s};
@@ -176,58 +192,60 @@ glm::vec4 CubeCorner(const glm::vec4& volume, int corner) {
 RasterGeometry MakeRasterGeometry(const Frame& frame, const PixelSample& sample) {
   RasterGeometry out;
   if (sample.pick != DepthPick::kEyeDepth) return out;
-  const L d = sample.eye_depth;
-  const L tan_y = frame.tan_half_fov_y, tan_x = static_cast<L>(frame.aspect) * tan_y;
-  const glm::vec<2, L> ndc = PixelNdc(frame, sample.x, sample.y);
-  const LVec3 camera = ToLong(frame.camera_position);
-  // The pixel's ray at unit eye depth, through an off-centre lens too.
-  const LVec3 ray_view(ndc.x * tan_x + frame.centre_x, ndc.y * tan_y + frame.centre_y, -1.0L);
-  const LVec3 centre_view = ray_view * d;
+  const double d = sample.eye_depth;
+  const double tan_y = frame.tan_half_fov_y, tan_x = frame.aspect * tan_y;
+  const glm::dvec3 centre_view = PixelRayView<double>(frame, sample.x, sample.y) * d;
   // One pixel in view units at this depth, along x and (screen y down) y.
-  const L pixel_x = 2.0L * tan_x * d / frame.width, pixel_y = 2.0L * tan_y * d / frame.height;
+  const double pixel_x = 2.0 * tan_x * d / frame.width, pixel_y = 2.0 * tan_y * d / frame.height;
   // An equilateral triangle whose inscribed circle is centred on the pixel
   // centre; its orientation turns from sample to sample, by the golden
-  // ratio's fraction of a turn.
-  const UnitAngle first = TurnOf(std::fmod(static_cast<L>(sample.index) * 0.6180339887498948482L, 1.0L));
+  // ratio's fraction of a turn (that fraction in long double: a sample's
+  // index takes some 30 of its bits).
+  const auto turns = static_cast<double>(std::fmod(static_cast<L>(sample.index) * 0.6180339887498948482L, 1.0L));
+  const UnitAngle first = TurnOf(turns);
   std::array<glm::vec4, 3> corners;
   for (int k = 0; k < 3; ++k) {
     const UnitAngle corner = first.Plus(kThirdTurns[k]);
-    const L dx = 2.0L * kTriangleInradius * corner.cos, dy = 2.0L * kTriangleInradius * corner.sin;
-    const LVec3 view = centre_view + LVec3(dx * pixel_x, -dy * pixel_y, 0.0L);
-    corners[k] = ToFloat4(camera + Rotate(frame.rotation, view), 1.0f);
+    const double dx = 2.0 * kTriangleInradius * corner.cos, dy = 2.0 * kTriangleInradius * corner.sin;
+    const glm::dvec3 view = centre_view + glm::dvec3(dx * pixel_x, -dy * pixel_y, 0.0);
+    corners[k] = ToFloat4(frame.camera_position + Rotate(frame.rotation, view), 1.0f);
   }
 
   // The float corners must still hold the pixel centre well inside, seen
   // by the exact camera (a device's float32 matrix moves them by about
   // 2^-24 of the screen more, far below the margin).
-  std::array<glm::vec<2, L>, 3> screen;
+  std::array<DVec2, 3> screen;
   for (int k = 0; k < 3; ++k) {
-    const auto s = ExactScreen(frame, Xyz(corners[k]));
+    const auto s = ExactScreen(frame, Xyz<double>(corners[k]));
     if (!s) return out;
     screen[k] = *s;
   }
-  const glm::vec<2, L> centre(sample.x + 0.5L, sample.y + 0.5L);
-  const L orientation = EdgeDistance(screen[0], screen[1], screen[2]) > 0.0L ? 1.0L : -1.0L;
+  const DVec2 centre(sample.x + 0.5, sample.y + 0.5);
+  const double orientation = EdgeDistance(screen[0], screen[1], screen[2]) > 0.0 ? 1.0 : -1.0;
   for (int k = 0; k < 3; ++k) {
-    const L inside = orientation * EdgeDistance(screen[k], screen[(k + 1) % 3], centre);
-    if (!(inside > 0.5L * kTriangleInradius)) return out;
+    const double inside = orientation * EdgeDistance(screen[k], screen[(k + 1) % 3], centre);
+    if (!(inside > 0.5 * kTriangleInradius)) return out;
   }
 
-  // The truth: the pixel's ray meets the plane of the float corners.
-  const LVec3 ray = Rotate(frame.rotation, ray_view);
-  const LVec3 c0 = Xyz(corners[0]);
-  const LVec3 normal = glm::cross(Xyz(corners[1]) - c0, Xyz(corners[2]) - c0);
+  // The truth: the pixel's ray meets the plane of the float corners, in
+  // long double (the corners' differences are exact; the products and
+  // sums keep 11 bits more than double's).
+  const Vec3<L> camera(frame.camera_position);
+  const Vec3<L> ray = Rotate(frame.rotation, PixelRayView<L>(frame, sample.x, sample.y));
+  const Vec3<L> c0 = Xyz<L>(corners[0]);
+  const Vec3<L> normal = glm::cross(Xyz<L>(corners[1]) - c0, Xyz<L>(corners[2]) - c0);
   const L t = glm::dot(normal, c0 - camera) / glm::dot(normal, ray);
   if (!(t > 0.0L) || !std::isfinite(static_cast<double>(t))) return out;
 
   // The light volume: its centre must stay well inside around the ray too
   // (within half its half edge of the ray), or what the device covers is
   // not predictable either.
-  const LVec3 point = camera + ray * t;
-  const glm::vec4 volume = ToFloat4(point, static_cast<float>(d / 4.0L));
-  const LVec3 off = Xyz(volume) - camera;
-  const L along = glm::dot(off, ray) / glm::dot(ray, ray);
-  if (glm::length(off - ray * along) > 0.5L * volume.w) return out;
+  const Vec3<L> point = camera + ray * t;
+  const glm::vec4 volume = ToFloat4(point, static_cast<float>(d / 4.0));
+  const glm::dvec3 off = Xyz<double>(volume) - frame.camera_position;
+  const glm::dvec3 ray_world(ray);
+  const double along = glm::dot(off, ray_world) / glm::dot(ray_world, ray_world);
+  if (glm::length(off - ray_world * along) > 0.5 * volume.w) return out;
 
   out.sample = {corners[0], corners[1], corners[2], volume};
   out.rendered_depth = static_cast<double>(t);
