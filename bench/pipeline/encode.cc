@@ -255,20 +255,18 @@ float FetchTexel(Format format, std::uint32_t code) {
   return static_cast<float>(static_cast<double>(code) * (1.0 / UnormScale(info.bits)));
 }
 
-std::uint32_t CodeDistance(Format format, std::uint32_t a, std::uint32_t b) {
-  const FormatInfo& info = Info(format);
-  std::int64_t x = a, y = b;
-  if (info.texel != TexelKind::kUnorm) {
-    // Sign and magnitude to a line on which consecutive values are
-    // consecutive integers: the magnitude's bits, negated for a negative value.
-    const std::uint32_t sign = info.texel == TexelKind::kFloat32 ? 1u << 31 : 1u << 15;
-    const auto line = [sign](std::uint32_t code) {
-      const auto magnitude = static_cast<std::int64_t>(code & (sign - 1));
-      return (code & sign) != 0 ? -magnitude : magnitude;
-    };
-    x = line(a);
-    y = line(b);
+std::uint32_t CodeSignBit(Format format) {
+  switch (Info(format).texel) {
+    case TexelKind::kUnorm: return 0;
+    case TexelKind::kFloat32: return 1u << 31;
+    case TexelKind::kFloat16: return 1u << 15;
   }
+  return 0;
+}
+
+std::uint32_t CodeDistance(Format format, std::uint32_t a, std::uint32_t b) {
+  const std::uint32_t sign = CodeSignBit(format);
+  const std::int64_t x = CodeOnLine(a, sign), y = CodeOnLine(b, sign);
   const std::int64_t distance = x > y ? x - y : y - x;
   return static_cast<std::uint32_t>(std::min<std::int64_t>(distance, std::numeric_limits<std::uint32_t>::max()));
 }

@@ -98,6 +98,15 @@ float FetchTexel(Format format, std::uint32_t code);
 // stepped over between them (ulps), across binades and through zero (+0
 // and -0 are one value), saturating at 2^32 - 1.
 std::uint32_t CodeDistance(Format format, std::uint32_t a, std::uint32_t b);
+// CodeDistance's line, for loops over many codes of one format: the sign
+// bit of a float format's codes (0 for unorm), and a code's place on the
+// line on which consecutive values are consecutive integers (a float's
+// magnitude bits, negated where it is negative; a unorm code itself).
+std::uint32_t CodeSignBit(Format format);
+inline std::int64_t CodeOnLine(std::uint32_t code, std::uint32_t sign_bit) {
+  const auto magnitude = static_cast<std::int64_t>(code & (sign_bit - 1));
+  return (code & sign_bit) != 0 ? -magnitude : magnitude;
+}
 std::uint32_t FloatToUnorm(float value, int bits);  // clamps to [0, 1] first
 std::uint16_t FloatToHalf(float value);             // round to nearest even
 float HalfToFloat(std::uint16_t half);
