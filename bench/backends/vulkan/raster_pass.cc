@@ -743,12 +743,17 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   staged_lane_ = lane;
   const Lane& to = lanes_[lane];
   const std::uint32_t count = batch.count;
-  staged_resident_ = ResidentRun{.shape = ShapeOf(batch),
-                                 .which = {which.begin(), which.end()},
-                                 .unwritten_bits = unwritten_bits,
-                                 .codes = {},
-                                 .geometry = GeometryOf(batch, pool),
-                                 .pool = pool};
+  // The storage of the lane's last run, reused: 4 bytes a sample and depth
+  // slot, which a fresh vector would have the system zero and map page by
+  // page every batch.
+  staged_resident_ = std::move(lanes_[lane].finished);
+  lanes_[lane].finished.reset();
+  if (!staged_resident_) staged_resident_.emplace();
+  staged_resident_->shape = ShapeOf(batch);
+  staged_resident_->which.assign(which.begin(), which.end());
+  staged_resident_->unwritten_bits = unwritten_bits;
+  staged_resident_->geometry = GeometryOf(batch, pool);
+  staged_resident_->pool = pool;
   std::vector<std::uint32_t>& codes = staged_resident_->codes;
   codes.resize(std::size_t{count} * slots_.size());
   if (pool != nullptr) {
@@ -795,8 +800,9 @@ Status RasterPass::QueueResident() {
 Status RasterPass::FinishLane(std::uint32_t lane, ThreadPool* pool) {
   Lane& from = lanes_[lane];
   if (!from.queued) return Status::Ok();
-  const ResidentRun run = std::move(*from.queued);
+  from.finished = std::move(from.queued);
   from.queued.reset();
+  const ResidentRun& run = *from.finished;
   DB_RETURN_IF_ERROR(pass_->Wait(lane));
   DB_RETURN_IF_ERROR(from.readback.InvalidateForHostReads());
   const std::vector<bool> drawn = EverySlot();

@@ -271,6 +271,7 @@ class RasterPass {
     };
     std::vector<Recorder> recorders;
     std::optional<ResidentRun> queued;  // the resident run queued here and not yet finished
+    std::optional<ResidentRun> finished;  // the last finished, whose storage the next reuses
     std::uint64_t order = 0;            // when it was queued, counted over the resident runs
   };
   static constexpr std::uint32_t kLanes = 2;
