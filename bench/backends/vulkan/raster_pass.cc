@@ -748,7 +748,7 @@ Expected<DeviceRunBuffers> RasterPass::StageResident(const ShaderInputs& batch, 
   // page every batch.
   staged_resident_ = std::move(lanes_[lane].finished);
   lanes_[lane].finished.reset();
-  if (!staged_resident_) staged_resident_.emplace();
+  if (!staged_resident_) staged_resident_ = ResidentRun{};
   staged_resident_->shape = ShapeOf(batch);
   staged_resident_->which.assign(which.begin(), which.end());
   staged_resident_->unwritten_bits = unwritten_bits;
