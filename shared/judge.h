@@ -125,7 +125,7 @@ struct JudgePass {
   uint first_index_lo;
   uint first_index_hi;
   uint phase;  // judge: 0 bins, counts, maxima and their candidates, 1 the index of each maximum; storage: 0 the
-               // pipelines' floats, 1 the texels
+               // pipelines' floats made and stored, 1 the uploaded floats stored
   uint record_distances;  // 1: natural samples also go to their camera-distance band
   uint cells;
   uint depth_slots;       // slices of the reference buffers, and the depth slots' accumulators

@@ -65,6 +65,7 @@ constexpr std::array<Metric, L::DB_JUDGE_METRICS> kCellMetrics = {Metric::kTotal
 constexpr std::array<Metric, 2> kEncodingMetrics = {Metric::kStorage, Metric::kProduction};
 constexpr std::uint32_t kWorkgroupSize = 64;  // store.comp's and reference.comp's local_size_x
 constexpr std::size_t kUploadChunk = 16384;   // samples per job of the uploads
+constexpr std::uint32_t kNoDepthSlot = 0xffffffffu;  // bindings.glsl's: the end of a pipeline's slots
 
 // The storage buffers of the three passes, by binding number
 // (shaders/judge/bindings.glsl says what each holds).
@@ -284,7 +285,7 @@ struct DeviceJudge::State {
   // The cells' accumulators, then the depth slots'.
   std::size_t accumulators() const { return cell_count() + depth_slots; }
   std::size_t counted_slots() const { return accumulators() * L::DB_JUDGE_SLOTS; }
-  std::size_t row_order_at() const { return cell_count() + 2 * depth_slots + pipelines; }
+  std::size_t row_order_at() const { return cell_count() + 3 * depth_slots + pipelines; }
   // The fused passes' rows: the cells grouped by variant.
   std::size_t fused_rows_at() const { return row_order_at() + accumulators(); }
   // Per cell, its convention slot within a frame's DepthParams.
@@ -499,8 +500,13 @@ Expected<std::unique_ptr<DeviceJudge>> DeviceJudge::Create(Backend& backend, con
     words[state->cell_count() + s] = EncodingWord(layout.encodings[s], pipeline_of_slot[s]);
     words[state->accumulators() + s] = TexelWord(layout.encodings[s].format);
   }
+  // Each pipeline's slots as a list: its first, and each one's next.
+  std::uint32_t* next_slot = words + state->accumulators() + state->depth_slots;
+  std::uint32_t* first_slot = next_slot + state->depth_slots;
+  std::fill_n(first_slot, state->pipelines, kNoDepthSlot);
   for (std::uint32_t s = static_cast<std::uint32_t>(state->depth_slots); s-- > 0;) {
-    words[state->accumulators() + state->depth_slots + pipeline_of_slot[s]] = s;  // the pipeline's first slot
+    next_slot[s] = first_slot[pipeline_of_slot[s]];
+    first_slot[pipeline_of_slot[s]] = s;
   }
   // The judge's rows: the cells that read one depth slot one after the
   // other, so that the workgroups running at once share the slot's
@@ -772,20 +778,14 @@ void DeviceJudge::State::RecordStore(VkCommandBuffer commands, L::JudgePass cons
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   }
   RecordMark(commands, kSampled);
-  pass->Bind(commands, store_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
-  const auto slots = static_cast<std::uint32_t>(depth_slots);
-  if (device_produces()) {
-    pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, (constants.count + kWorkgroupSize - 1) / kWorkgroupSize,
-                  static_cast<std::uint32_t>(pipelines), 1);
-    RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
-  }
-  // Every slice whole, but where the backend's rasterizer stores them.
+  // Every slice whole, a row per pipeline, but where the backend's
+  // rasterizer stores them; the pipelines' floats made first where the
+  // device produces them.
   if (!rasterized()) {
-    constants.phase = 1;
+    pass->Bind(commands, store_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
+    constants.phase = device_produces() ? 0 : 1;
     pass->PushConstants(commands, &constants, sizeof(constants));
-    vkCmdDispatch(commands, slice_groups, slots, 1);
+    vkCmdDispatch(commands, slice_groups, static_cast<std::uint32_t>(pipelines), 1);
     // The reconstruction pass (the backend's, queued next) and the reference read them.
     RecordMemoryBarrier(commands, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
@@ -802,10 +802,10 @@ void DeviceJudge::State::Record(VkCommandBuffer commands, L::JudgePass constants
   vkCmdFillBuffer(commands, Buffer(kMaxima).handle(), half, half, 0xffffffffu);
   vkCmdFillBuffer(commands, Buffer(kCandidateCounts).handle(), 0, VK_WHOLE_SIZE, 0u);
   const std::uint32_t groups = (constants.count + kWorkgroupSize - 1) / kWorkgroupSize;
-  // The reference of every (depth slot, sample).
+  // The reference of every (depth slot, sample), a row per pipeline.
   pass->Bind(commands, reference_pipeline.get(), VK_PIPELINE_BIND_POINT_COMPUTE, lane);
   pass->PushConstants(commands, &constants, sizeof(constants));
-  vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(depth_slots), 1);
+  vkCmdDispatch(commands, groups, static_cast<std::uint32_t>(pipelines), 1);
   RecordMark(commands, kReferenced);
   // The fills, the reference, and the reconstruction pass's positions (an
   // earlier submission to the same queue), before the judge reads.

@@ -8,9 +8,10 @@
 // its encoding word (what the format stores, the convention, the hardware
 // convention, a far plane at infinity, the pipeline: shared/judge.h's
 // db_encoding_*); then per depth slot its texel word (how the format keeps
-// a value, a unorm's bits: db_texel_*); then per pipeline its first depth
-// slot; then, from pass.row_order, the accumulator each workgroup row of
-// the judge takes.
+// a value, a unorm's bits: db_texel_*); then per depth slot the next slot
+// of its pipeline (kNoDepthSlot after the last); then per pipeline its first
+// depth slot; then, from pass.row_order, the accumulator each workgroup
+// row of the judge takes.
 layout(std430, set = 0, binding = 0) readonly buffer Layout { uint run_layout[]; };
 // Float32 values are read as their bits and made doubles by float_value:
 // a device may flush float32 subnormals to zero in arithmetic and
@@ -116,6 +117,12 @@ layout(std430, set = 0, binding = 24) readonly buffer TexelStatus { uint texel_s
 layout(push_constant) uniform Pass { JudgePass pass; };
 
 uint frame_of(uint i) { return (i + pass.first_offset) / 64u; }
+
+// The run's layout (Layout above): pipeline p's first depth slot, and the
+// slot after s in its pipeline (kNoDepthSlot after the last).
+const uint kNoDepthSlot = 0xffffffffu;
+uint pipeline_first_slot(uint p) { return run_layout[pass.cells + 3u * pass.depth_slots + p]; }
+uint pipeline_next_slot(uint s) { return run_layout[pass.cells + 2u * pass.depth_slots + s]; }
 
 // The float32 with these bits, exactly, subnormals included.
 double float_value(uint bits) {

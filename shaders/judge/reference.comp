@@ -10,7 +10,8 @@
 // operation for operation: encode.cc's DecodeValue and reference.cc's
 // ReferenceOf, in the same order, unfused (`precise`), so that it equals
 // the host's bit for bit (tests/device_judge_test.cc). Workgroup row y
-// computes depth slot y.
+// computes pipeline y's depth slots: the sample, the pipeline's float and
+// what the frame's constants give are worked out once for them all.
 #include "../../shared/compat.h"
 #include "../../shared/params.h"
 #include "../../shared/judge.h"
@@ -68,16 +69,19 @@ uint decade_band(double x, uint count) {
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  uint slot = gl_WorkGroupID.y;
+  uint pipeline = gl_WorkGroupID.y;
   if (i >= pass.count) {
     return;
   }
-  uint encoding = run_layout[pass.cells + slot];
+  // What a pipeline's slots share (batch.cc's PipelineOfSlots groups them
+  // by convention and by what the format stores): its first slot's
+  // encoding serves them all.
+  uint first_slot = pipeline_first_slot(pipeline);
+  uint encoding = run_layout[pass.cells + first_slot];
   uint stores = db_encoding_stores(encoding);
   uint convention = db_encoding_convention(encoding);
   uint hardware = db_encoding_hardware(encoding);
   bool infinite_far = db_encoding_infinite_far(encoding);
-  uint pipeline = db_encoding_pipeline(encoding);
 
   uint frame = frame_of(i);
   uint fd = frame * DB_JUDGE_FRAME_DEPTHS;
@@ -103,56 +107,61 @@ void main() {
   dvec3 ray = dvec3(rays[i], rays[pass.count + i], rays[2u * pass.count + i]);
   precise double ray_length_sq = ray.x * ray.x + ray.y * ray.y + ray.z * ray.z;
   precise double eye_inverse_distance_sq = 1.0lf / (eye_depth * eye_depth * ray_length_sq);
-
-  double denoted_hi = decode(stores, convention, near, far, a, b, texel_bits[slot * pass.slice_length + pass.lead + i]);
-  double produced_hi = decode(stores, convention, near, far, a, b, pipeline_float_bits[pipeline * pass.count + i]);
-
-  // reference.cc's ReferenceOf.
-  double t = eye ? eye_depth : denoted_hi;
-  double produced = eye ? produced_hi : denoted_hi;
-  double denoted_out = dd_finite(denoted_hi) ? denoted_hi : 1.7976931348623157e+308lf;
-  precise double t_extent = t * t * ray_length_sq;
-  bool holdable = t > 0.0lf && t_extent < kLargestFloatSquared;
+  // The pipeline's float denotes the same depth in each of its slots; a
+  // stored-value pick reads its own stored value instead.
+  double produced_hi =
+      eye ? decode(stores, convention, near, far, a, b, pipeline_float_bits[pipeline * pass.count + i]) : 0.0lf;
   double limit = infinite_far ? 1.0lf / 0.0lf : depth_limit;
   double far_end = interest_max < limit ? interest_max : limit;
   double nearest = near < interest_min ? interest_min : near;
   precise double low = nearest * (1.0lf - kPlaneSlack);
   precise double high = far_end * (1.0lf + kPlaneSlack);
-  bool outside = t < low || t > high;
-  uint status = holdable ? (outside ? DB_JUDGE_STATUS_OUTSIDE : DB_JUDGE_STATUS_JUDGED) : DB_JUDGE_STATUS_DEGENERATE;
-  precise double s_extent = denoted_hi * denoted_hi * ray_length_sq;
-  bool stored_holdable = denoted_hi > 0.0lf && s_extent < kLargestFloatSquared;
-  precise double inverse = eye ? eye_inverse_distance_sq : 1.0lf / t_extent;
-  double inverse_out = status == DB_JUDGE_STATUS_JUDGED ? inverse : 0.0lf;
-  precise double scale = inverse_out * ray_length_sq;
-  precise double storage = denoted_hi - produced;
-  precise double production = produced - t;
-  precise double storage_square = storage * storage * scale;
-  precise double production_square = production * production * scale;
-  // The raster form (batch.cc's ReferenceChunk and AdoptStoredDepths):
-  // a sample the host had no geometry for has no point to judge; a texel
-  // the rasterizer left as cleared holds no depth of the sample's.
-  if (pass.production == DB_JUDGE_PRODUCTION_RASTER) {
-    uint drawn = texel_status[slot * pass.slice_length + pass.lead + i];
-    if (drawn == DB_RASTER_TEXEL_NO_GEOMETRY) {
-      status = DB_JUDGE_STATUS_DEGENERATE;
-      inverse_out = 0.0lf;
-    } else if (drawn == DB_RASTER_TEXEL_UNDRAWN) {
-      status = DB_JUDGE_STATUS_UNDRAWN;
-    }
-  }
-
-  // Bands: a stored-value pick takes the decade of the depth it denotes.
-  precise double depth_over_near = (eye ? eye_depth : t) / near;
-  uint depth_band = decade_band(depth_over_near, DB_JUDGE_DEPTH_BANDS);
-  uint joint = (infinite_far ? DB_JUDGE_INFINITE_RATIO_BAND : ratio_band) * DB_JUDGE_DEPTH_BANDS + depth_band;
-
-  uint r = slot * pass.count + i;
   uint slot_samples = pass.depth_slots * pass.count;
-  reference[r] = t;
-  reference[slot_samples + r] = denoted_out;
-  reference[2u * slot_samples + r] = inverse_out;
-  reference[3u * slot_samples + r] = storage_square;
-  reference[4u * slot_samples + r] = production_square;
-  reference_info[r] = db_reference_info_word(joint, status, stored_holdable);
+
+  for (uint slot = first_slot; slot != kNoDepthSlot; slot = pipeline_next_slot(slot)) {
+    double denoted_hi = decode(stores, convention, near, far, a, b, texel_bits[slot * pass.slice_length + pass.lead + i]);
+
+    // reference.cc's ReferenceOf.
+    double t = eye ? eye_depth : denoted_hi;
+    double produced = eye ? produced_hi : denoted_hi;
+    double denoted_out = dd_finite(denoted_hi) ? denoted_hi : 1.7976931348623157e+308lf;
+    precise double t_extent = t * t * ray_length_sq;
+    bool holdable = t > 0.0lf && t_extent < kLargestFloatSquared;
+    bool outside = t < low || t > high;
+    uint status = holdable ? (outside ? DB_JUDGE_STATUS_OUTSIDE : DB_JUDGE_STATUS_JUDGED) : DB_JUDGE_STATUS_DEGENERATE;
+    precise double s_extent = denoted_hi * denoted_hi * ray_length_sq;
+    bool stored_holdable = denoted_hi > 0.0lf && s_extent < kLargestFloatSquared;
+    precise double inverse = eye ? eye_inverse_distance_sq : 1.0lf / t_extent;
+    double inverse_out = status == DB_JUDGE_STATUS_JUDGED ? inverse : 0.0lf;
+    precise double scale = inverse_out * ray_length_sq;
+    precise double storage = denoted_hi - produced;
+    precise double production = produced - t;
+    precise double storage_square = storage * storage * scale;
+    precise double production_square = production * production * scale;
+    // The raster form (batch.cc's ReferenceChunk and AdoptStoredDepths):
+    // a sample the host had no geometry for has no point to judge; a texel
+    // the rasterizer left as cleared holds no depth of the sample's.
+    if (pass.production == DB_JUDGE_PRODUCTION_RASTER) {
+      uint drawn = texel_status[slot * pass.slice_length + pass.lead + i];
+      if (drawn == DB_RASTER_TEXEL_NO_GEOMETRY) {
+        status = DB_JUDGE_STATUS_DEGENERATE;
+        inverse_out = 0.0lf;
+      } else if (drawn == DB_RASTER_TEXEL_UNDRAWN) {
+        status = DB_JUDGE_STATUS_UNDRAWN;
+      }
+    }
+
+    // Bands: a stored-value pick takes the decade of the depth it denotes.
+    precise double depth_over_near = (eye ? eye_depth : t) / near;
+    uint depth_band = decade_band(depth_over_near, DB_JUDGE_DEPTH_BANDS);
+    uint joint = (infinite_far ? DB_JUDGE_INFINITE_RATIO_BAND : ratio_band) * DB_JUDGE_DEPTH_BANDS + depth_band;
+
+    uint r = slot * pass.count + i;
+    reference[r] = t;
+    reference[slot_samples + r] = denoted_out;
+    reference[2u * slot_samples + r] = inverse_out;
+    reference[3u * slot_samples + r] = storage_square;
+    reference[4u * slot_samples + r] = production_square;
+    reference_info[r] = db_reference_info_word(joint, status, stored_holdable);
+  }
 }

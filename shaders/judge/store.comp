@@ -16,13 +16,15 @@
 // float widths is left to the device, whose rounding of them Vulkan does
 // not fix and whose handling of float32 subnormals differs (bindings.glsl).
 //
-// Phase 0 (where depths are produced in float32; exact production stays
-// with the host, which uploads the floats): workgroup row y computes
-// pipeline y's floats. Phase 1: row y writes depth slot y's whole slice
-// (the lead and the padding as zeros); a stored-value pick's texel comes
-// from the table the host made for the frame (the picks are a few per
-// cent of the samples, and their values depend on the format alone, or on
-// the frame's far plane).
+// Workgroup row y takes pipeline y: each invocation makes the pipeline's
+// float of its sample (phase 0, where depths are produced in float32) or
+// reads the one the host uploaded (phase 1: exact production, which stays
+// with the host), then writes the texel of each of the pipeline's depth
+// slots, so that the float is made and read once for them all. The slots'
+// whole slices are written, the lead and the padding as zeros. A
+// stored-value pick's texel comes from the table the host made for the
+// frame (the picks are a few per cent of the samples, and their values
+// depend on the format alone, or on the frame's far plane).
 #include "../../shared/compat.h"
 #include "../../shared/params.h"
 #include "../../shared/judge.h"
@@ -96,7 +98,7 @@ double f32_div(double a, double b) {
 
 // Float32PipelineFloats for pipeline `pipeline`'s encoding and sample i.
 uint pipeline_float(uint pipeline, uint i) {
-  uint encoding = run_layout[pass.cells + run_layout[pass.cells + 2u * pass.depth_slots + pipeline]];
+  uint encoding = run_layout[pass.cells + pipeline_first_slot(pipeline)];
   uint stores = db_encoding_stores(encoding);
   uint convention = db_encoding_convention(encoding);
   uint hardware = db_encoding_hardware(encoding);
@@ -204,29 +206,30 @@ uint fetched_bits(uint slot, uint value_bits) {
 }
 
 void main() {
-  uint slot = gl_WorkGroupID.y;
-  if (pass.phase == 0u) {
-    uint i = gl_GlobalInvocationID.x;
-    if (i < pass.count) {
-      pipeline_float_bits[slot * pass.count + i] = pipeline_float(slot, i);  // (row y: pipeline y)
-    }
-    return;
-  }
+  uint pipeline = gl_WorkGroupID.y;
   uint element = gl_GlobalInvocationID.x;
   if (element >= pass.slice_length) {
     return;
   }
-  uint at = slot * pass.slice_length + element;
+  uint first_slot = pipeline_first_slot(pipeline);
   if (element < pass.lead || element >= pass.lead + pass.count) {
-    texel_bits[at] = 0u;
+    for (uint slot = first_slot; slot != kNoDepthSlot; slot = pipeline_next_slot(slot)) {
+      texel_bits[slot * pass.slice_length + element] = 0u;
+    }
     return;
   }
   uint i = element - pass.lead;
-  uint pick = db_coverage_pick(coverage[i]);
-  if (pick != 0u) {
-    texel_bits[at] = edge_texel_bits[(frame_of(i) * pass.depth_slots + slot) * 4u + pick - 1u];
-    return;
+  uint value;
+  if (pass.phase == 0u) {
+    value = pipeline_float(pipeline, i);
+    pipeline_float_bits[pipeline * pass.count + i] = value;
+  } else {
+    value = pipeline_float_bits[pipeline * pass.count + i];
   }
-  uint pipeline = db_encoding_pipeline(run_layout[pass.cells + slot]);
-  texel_bits[at] = fetched_bits(slot, pipeline_float_bits[pipeline * pass.count + i]);
+  uint pick = db_coverage_pick(coverage[i]);
+  for (uint slot = first_slot; slot != kNoDepthSlot; slot = pipeline_next_slot(slot)) {
+    texel_bits[slot * pass.slice_length + element] =
+        pick != 0u ? edge_texel_bits[(frame_of(i) * pass.depth_slots + slot) * 4u + pick - 1u]
+                   : fetched_bits(slot, value);
+  }
 }
