@@ -153,8 +153,10 @@ struct JudgeGroups {
 
 // With the table: as large as the device allows, up to 1024 invocations,
 // 16384 samples (below 2^15, the count an entry holds) and 4096 entries
-// (16 KiB, the shared memory every Vulkan device has). Larger groups merge
-// more of their bins before the device's counters see them
+// (16 KiB), beside judge.glsl's word per (slot, metric) of the group's
+// running maxima, in the shared memory the device allows a workgroup
+// (16 KiB on some devices, which then get a table half as large). Larger
+// groups merge more of their bins before the device's counters see them
 // (reports/device-judge/lavapipe.txt, section 2). Fewer, wider groups hold
 // less shared memory on each of a GPU's multiprocessors at once, and what
 // they do not hold serves as cache: the widest groups are the fastest, and
@@ -181,7 +183,10 @@ JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeT
       .table_entries = 4096,
       .use_table = VK_TRUE,
       .candidates_per_row = tuning.candidates_per_row};
-  while (groups.table_entries * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) groups.table_entries /= 2;
+  const std::uint32_t maxima_words = L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS;  // judge.glsl's group_high
+  while ((groups.table_entries + maxima_words) * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) {
+    groups.table_entries /= 2;
+  }
   return groups;
 }
 

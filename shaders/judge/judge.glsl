@@ -31,6 +31,12 @@ const uint kNoSlot = 0xffffffffu;
 const uint kTableProbes = 16u;
 const uint kCountBits = 15u;
 shared uint table[kTableEntries];
+// The high word of the largest square this workgroup has met in each
+// (slot, metric) of its row: a square whose high word is below it cannot
+// raise or meet the row's running maximum, so it skips the device's copy
+// (device_judge.cc's ChooseJudgeGroups counts these words in the shared
+// memory it allows the table).
+shared uint group_high[DB_JUDGE_SLOTS * DB_JUDGE_METRICS];
 
 // One more sample in bin `key` of accumulator k.
 void add_to_bin(uint k, uint key) {
@@ -90,11 +96,19 @@ void record(uint k, uint slot, uint m, double square, uint i) {
   bool candidate = square > 0.0lf;
   if (pass.phase == 0u) {
     add_to_bin(k, slot * DB_JUDGE_SLOT_UINTS + m * DB_JUDGE_BINS + dense_bin(square, kLowestOctave[m]));
-    // (A stale read is never above the maximum, which only grows.)
-    if (candidate && bits >= maxima[max_at] && bits >= atomicMax(maxima[max_at], bits)) {
-      uint listed = atomicAdd(candidate_counts[k], 1u);
-      if (listed < kCandidatesPerRow) {
-        candidates[k * kCandidatesPerRow + listed] = uvec4(max_at, i, unpackUint2x32(bits));
+    // Each filter lets through every square that raises or meets the
+    // running maximum: the group's high word and the device's maximum only
+    // grow, so a stale read of either is never above it. The square that
+    // ends as the maximum, at its first index, passes both, and is listed.
+    uint high = uint(bits >> 32u);
+    uint group_at = slot * DB_JUDGE_METRICS + m;
+    if (candidate && high >= group_high[group_at]) {
+      atomicMax(group_high[group_at], high);
+      if (bits >= maxima[max_at] && bits >= atomicMax(maxima[max_at], bits)) {
+        uint listed = atomicAdd(candidate_counts[k], 1u);
+        if (listed < kCandidatesPerRow) {
+          candidates[k * kCandidatesPerRow + listed] = uvec4(max_at, i, unpackUint2x32(bits));
+        }
       }
     }
   } else if (candidate && bits == maxima[max_at]) {
@@ -251,9 +265,14 @@ void main() {
     return;
   }
   bool tabling = kUseTable && pass.phase == 0u;  // phase 0 through the table
-  if (tabling) {
-    for (uint entry = lane; entry < kTableEntries; entry += gl_WorkGroupSize.x) {
-      table[entry] = 0u;
+  if (pass.phase == 0u) {
+    if (tabling) {
+      for (uint entry = lane; entry < kTableEntries; entry += gl_WorkGroupSize.x) {
+        table[entry] = 0u;
+      }
+    }
+    for (uint entry = lane; entry < DB_JUDGE_SLOTS * DB_JUDGE_METRICS; entry += gl_WorkGroupSize.x) {
+      group_high[entry] = 0u;
     }
     barrier();
   }
