@@ -229,20 +229,27 @@ TEST_F(GpuPassTimerTest, BandwidthProbeIsTheHostsMemoryAndFloorsThePass) {
 // The stage probe on lavapipe: every stage runs, and counts each of its
 // invocations once (a fragment row that drew the triangle over the wrong
 // area, or a vertex row that drew another count of points, would time
-// other work than the compute row's); lavapipe names no processors. Eight
-// times the arithmetic takes longer in every stage: at 4096 multiply-adds
-// an invocation the arithmetic is most of a pass, so the factor of 2 asked
-// leaves room for what else a pass costs and for the noise of a busy
-// 2-core machine, while a probe whose count did not reach the program
-// would time the same at both counts.
+// other work than the compute row's); lavapipe names no processors.
+// Thirty-two times the arithmetic takes longer in every stage: at 8192
+// multiply-adds an invocation the arithmetic is most of a pass (the heavy
+// pass's fastest is 13 to 38 times the light one's 0.23 to 0.42 ms on the
+// 2-core machine, loaded or not), so the factor of 4 asked leaves room for
+// what else a pass costs, while a probe whose count did not reach the
+// program would time the same at both counts (two runs at one count differ
+// by up to 2 times in their fastest pass, which is why the factor is not
+// 2). Lavapipe's timestamps are the host's clock, so a pass that another
+// process preempts measures long: a CI run in parallel once timed a light
+// vertex row at 6 ms in two of three passes. The fastest of seven passes
+// is the one least disturbed, so that is what is compared.
 TEST_F(GpuPassTimerTest, StageProbeRunsEveryStageOnceAPixel) {
   const Resolution size{128, 64};
-  auto light = timer_->MeasureStages(size, 128, 1, 3);
+  constexpr std::uint32_t kPasses = 7;
+  auto light = timer_->MeasureStages(size, 64, 1, kPasses);
   ASSERT_TRUE(light.ok()) << light.status().message();
-  auto heavy = timer_->MeasureStages(size, 1024, 1, 3);
+  auto heavy = timer_->MeasureStages(size, 2048, 1, kPasses);
   ASSERT_TRUE(heavy.ok()) << heavy.status().message();
   EXPECT_TRUE(heavy->left_out.empty());
-  EXPECT_EQ(heavy->fma_per_invocation, 4096u);
+  EXPECT_EQ(heavy->fma_per_invocation, 8192u);
   EXPECT_EQ(heavy->processors, 0u);
   ASSERT_EQ(heavy->stages.size(), 3u);
   const char* const names[] = {"compute", "vertex", "fragment"};
@@ -252,11 +259,12 @@ TEST_F(GpuPassTimerTest, StageProbeRunsEveryStageOnceAPixel) {
     EXPECT_EQ(heavy->stages[s].invocations, 128u * 64u);
     EXPECT_EQ(light->stages[s].invocations, 128u * 64u);
     EXPECT_EQ(heavy->stages[s].processors_used, 0u);
-    ASSERT_EQ(heavy->stages[s].timing.ns_per_pass.size(), 3u);
+    ASSERT_EQ(heavy->stages[s].timing.ns_per_pass.size(), kPasses);
     auto light_ns = SummarizeTimings(light->stages[s].timing.ns_per_pass);
     auto heavy_ns = SummarizeTimings(heavy->stages[s].timing.ns_per_pass);
     ASSERT_TRUE(light_ns.ok() && heavy_ns.ok());
-    EXPECT_GT(heavy_ns->median, 2.0 * light_ns->median);
+    EXPECT_GT(heavy_ns->min, 4.0 * light_ns->min)
+        << "light " << light_ns->min << " ns, heavy " << heavy_ns->min << " ns";
   }
   EXPECT_FALSE(timer_->MeasureStages({100, 3}, 16, 1, 1).ok());  // 300 invocations: not whole workgroups of 64
   EXPECT_FALSE(timer_->MeasureStages({64, 64}, 0, 1, 1).ok());
