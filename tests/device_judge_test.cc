@@ -25,6 +25,7 @@
 #include "bench/backends/cpu/cpu_backend.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/device_judge/device_judge.h"
+#include "bench/device_judge/judge_groups.h"
 #include "bench/numerics/formulas_mpfr.h"
 #include "bench/sweep/sweep.h"
 #include "shared/compat.h"
@@ -731,6 +732,56 @@ TEST(DeviceJudgeWords, TheReferenceInfoWordKeepsEachField) {
                                             W::db_reference_info_stored_holdable(w) ? 1u : 0u};
       },
       {0xffu, 0xffu, 1u}});
+}
+
+// The workgroup's shape from the device's limits alone. A GPU gets the
+// table of bins as large as fits beside judge.glsl's word per (slot,
+// metric) of running maxima: 4096 entries where a workgroup may hold 48 KiB
+// or 32 KiB (lavapipe's limit), 2048 where only the 16 KiB Vulkan
+// guarantees (4096 entries and the 369 words would need 17860 bytes). A
+// CPU device adds to the device's counters directly, in groups of 64.
+VulkanDeviceProperties DeviceWithLimits(VkPhysicalDeviceType type, std::uint32_t shared_bytes,
+                                        std::uint32_t invocations) {
+  VulkanDeviceProperties device;
+  device.type = type;
+  device.limits.maxComputeSharedMemorySize = shared_bytes;
+  device.limits.maxComputeWorkGroupInvocations = invocations;
+  device.limits.maxComputeWorkGroupSize[0] = invocations;
+  return device;
+}
+
+TEST(JudgeGroupsTest, TheTableFillsWhatSharedMemoryHoldsBesideTheMaxima) {
+  const std::uint32_t maxima_words = W::DB_JUDGE_SLOTS * W::DB_JUDGE_METRICS;
+  for (const auto& [shared_bytes, entries] : {std::pair{49152u, 4096u}, {32768u, 4096u}, {16384u, 2048u}}) {
+    SCOPED_TRACE(shared_bytes);
+    const JudgeGroups groups =
+        ChooseJudgeGroups(DeviceWithLimits(VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, shared_bytes, 1024), {});
+    EXPECT_EQ(groups.use_table, VK_TRUE);
+    EXPECT_EQ(groups.table_entries, entries);
+    EXPECT_EQ(JudgeSharedWords(groups), entries + maxima_words);
+    EXPECT_LE(JudgeSharedWords(groups) * 4, shared_bytes);
+    EXPECT_EQ(groups.invocations, 1024u);
+    EXPECT_EQ(groups.samples, 16384u);  // below 2^15, what a table entry counts
+  }
+  // Fewer invocations than 1024 where the device allows fewer.
+  EXPECT_EQ(ChooseJudgeGroups(DeviceWithLimits(VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, 16384, 256), {}).invocations,
+            256u);
+}
+
+TEST(JudgeGroupsTest, ACpuDeviceAddsToTheDevicesCounters) {
+  const JudgeGroups cpu = ChooseJudgeGroups(DeviceWithLimits(VK_PHYSICAL_DEVICE_TYPE_CPU, 32768, 1024), {});
+  EXPECT_EQ(cpu.use_table, VK_FALSE);
+  EXPECT_EQ(cpu.invocations, 64u);
+  EXPECT_EQ(cpu.samples, 64u);
+  // Either choice can be asked for.
+  EXPECT_EQ(ChooseJudgeGroups(DeviceWithLimits(VK_PHYSICAL_DEVICE_TYPE_CPU, 32768, 1024),
+                              {.bins = JudgeBinMerge::kWorkgroupTable})
+                .use_table,
+            VK_TRUE);
+  EXPECT_EQ(ChooseJudgeGroups(DeviceWithLimits(VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, 49152, 1024),
+                              {.bins = JudgeBinMerge::kDeviceCounters})
+                .use_table,
+            VK_FALSE);
 }
 
 }  // namespace

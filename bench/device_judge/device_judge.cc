@@ -19,6 +19,7 @@
 #include "bench/backends/vulkan/timestamps.h"
 #include "bench/backends/vulkan/vulkan_backend.h"
 #include "bench/base/resources.h"
+#include "bench/device_judge/judge_groups.h"
 
 namespace depthbench {
 namespace judge_layout {
@@ -139,18 +140,6 @@ std::uint32_t TexelWord(Format format) {
 
 }  // namespace
 
-// The judge's workgroup shape (judge.comp's specialization constants):
-// its invocations, the consecutive samples of one accumulator it judges,
-// the entries of its table of bins in shared memory, and whether it adds
-// bins there first.
-struct JudgeGroups {
-  std::uint32_t invocations = 0;
-  std::uint32_t samples = 0;
-  std::uint32_t table_entries = 0;
-  VkBool32 use_table = VK_FALSE;
-  std::uint32_t candidates_per_row = 0;
-};
-
 // With the table: as large as the device allows, up to 1024 invocations,
 // 16384 samples (below 2^15, the count an entry holds) and 4096 entries
 // (16 KiB), beside judge.glsl's word per (slot, metric) of the group's
@@ -183,11 +172,14 @@ JudgeGroups ChooseJudgeGroups(const VulkanDeviceProperties& device, DeviceJudgeT
       .table_entries = 4096,
       .use_table = VK_TRUE,
       .candidates_per_row = tuning.candidates_per_row};
-  const std::uint32_t maxima_words = L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS;  // judge.glsl's group_high
-  while ((groups.table_entries + maxima_words) * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) {
+  while (JudgeSharedWords(groups) * sizeof(std::uint32_t) > limits.maxComputeSharedMemorySize) {
     groups.table_entries /= 2;
   }
   return groups;
+}
+
+std::uint32_t JudgeSharedWords(const JudgeGroups& groups) {
+  return groups.table_entries + L::DB_JUDGE_SLOTS * L::DB_JUDGE_METRICS;  // judge.glsl's table and group_high
 }
 
 namespace {
