@@ -56,7 +56,8 @@ class DeviceJudgeTest : public ::testing::Test {
   static void TearDownTestSuite() { delete context_; }
 
   // A sweep of shard 2/3 (its first sample lies inside a frame) in batches
-  // of 1000 samples (not whole frames), flushed every 5000 samples.
+  // of 1000 samples (not whole frames; ExpectSameStatistics may ask
+  // others), flushed every 5000 samples.
   static SweepOptions Options(const Domain& domain) {
     SweepOptions options;
     options.seed = 7;
@@ -137,10 +138,12 @@ std::pair<std::vector<std::string>, double> NamesAndTotal(const std::vector<std:
 }
 
 void ExpectSameStatistics(const Domain& domain, const std::string& name, DeviceJudgeTuning tuning = {},
-                          bool device_draws = true) {
+                          bool device_draws = true, std::uint32_t batch_size = 1000) {
   SCOPED_TRACE(name);
-  auto host = DeviceJudgeTest::Sweep(DeviceJudgeTest::Options(domain), JudgeSite::kHost);
-  SweepOptions on_device = DeviceJudgeTest::Options(domain);
+  SweepOptions on_host = DeviceJudgeTest::Options(domain);
+  on_host.batch_size = batch_size;
+  auto host = DeviceJudgeTest::Sweep(on_host, JudgeSite::kHost);
+  SweepOptions on_device = on_host;
   on_device.device_tuning = tuning;
   on_device.device_draws = device_draws;
   auto device = DeviceJudgeTest::Sweep(on_device, JudgeSite::kDevice);
@@ -227,6 +230,20 @@ TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheWideDomain) {
       WideDomain(), "wide, fused, workgroup table, no candidates, drawn on the host",
       {.bins = JudgeBinMerge::kWorkgroupTable, .fusion = JudgeFusion::kFused, .candidates_per_row = 0},
       /*device_draws=*/false);
+}
+
+// Batches of 1000 samples leave each of a workgroup's 1024 lanes (the
+// table's shape on lavapipe, as on a GPU) one sample at most. Batches of
+// 7000 (7000, 7000 and 1000 samples of the shard's 15000) give a lane
+// seven samples in turn, as a GPU's batches of 262144 give it sixteen: the
+// loop over a lane's samples, and the table and maxima kept across them,
+// are judged too.
+TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsWhereALaneJudgesSeveralSamples) {
+  ExpectSameStatistics(WideDomain(), "wide, workgroup table, batches of 7000", {.bins = JudgeBinMerge::kWorkgroupTable},
+                       /*device_draws=*/true, /*batch_size=*/7000);
+  ExpectSameStatistics(WideDomain(), "wide, fused, workgroup table, batches of 7000",
+                       {.bins = JudgeBinMerge::kWorkgroupTable, .fusion = JudgeFusion::kFused},
+                       /*device_draws=*/true, /*batch_size=*/7000);
 }
 
 TEST_F(DeviceJudgeTest, RecordsWhatTheHostJudgeRecordsInTheExtremesDomain) {
